@@ -1,0 +1,60 @@
+#pragma once
+// Starts each stage of the stack as its own OS process and stops them all cleanly.
+//
+// Every child is started with fork/exec, its stdout and stderr appended to a log file, and with
+// PR_SET_PDEATHSIG = SIGTERM so it stops if the launcher itself dies. stop_all() sends SIGTERM to
+// each child by its pid (only processes this group started), waits up to a grace period and then
+// sends SIGKILL to the ones still running.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace crane::launch {
+
+struct ProcessSpec {
+  std::string name;                // stage name, e.g. "plant"
+  std::string executable;          // absolute path
+  std::vector<std::string> arguments;
+  std::string log_path;            // stdout+stderr go here; empty: inherit
+};
+
+struct ChildExit {
+  std::string name;
+  pid_t pid{0};
+  int status{0};                   // raw waitpid status
+  [[nodiscard]] std::string describe() const;  // "plant (pid 123) exited with code 1" / "killed by signal 9"
+};
+
+class ProcessGroup {
+ public:
+  ProcessGroup() = default;
+  ~ProcessGroup();
+  ProcessGroup(const ProcessGroup&) = delete;
+  ProcessGroup& operator=(const ProcessGroup&) = delete;
+
+  /// Starts one process; throws std::runtime_error naming the executable if fork or exec fails.
+  pid_t start(const ProcessSpec& spec);
+  /// Reaps one child that exited, if any (non-blocking).
+  std::optional<ChildExit> poll();
+  /// SIGTERM to every running child, wait up to `grace`, then SIGKILL. Returns how each ended.
+  std::vector<ChildExit> stop_all(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
+
+  struct Child {
+    std::string name;
+    pid_t pid;
+    bool running;
+  };
+  [[nodiscard]] const std::vector<Child>& children() const noexcept { return children_; }
+
+ private:
+  std::vector<Child> children_;
+};
+
+/// Absolute path of the directory holding this executable (/proc/self/exe).
+std::string executable_directory();
+
+}  // namespace crane::launch

@@ -1,0 +1,483 @@
+// crane_demo: the main job. For each maneuver of section 3.3.3 (and each friction-compensation
+// setting) it launches the whole simulated stack as separate processes, waits until every stage is
+// matched and the supervisor is ready, sends the move over DDS, records every cycle, stops the
+// stack, and reports the figures of merit (table, summary.json, CSV, plots).
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "crane/config/stack_config.hpp"
+#include "crane/launch/maneuver_metrics.hpp"
+#include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
+
+namespace {
+
+using namespace crane;
+namespace tp = transport::topics;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct DemoOptions {
+  std::string config_path;
+  std::string out_dir{"demo-out"};
+  std::string dds{"fast"};
+  std::vector<std::string> maneuvers;
+  std::string compensation{"both"};
+  bool realtime{false};
+  unsigned domain_id{0};
+  std::string plot_script;
+  std::string python{"/usr/bin/python3"};
+  double ready_timeout{60.0};
+};
+
+struct ProcessRecord {
+  std::string name;
+  pid_t pid;
+  std::string dds;
+  std::string run;
+};
+
+struct RunResult {
+  std::string maneuver;
+  bool friction_compensation;
+  launch::ManeuverMetrics metrics;
+  double swing_period;
+  std::size_t samples;
+  std::size_t missing;
+  std::string csv;
+  std::uint64_t cycles{0};
+  std::uint64_t overruns{0};
+  std::uint64_t nonfinite_rejected{0};
+  std::vector<double> latencies_us;
+  std::vector<ProcessRecord> processes;
+  bool diagnostics_complete{false};
+};
+
+// Everything the operator records in one run, keyed by cycle.
+struct Recording {
+  std::map<std::uint64_t, tp::msgs::SensorSample_> sensors;
+  std::map<std::uint64_t, tp::msgs::Reference_> references;
+  std::map<std::uint64_t, tp::msgs::LinearCommand_> linear;
+  std::map<std::uint64_t, tp::msgs::ActuatorCommand_> actuators;
+};
+
+class Operator {
+ public:
+  explicit Operator(transport::Participant& participant)
+      : status_(participant.make_reader<tp::SafetyStatus>(&wakeup_)),
+        sensors_(participant.make_recording_reader<tp::Sensors>(&wakeup_, 8192)),
+        references_(participant.make_recording_reader<tp::Reference>(&wakeup_, 8192)),
+        linear_(participant.make_recording_reader<tp::LinearCommand>(&wakeup_, 8192)),
+        actuators_(participant.make_recording_reader<tp::Actuators>(&wakeup_, 8192)),
+        diagnostics_(participant.make_recording_reader<tp::LoopDiagnostics>(&wakeup_, 256)),
+        goal_(participant.make_writer<tp::Goal>()) {}
+
+  transport::Wakeup& wakeup() { return wakeup_; }
+
+  void drain_all() {
+    tp::msgs::SupervisorStatus_ s;
+    status_->take_latest(s);
+    tp::msgs::SensorSample_ a;
+    sensors_->take_latest(a);
+    tp::msgs::Reference_ b;
+    references_->take_latest(b);
+    tp::msgs::LinearCommand_ c;
+    linear_->take_latest(c);
+    tp::msgs::ActuatorCommand_ d;
+    actuators_->take_latest(d);
+    tp::msgs::LoopDiagnostics_ e;
+    diagnostics_->take_latest(e);
+  }
+
+  std::optional<tp::msgs::SupervisorStatus_> latest_status() {
+    tp::msgs::SupervisorStatus_ s;
+    if (status_->take_latest(s)) last_status_ = s;
+    return last_status_;
+  }
+  void forget_status() { last_status_.reset(); }
+
+  void record(Recording& r) {
+    tp::msgs::SensorSample_ a;
+    while (sensors_->take_next(a)) r.sensors[a.header().seq()] = a;
+    tp::msgs::Reference_ b;
+    while (references_->take_next(b)) r.references[b.header().seq()] = b;
+    tp::msgs::LinearCommand_ c;
+    while (linear_->take_next(c)) r.linear[c.header().seq()] = c;
+    tp::msgs::ActuatorCommand_ d;
+    while (actuators_->take_next(d)) r.actuators[d.header().seq()] = d;
+  }
+
+  void collect_diagnostics(std::map<std::uint32_t, tp::msgs::LoopDiagnostics_>& by_pid) {
+    tp::msgs::LoopDiagnostics_ d;
+    while (diagnostics_->take_next(d)) by_pid[d.pid()] = d;
+  }
+
+  int goal_matches() const { return goal_->health().matched_readers; }
+  bool send_goal(const tp::msgs::MoveRequest_& goal) { return goal_->write(goal); }
+
+ private:
+  transport::Wakeup wakeup_;
+  std::unique_ptr<transport::Reader<tp::SafetyStatus>> status_;
+  std::unique_ptr<transport::Reader<tp::Sensors>> sensors_;
+  std::unique_ptr<transport::Reader<tp::Reference>> references_;
+  std::unique_ptr<transport::Reader<tp::LinearCommand>> linear_;
+  std::unique_ptr<transport::Reader<tp::Actuators>> actuators_;
+  std::unique_ptr<transport::Reader<tp::LoopDiagnostics>> diagnostics_;
+  std::unique_ptr<transport::Writer<tp::Goal>> goal_;
+  std::optional<tp::msgs::SupervisorStatus_> last_status_;
+};
+
+class RunFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void check_children(launch::ProcessGroup& group) {
+  if (auto exit = group.poll()) throw RunFailure("stage died: " + exit->describe());
+  if (runtime::stop_requested()) throw RunFailure("interrupted");
+}
+
+std::string format_number(double v, int precision) {
+  if (!std::isfinite(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof(b), "%.*f", precision, v);
+  return b;
+}
+
+
+RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cfg, const config::ManeuverConfig& m,
+                       bool compensation, Operator& op, std::uint32_t request_id) {
+  const std::string run_name = m.name + (compensation ? "_fc_on" : "_fc_off");
+  const fs::path out(options.out_dir);
+  const fs::path log_dir = out / "logs" / run_name;
+  fs::create_directories(log_dir);
+
+  launch::StackOptions stack;
+  stack.config_path = fs::absolute(options.config_path).string();
+  stack.binary_directory = launch::executable_directory();
+  stack.log_directory = log_dir.string();
+  stack.dds = options.dds;
+  stack.domain_id = options.domain_id;
+  stack.lockstep = !options.realtime;
+  stack.initial_trolley_position = m.initial_trolley_position;
+  stack.initial_slew_angle = m.initial_slew_angle;
+  stack.friction_compensation = compensation;
+  stack.plant_stats_path = (log_dir / "plant_stats.json").string();
+
+  RunResult result;
+  result.maneuver = m.name;
+  result.friction_compensation = compensation;
+  result.swing_period = 2.0 * kPi * std::sqrt(cfg.crane.cable_length / cfg.crane.gravity);
+
+  launch::ProcessGroup group;
+  op.drain_all();
+  op.forget_status();
+  for (const auto& spec : launch::simulated_stack(stack)) {
+    const pid_t pid = group.start(spec);
+    result.processes.push_back(ProcessRecord{spec.name, pid, options.dds, run_name});
+  }
+
+  // 1. Wait until every stage is matched and alive and the supervisor is ready.
+  const auto ready_deadline = Clock::now() + std::chrono::duration<double>(options.ready_timeout);
+  while (true) {
+    check_children(group);
+    const auto status = op.latest_status();
+    if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0) break;
+    if (Clock::now() > ready_deadline) {
+      throw RunFailure(run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
+                       " s (stages_alive=" + (status ? std::to_string(status->stages_alive()) : "none") +
+                       ", see " + log_dir.string() + ")");
+    }
+    op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
+  }
+
+  // 2. Send the move.
+  Recording rec;
+  op.record(rec);
+  rec = Recording{};
+  tp::msgs::MoveRequest_ goal;
+  runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
+  goal.request_id(request_id);
+  goal.profile(1);  // trapezoid (3.43)
+  goal.axes(0x3);
+  goal.trolley_target(m.trolley_target);
+  goal.slew_target(m.slew_target);
+  goal.cable_length_target(cfg.crane.cable_length);
+  goal.trolley_max_velocity(m.trolley_max_velocity);
+  goal.trolley_max_acceleration(m.trolley_max_acceleration);
+  goal.slew_max_velocity(m.slew_max_velocity);
+  goal.slew_max_acceleration(m.slew_max_acceleration);
+  if (!op.send_goal(goal)) throw RunFailure(run_name + ": the move request could not be written");
+  spdlog::info("{}: stack ready, move {} sent", run_name, request_id);
+  auto next_resend = Clock::now() + std::chrono::milliseconds(100);
+
+  // 3. Record until `duration` seconds of cycles after the move started.
+  const double dt = cfg.plant.sample_period;
+  const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
+  std::optional<std::uint64_t> start_seq;
+  const double wall_budget = options.realtime ? m.duration * 1.5 + 20.0 : m.duration * 20.0 + 60.0;
+  const auto record_deadline = Clock::now() + std::chrono::duration<double>(wall_budget);
+  while (true) {
+    check_children(group);
+    op.record(rec);
+    if (!start_seq && Clock::now() > next_resend) {
+      // Discovery is not symmetric: the planner may not have matched us when the request went out.
+      op.send_goal(goal);
+      next_resend = Clock::now() + std::chrono::milliseconds(100);
+    }
+    if (!start_seq) {
+      for (const auto& [seq, r] : rec.references) {
+        if (r.request_id() == request_id && r.phase() != 0) {
+          start_seq = seq;
+          break;
+        }
+      }
+    }
+    if (start_seq && !rec.sensors.empty() && rec.sensors.rbegin()->first >= *start_seq + cycles_needed + 1) break;
+    if (Clock::now() > record_deadline) {
+      throw RunFailure(run_name + ": recording did not complete within " + format_number(wall_budget, 0) + " s");
+    }
+    op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
+  }
+
+  // 4. Stop the stack; every stage publishes its final loop diagnostics on the way out.
+  for (const auto& exit : group.stop_all()) {
+    const bool clean = WIFEXITED(exit.status) && WEXITSTATUS(exit.status) == 0;
+    if (!clean) spdlog::warn("{}: {}", run_name, exit.describe());
+  }
+  std::map<std::uint32_t, tp::msgs::LoopDiagnostics_> diagnostics;
+  const auto diag_deadline = Clock::now() + std::chrono::milliseconds(500);
+  while (Clock::now() < diag_deadline) {
+    op.collect_diagnostics(diagnostics);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::size_t reported = 0;
+  for (const auto& p : result.processes) {
+    const auto found = diagnostics.find(static_cast<std::uint32_t>(p.pid));
+    if (found == diagnostics.end()) continue;
+    ++reported;
+    result.overruns += found->second.overruns();
+    result.nonfinite_rejected += found->second.nonfinite_rejected();
+    if (p.name == "plant") result.cycles = found->second.cycles();
+  }
+  result.diagnostics_complete = reported == result.processes.size();
+  {
+    std::ifstream stats(stack.plant_stats_path);
+    if (stats) {
+      const json j = json::parse(stats, nullptr, false);
+      if (!j.is_discarded()) {
+        result.cycles = j.value("cycles", result.cycles);
+        result.latencies_us = j.value("latency_us", std::vector<double>{});
+      }
+    }
+  }
+
+  // 5. Assemble the cycles of the move and evaluate them.
+  std::vector<launch::RecordedCycle> cycles;
+  const fs::path csv_path = out / (run_name + ".csv");
+  std::ofstream csv(csv_path);
+  csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,seq,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,"
+         "u_x_cmd,u_gamma_cmd,brakes\n";
+  csv.precision(9);
+  for (std::uint64_t seq = *start_seq; seq <= *start_seq + cycles_needed; ++seq) {
+    const auto s = rec.sensors.find(seq);
+    const auto next = rec.sensors.find(seq + 1);
+    if (s == rec.sensors.end() || next == rec.sensors.end()) {
+      ++result.missing;
+      continue;
+    }
+    const double t = static_cast<double>(seq - *start_seq) * dt;
+    launch::RecordedCycle c;
+    c.time = t;
+    c.trolley_position = s->second.trolley_position();
+    c.slew_angle = s->second.slew_angle();
+    c.swing_in_plane = s->second.swing_in_plane();
+    c.swing_out_of_plane = s->second.swing_out_of_plane();
+    c.trolley_voltage = next->second.applied_trolley_voltage();
+    c.slew_voltage = next->second.applied_slew_voltage();
+    cycles.push_back(c);
+    const auto r = rec.references.find(seq);
+    const auto l = rec.linear.find(seq);
+    const auto a = rec.actuators.find(seq);
+    const double nan = std::nan("");
+    csv << t << ',' << c.trolley_voltage << ',' << c.slew_voltage << ',' << c.trolley_position << ','
+        << c.slew_angle << ',' << c.swing_in_plane << ',' << c.swing_out_of_plane << ','
+        << s->second.cable_length() << ',' << seq << ','
+        << (r != rec.references.end() ? r->second.trolley_position() : nan) << ','
+        << (r != rec.references.end() ? r->second.slew_angle() : nan) << ','
+        << (l != rec.linear.end() ? l->second.trolley_voltage() : nan) << ','
+        << (l != rec.linear.end() ? l->second.slew_voltage() : nan) << ','
+        << (a != rec.actuators.end() ? a->second.trolley_friction_voltage() : nan) << ','
+        << (a != rec.actuators.end() ? a->second.slew_friction_voltage() : nan) << ','
+        << (a != rec.actuators.end() ? a->second.trolley_voltage() : nan) << ','
+        << (a != rec.actuators.end() ? a->second.slew_voltage() : nan) << ','
+        << (next->second.brakes_engaged() ? 1 : 0) << '\n';
+  }
+  if (cycles.empty()) throw RunFailure(run_name + ": no cycle was recorded");
+  result.samples = cycles.size();
+  result.csv = csv_path.filename().string();
+  result.metrics = launch::evaluate_maneuver(cycles, m.trolley_target, m.slew_target);
+  return result;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double rank = p / 100.0 * static_cast<double>(values.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(rank));
+  const auto hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_demo: the full simulated crane stack over DDS doing the maneuvers of section 3.3.3"};
+  DemoOptions options;
+  app.add_option("--config", options.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_option("--out", options.out_dir, "output directory (summary.json, CSV, plots, logs)");
+  app.add_option("--dds", options.dds, "DDS vendor of every process: fast | cyclone");
+  app.add_option("--maneuver", options.maneuvers, "maneuver names to run (default: all in the config)");
+  app.add_option("--friction-compensation", options.compensation, "on | off | both")
+      ->check(CLI::IsMember({"on", "off", "both"}));
+  app.add_flag("--realtime", options.realtime, "plant on absolute 10 ms deadlines instead of lockstep");
+  app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
+  app.add_option("--python", options.python, "python interpreter with matplotlib");
+  app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    runtime::configure_logging("info", "demo");
+    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    std::vector<config::ManeuverConfig> selected;
+    for (const auto& m : cfg.maneuvers) {
+      if (options.maneuvers.empty() ||
+          std::find(options.maneuvers.begin(), options.maneuvers.end(), m.name) != options.maneuvers.end()) {
+        selected.push_back(m);
+      }
+    }
+    for (const auto& name : options.maneuvers) {
+      if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
+        throw std::invalid_argument("--maneuver '" + name + "' is not in " + options.config_path);
+      }
+    }
+    std::vector<bool> settings;
+    if (options.compensation != "off") settings.push_back(true);
+    if (options.compensation != "on") settings.push_back(false);
+    fs::create_directories(options.out_dir);
+
+    runtime::NodeOptions node;
+    node.dds = options.dds;
+    node.domain_id = options.domain_id;
+    auto participant = runtime::make_participant(node, "operator");
+    Operator op(*participant);
+    runtime::install_stop_handlers(&op.wakeup());
+
+    std::vector<RunResult> results;
+    std::uint32_t request_id = 1;
+    for (const auto& m : selected) {
+      for (const bool compensation : settings) {
+        results.push_back(run_maneuver(options, cfg, m, compensation, op, request_id++));
+        const auto& r = results.back();
+        spdlog::info("{} (friction compensation {}): settle {} s, position error {} mm, residual swing {} deg",
+                     r.maneuver, r.friction_compensation ? "on" : "off", format_number(r.metrics.settle_time, 2),
+                     format_number(r.metrics.final_position_error * 1e3, 2), format_number(r.metrics.residual_swing * 180 / kPi, 3));
+      }
+    }
+
+    // summary.json
+    json summary;
+    summary["config"] = fs::absolute(options.config_path).string();
+    summary["clock"] = options.realtime ? "realtime" : "lockstep";
+    summary["dds"] = options.dds;
+    json maneuvers = json::array();
+    std::vector<double> all_latencies;
+    std::uint64_t cycles = 0, overruns = 0, nonfinite = 0;
+    json processes = json::array();
+    bool diagnostics_complete = true;
+    for (const auto& r : results) {
+      json j;
+      j["name"] = r.maneuver;
+      j["friction_compensation"] = r.friction_compensation;
+      j["settle_time_s"] = std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time) : json(nullptr);
+      j["settle_time_periods"] =
+          std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time / r.swing_period) : json(nullptr);
+      j["final_position_error_m"] = r.metrics.final_position_error;
+      j["final_slew_error_rad"] = r.metrics.final_slew_error;
+      j["max_swing_rad"] = r.metrics.max_swing;
+      j["residual_swing_rad"] = r.metrics.residual_swing;
+      j["max_voltage_V"] = r.metrics.max_voltage;
+      j["samples"] = r.samples;
+      j["missing_samples"] = r.missing;
+      j["csv"] = r.csv;
+      j["plant_cycles"] = r.cycles;
+      j["overruns"] = r.overruns;
+      maneuvers.push_back(j);
+      all_latencies.insert(all_latencies.end(), r.latencies_us.begin(), r.latencies_us.end());
+      cycles += r.cycles;
+      overruns += r.overruns;
+      nonfinite += r.nonfinite_rejected;
+      diagnostics_complete = diagnostics_complete && r.diagnostics_complete;
+      for (const auto& p : r.processes) {
+        processes.push_back({{"name", p.name}, {"pid", p.pid}, {"dds", p.dds}, {"run", p.run}});
+      }
+    }
+    processes.push_back({{"name", "operator"}, {"pid", getpid()}, {"dds", options.dds}, {"run", "all"}});
+    summary["maneuvers"] = maneuvers;
+    summary["loop"] = {{"cycles", cycles},
+                       {"overruns", overruns},
+                       {"nonfinite_rejected", nonfinite},
+                       {"diagnostics_complete", diagnostics_complete},
+                       {"latency_us",
+                        {{"p50", percentile(all_latencies, 50)},
+                         {"p99", percentile(all_latencies, 99)},
+                         {"max", all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end())},
+                         {"samples", all_latencies.size()}}},
+                       {"processes", processes}};
+    const fs::path summary_path = fs::path(options.out_dir) / "summary.json";
+    std::ofstream(summary_path) << summary.dump(2) << '\n';
+
+    // Table.
+    std::printf("\n%-9s %-9s %9s %7s %10s %11s %10s %12s %8s\n", "maneuver", "friction", "settle_s", "settle_T",
+                "pos_err_mm", "slew_err_mrad", "max_swing_deg", "resid_swing_deg", "max_V");
+    for (const auto& r : results) {
+      std::printf("%-9s %-9s %9s %7s %10s %11s %10s %12s %8s\n", r.maneuver.c_str(),
+                  r.friction_compensation ? "comp_on" : "comp_off", format_number(r.metrics.settle_time, 2).c_str(),
+                  format_number(r.metrics.settle_time / r.swing_period, 2).c_str(),
+                  format_number(r.metrics.final_position_error * 1e3, 2).c_str(), format_number(r.metrics.final_slew_error * 1e3, 2).c_str(),
+                  format_number(r.metrics.max_swing * 180 / kPi, 2).c_str(), format_number(r.metrics.residual_swing * 180 / kPi, 3).c_str(),
+                  format_number(r.metrics.max_voltage, 2).c_str());
+    }
+    std::printf("\nloop: %llu cycles, %llu overruns, latency sensor->command p50 %.0f us, p99 %.0f us, max %.0f us (%s)\n",
+                static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(overruns),
+                percentile(all_latencies, 50), percentile(all_latencies, 99),
+                all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end()),
+                options.realtime ? "realtime" : "lockstep");
+    std::printf("summary: %s\n", summary_path.string().c_str());
+
+    if (!options.plot_script.empty()) {
+      const std::string command = "'" + options.python + "' '" + options.plot_script + "' --out '" + options.out_dir + "'";
+      const int rc = std::system(command.c_str());
+      if (rc != 0) throw std::runtime_error("plot script failed: " + command);
+    }
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,36 @@
+#include "crane/launch/maneuver_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace crane::launch {
+
+ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
+                                  double slew_target, const SettleCriteria& criteria) {
+  if (cycles.empty()) throw std::invalid_argument("evaluate_maneuver: the recording has no cycles");
+  ManeuverMetrics m;
+  const double end_time = cycles.back().time;
+  std::ptrdiff_t last_violation = -1;
+  for (std::size_t i = 0; i < cycles.size(); ++i) {
+    const auto& c = cycles[i];
+    const double swing = std::max(std::fabs(c.swing_in_plane), std::fabs(c.swing_out_of_plane));
+    m.max_swing = std::max(m.max_swing, swing);
+    m.max_voltage = std::max({m.max_voltage, std::fabs(c.trolley_voltage), std::fabs(c.slew_voltage)});
+    if (c.time >= end_time - criteria.residual_window) m.residual_swing = std::max(m.residual_swing, swing);
+    const bool settled = std::fabs(c.trolley_position - trolley_target) < criteria.trolley_tolerance &&
+                         std::fabs(c.slew_angle - slew_target) < criteria.slew_tolerance &&
+                         std::fabs(c.swing_in_plane) < criteria.swing_tolerance &&
+                         std::fabs(c.swing_out_of_plane) < criteria.swing_tolerance;
+    if (!settled) last_violation = static_cast<std::ptrdiff_t>(i);
+  }
+  const auto first_good = static_cast<std::size_t>(last_violation + 1);
+  m.settle_time = first_good < cycles.size() ? std::max(0.0, cycles[first_good].time)
+                                             : std::numeric_limits<double>::quiet_NaN();
+  m.final_position_error = std::fabs(cycles.back().trolley_position - trolley_target);
+  m.final_slew_error = std::fabs(cycles.back().slew_angle - slew_target);
+  return m;
+}
+
+}  // namespace crane::launch

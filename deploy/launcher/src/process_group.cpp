@@ -1,0 +1,120 @@
+#include "crane/launch/process_group.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+
+namespace crane::launch {
+
+std::string ChildExit::describe() const {
+  std::string text = name + " (pid " + std::to_string(pid) + ")";
+  if (WIFEXITED(status)) return text + " exited with code " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return text + " was killed by signal " + std::to_string(WTERMSIG(status));
+  return text + " ended";
+}
+
+ProcessGroup::~ProcessGroup() { stop_all(); }
+
+pid_t ProcessGroup::start(const ProcessSpec& spec) {
+  std::vector<std::string> argv_storage;
+  argv_storage.push_back(spec.executable);
+  argv_storage.insert(argv_storage.end(), spec.arguments.begin(), spec.arguments.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("cannot fork for " + spec.name + ": " + std::strerror(errno));
+  if (pid == 0) {
+    // Child: stop with the launcher, log to file, exec.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
+    if (!spec.log_path.empty()) {
+      const int fd = open(spec.log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      if (fd >= 0) {
+        dup2(fd, STDOUT_FILENO);
+        dup2(fd, STDERR_FILENO);
+        close(fd);
+      }
+    }
+    const int null_fd = open("/dev/null", O_RDONLY);
+    if (null_fd >= 0) {
+      dup2(null_fd, STDIN_FILENO);
+      close(null_fd);
+    }
+    // Restore default signal handling for the child.
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    execv(spec.executable.c_str(), argv.data());
+    const char* message = "exec failed\n";
+    (void)!write(STDERR_FILENO, message, std::strlen(message));
+    _exit(127);
+  }
+  children_.push_back(Child{spec.name, pid, true});
+  return pid;
+}
+
+std::optional<ChildExit> ProcessGroup::poll() {
+  for (auto& child : children_) {
+    if (!child.running) continue;
+    int status = 0;
+    const pid_t r = waitpid(child.pid, &status, WNOHANG);
+    if (r == child.pid) {
+      child.running = false;
+      return ChildExit{child.name, child.pid, status};
+    }
+  }
+  return std::nullopt;
+}
+
+std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
+  std::vector<ChildExit> exits;
+  for (auto& child : children_) {
+    if (child.running) kill(child.pid, SIGTERM);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + grace;
+  auto any_running = [this] {
+    for (const auto& c : children_) {
+      if (c.running) return true;
+    }
+    return false;
+  };
+  while (any_running()) {
+    for (auto& child : children_) {
+      if (!child.running) continue;
+      int status = 0;
+      if (waitpid(child.pid, &status, WNOHANG) == child.pid) {
+        child.running = false;
+        exits.push_back(ChildExit{child.name, child.pid, status});
+      }
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      for (auto& child : children_) {
+        if (!child.running) continue;
+        kill(child.pid, SIGKILL);
+        int status = 0;
+        waitpid(child.pid, &status, 0);
+        child.running = false;
+        exits.push_back(ChildExit{child.name, child.pid, status});
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return exits;
+}
+
+std::string executable_directory() {
+  return std::filesystem::canonical("/proc/self/exe").parent_path().string();
+}
+
+}  // namespace crane::launch

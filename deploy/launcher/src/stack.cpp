@@ -1,0 +1,43 @@
+#include "crane/launch/stack.hpp"
+
+#include <cstdio>
+
+namespace crane::launch {
+
+const std::vector<std::string>& simulated_stage_names() {
+  static const std::vector<std::string> names{"supervisor", "friction_compensation", "tracking", "anti_swing",
+                                              "trajectory_planner", "state_estimator", "plant"};
+  return names;
+}
+
+namespace {
+std::string number(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+}  // namespace
+
+std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
+  std::vector<ProcessSpec> specs;
+  for (const auto& name : simulated_stage_names()) {
+    ProcessSpec spec;
+    spec.name = name;
+    spec.executable = o.binary_directory + "/" + name;
+    const auto vendor = o.dds_per_process.count(name) != 0 ? o.dds_per_process.at(name) : o.dds;
+    spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
+                      "--log-level", o.log_level};
+    if (name == "plant") {
+      spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
+      spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),
+                                                   "--initial-slew", number(o.initial_slew_angle)});
+      if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
+    }
+    if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
+    if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
+    specs.push_back(std::move(spec));
+  }
+  return specs;
+}
+
+}  // namespace crane::launch

@@ -1,0 +1,36 @@
+#pragma once
+// The topic table of the control bus: one struct per topic with its ROS 2 wire name, message type
+// and QoS profile. Message types are the C++ classes fastddsgen generates from idl/crane_msgs.idl;
+// they are the canonical in-process representation for every vendor adapter.
+
+#include "crane/transport/qos.hpp"
+#include "crane_msgs.h"
+#include "crane_msgsPubSubTypes.h"
+
+namespace crane::transport::topics {
+
+namespace msgs = crane_msgs::msg::dds_;
+
+#define CRANE_TOPIC(Tag, Type, wire_name, kind)                     \
+  struct Tag {                                                      \
+    using Message = msgs::Type;                                     \
+    using FastDdsType = msgs::Type##PubSubType;                     \
+    static constexpr const char* name = wire_name;                  \
+    static constexpr const char* type_name = "crane_msgs::msg::dds_::" #Type; \
+    static constexpr QosKind qos = kind;                            \
+  }
+
+CRANE_TOPIC(Sensors, SensorSample_, "rt/crane/hw/sensors", QosKind::stream);
+CRANE_TOPIC(Actuators, ActuatorCommand_, "rt/crane/hw/actuators", QosKind::stream);
+CRANE_TOPIC(StateEstimate, CraneState_, "rt/crane/state/estimate", QosKind::stream);
+CRANE_TOPIC(Goal, MoveRequest_, "rt/crane/planner/goal", QosKind::command);
+CRANE_TOPIC(Reference, Reference_, "rt/crane/planner/reference", QosKind::stream);
+CRANE_TOPIC(AntiSwing, AntiSwingCommand_, "rt/crane/control/anti_swing", QosKind::stream);
+CRANE_TOPIC(LinearCommand, LinearCommand_, "rt/crane/control/linear", QosKind::stream);
+CRANE_TOPIC(SafetyStatus, SupervisorStatus_, "rt/crane/safety/status", QosKind::safety);
+CRANE_TOPIC(SafetyCommand, SupervisorCommand_, "rt/crane/safety/command", QosKind::command);
+CRANE_TOPIC(LoopDiagnostics, LoopDiagnostics_, "rt/crane/diag/loop", QosKind::diagnostics);
+
+#undef CRANE_TOPIC
+
+}  // namespace crane::transport::topics

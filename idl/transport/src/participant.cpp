@@ -1,0 +1,56 @@
+#include "crane/transport/participant.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+namespace crane::transport {
+
+Vendor parse_vendor(std::string_view text) {
+  if (text == "fast" || text == "fastdds" || text == "fast_dds") return Vendor::fast_dds;
+  if (text == "cyclone" || text == "cyclonedds" || text == "cyclone_dds") return Vendor::cyclone_dds;
+  throw std::invalid_argument("dds vendor '" + std::string(text) + "' is not known: must be 'fast' or 'cyclone'");
+}
+
+Vendor vendor_from_environment() {
+  const char* value = std::getenv("CRANE_DDS");
+  if (value == nullptr || *value == '\0') return Vendor::fast_dds;
+  return parse_vendor(value);
+}
+
+const char* vendor_name(Vendor vendor) noexcept {
+  switch (vendor) {
+    case Vendor::fast_dds: return "fast";
+    case Vendor::cyclone_dds: return "cyclone";
+  }
+  return "unknown";
+}
+
+void Wakeup::notify() noexcept {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = true;
+  }
+  condition_.notify_one();
+}
+
+bool Wakeup::wait_until(std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const bool notified = condition_.wait_until(lock, deadline, [this] { return pending_; });
+  pending_ = false;
+  return notified;
+}
+
+Participant::Participant(const ParticipantOptions& options) : options_(options) {
+  switch (options.vendor) {
+    case Vendor::fast_dds:
+      backend_ = detail::make_fast_dds_backend(options);
+      break;
+    case Vendor::cyclone_dds:
+      throw std::runtime_error("dds vendor 'cyclone' is not built into this version: use --dds fast");
+  }
+}
+
+Participant::~Participant() = default;
+
+}  // namespace crane::transport

@@ -1,0 +1,124 @@
+#pragma once
+// Simulated tower crane: the facade the plant node steps at the sample rate.
+//
+//   DriveInput (ZOH over one sample_period)
+//     -> DAC (clamp +-dac_range, dac_bits quantization; drives_and_sensors.hpp)
+//     -> drive force F_x = M_drive K_mx V_x, torque T_gamma = J_o K_mgamma V_gamma (2.26)-(2.27)
+//     -> TowerCraneModel (Lagrangian (2.11)-(2.16)) with stick-slip friction (3.1)-(3.3) and brakes
+//        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
+//     -> encoders (quadrature counts) -> SimulatorOutput.
+// The cable length follows the hoist speed command kinematically: the commanded speed is limited so
+// the hoist can still stop inside [min_cable_length, max_cable_length] at hoist_max_acceleration
+// (accounting for the distance covered during this sample), then rate limited to
+// hoist_max_acceleration (L_ddot is constant over each sample). A discrete overshoot of the length
+// limits of order hoist_max_acceleration * sample_period^2 remains possible.
+//
+// Units: SI throughout ([m], [rad], [s], [V], [m/s]).
+// Errors: the constructor and reset() throw common::ConfigError naming the field, its value and the
+// bound. step() is noexcept and allocation-free; it returns
+//   ok                  sample advanced normally,
+//   rejected_nonfinite  an input was NaN/Inf: 0 V, zero hoist speed and engaged brakes were applied
+//                       for this sample instead,
+//   not_ready           the integrator failed (counted in integrator_failure_count()); the state was
+//                       held at its value before the sample. (common::StepStatus has no better
+//                       fitting value.)
+
+#include <cstdint>
+
+#include "crane/common/crane_parameters.hpp"
+#include "crane/common/crane_signals.hpp"
+#include "crane/plant/axis_friction.hpp"
+#include "crane/plant/cvode_integrator.hpp"
+#include "crane/plant/drives_and_sensors.hpp"
+#include "crane/plant/tower_crane_model.hpp"
+
+namespace crane::plant {
+
+/// True plant state, SI.
+struct PlantState {
+  double trolley_position{0.0};          // [m] x
+  double trolley_velocity{0.0};          // [m/s]
+  double slew_angle{0.0};                // [rad] gamma
+  double slew_rate{0.0};                 // [rad/s]
+  double swing_in_plane{0.0};            // [rad] phi
+  double swing_in_plane_rate{0.0};       // [rad/s]
+  double swing_out_of_plane{0.0};        // [rad] theta
+  double swing_out_of_plane_rate{0.0};   // [rad/s]
+  double cable_length{1.0};              // [m] L
+  double cable_length_rate{0.0};         // [m/s]
+};
+
+/// Commands held for one sample.
+struct DriveInput {
+  double trolley_voltage{0.0};  // [V] before the DAC
+  double slew_voltage{0.0};     // [V] before the DAC
+  double hoist_speed{0.0};      // [m/s] commanded dL/dt (positive lowers the load)
+  bool brakes_engaged{true};    // both drive brakes
+};
+
+struct SimulatorParameters {
+  common::CraneParameters crane{};
+  double sample_period{0.01};          // [s] in (0, 1]
+  double relative_tolerance{1e-8};     // [-] CVODE rtol in (0, 1e-2]
+  double absolute_tolerance{1e-10};    // [SI] CVODE atol in (0, 1e-2]
+  double brake_holding_factor{20.0};   // [-] brake holding force / drive force at full DAC range, >= 0
+  double hoist_max_acceleration{0.5};  // [m/s^2] > 0
+  double min_cable_length{0.2};        // [m] > 0
+  double max_cable_length{3.0};        // [m] > min_cable_length
+  PlantState initial_state{};          // finite; cable_length within [min, max]; |swing| < pi/2
+};
+
+struct SimulatorOutput {
+  common::CraneMeasurement measurement;  // quantized sensors of the current state
+  double applied_trolley_voltage{0.0};   // [V] after the DAC, last sample
+  double applied_slew_voltage{0.0};      // [V] after the DAC, last sample
+  double applied_hoist_speed{0.0};       // [m/s] rate-limited hoist speed at the end of the last sample
+  bool brakes_engaged{true};             // last sample
+};
+
+class CraneSimulator {
+ public:
+  /// Validates everything (field names prefixed "simulator."); throws common::ConfigError.
+  explicit CraneSimulator(const SimulatorParameters& parameters);
+
+  /// Advances exactly one sample_period with `input` held (zero-order hold). noexcept.
+  [[nodiscard]] common::StepStatus step(const DriveInput& input) noexcept;
+
+  [[nodiscard]] SimulatorOutput output() const noexcept;
+  /// True, unquantized state.
+  [[nodiscard]] const PlantState& state() const noexcept { return state_; }
+  /// Restarts at `state` and time 0 (counters are kept). Throws common::ConfigError like the
+  /// constructor for an invalid state.
+  void reset(const PlantState& state);
+  /// [s] = number of samples since construction/reset times sample_period (no accumulation).
+  [[nodiscard]] double time() const noexcept;
+
+  [[nodiscard]] long friction_event_count() const noexcept { return integrator_.friction_event_count(); }
+  [[nodiscard]] long integrator_failure_count() const noexcept { return integrator_.solver_failure_count(); }
+  [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return integrator_.last_friction_event(); }
+  [[nodiscard]] AxisMode axis_mode(FrictionAxis axis) const noexcept { return integrator_.mode(axis); }
+
+  [[nodiscard]] const SimulatorParameters& parameters() const noexcept { return parameters_; }
+  [[nodiscard]] const TowerCraneModel& model() const noexcept { return model_; }
+  [[nodiscard]] const DrivesAndSensors& drives_and_sensors() const noexcept { return sensors_; }
+  /// Total mechanical energy of the true state [J] (TowerCraneModel::total_energy).
+  [[nodiscard]] double total_energy() const noexcept;
+
+ private:
+  static const SimulatorParameters& validated(const SimulatorParameters& parameters);
+  void validate_state(const PlantState& state) const;
+  void refresh_state() noexcept;
+
+  SimulatorParameters parameters_;
+  TowerCraneModel model_;
+  DrivesAndSensors sensors_;
+  CvodeIntegrator integrator_;
+  PlantState state_{};
+  std::int64_t sample_index_{0};
+  double applied_trolley_voltage_{0.0};
+  double applied_slew_voltage_{0.0};
+  double applied_hoist_speed_{0.0};
+  bool brakes_engaged_{true};
+};
+
+}  // namespace crane::plant

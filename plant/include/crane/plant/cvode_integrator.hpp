@@ -1,0 +1,145 @@
+#pragma once
+// Hybrid integrator of the tower crane with stick-slip friction: a RAII wrapper around SUNDIALS 6.4
+// CVODE (BDF, dense SUNMatrix + dense SUNLinearSolver, Jacobian by CVODE's difference quotients).
+//
+// State y (10): q = (x, phi, gamma, theta), q_dot, L, L_dot. Model: TowerCraneModel
+// (Lagrangian, (2.11)-(2.16)); friction: AxisFrictionModel ((3.1)-(3.3) as plant truth) on the
+// trolley (x) and slew (gamma) axes; hoist: L_ddot held constant over each advance (zero-order hold).
+//
+// Friction switching is an explicit hybrid automaton per axis, never a smoothed sign() or a tiny
+// fixed step:
+//   slipping (+/-): friction is the smooth sliding law of the current direction; root function is
+//                   the axis velocity. At its zero crossing the axis either sticks (driving force
+//                   within the holding limits) or continues in the opposite direction.
+//   stuck:          the axis velocity and acceleration are constrained to zero; the other
+//                   coordinates move under the reduced equations and the friction force that holds
+//                   the axis follows from the eliminated row. Root function is the stick margin
+//                   (holding limit minus driving force); at its zero crossing the axis breaks away.
+// Events are located by CVodeRootInit root finding, then the mode switches and CVODE is
+// re-initialised (CVodeReInit) at the event time. A changed input (ZOH step) also re-initialises.
+//
+// Every advance lands exactly on the requested end time (CV_NORMAL with CVodeSetStopTime).
+// advance_to() is noexcept and allocation-free (all N_Vectors and matrices are created in the
+// constructor); the constructor throws std::runtime_error if SUNDIALS cannot allocate.
+
+#include <array>
+#include <memory>
+
+#include <sundials/sundials_context.hpp>
+#include <sundials/sundials_linearsolver.h>
+#include <sundials/sundials_matrix.h>
+#include <sundials/sundials_nvector.h>
+
+#include "crane/plant/axis_friction.hpp"
+#include "crane/plant/tower_crane_model.hpp"
+
+namespace crane::plant {
+
+/// The two axes with friction and brakes.
+enum class FrictionAxis : int { trolley = 0, slew = 1 };
+inline constexpr int kNumFrictionAxes = 2;
+
+enum class AxisMode : int { slipping_positive, slipping_negative, stuck };
+
+/// Inputs held constant (zero-order hold) over one advance.
+struct SampleInput {
+  double trolley_drive_force{0.0};        // [N] F_x from the drive (friction excluded)
+  double slew_drive_torque{0.0};          // [N m] T_gamma from the drive (friction excluded)
+  double cable_length_acceleration{0.0};  // [m/s^2] L_ddot
+  bool brakes_engaged{false};             // both drive brakes
+  bool operator==(const SampleInput&) const = default;
+};
+
+struct IntegratorSettings {
+  double relative_tolerance{1e-8};   // [-] CVODE rtol, > 0
+  double absolute_tolerance{1e-10};  // [SI of each state] CVODE atol, > 0
+  long max_steps_per_advance{100000};  // CVODE mxstep
+  int max_events_per_advance{1000};    // friction events per advance before giving up
+};
+
+enum class [[nodiscard]] IntegrationStatus {
+  ok,
+  invalid_request,   // end time not after the current time, or non-finite input
+  solver_failure,    // CVODE failed; the state was restored to the start of the advance
+  too_many_events,   // event storm; the state was restored to the start of the advance
+};
+
+/// One mode change of a friction axis.
+struct FrictionEvent {
+  double time{0.0};  // [s]
+  FrictionAxis axis{FrictionAxis::trolley};
+  AxisMode new_mode{AxisMode::stuck};
+};
+
+class CvodeIntegrator {
+ public:
+  /// Copies the model and frictions. Throws common::ConfigError for invalid settings (field names
+  /// prefixed "integrator."), std::runtime_error if SUNDIALS fails to allocate.
+  CvodeIntegrator(const TowerCraneModel& model, const AxisFrictionModel& trolley_friction,
+                  const AxisFrictionModel& slew_friction, const IntegratorSettings& settings);
+  ~CvodeIntegrator();
+  CvodeIntegrator(const CvodeIntegrator&) = delete;
+  CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
+  CvodeIntegrator(CvodeIntegrator&&) = delete;
+  CvodeIntegrator& operator=(CvodeIntegrator&&) = delete;
+
+  /// Sets time [s], state and hoist (L [m] > 0, L_dot [m/s]); friction modes are decided from the
+  /// state (velocity sign, or stick/breakaway at zero velocity) under the current input.
+  void reset(double time, const ModelState& state, double cable_length, double cable_length_rate) noexcept;
+
+  /// Integrates to exactly `end_time` [s] (> time()) with `input` held constant. noexcept,
+  /// allocation-free. On failure the state is restored to its value before the call and time()
+  /// still becomes end_time.
+  IntegrationStatus advance_to(double end_time, const SampleInput& input) noexcept;
+
+  [[nodiscard]] double time() const noexcept { return time_; }
+  [[nodiscard]] ModelState state() const noexcept;
+  [[nodiscard]] double cable_length() const noexcept;       // [m]
+  [[nodiscard]] double cable_length_rate() const noexcept;  // [m/s]
+  [[nodiscard]] AxisMode mode(FrictionAxis axis) const noexcept { return modes_[index(axis)]; }
+  /// Driving force [N] (trolley) or torque [N m] (slew) that friction holds while the axis is stuck;
+  /// 0 when slipping.
+  [[nodiscard]] double holding_force(FrictionAxis axis) const noexcept;
+
+  [[nodiscard]] long friction_event_count() const noexcept { return friction_event_count_; }
+  [[nodiscard]] long solver_failure_count() const noexcept { return solver_failure_count_; }
+  [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return last_event_; }
+
+ private:
+  static constexpr int kStateSize = 10;
+  static int index(FrictionAxis axis) noexcept { return static_cast<int>(axis); }
+  static int right_hand_side(double t, N_Vector y, N_Vector y_dot, void* user_data);
+  static int root_functions(double t, N_Vector y, double* g, void* user_data);
+
+  // Evaluates the hybrid dynamics at y with `modes`; writes y_dot if non-null and the driving force
+  // of each stuck axis.
+  void evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
+                std::array<double, kNumFrictionAxes>& driving_force) const noexcept;
+  void settle_modes() noexcept;
+  void release() noexcept;
+  void set_mode(int axis, AxisMode mode) noexcept;
+  const AxisFrictionModel& friction(int axis) const noexcept { return axis == 0 ? trolley_friction_ : slew_friction_; }
+
+  TowerCraneModel model_;
+  AxisFrictionModel trolley_friction_;
+  AxisFrictionModel slew_friction_;
+  IntegratorSettings settings_;
+
+  sundials::Context context_;
+  N_Vector y_{nullptr};
+  N_Vector y_saved_{nullptr};
+  SUNMatrix jacobian_{nullptr};
+  SUNLinearSolver linear_solver_{nullptr};
+  void* cvode_memory_{nullptr};
+
+  double time_{0.0};
+  SampleInput input_{};
+  std::array<AxisMode, kNumFrictionAxes> modes_{AxisMode::slipping_positive, AxisMode::slipping_positive};
+  std::array<bool, kNumFrictionAxes> decision_pending_{true, true};
+  bool needs_reinit_{true};
+  long friction_event_count_{0};
+  long solver_failure_count_{0};
+  FrictionEvent last_event_{};
+};
+
+}  // namespace crane::plant

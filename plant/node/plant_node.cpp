@@ -1,0 +1,218 @@
+// plant process: the simulated crane. The only clock of the stack: at cycle k it samples and
+// publishes rt/crane/hw/sensors{seq = k}, applies the actuator command of cycle k (zero-order hold
+// over one sample period) and integrates the nonlinear model to k+1.
+//
+//   --lockstep  advance as soon as the command of cycle k arrives (or after lockstep_timeout, then
+//               the cycle counts as an overrun and is integrated with 0 V and brakes on);
+//   --realtime  absolute deadlines every sample_period on the monotonic clock; a command that has
+//               not arrived by the deadline is an overrun, treated the same way.
+// Brakes are released and the command applied only while the supervisor's latest status, no older
+// than safety_status_timeout, says so. Non-finite commands are rejected and counted.
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include "crane/config/stack_config.hpp"
+#include "crane/plant/crane_simulator.hpp"
+#include "crane/runtime/node_runtime.hpp"
+
+namespace {
+using namespace crane;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+
+void fill_sensors(tp::msgs::SensorSample_& s, const plant::SimulatorOutput& o, std::uint64_t seq,
+                  const builtin_interfaces::msg::dds_::Time_& origin) {
+  runtime::stamp_header(s.header(), seq, origin);
+  s.source(1);
+  s.writer_pid(static_cast<std::uint32_t>(getpid()));
+  s.trolley_position(o.measurement.trolley_position);
+  s.slew_angle(o.measurement.slew_angle);
+  s.swing_in_plane(o.measurement.swing_in_plane);
+  s.swing_out_of_plane(o.measurement.swing_out_of_plane);
+  s.cable_length(o.measurement.cable_length);
+  s.applied_trolley_voltage(o.applied_trolley_voltage);
+  s.applied_slew_voltage(o.applied_slew_voltage);
+  s.applied_hoist_speed(o.applied_hoist_speed);
+  s.brakes_engaged(o.brakes_engaged);
+  s.emergency_stop_input(false);
+  s.limit_switches(0);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"plant: simulated tower crane (nonlinear model, friction, drives and sensors) on the DDS bus"};
+  runtime::NodeOptions options;
+  runtime::add_node_options(app, options);
+  bool realtime = false;
+  double initial_trolley = 0.25;
+  double initial_slew = 0.0;
+  double initial_swing = 0.0;
+  std::string stats_path;
+  bool lockstep = false;
+  auto* lockstep_flag = app.add_flag("--lockstep", lockstep, "advance as soon as each command arrives (default)");
+  app.add_flag("--realtime", realtime, "absolute 10 ms deadlines on the wall clock")->excludes(lockstep_flag);
+  app.add_option("--initial-trolley", initial_trolley, "[m] initial trolley position");
+  app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle");
+  app.add_option("--initial-swing", initial_swing, "[rad] initial in-plane swing");
+  app.add_option("--stats-out", stats_path, "write loop statistics (JSON) here on exit");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    runtime::configure_logging(options.log_level, "plant");
+    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    plant::SimulatorParameters sim_params;
+    sim_params.crane = cfg.crane;
+    sim_params.sample_period = cfg.plant.sample_period;
+    sim_params.relative_tolerance = cfg.plant.relative_tolerance;
+    sim_params.absolute_tolerance = cfg.plant.absolute_tolerance;
+    sim_params.brake_holding_factor = cfg.plant.brake_holding_factor;
+    sim_params.hoist_max_acceleration = cfg.plant.hoist_max_acceleration;
+    sim_params.min_cable_length = cfg.plant.min_cable_length;
+    sim_params.max_cable_length = cfg.plant.max_cable_length;
+    sim_params.initial_state.trolley_position = initial_trolley;
+    sim_params.initial_state.slew_angle = initial_slew;
+    sim_params.initial_state.swing_in_plane = initial_swing;
+    sim_params.initial_state.cable_length = cfg.crane.cable_length;
+    plant::CraneSimulator simulator(sim_params);
+
+    auto participant = runtime::make_participant(options, "plant");
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+    auto sensors = participant->make_writer<tp::Sensors>();
+    auto actuators = participant->make_reader<tp::Actuators>(&wakeup);
+    auto safety = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::plant);
+    runtime::LatencyStatistics latency;
+    runtime::LoopCounters counters;
+    std::vector<double> latency_log;
+    latency_log.reserve(1 << 16);
+
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
+    const auto lockstep_timeout = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(cfg.plant.lockstep_timeout));
+    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(cfg.plant.safety_status_timeout));
+    const auto republish = std::chrono::milliseconds(10);
+
+    tp::msgs::SensorSample_ sample;
+    tp::msgs::ActuatorCommand_ command;
+    tp::msgs::ActuatorCommand_ incoming;
+    tp::msgs::SupervisorStatus_ status;
+    tp::msgs::SupervisorStatus_ incoming_status;
+    Clock::time_point status_received{};
+    bool have_status = false;
+    bool started = false;  // lockstep: the chain has answered once
+    std::uint64_t seq = 0;
+    builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
+    std::int64_t origin_ns = runtime::to_nanoseconds(origin);
+    fill_sensors(sample, simulator.output(), seq, origin);
+    sensors->write(sample);
+    auto cycle_start = Clock::now();
+    auto next_deadline = cycle_start + period;
+    spdlog::info("simulating at {} Hz, {} clock, x0 = {} m, gamma0 = {} rad", 1.0 / cfg.plant.sample_period,
+                 realtime ? "realtime" : "lockstep", initial_trolley, initial_slew);
+
+    while (!runtime::stop_requested()) {
+      // Wait for the command of cycle `seq`.
+      bool got = false;
+      std::int64_t arrival_ns = 0;
+      const auto deadline = realtime ? next_deadline : cycle_start + lockstep_timeout;
+      auto next_republish = Clock::now() + republish;
+      while (!runtime::stop_requested()) {
+        while (actuators->take_next(incoming)) {
+          if (!runtime::all_finite(incoming)) {
+            ++counters.nonfinite_rejected;
+            continue;
+          }
+          if (incoming.header().seq() == seq) {
+            command = incoming;
+            got = true;
+            arrival_ns = runtime::now_nanoseconds();
+          }
+        }
+        while (safety->take_next(incoming_status)) {
+          if (!runtime::all_finite(incoming_status)) {
+            ++counters.nonfinite_rejected;
+            continue;
+          }
+          status = incoming_status;
+          status_received = Clock::now();
+          have_status = true;
+        }
+        if (got && !realtime) break;
+        const auto now = Clock::now();
+        if (now >= deadline) break;
+        if (!realtime && !started && now >= next_republish) {
+          // Start-up: keep offering cycle 0 until the chain answers (not an overrun).
+          fill_sensors(sample, simulator.output(), seq, origin);
+          sensors->write(sample);
+          next_republish = now + republish;
+        }
+        wakeup.wait_until(std::min(deadline, next_republish));
+      }
+      if (runtime::stop_requested()) break;
+      if (!got && !started && !realtime) {  // lockstep start-up: offer the same cycle again
+        cycle_start = Clock::now();
+        continue;
+      }
+      const bool count_overrun = !got && started;  // realtime start-up: advance, but not an overrun
+      if (got) started = true;
+
+      plant::DriveInput input;  // default: 0 V, brakes engaged
+      if (got) {
+        latency.record(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
+        if (latency_log.size() < latency_log.capacity()) latency_log.push_back(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
+        const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
+        if (status_fresh && status.brakes_released() && status.motion_enabled()) {
+          input.trolley_voltage = command.trolley_voltage();
+          input.slew_voltage = command.slew_voltage();
+          input.hoist_speed = command.hoist_speed();
+          input.brakes_engaged = false;
+        }
+      } else if (count_overrun) {
+        ++counters.overruns;
+      }
+      const auto step_status = simulator.step(input);
+      if (step_status != common::StepStatus::ok) {
+        spdlog::error("plant step at cycle {} returned status {}", seq, static_cast<int>(step_status));
+      }
+      ++counters.cycles;
+      ++seq;
+      counters.last_seq = seq;
+
+      if (realtime) {
+        std::this_thread::sleep_until(next_deadline);
+        next_deadline += period;
+      }
+      cycle_start = Clock::now();
+      origin = runtime::now_stamp();
+      origin_ns = runtime::to_nanoseconds(origin);
+      fill_sensors(sample, simulator.output(), seq, origin);
+      sensors->write(sample);
+      diagnostics.maybe_publish(counters, &latency);
+    }
+
+    diagnostics.publish(counters, &latency);
+    spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} non-finite commands rejected, latency p50 {:.0f} "
+                 "us p99 {:.0f} us max {:.0f} us, {} friction events",
+                 simulator.time(), counters.cycles, counters.overruns, counters.nonfinite_rejected,
+                 latency.percentile(50), latency.percentile(99), latency.maximum(), simulator.friction_event_count());
+    if (!stats_path.empty()) {
+      std::ofstream out(stats_path);
+      out << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns
+          << ", \"nonfinite_rejected\": " << counters.nonfinite_rejected << ", \"latency_us\": [";
+      for (std::size_t i = 0; i < latency_log.size(); ++i) out << (i ? "," : "") << latency_log[i];
+      out << "]}\n";
+    }
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,168 @@
+#include "crane/plant/crane_simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "crane/common/validation.hpp"
+
+namespace crane::plant {
+
+namespace {
+
+ModelState to_model_state(const PlantState& s) {
+  ModelState m;
+  m.position << s.trolley_position, s.swing_in_plane, s.slew_angle, s.swing_out_of_plane;
+  m.velocity << s.trolley_velocity, s.swing_in_plane_rate, s.slew_rate, s.swing_out_of_plane_rate;
+  return m;
+}
+
+IntegratorSettings integrator_settings(const SimulatorParameters& p) {
+  IntegratorSettings settings;
+  settings.relative_tolerance = p.relative_tolerance;
+  settings.absolute_tolerance = p.absolute_tolerance;
+  return settings;
+}
+
+double trolley_force_per_volt(const common::CraneParameters& c) { return c.trolley_drive_mass * c.trolley_drive_gain; }
+double slew_torque_per_volt(const common::CraneParameters& c) { return c.jib_inertia * c.slew_drive_gain; }
+
+}  // namespace
+
+const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& p) {
+  common::validate(p.crane, "simulator.crane");
+  common::require_in_range("simulator.sample_period", p.sample_period, 1e-6, 1.0);
+  common::require_greater("simulator.relative_tolerance", p.relative_tolerance, 0.0);
+  common::require_in_range("simulator.relative_tolerance", p.relative_tolerance, 0.0, 1e-2);
+  common::require_greater("simulator.absolute_tolerance", p.absolute_tolerance, 0.0);
+  common::require_in_range("simulator.absolute_tolerance", p.absolute_tolerance, 0.0, 1e-2);
+  common::require_in_range("simulator.brake_holding_factor", p.brake_holding_factor, 0.0, 1e6);
+  common::require_greater("simulator.hoist_max_acceleration", p.hoist_max_acceleration, 0.0);
+  common::require_greater("simulator.min_cable_length", p.min_cable_length, 0.0);
+  common::require_greater("simulator.max_cable_length", p.max_cable_length, p.min_cable_length);
+  return p;
+}
+
+CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
+    : parameters_(validated(parameters)),
+      model_(parameters_.crane),
+      sensors_(parameters_.crane),
+      integrator_(model_,
+                  AxisFrictionModel(parameters_.crane.trolley_friction, trolley_force_per_volt(parameters_.crane),
+                                    parameters_.brake_holding_factor * trolley_force_per_volt(parameters_.crane) *
+                                        parameters_.crane.dac_range,
+                                    "simulator.crane.trolley_friction"),
+                  AxisFrictionModel(parameters_.crane.slew_friction, slew_torque_per_volt(parameters_.crane),
+                                    parameters_.brake_holding_factor * slew_torque_per_volt(parameters_.crane) *
+                                        parameters_.crane.dac_range,
+                                    "simulator.crane.slew_friction"),
+                  integrator_settings(parameters_)) {
+  reset(parameters_.initial_state);
+}
+
+void CraneSimulator::validate_state(const PlantState& s) const {
+  const std::string p = "simulator.initial_state.";
+  const double limit = 1e6;
+  common::require_in_range(p + "trolley_position", s.trolley_position, -limit, limit);
+  common::require_in_range(p + "trolley_velocity", s.trolley_velocity, -limit, limit);
+  common::require_in_range(p + "slew_angle", s.slew_angle, -limit, limit);
+  common::require_in_range(p + "slew_rate", s.slew_rate, -limit, limit);
+  const double swing_limit = 0.5 * std::numbers::pi - 1e-3;
+  common::require_in_range(p + "swing_in_plane", s.swing_in_plane, -swing_limit, swing_limit);
+  common::require_in_range(p + "swing_in_plane_rate", s.swing_in_plane_rate, -limit, limit);
+  common::require_in_range(p + "swing_out_of_plane", s.swing_out_of_plane, -swing_limit, swing_limit);
+  common::require_in_range(p + "swing_out_of_plane_rate", s.swing_out_of_plane_rate, -limit, limit);
+  common::require_in_range(p + "cable_length", s.cable_length, parameters_.min_cable_length,
+                           parameters_.max_cable_length);
+  common::require_in_range(p + "cable_length_rate", s.cable_length_rate, -limit, limit);
+}
+
+void CraneSimulator::reset(const PlantState& state) {
+  validate_state(state);
+  sample_index_ = 0;
+  integrator_.reset(0.0, to_model_state(state), state.cable_length, state.cable_length_rate);
+  refresh_state();
+}
+
+double CraneSimulator::time() const noexcept {
+  return static_cast<double>(sample_index_) * parameters_.sample_period;
+}
+
+void CraneSimulator::refresh_state() noexcept {
+  const ModelState m = integrator_.state();
+  state_.trolley_position = m.position[kTrolleyIndex];
+  state_.swing_in_plane = m.position[kInPlaneSwingIndex];
+  state_.slew_angle = m.position[kSlewIndex];
+  state_.swing_out_of_plane = m.position[kOutOfPlaneSwingIndex];
+  state_.trolley_velocity = m.velocity[kTrolleyIndex];
+  state_.swing_in_plane_rate = m.velocity[kInPlaneSwingIndex];
+  state_.slew_rate = m.velocity[kSlewIndex];
+  state_.swing_out_of_plane_rate = m.velocity[kOutOfPlaneSwingIndex];
+  state_.cable_length = integrator_.cable_length();
+  state_.cable_length_rate = integrator_.cable_length_rate();
+}
+
+common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
+  common::StepStatus status = common::StepStatus::ok;
+  DriveInput safe = input;
+  if (!std::isfinite(input.trolley_voltage) || !std::isfinite(input.slew_voltage) ||
+      !std::isfinite(input.hoist_speed)) {
+    status = common::StepStatus::rejected_nonfinite;
+    safe = DriveInput{0.0, 0.0, 0.0, true};
+  }
+  applied_trolley_voltage_ = sensors_.applied_voltage(safe.trolley_voltage);
+  applied_slew_voltage_ = sensors_.applied_voltage(safe.slew_voltage);
+  brakes_engaged_ = safe.brakes_engaged;
+
+  // Hoist: limit the speed v_next reached at the end of this sample so that the hoist can still stop
+  // inside the length range: distance this sample (v + v_next) T_s / 2 plus braking distance
+  // v_next^2 / (2 a_max) must not exceed the distance d to the limit:
+  //   v_next^2 + a_max T_s v_next + 2 a_max (v T_s / 2 - d) <= 0.
+  // Then rate-limit to a_max over this sample.
+  const double T_s = parameters_.sample_period;
+  const double a_max = parameters_.hoist_max_acceleration;
+  const double L = integrator_.cable_length();
+  const double L_dot = integrator_.cable_length_rate();
+  const auto max_speed_toward_limit = [&](double distance, double speed_toward) {
+    const double c = speed_toward * T_s / 2.0 - distance;
+    const double discriminant = a_max * a_max * T_s * T_s - 8.0 * a_max * c;
+    if (discriminant <= 0.0) return 0.0;
+    return std::max(0.0, (-a_max * T_s + std::sqrt(discriminant)) / 2.0);
+  };
+  const double lowering_limit = max_speed_toward_limit(parameters_.max_cable_length - L, L_dot);
+  const double raising_limit = -max_speed_toward_limit(L - parameters_.min_cable_length, -L_dot);
+  const double target_rate = std::clamp(safe.hoist_speed, raising_limit, lowering_limit);
+  const double L_ddot = std::clamp((target_rate - L_dot) / T_s, -a_max, a_max);
+
+  SampleInput sample;
+  sample.trolley_drive_force = applied_trolley_voltage_ * model_.trolley_force_per_volt();  // (2.26)
+  sample.slew_drive_torque = applied_slew_voltage_ * model_.slew_torque_per_volt();         // (2.27)
+  sample.cable_length_acceleration = L_ddot;
+  sample.brakes_engaged = safe.brakes_engaged;
+
+  const double end_time = static_cast<double>(sample_index_ + 1) * T_s;
+  const IntegrationStatus result = integrator_.advance_to(end_time, sample);
+  ++sample_index_;
+  refresh_state();
+  applied_hoist_speed_ = state_.cable_length_rate;
+  if (result != IntegrationStatus::ok && status == common::StepStatus::ok) status = common::StepStatus::not_ready;
+  return status;
+}
+
+SimulatorOutput CraneSimulator::output() const noexcept {
+  SimulatorOutput out;
+  out.measurement = sensors_.measure(state_.trolley_position, state_.slew_angle, state_.swing_in_plane,
+                                     state_.swing_out_of_plane, state_.cable_length);
+  out.applied_trolley_voltage = applied_trolley_voltage_;
+  out.applied_slew_voltage = applied_slew_voltage_;
+  out.applied_hoist_speed = applied_hoist_speed_;
+  out.brakes_engaged = brakes_engaged_;
+  return out;
+}
+
+double CraneSimulator::total_energy() const noexcept {
+  const ModelState m = to_model_state(state_);
+  return model_.total_energy(m, HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
+}
+
+}  // namespace crane::plant

@@ -1,0 +1,337 @@
+#include "crane/plant/cvode_integrator.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "crane/common/validation.hpp"
+
+namespace crane::plant {
+
+namespace {
+
+// Layout of the CVODE state vector.
+constexpr int kPositionOffset = 0;
+constexpr int kVelocityOffset = kNumCoordinates;
+constexpr int kCableLengthIndex = 2 * kNumCoordinates;
+constexpr int kCableLengthRateIndex = 2 * kNumCoordinates + 1;
+
+// Generalized coordinate of each friction axis.
+constexpr std::array<int, kNumFrictionAxes> kAxisCoordinate{kTrolleyIndex, kSlewIndex};
+
+void silent_error_handler(int, const char*, const char*, char*, void*) {}
+
+AxisMode slipping(int direction) {
+  return direction >= 0 ? AxisMode::slipping_positive : AxisMode::slipping_negative;
+}
+
+void check(int flag, const char* what) {
+  if (flag != CV_SUCCESS) throw std::runtime_error(std::string("CvodeIntegrator: ") + what + " failed");
+}
+
+}  // namespace
+
+CvodeIntegrator::CvodeIntegrator(const TowerCraneModel& model, const AxisFrictionModel& trolley_friction,
+                                 const AxisFrictionModel& slew_friction, const IntegratorSettings& settings)
+    : model_(model), trolley_friction_(trolley_friction), slew_friction_(slew_friction), settings_(settings) {
+  common::require_greater("integrator.relative_tolerance", settings.relative_tolerance, 0.0);
+  common::require_greater("integrator.absolute_tolerance", settings.absolute_tolerance, 0.0);
+  common::require_at_least("integrator.max_steps_per_advance", static_cast<double>(settings.max_steps_per_advance),
+                           1.0);
+  common::require_at_least("integrator.max_events_per_advance",
+                           static_cast<double>(settings.max_events_per_advance), 1.0);
+
+  y_ = N_VNew_Serial(kStateSize, context_);
+  y_saved_ = N_VNew_Serial(kStateSize, context_);
+  jacobian_ = SUNDenseMatrix(kStateSize, kStateSize, context_);
+  cvode_memory_ = CVodeCreate(CV_BDF, context_);
+  if (y_ == nullptr || y_saved_ == nullptr || jacobian_ == nullptr || cvode_memory_ == nullptr) {
+    release();
+    throw std::runtime_error("CvodeIntegrator: SUNDIALS allocation failed");
+  }
+  N_VConst(0.0, y_);
+  NV_Ith_S(y_, kCableLengthIndex) = model_.parameters().cable_length;
+  linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);
+  try {
+    if (linear_solver_ == nullptr) throw std::runtime_error("CvodeIntegrator: SUNLinSol_Dense failed");
+    check(CVodeSetErrHandlerFn(cvode_memory_, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
+    check(CVodeInit(cvode_memory_, &CvodeIntegrator::right_hand_side, 0.0, y_), "CVodeInit");
+    check(CVodeSStolerances(cvode_memory_, settings.relative_tolerance, settings.absolute_tolerance),
+          "CVodeSStolerances");
+    check(CVodeSetUserData(cvode_memory_, this), "CVodeSetUserData");
+    check(CVodeSetLinearSolver(cvode_memory_, linear_solver_, jacobian_), "CVodeSetLinearSolver");
+    check(CVodeRootInit(cvode_memory_, kNumFrictionAxes, &CvodeIntegrator::root_functions), "CVodeRootInit");
+    check(CVodeSetNoInactiveRootWarn(cvode_memory_), "CVodeSetNoInactiveRootWarn");
+    check(CVodeSetMaxNumSteps(cvode_memory_, settings.max_steps_per_advance), "CVodeSetMaxNumSteps");
+  } catch (...) {
+    release();
+    throw;
+  }
+  ModelState rest;
+  reset(0.0, rest, model_.parameters().cable_length, 0.0);
+}
+
+CvodeIntegrator::~CvodeIntegrator() { release(); }
+
+void CvodeIntegrator::release() noexcept {
+  if (cvode_memory_ != nullptr) CVodeFree(&cvode_memory_);
+  if (linear_solver_ != nullptr) SUNLinSolFree(linear_solver_);
+  if (jacobian_ != nullptr) SUNMatDestroy(jacobian_);
+  if (y_saved_ != nullptr) N_VDestroy(y_saved_);
+  if (y_ != nullptr) N_VDestroy(y_);
+  cvode_memory_ = nullptr;
+  linear_solver_ = nullptr;
+  jacobian_ = nullptr;
+  y_saved_ = nullptr;
+  y_ = nullptr;
+}
+
+void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
+                               std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
+  ModelState state;
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    state.position[j] = y[kPositionOffset + j];
+    state.velocity[j] = y[kVelocityOffset + j];
+  }
+  const HoistMotion hoist{y[kCableLengthIndex], y[kCableLengthRateIndex], input_.cable_length_acceleration};
+  CoordinateMatrix mass;
+  CoordinateVector bias;
+  model_.compute_dynamics(state, hoist, mass, bias);
+
+  // Generalized forces (2.15): drives plus the sliding friction of slipping axes.
+  CoordinateVector force = CoordinateVector::Zero();
+  force[kTrolleyIndex] = input_.trolley_drive_force;
+  force[kSlewIndex] = input_.slew_drive_torque;
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (modes[a] == AxisMode::stuck) continue;
+    const int j = kAxisCoordinate[a];
+    const int direction = modes[a] == AxisMode::slipping_positive ? 1 : -1;
+    force[j] += friction(a).sliding_force(state.velocity[j], direction, input_.brakes_engaged);
+  }
+  const CoordinateVector rhs = force - bias;
+
+  // Stuck axes: q_dd_j = 0 is imposed by replacing row and column j with the identity (column j
+  // multiplies q_dd_j = 0); the friction that holds the axis is the residual of the original row j.
+  CoordinateMatrix constrained = mass;
+  CoordinateVector constrained_rhs = rhs;
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (modes[a] != AxisMode::stuck) continue;
+    const int j = kAxisCoordinate[a];
+    constrained.row(j).setZero();
+    constrained.col(j).setZero();
+    constrained(j, j) = 1.0;
+    constrained_rhs[j] = 0.0;
+  }
+  const CoordinateVector q_dd = constrained.partialPivLu().solve(constrained_rhs);
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    const int j = kAxisCoordinate[a];
+    // Driving force D = everything but the holding friction: friction must supply -D.
+    driving_force[a] = modes[a] == AxisMode::stuck ? rhs[j] - mass.row(j).dot(q_dd) : 0.0;
+  }
+  if (y_dot == nullptr) return;
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    y_dot[kPositionOffset + j] = state.velocity[j];
+    y_dot[kVelocityOffset + j] = q_dd[j];
+  }
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (modes[a] == AxisMode::stuck) y_dot[kPositionOffset + kAxisCoordinate[a]] = 0.0;
+  }
+  y_dot[kCableLengthIndex] = hoist.cable_length_rate;
+  y_dot[kCableLengthRateIndex] = hoist.cable_length_acceleration;
+}
+
+int CvodeIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* user_data) {
+  const auto* self = static_cast<const CvodeIntegrator*>(user_data);
+  std::array<double, kNumFrictionAxes> driving{};
+  self->evaluate(N_VGetArrayPointer(y), self->modes_, N_VGetArrayPointer(y_dot), driving);
+  for (int i = 0; i < kStateSize; ++i) {
+    if (!std::isfinite(NV_Ith_S(y_dot, i))) return 1;  // recoverable: CVODE retries with a smaller step
+  }
+  return 0;
+}
+
+int CvodeIntegrator::root_functions(double, N_Vector y, double* g, void* user_data) {
+  const auto* self = static_cast<const CvodeIntegrator*>(user_data);
+  const double* values = N_VGetArrayPointer(y);
+  std::array<double, kNumFrictionAxes> driving{};
+  self->evaluate(values, self->modes_, nullptr, driving);
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (self->modes_[a] == AxisMode::stuck) {
+      g[a] = self->friction(a).stick_margin(driving[a], self->input_.brakes_engaged);
+    } else {
+      g[a] = values[kVelocityOffset + kAxisCoordinate[a]];
+    }
+  }
+  return 0;
+}
+
+void CvodeIntegrator::set_mode(int axis, AxisMode mode) noexcept {
+  if (modes_[axis] == mode) return;
+  const bool counts_as_event = mode == AxisMode::stuck || modes_[axis] == AxisMode::stuck;
+  modes_[axis] = mode;
+  if (!counts_as_event) return;
+  ++friction_event_count_;
+  last_event_ = FrictionEvent{time_, static_cast<FrictionAxis>(axis), mode};
+}
+
+void CvodeIntegrator::settle_modes() noexcept {
+  double* y = N_VGetArrayPointer(y_);
+  // A few passes: a mode change of one axis changes the driving force on the other.
+  for (int pass = 0; pass < 2 * kNumFrictionAxes + 1; ++pass) {
+    bool changed = false;
+    for (int a = 0; a < kNumFrictionAxes; ++a) {
+      const int velocity_index = kVelocityOffset + kAxisCoordinate[a];
+      const AxisMode before = modes_[a];
+      if (modes_[a] == AxisMode::stuck) {
+        std::array<double, kNumFrictionAxes> driving{};
+        evaluate(y, modes_, nullptr, driving);
+        const int motion = friction(a).motion_at_rest(driving[a], input_.brakes_engaged);
+        if (motion != 0) set_mode(a, slipping(motion));
+      } else if (decision_pending_[a] && y[velocity_index] == 0.0) {
+        // At rest: would the axis stay stuck if held? Evaluate with it constrained.
+        std::array<AxisMode, kNumFrictionAxes> trial = modes_;
+        trial[a] = AxisMode::stuck;
+        std::array<double, kNumFrictionAxes> driving{};
+        evaluate(y, trial, nullptr, driving);
+        const int motion = friction(a).motion_at_rest(driving[a], input_.brakes_engaged);
+        set_mode(a, motion == 0 ? AxisMode::stuck : slipping(motion));
+        decision_pending_[a] = false;
+      } else if (y[velocity_index] != 0.0) {
+        // Direction follows the velocity (only differs from the mode after a reset or a missed root).
+        set_mode(a, slipping(y[velocity_index] > 0.0 ? 1 : -1));
+        decision_pending_[a] = false;
+      }
+      if (modes_[a] != before) changed = true;
+      if (modes_[a] == AxisMode::stuck) {
+        y[velocity_index] = 0.0;
+        decision_pending_[a] = false;
+      }
+    }
+    if (!changed) break;
+  }
+}
+
+void CvodeIntegrator::reset(double time, const ModelState& state, double cable_length,
+                            double cable_length_rate) noexcept {
+  time_ = time;
+  double* y = N_VGetArrayPointer(y_);
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    y[kPositionOffset + j] = state.position[j];
+    y[kVelocityOffset + j] = state.velocity[j];
+  }
+  y[kCableLengthIndex] = cable_length;
+  y[kCableLengthRateIndex] = cable_length_rate;
+  modes_ = {AxisMode::slipping_positive, AxisMode::slipping_positive};
+  decision_pending_ = {true, true};
+  // The initial mode decision is not a friction event.
+  const long event_count = friction_event_count_;
+  const FrictionEvent last_event = last_event_;
+  settle_modes();
+  friction_event_count_ = event_count;
+  last_event_ = last_event;
+  needs_reinit_ = true;
+}
+
+IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput& input) noexcept {
+  if (!std::isfinite(end_time) || !(end_time > time_) || !std::isfinite(input.trolley_drive_force) ||
+      !std::isfinite(input.slew_drive_torque) || !std::isfinite(input.cable_length_acceleration)) {
+    return IntegrationStatus::invalid_request;
+  }
+  N_VScale(1.0, y_, y_saved_);
+  const auto saved_modes = modes_;
+  if (!(input == input_)) {
+    input_ = input;
+    settle_modes();
+    needs_reinit_ = true;
+  }
+  IntegrationStatus status = IntegrationStatus::ok;
+  int events = 0;
+  while (time_ < end_time) {
+    if (needs_reinit_) {
+      if (CVodeReInit(cvode_memory_, time_, y_) != CV_SUCCESS) {
+        status = IntegrationStatus::solver_failure;
+        break;
+      }
+      needs_reinit_ = false;
+    }
+    if (CVodeSetStopTime(cvode_memory_, end_time) != CV_SUCCESS) {
+      status = IntegrationStatus::solver_failure;
+      break;
+    }
+    double reached = time_;
+    const int flag = CVode(cvode_memory_, end_time, y_, &reached, CV_NORMAL);
+    if (flag == CV_ROOT_RETURN) {
+      time_ = reached;
+      int found[kNumFrictionAxes] = {0, 0};
+      CVodeGetRootInfo(cvode_memory_, found);
+      double* y = N_VGetArrayPointer(y_);
+      std::array<double, kNumFrictionAxes> driving{};
+      evaluate(y, modes_, nullptr, driving);
+      for (int a = 0; a < kNumFrictionAxes; ++a) {
+        if (found[a] == 0) continue;
+        if (modes_[a] == AxisMode::stuck) {
+          // Stick margin crossed zero: break away toward the driving force.
+          set_mode(a, slipping(driving[a] >= 0.0 ? 1 : -1));
+          decision_pending_[a] = false;
+        } else {
+          // Velocity crossed zero: snap it, then stick or reverse (decided in settle_modes).
+          y[kVelocityOffset + kAxisCoordinate[a]] = 0.0;
+          decision_pending_[a] = true;
+        }
+      }
+      settle_modes();
+      needs_reinit_ = true;
+      if (++events > settings_.max_events_per_advance) {
+        status = IntegrationStatus::too_many_events;
+        break;
+      }
+      continue;
+    }
+    if (flag == CV_TSTOP_RETURN || flag == CV_SUCCESS) {
+      time_ = end_time;
+      break;
+    }
+    status = IntegrationStatus::solver_failure;
+    break;
+  }
+  if (status != IntegrationStatus::ok) {
+    ++solver_failure_count_;
+    N_VScale(1.0, y_saved_, y_);
+    modes_ = saved_modes;
+    time_ = end_time;
+    needs_reinit_ = true;
+  }
+  return status;
+}
+
+ModelState CvodeIntegrator::state() const noexcept {
+  const double* y = N_VGetArrayPointer(y_);
+  ModelState state;
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    state.position[j] = y[kPositionOffset + j];
+    state.velocity[j] = y[kVelocityOffset + j];
+  }
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (modes_[a] == AxisMode::stuck) state.velocity[kAxisCoordinate[a]] = 0.0;
+  }
+  return state;
+}
+
+double CvodeIntegrator::cable_length() const noexcept { return NV_Ith_S(y_, kCableLengthIndex); }
+
+double CvodeIntegrator::cable_length_rate() const noexcept { return NV_Ith_S(y_, kCableLengthRateIndex); }
+
+double CvodeIntegrator::holding_force(FrictionAxis axis) const noexcept {
+  const int a = index(axis);
+  if (modes_[a] != AxisMode::stuck) return 0.0;
+  std::array<double, kNumFrictionAxes> driving{};
+  evaluate(N_VGetArrayPointer(y_), modes_, nullptr, driving);
+  return driving[a];
+}
+
+}  // namespace crane::plant

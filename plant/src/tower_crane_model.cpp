@@ -1,0 +1,170 @@
+#include "crane/plant/tower_crane_model.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "crane/common/validation.hpp"
+
+namespace crane::plant {
+
+namespace {
+
+using Eigen::Vector3d;
+
+// Kinematics of the load in the rotating jib frame, tower convention (2.11) with ERRATA:
+//   r = x e_x + L u(phi, theta),  u = (-cos(theta) sin(phi), sin(theta), -cos(theta) cos(phi)).
+// Columns c_j = dr/dq_j of the load position (c_gamma = e_z x r is the rotation about z), and the
+// acceleration split a = sum_j c_j q_ddot_j + a_rest where, with omega = gamma_dot e_z,
+//   a_rest = L_dd u + 2 L_d u_dot + L (u_pp phi_d^2 + 2 u_pt phi_d theta_d + u_tt theta_d^2)
+//            + 2 omega x r_dot + omega x (omega x r)
+// (relative acceleration + Coriolis + centripetal; the Euler term omega_dot x r is c_gamma gamma_dd).
+struct LoadKinematics {
+  Vector3d r;          // load position in the jib frame [m]
+  Vector3d r_dot;      // its derivative in the jib frame [m/s]
+  Vector3d velocity;   // inertial velocity, jib-frame components r_dot + omega x r [m/s]
+  Vector3d column[kNumCoordinates];  // dp/dq_j, jib-frame components
+  Vector3d a_rest;     // velocity-product and hoist terms of the acceleration [m/s^2]
+};
+
+Vector3d cross_z(double omega, const Vector3d& v) { return Vector3d(-omega * v.y(), omega * v.x(), 0.0); }
+
+LoadKinematics load_kinematics(const ModelState& state, const HoistMotion& hoist) {
+  const double x = state.position[kTrolleyIndex];
+  const double phi = state.position[kInPlaneSwingIndex];
+  const double theta = state.position[kOutOfPlaneSwingIndex];
+  const double x_d = state.velocity[kTrolleyIndex];
+  const double phi_d = state.velocity[kInPlaneSwingIndex];
+  const double gamma_d = state.velocity[kSlewIndex];
+  const double theta_d = state.velocity[kOutOfPlaneSwingIndex];
+  const double L = hoist.cable_length;
+  const double L_d = hoist.cable_length_rate;
+  const double L_dd = hoist.cable_length_acceleration;
+
+  const double sp = std::sin(phi), cp = std::cos(phi), st = std::sin(theta), ct = std::cos(theta);
+  const Vector3d u(-ct * sp, st, -ct * cp);
+  const Vector3d u_p(-ct * cp, 0.0, ct * sp);       // du/dphi
+  const Vector3d u_t(st * sp, ct, st * cp);         // du/dtheta
+  const Vector3d u_pp(ct * sp, 0.0, ct * cp);       // d2u/dphi2
+  const Vector3d u_pt(st * cp, 0.0, -st * sp);      // d2u/dphi dtheta
+  const Vector3d u_tt = -u;                          // d2u/dtheta2
+  const Vector3d u_dot = u_p * phi_d + u_t * theta_d;
+
+  LoadKinematics k;
+  k.r = Vector3d(x, 0.0, 0.0) + L * u;
+  k.r_dot = Vector3d(x_d, 0.0, 0.0) + L_d * u + L * u_dot;
+  k.velocity = k.r_dot + cross_z(gamma_d, k.r);
+  k.column[kTrolleyIndex] = Vector3d(1.0, 0.0, 0.0);
+  k.column[kInPlaneSwingIndex] = L * u_p;
+  k.column[kSlewIndex] = Vector3d(-k.r.y(), k.r.x(), 0.0);
+  k.column[kOutOfPlaneSwingIndex] = L * u_t;
+  k.a_rest = L_dd * u + 2.0 * L_d * u_dot +
+             L * (u_pp * (phi_d * phi_d) + 2.0 * u_pt * (phi_d * theta_d) + u_tt * (theta_d * theta_d)) +
+             2.0 * cross_z(gamma_d, k.r_dot) + cross_z(gamma_d, cross_z(gamma_d, k.r));
+  return k;
+}
+
+bool is_swing_row(int j) { return j == kInPlaneSwingIndex || j == kOutOfPlaneSwingIndex; }
+
+}  // namespace
+
+TowerCraneModel::TowerCraneModel(const common::CraneParameters& parameters) : parameters_(parameters) {
+  common::validate(parameters_, "crane");
+}
+
+double TowerCraneModel::trolley_force_per_volt() const noexcept {
+  return parameters_.trolley_drive_mass * parameters_.trolley_drive_gain;
+}
+
+double TowerCraneModel::slew_torque_per_volt() const noexcept {
+  return parameters_.jib_inertia * parameters_.slew_drive_gain;
+}
+
+void TowerCraneModel::compute_dynamics(const ModelState& state, const HoistMotion& hoist,
+                                       CoordinateMatrix& mass_matrix, CoordinateVector& bias) const noexcept {
+  const double m = parameters_.load_mass;
+  const double g = parameters_.gravity;
+  const double M_drive = parameters_.trolley_drive_mass;
+  const double M_trolley = parameters_.trolley_mass;
+  const double J_o = parameters_.jib_inertia;
+  const LoadKinematics k = load_kinematics(state, hoist);
+  const Vector3d a_plus_gravity = k.a_rest + Vector3d(0.0, 0.0, g);
+
+  // Load: m c_j . (sum_k c_k q_dd_k + a_rest + g e_z); swing rows divided by m.
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    const double row_scale = is_swing_row(j) ? 1.0 : m;
+    for (int c = 0; c < kNumCoordinates; ++c) mass_matrix(j, c) = row_scale * k.column[j].dot(k.column[c]);
+    bias[j] = row_scale * k.column[j].dot(a_plus_gravity);
+  }
+  // Trolley and jib: T = 1/2 M_drive x_d^2 + 1/2 (M_trolley x^2 + J_o) gamma_d^2.
+  //   x:     M_drive x_dd - M_trolley x gamma_d^2
+  //   gamma: (M_trolley x^2 + J_o) gamma_dd + 2 M_trolley x x_d gamma_d
+  const double x = state.position[kTrolleyIndex];
+  const double x_d = state.velocity[kTrolleyIndex];
+  const double gamma_d = state.velocity[kSlewIndex];
+  mass_matrix(kTrolleyIndex, kTrolleyIndex) += M_drive;
+  bias[kTrolleyIndex] -= M_trolley * x * gamma_d * gamma_d;
+  mass_matrix(kSlewIndex, kSlewIndex) += M_trolley * x * x + J_o;
+  bias[kSlewIndex] += 2.0 * M_trolley * x * x_d * gamma_d;
+}
+
+CoordinateVector TowerCraneModel::acceleration(const ModelState& state, const HoistMotion& hoist,
+                                               const CoordinateVector& generalized_force) const noexcept {
+  CoordinateMatrix mass;
+  CoordinateVector bias;
+  compute_dynamics(state, hoist, mass, bias);
+  return mass.partialPivLu().solve(generalized_force - bias);
+}
+
+double TowerCraneModel::kinetic_energy(const ModelState& state, const HoistMotion& hoist) const noexcept {
+  const LoadKinematics k = load_kinematics(state, hoist);
+  const double x = state.position[kTrolleyIndex];
+  const double x_d = state.velocity[kTrolleyIndex];
+  const double gamma_d = state.velocity[kSlewIndex];
+  return 0.5 * parameters_.load_mass * k.velocity.squaredNorm() + 0.5 * parameters_.trolley_drive_mass * x_d * x_d +
+         0.5 * (parameters_.trolley_mass * x * x + parameters_.jib_inertia) * gamma_d * gamma_d;
+}
+
+double TowerCraneModel::potential_energy(const ModelState& state, double cable_length) const noexcept {
+  // (2.14)
+  return -parameters_.load_mass * parameters_.gravity * cable_length *
+         std::cos(state.position[kOutOfPlaneSwingIndex]) * std::cos(state.position[kInPlaneSwingIndex]);
+}
+
+double TowerCraneModel::total_energy(const ModelState& state, const HoistMotion& hoist) const noexcept {
+  return kinetic_energy(state, hoist) + potential_energy(state, hoist.cable_length);
+}
+
+double TowerCraneModel::slew_momentum(const ModelState& state, const HoistMotion& hoist) const noexcept {
+  const LoadKinematics k = load_kinematics(state, hoist);
+  const double x = state.position[kTrolleyIndex];
+  return parameters_.load_mass * k.velocity.dot(k.column[kSlewIndex]) +
+         (parameters_.trolley_mass * x * x + parameters_.jib_inertia) * state.velocity[kSlewIndex];
+}
+
+Eigen::Vector3d TowerCraneModel::load_position(const ModelState& state, double cable_length) const noexcept {
+  HoistMotion hoist;
+  hoist.cable_length = cable_length;
+  const Vector3d r = load_kinematics(state, hoist).r;
+  const double gamma = state.position[kSlewIndex];
+  const double cg = std::cos(gamma), sg = std::sin(gamma);
+  return Vector3d(cg * r.x() - sg * r.y(), sg * r.x() + cg * r.y(), r.z());
+}
+
+LinearizedModel TowerCraneModel::linearize_at_rest(double trolley_position, double cable_length) const noexcept {
+  ModelState rest;
+  rest.position[kTrolleyIndex] = trolley_position;
+  HoistMotion hoist;
+  hoist.cable_length = cable_length;
+  LinearizedModel lin;
+  CoordinateVector bias_at_rest;
+  compute_dynamics(rest, hoist, lin.mass, bias_at_rest);
+  // At rest the bias is the gravity gradient dV/dq; its Jacobian is the Hessian of
+  // V = -m g L cos(theta) cos(phi) at phi = theta = 0: diag(0, m g L, 0, m g L), swing rows / m.
+  lin.stiffness(kInPlaneSwingIndex, kInPlaneSwingIndex) = parameters_.gravity * cable_length;
+  lin.stiffness(kOutOfPlaneSwingIndex, kOutOfPlaneSwingIndex) = parameters_.gravity * cable_length;
+  lin.input(kTrolleyIndex, 0) = trolley_force_per_volt();
+  lin.input(kSlewIndex, 1) = slew_torque_per_volt();
+  return lin;
+}
+
+}  // namespace crane::plant

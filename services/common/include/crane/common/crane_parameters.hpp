@@ -1,0 +1,58 @@
+#pragma once
+// Physical parameters of a tower crane (a gantry crane is the same with the slew locked).
+//
+// Source: H. M. Omar, "Control of Gantry and Tower Cranes", Virginia Tech 2003, section 4.2 and
+// (3.53). Defaults are the dissertation's lab tower crane. All values SI unless the name says
+// otherwise. Friction coefficients are kept in the dissertation's "volt-equivalent" form
+// (coefficient divided by the motor gain K_m, Tables 3.1-4.2), so the same numbers serve the plant
+// and the friction compensator (3.5).
+
+namespace crane::common {
+
+/// Direction-dependent friction of one drive axis, (3.1)-(3.3), in volt-equivalents:
+/// a friction force F on an axis with drive gain K_m [accel/V] is stored as F/(mass*K_m) [V].
+struct AxisFriction {
+  double viscous_positive{0.0};  // [V s/m] or [V s/rad] b+/K_m, velocity > 0
+  double viscous_negative{0.0};  // [V s/m] or [V s/rad] b-/K_m, velocity < 0
+  double coulomb_positive{0.0};  // [V] c+/K_m, velocity > 0 (opposes the motion)
+  double coulomb_negative{0.0};  // [V] c-/K_m, velocity < 0 (opposes the motion)
+  double static_positive{0.0};   // [V] fs+/K_m, breakaway threshold toward + (4.13)/(4.15)
+  double static_negative{0.0};   // [V] fs-/K_m, breakaway threshold toward -
+};
+
+/// Mass properties, drive gains and sensors of the crane.
+struct CraneParameters {
+  double gravity{9.8};             // [m/s^2] 9.8 reproduces the dissertation's digits (ERRATA)
+  double load_mass{2.0};           // [kg] m (section 4.5)
+  double cable_length{1.0};        // [m] L, initial cable length
+  double trolley_drive_mass{22.222};  // [kg] M: mass seen by the trolley drive along the jib,
+                                      // trolley plus reflected leadscrew/rotor inertia; m_t = m/M = 0.09
+  double trolley_mass{1.93};       // [kg] physical trolley mass (slewing inertia), M_r = M/J_o = 0.27
+  double jib_inertia{7.143};       // [kg m^2] J_o about the slew axis; m_r = m/J_o = 0.28
+  double trolley_drive_gain{2.0};  // [m/s^2/V] K_mx (4.4): trolley acceleration per volt on mass M
+  double slew_drive_gain{1.14};    // [rad/s^2/V] K_mgamma (4.5): slew acceleration per volt on J_o
+  AxisFriction trolley_friction{1.5, 6.0, 0.9, 1.2, 1.0, 1.2};   // (4.12), (4.13)
+  AxisFriction slew_friction{1.5, 0.05, 0.7, 0.6, 0.7, 0.6};     // (4.16), (4.15)
+
+  // Drives and sensors, section 4.1.
+  int dac_bits{13};                     // [bit] analog output resolution
+  double dac_range{10.0};               // [V] outputs saturate at +-dac_range
+  int motor_encoder_lines{2000};        // [lines/rev] on both motors, read in quadrature (x4)
+  int swing_encoder_lines{6000};        // [lines/rev] on both swing axes, read in quadrature (x4)
+  double leadscrew_pitch{0.0127 / (2.0 * 3.14159265358979323846)};  // [m/rad] 0.5 in/rev
+  double slew_gear_ratio{45.0};         // [-] motor revolutions per jib revolution
+
+  /// m_t = m/M (2.25)
+  [[nodiscard]] double mass_ratio() const { return load_mass / trolley_drive_mass; }
+  /// m_r = m/J_o (2.25) [1/m^2]
+  [[nodiscard]] double load_inertia_ratio() const { return load_mass / jib_inertia; }
+  /// M_r = M/J_o (2.25) [1/m^2], with the physical trolley mass
+  [[nodiscard]] double trolley_inertia_ratio() const { return trolley_mass / jib_inertia; }
+};
+
+/// Throws crane::common::ConfigError naming the field (prefixed by `prefix`), value and bound
+/// if any parameter is non-finite or out of its physical range.
+void validate(const CraneParameters& parameters, const char* prefix = "crane");
+void validate(const AxisFriction& friction, const char* prefix);
+
+}  // namespace crane::common

@@ -1,0 +1,62 @@
+#pragma once
+// Core structs exchanged between the pure control libraries (no DDS type ever crosses a core API).
+// Symbols as in the dissertation (2.11): x trolley position, gamma slew angle, phi in-plane swing,
+// theta out-of-plane swing, L cable length. Tower sign convention: the load sits at
+// x - L cos(theta) sin(phi) along the jib.
+
+namespace crane::common {
+
+/// What the sensors give each cycle, in SI units (already converted from counts).
+struct CraneMeasurement {
+  double trolley_position{0.0};    // [m] x
+  double slew_angle{0.0};          // [rad] gamma
+  double swing_in_plane{0.0};      // [rad] phi
+  double swing_out_of_plane{0.0};  // [rad] theta
+  double cable_length{1.0};        // [m] L
+};
+
+/// Estimated state: positions and their rates (section 4.3).
+struct CraneStateEstimate {
+  double trolley_position{0.0};          // [m]
+  double trolley_velocity{0.0};          // [m/s] filtered then differentiated
+  double slew_angle{0.0};                // [rad]
+  double slew_rate{0.0};                 // [rad/s]
+  double swing_in_plane{0.0};            // [rad]
+  double swing_in_plane_rate{0.0};       // [rad/s]
+  double swing_out_of_plane{0.0};        // [rad]
+  double swing_out_of_plane_rate{0.0};   // [rad/s]
+  double cable_length{1.0};              // [m]
+  double cable_length_rate{0.0};         // [m/s]
+  double trolley_velocity_raw{0.0};      // [m/s] differentiated without the low-pass filter
+  double slew_rate_raw{0.0};             // [rad/s] differentiated without the low-pass filter
+};
+
+/// Reference for one axis at one instant.
+struct AxisReference {
+  double position{0.0};      // [m] or [rad]
+  double velocity{0.0};      // [m/s] or [rad/s]
+  double acceleration{0.0};  // [m/s^2] or [rad/s^2]
+};
+
+/// Reference for the whole crane at one instant.
+struct MotionReference {
+  AxisReference trolley;
+  AxisReference slew;
+  AxisReference cable_length;
+};
+
+/// Drive commands (after or before friction compensation, depending on where it is used).
+struct DriveCommand {
+  double trolley_voltage{0.0};  // [V]
+  double slew_voltage{0.0};     // [V]
+  double hoist_speed{0.0};      // [m/s]
+};
+
+/// Result of a cyclic step() of any core: the cyclic path never throws (STYLE.md habit 7).
+enum class [[nodiscard]] StepStatus {
+  ok,                 // outputs valid
+  rejected_nonfinite, // an input was NaN or Inf; outputs hold their safe value
+  not_ready,          // not enough history yet (e.g. a delay line filling); outputs are safe
+};
+
+}  // namespace crane::common

@@ -1,0 +1,77 @@
+#pragma once
+// Friction compensation, (3.1)-(3.5) of H. M. Omar, "Control of Gantry and Tower Cranes",
+// Virginia Tech 2003, in volt-equivalents (friction force divided by mass times drive gain):
+//   u = V + F_f/K_m                                                    (3.5)
+// with the compensation F_f/K_m pushing WITH the motion (Coulomb and viscous friction oppose it):
+//   velocity >  d_s:  + (c+ + b+ |v|)                                  (3.1), (3.3) eta = 1
+//   velocity < -d_s:  - (c- + b- |v|)                                  (3.1), (3.3) xi = 1
+//   |velocity| <= d_s: f_sh + f_s tanh(A V)  (stiction, driven by the commanded V)   (3.2)
+// with f_s = (fs+ + fs-)/2 and f_sh = (fs+ - fs-)/2, so the stiction term tends to +fs+ for
+// large positive V and to -fs- for large negative V ((4.13): 1.0/1.2 trolley, (4.15): 0.7/0.6 slew).
+// The velocity used is selectable per axis: raw (unfiltered) for the trolley by default as in
+// section 4.4.1, filtered for the slew as in section 4.4.2.
+//
+// Real-time: step() is noexcept, allocates nothing.
+
+#include "crane/common/crane_parameters.hpp"
+#include "crane/common/crane_signals.hpp"
+
+namespace crane::friction_compensation {
+
+enum class VelocitySource {
+  raw,       // CraneStateEstimate::trolley_velocity_raw / slew_rate_raw
+  filtered,  // CraneStateEstimate::trolley_velocity / slew_rate
+};
+
+struct AxisCompensationParams {
+  common::AxisFriction friction;           // volt-equivalents (see crane_parameters.hpp)
+  double zero_velocity_band{0.01};         // [m/s] or [rad/s] d_s (3.3), >= 0
+  double stiction_slope{20.0};             // [1/V] A in tanh(A V) (3.2), > 0
+  VelocitySource velocity_source{VelocitySource::raw};
+};
+
+struct FrictionCompensationParams {
+  bool enabled{true};  // false: u = V (still clamped)
+  AxisCompensationParams trolley{common::CraneParameters{}.trolley_friction, 0.01, 20.0,
+                                 VelocitySource::raw};       // (4.12), (4.13); section 4.4.1
+  AxisCompensationParams slew{common::CraneParameters{}.slew_friction, 0.01, 20.0,
+                              VelocitySource::filtered};     // (4.16), (4.15); section 4.4.2
+  double voltage_limit{10.0};  // [V] outputs clamped to +-voltage_limit, > 0
+};
+
+struct FrictionCompensationInput {
+  common::CraneStateEstimate estimate;  // velocities [m/s], [rad/s]
+  common::DriveCommand command;         // V from the linear controller [V]; hoist passes through
+};
+
+struct FrictionCompensationOutput {
+  common::DriveCommand command;       // u (3.5), clamped [V]
+  double trolley_friction{0.0};       // [V] F_f/K_m added on the trolley
+  double slew_friction{0.0};          // [V] F_f/K_m added on the slew
+  bool trolley_saturated{false};
+  bool slew_saturated{false};
+};
+
+/// F_f/K_m [V] for one axis at `velocity` [m/s or rad/s] and commanded voltage [V].
+/// Preconditions: finite inputs, validated params.
+[[nodiscard]] double friction_voltage(const AxisCompensationParams& axis, double velocity,
+                                      double commanded_voltage) noexcept;
+
+class FrictionCompensation {
+ public:
+  /// Throws common::ConfigError naming the field, value and bound for negative or non-finite
+  /// friction coefficients, zero_velocity_band < 0, stiction_slope <= 0, voltage_limit <= 0, or an
+  /// unknown velocity source.
+  explicit FrictionCompensation(const FrictionCompensationParams& params);
+
+  /// rejected_nonfinite if a used input is NaN/Inf: output set to zero voltages and hoist speed.
+  [[nodiscard]] common::StepStatus step(const FrictionCompensationInput& input,
+                                        FrictionCompensationOutput& output) const noexcept;
+
+  [[nodiscard]] const FrictionCompensationParams& params() const noexcept { return params_; }
+
+ private:
+  FrictionCompensationParams params_;
+};
+
+}  // namespace crane::friction_compensation

@@ -1,0 +1,85 @@
+#include "crane/friction_compensation/friction_compensation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "crane/common/validation.hpp"
+
+namespace crane::friction_compensation {
+namespace {
+
+void validate_axis(const AxisCompensationParams& axis, const std::string& prefix) {
+  common::validate(axis.friction, (prefix + ".friction").c_str());
+  common::require_at_least(prefix + ".zero_velocity_band", axis.zero_velocity_band, 0.0);
+  common::require_greater(prefix + ".stiction_slope", axis.stiction_slope, 0.0);
+  if (axis.velocity_source != VelocitySource::raw && axis.velocity_source != VelocitySource::filtered) {
+    throw common::ConfigError(prefix + ".velocity_source = " +
+                              std::to_string(static_cast<int>(axis.velocity_source)) +
+                              " is not a VelocitySource");
+  }
+}
+
+FrictionCompensationParams validated(const FrictionCompensationParams& params) {
+  validate_axis(params.trolley, "friction_compensation.trolley");
+  validate_axis(params.slew, "friction_compensation.slew");
+  common::require_greater("friction_compensation.voltage_limit", params.voltage_limit, 0.0);
+  return params;
+}
+
+double clamp_voltage(double value, double limit, bool& saturated) {
+  saturated = std::abs(value) > limit;
+  return std::clamp(value, -limit, limit);
+}
+
+}  // namespace
+
+double friction_voltage(const AxisCompensationParams& axis, double velocity,
+                        double commanded_voltage) noexcept {
+  const auto& f = axis.friction;
+  const double d_s = axis.zero_velocity_band;
+  if (velocity > d_s) {  // eta = 1 (3.3): c+ + b+ v, with the motion
+    return f.coulomb_positive + f.viscous_positive * velocity;
+  }
+  if (velocity < -d_s) {  // xi = 1: -(c- + b- |v|)
+    return -(f.coulomb_negative - f.viscous_negative * velocity);
+  }
+  // Stiction (3.2): F_fs = f_sh + f_s tanh(A V), -> +fs+ (V >> 0), -> -fs- (V << 0).
+  const double f_s = 0.5 * (f.static_positive + f.static_negative);
+  const double f_sh = 0.5 * (f.static_positive - f.static_negative);
+  return f_sh + f_s * std::tanh(axis.stiction_slope * commanded_voltage);
+}
+
+FrictionCompensation::FrictionCompensation(const FrictionCompensationParams& params)
+    : params_(validated(params)) {}
+
+common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& input,
+                                              FrictionCompensationOutput& output) const noexcept {
+  const auto& est = input.estimate;
+  const double trolley_velocity = params_.trolley.velocity_source == VelocitySource::raw
+                                      ? est.trolley_velocity_raw
+                                      : est.trolley_velocity;
+  const double slew_velocity =
+      params_.slew.velocity_source == VelocitySource::raw ? est.slew_rate_raw : est.slew_rate;
+  if (!std::isfinite(trolley_velocity) || !std::isfinite(slew_velocity) ||
+      !std::isfinite(input.command.trolley_voltage) || !std::isfinite(input.command.slew_voltage) ||
+      !std::isfinite(input.command.hoist_speed)) {
+    output = FrictionCompensationOutput{};
+    return common::StepStatus::rejected_nonfinite;
+  }
+  output = FrictionCompensationOutput{};
+  if (params_.enabled) {
+    output.trolley_friction =
+        friction_voltage(params_.trolley, trolley_velocity, input.command.trolley_voltage);
+    output.slew_friction = friction_voltage(params_.slew, slew_velocity, input.command.slew_voltage);
+  }
+  // (3.5): u = V + F_f/K_m
+  output.command.trolley_voltage = clamp_voltage(input.command.trolley_voltage + output.trolley_friction,
+                                                 params_.voltage_limit, output.trolley_saturated);
+  output.command.slew_voltage = clamp_voltage(input.command.slew_voltage + output.slew_friction,
+                                              params_.voltage_limit, output.slew_saturated);
+  output.command.hoist_speed = input.command.hoist_speed;
+  return common::StepStatus::ok;
+}
+
+}  // namespace crane::friction_compensation

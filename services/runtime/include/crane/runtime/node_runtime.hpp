@@ -1,0 +1,121 @@
+#pragma once
+// Plumbing shared by every process of the stack (the "thin node" side of STYLE.md habit 1):
+// command-line options, signal handling, wall-clock stamps, latency statistics, loop diagnostics
+// and the NaN/Inf gate at every topic entry. Nothing here is crane physics or control.
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crane/transport/participant.hpp"
+#include "crane/transport/topics.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace crane::runtime {
+
+namespace msgs = crane_msgs::msg::dds_;
+
+/// Process identifiers carried in LoopDiagnostics_.process.
+enum class ProcessId : std::uint8_t {
+  plant = 1,
+  hardware_bridge = 2,
+  state_estimator = 3,
+  trajectory_planner = 4,
+  anti_swing = 5,
+  tracking = 6,
+  friction_compensation = 7,
+  supervisor = 8,
+  operator_console = 9,
+};
+[[nodiscard]] const char* process_name(ProcessId id) noexcept;
+
+/// Options every node accepts.
+struct NodeOptions {
+  std::string config_path;  // YAML configuration (deploy/config/*.yaml)
+  std::string dds{};        // "fast" | "cyclone"; empty: CRANE_DDS, else fast
+  std::uint32_t domain_id{0};
+  bool loopback_only{true};
+  std::string log_level{"info"};
+};
+
+/// Adds --config, --dds, --domain, --lan, --log-level to `app`, bound to `options`.
+void add_node_options(CLI::App& app, NodeOptions& options);
+
+/// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS).
+/// Throws std::invalid_argument on a bad vendor name, std::runtime_error if DDS fails.
+std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name);
+
+/// Applies --log-level to spdlog's default logger; throws std::invalid_argument on an unknown level.
+void configure_logging(const std::string& level, const std::string& process);
+
+/// SIGINT/SIGTERM set a flag (async-signal-safe) and wake the given Wakeup.
+void install_stop_handlers(transport::Wakeup* wakeup);
+[[nodiscard]] bool stop_requested() noexcept;
+
+/// Wall-clock (CLOCK_REALTIME) stamps for message headers.
+[[nodiscard]] builtin_interfaces::msg::dds_::Time_ now_stamp() noexcept;
+[[nodiscard]] std::int64_t to_nanoseconds(const builtin_interfaces::msg::dds_::Time_& stamp) noexcept;
+[[nodiscard]] std::int64_t now_nanoseconds() noexcept;
+
+/// Fills header.stamp = now, header.seq, header.origin.
+void stamp_header(msgs::CycleHeader_& header, std::uint64_t seq, const builtin_interfaces::msg::dds_::Time_& origin) noexcept;
+
+/// Latency statistics with storage sized at construction: record() never allocates.
+/// Percentiles are computed over the last `capacity` samples.
+class LatencyStatistics {
+ public:
+  explicit LatencyStatistics(std::size_t capacity = 1U << 16);
+  void record(double microseconds) noexcept;
+  [[nodiscard]] std::uint64_t count() const noexcept { return count_; }
+  /// p in [0, 100]; 0 when empty. Allocates (a copy of the window): call off the cyclic path.
+  [[nodiscard]] double percentile(double p) const;
+  [[nodiscard]] double maximum() const noexcept { return maximum_; }
+
+ private:
+  std::vector<double> window_;
+  std::size_t next_{0};
+  std::uint64_t count_{0};
+  double maximum_{0.0};
+};
+
+/// Counters every node keeps and publishes once per second on rt/crane/diag/loop.
+struct LoopCounters {
+  std::uint64_t cycles{0};
+  std::uint64_t overruns{0};
+  std::uint64_t nonfinite_rejected{0};
+  std::uint64_t last_seq{0};
+};
+
+class DiagnosticsPublisher {
+ public:
+  DiagnosticsPublisher(transport::Participant& participant, ProcessId process);
+  /// Publishes if at least one second passed since the last publication.
+  void maybe_publish(const LoopCounters& counters, const LatencyStatistics* latency);
+  /// Publishes now (used once more on the way out, so the last figures are not lost).
+  void publish(const LoopCounters& counters, const LatencyStatistics* latency);
+
+ private:
+  ProcessId process_;
+  std::uint8_t vendor_;
+  std::unique_ptr<transport::Writer<transport::topics::LoopDiagnostics>> writer_;
+  std::chrono::steady_clock::time_point next_;
+};
+
+/// NaN/Inf gate at the entry of each topic: true when every floating-point field is finite.
+[[nodiscard]] bool all_finite(const msgs::SensorSample_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::ActuatorCommand_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::CraneState_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::MoveRequest_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::Reference_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::AntiSwingCommand_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::LinearCommand_& m) noexcept;
+[[nodiscard]] bool all_finite(const msgs::SupervisorStatus_& m) noexcept;
+
+}  // namespace crane::runtime

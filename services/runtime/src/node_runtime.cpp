@@ -1,0 +1,195 @@
+#include "crane/runtime/node_runtime.hpp"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <csignal>
+#include <ctime>
+#include <stdexcept>
+
+namespace crane::runtime {
+
+const char* process_name(ProcessId id) noexcept {
+  switch (id) {
+    case ProcessId::plant: return "plant";
+    case ProcessId::hardware_bridge: return "hardware_bridge";
+    case ProcessId::state_estimator: return "state_estimator";
+    case ProcessId::trajectory_planner: return "trajectory_planner";
+    case ProcessId::anti_swing: return "anti_swing";
+    case ProcessId::tracking: return "tracking";
+    case ProcessId::friction_compensation: return "friction_compensation";
+    case ProcessId::supervisor: return "supervisor";
+    case ProcessId::operator_console: return "operator";
+  }
+  return "unknown";
+}
+
+void add_node_options(CLI::App& app, NodeOptions& options) {
+  app.add_option("--config", options.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_option("--dds", options.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
+  app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_flag("--lan{false},--loopback-only{true}", options.loopback_only,
+               "bind DDS to loopback only (default) or to every interface (--lan)");
+  app.add_option("--log-level", options.log_level, "trace | debug | info | warn | error");
+}
+
+std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name) {
+  transport::ParticipantOptions p;
+  p.name = name;
+  p.domain_id = options.domain_id;
+  p.loopback_only = options.loopback_only;
+  p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
+  return std::make_unique<transport::Participant>(p);
+}
+
+void configure_logging(const std::string& level, const std::string& process) {
+  const auto parsed = spdlog::level::from_str(level);
+  if (parsed == spdlog::level::off && level != "off") {
+    throw std::invalid_argument("--log-level '" + level + "' is not known");
+  }
+  spdlog::set_level(parsed);
+  spdlog::set_pattern("[%H:%M:%S.%e] [" + process + "] [%^%l%$] %v");
+}
+
+namespace {
+std::atomic<bool> g_stop{false};
+std::atomic<transport::Wakeup*> g_wakeup{nullptr};
+extern "C" void on_stop_signal(int) {
+  g_stop.store(true);
+  // Wakeup::notify takes a mutex; instead of calling it from the handler a watcher thread would be
+  // cleaner, but every loop also wakes at least every few milliseconds, so the flag is enough.
+}
+}  // namespace
+
+void install_stop_handlers(transport::Wakeup* wakeup) {
+  g_wakeup.store(wakeup);
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+bool stop_requested() noexcept { return g_stop.load(); }
+
+builtin_interfaces::msg::dds_::Time_ now_stamp() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  builtin_interfaces::msg::dds_::Time_ t;
+  t.sec(static_cast<int32_t>(ts.tv_sec));
+  t.nanosec(static_cast<uint32_t>(ts.tv_nsec));
+  return t;
+}
+
+std::int64_t to_nanoseconds(const builtin_interfaces::msg::dds_::Time_& stamp) noexcept {
+  return static_cast<std::int64_t>(stamp.sec()) * 1000000000LL + static_cast<std::int64_t>(stamp.nanosec());
+}
+
+std::int64_t now_nanoseconds() noexcept { return to_nanoseconds(now_stamp()); }
+
+void stamp_header(msgs::CycleHeader_& header, std::uint64_t seq,
+                  const builtin_interfaces::msg::dds_::Time_& origin) noexcept {
+  header.stamp(now_stamp());
+  header.seq(seq);
+  header.origin(origin);
+}
+
+LatencyStatistics::LatencyStatistics(std::size_t capacity) : window_(std::max<std::size_t>(capacity, 1)) {}
+
+void LatencyStatistics::record(double microseconds) noexcept {
+  window_[next_] = microseconds;
+  next_ = (next_ + 1) % window_.size();
+  ++count_;
+  maximum_ = std::max(maximum_, microseconds);
+}
+
+double LatencyStatistics::percentile(double p) const {
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(count_, window_.size()));
+  if (n == 0) return 0.0;
+  std::vector<double> sorted(window_.begin(), window_.begin() + static_cast<std::ptrdiff_t>(n));
+  std::sort(sorted.begin(), sorted.end());
+  const double rank = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(n - 1);
+  const auto lower = static_cast<std::size_t>(std::floor(rank));
+  const auto upper = std::min(lower + 1, n - 1);
+  const double fraction = rank - static_cast<double>(lower);
+  return sorted[lower] + fraction * (sorted[upper] - sorted[lower]);
+}
+
+DiagnosticsPublisher::DiagnosticsPublisher(transport::Participant& participant, ProcessId process)
+    : process_(process),
+      vendor_(static_cast<std::uint8_t>(participant.vendor())),
+      writer_(participant.make_writer<transport::topics::LoopDiagnostics>()),
+      next_(std::chrono::steady_clock::now() + std::chrono::seconds(1)) {}
+
+void DiagnosticsPublisher::maybe_publish(const LoopCounters& counters, const LatencyStatistics* latency) {
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_) return;
+  publish(counters, latency);
+}
+
+void DiagnosticsPublisher::publish(const LoopCounters& counters, const LatencyStatistics* latency) {
+  next_ = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  msgs::LoopDiagnostics_ d;
+  stamp_header(d.header(), counters.last_seq, now_stamp());
+  d.process(static_cast<std::uint8_t>(process_));
+  d.dds_vendor(vendor_);
+  d.pid(static_cast<std::uint32_t>(getpid()));
+  d.cycles(counters.cycles);
+  d.overruns(counters.overruns);
+  d.nonfinite_rejected(counters.nonfinite_rejected);
+  if (latency != nullptr) {
+    d.latency_p50_us(latency->percentile(50.0));
+    d.latency_p99_us(latency->percentile(99.0));
+    d.latency_max_us(latency->maximum());
+  }
+  writer_->write(d);
+}
+
+namespace {
+template <class... T>
+bool finite(T... values) noexcept {
+  return (std::isfinite(values) && ...);
+}
+template <std::size_t N>
+bool finite_array(const std::array<double, N>& values) noexcept {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+}  // namespace
+
+bool all_finite(const msgs::SensorSample_& m) noexcept {
+  return finite(m.trolley_position(), m.slew_angle(), m.swing_in_plane(), m.swing_out_of_plane(), m.cable_length(),
+                m.applied_trolley_voltage(), m.applied_slew_voltage(), m.applied_hoist_speed());
+}
+bool all_finite(const msgs::ActuatorCommand_& m) noexcept {
+  return finite(m.trolley_voltage(), m.slew_voltage(), m.hoist_speed(), m.trolley_friction_voltage(),
+                m.slew_friction_voltage());
+}
+bool all_finite(const msgs::CraneState_& m) noexcept {
+  return finite(m.trolley_position(), m.trolley_velocity(), m.slew_angle(), m.slew_rate(), m.swing_in_plane(),
+                m.swing_in_plane_rate(), m.swing_out_of_plane(), m.swing_out_of_plane_rate(), m.cable_length(),
+                m.cable_length_rate(), m.trolley_velocity_raw(), m.slew_rate_raw());
+}
+bool all_finite(const msgs::MoveRequest_& m) noexcept {
+  return finite(m.trolley_target(), m.slew_target(), m.cable_length_target(), m.trolley_max_velocity(),
+                m.trolley_max_acceleration(), m.slew_max_velocity(), m.slew_max_acceleration()) &&
+         finite_array(m.waypoint_trolley()) && finite_array(m.waypoint_slew()) &&
+         finite_array(m.waypoint_cable_length());
+}
+bool all_finite(const msgs::Reference_& m) noexcept {
+  return finite(m.trolley_position(), m.trolley_velocity(), m.trolley_acceleration(), m.slew_angle(), m.slew_rate(),
+                m.slew_acceleration(), m.cable_length(), m.cable_length_rate(), m.cable_length_acceleration(),
+                m.time_in_move(), m.move_duration());
+}
+bool all_finite(const msgs::AntiSwingCommand_& m) noexcept { return finite(m.trolley_action(), m.slew_action()); }
+bool all_finite(const msgs::LinearCommand_& m) noexcept {
+  return finite(m.trolley_voltage(), m.slew_voltage(), m.hoist_speed(), m.trolley_tracking_action(),
+                m.slew_tracking_action());
+}
+bool all_finite(const msgs::SupervisorStatus_& m) noexcept {
+  return finite(m.trolley_voltage_limit(), m.slew_voltage_limit());
+}
+
+}  // namespace crane::runtime

@@ -1,0 +1,68 @@
+#include "crane/runtime/stage_node.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+namespace crane::runtime {
+
+bool SequenceWatch::advance(std::uint64_t seq, LoopCounters& counters) noexcept {
+  if (!any_) {
+    any_ = true;
+    last_ = seq;
+    counters.last_seq = seq;
+    return true;
+  }
+  if (seq <= last_) return false;
+  counters.overruns += seq - last_ - 1;
+  last_ = seq;
+  counters.last_seq = seq;
+  return true;
+}
+
+void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header) noexcept {
+  latency.record(static_cast<double>(now_nanoseconds() - to_nanoseconds(header.origin())) / 1000.0);
+}
+
+int run_stage(int argc, char** argv, ProcessId process, const std::string& description,
+              const std::function<void(CLI::App&)>& add_options,
+              const std::function<std::function<void()>(StageContext&)>& setup) {
+  CLI::App app{description};
+  NodeOptions options;
+  add_node_options(app, options);
+  if (add_options) add_options(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error);
+  }
+  const std::string name = process_name(process);
+  try {
+    configure_logging(options.log_level, name);
+    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    auto participant = make_participant(options, name);
+    transport::Wakeup wakeup;
+    install_stop_handlers(&wakeup);
+    LoopCounters counters;
+    LatencyStatistics latency;
+    DiagnosticsPublisher diagnostics(*participant, process);
+    StageContext context{cfg, *participant, wakeup, counters, latency};
+    const auto poll = setup(context);
+    spdlog::info("running on {} dds, domain {}", transport::vendor_name(participant->vendor()), options.domain_id);
+    while (!stop_requested()) {
+      wakeup.wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(5));
+      poll();
+      diagnostics.maybe_publish(counters, &latency);
+    }
+    diagnostics.publish(counters, &latency);
+    spdlog::info("stopping: {} cycles, {} overruns, {} non-finite samples rejected, latency p50 {:.0f} us p99 {:.0f} us",
+                 counters.cycles, counters.overruns, counters.nonfinite_rejected, latency.percentile(50),
+                 latency.percentile(99));
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace crane::runtime

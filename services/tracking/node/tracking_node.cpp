@@ -1,0 +1,65 @@
+// tracking process: joins rt/crane/state/estimate, rt/crane/planner/reference and
+// rt/crane/control/anti_swing of the same cycle -> PD tracking (3.40)-(3.42) with the voltage
+// mapping (3.37)-(3.38) -> rt/crane/control/linear.
+#include "crane/runtime/stage_node.hpp"
+#include "crane/tracking/tracking_controller.hpp"
+
+int main(int argc, char** argv) {
+  using namespace crane;
+  namespace tp = transport::topics;
+  return runtime::run_stage(
+      argc, argv, runtime::ProcessId::tracking,
+      "tracking: PD tracking (3.40)-(3.42) plus the anti-swing action, mapped to drive voltages (3.37)-(3.38)", {},
+      [](runtime::StageContext& ctx) -> std::function<void()> {
+        auto controller = std::make_shared<tracking::TrackingController>(ctx.config.tracking);
+        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
+        auto references = std::shared_ptr(ctx.participant.make_reader<tp::Reference>(&ctx.wakeup));
+        auto actions = std::shared_ptr(ctx.participant.make_reader<tp::AntiSwing>(&ctx.wakeup));
+        auto writer = std::shared_ptr(ctx.participant.make_writer<tp::LinearCommand>());
+        auto watch = std::make_shared<runtime::SequenceWatch>();
+        auto state = std::make_shared<tp::msgs::CraneState_>();
+        auto reference = std::make_shared<tp::msgs::Reference_>();
+        auto action = std::make_shared<tp::msgs::AntiSwingCommand_>();
+        auto fresh = std::make_shared<std::array<bool, 3>>(std::array<bool, 3>{false, false, false});
+        auto out = std::make_shared<tp::msgs::LinearCommand_>();
+        return [=, &ctx] {
+          auto take = [&](auto& reader, auto& latest, bool& flag) {
+            typename std::remove_reference_t<decltype(latest)> sample;
+            while (reader.take_next(sample)) {
+              if (!runtime::all_finite(sample)) {
+                ++ctx.counters.nonfinite_rejected;
+                continue;
+              }
+              latest = sample;
+              flag = true;
+            }
+          };
+          take(*states, *state, (*fresh)[0]);
+          take(*references, *reference, (*fresh)[1]);
+          take(*actions, *action, (*fresh)[2]);
+          const auto seq = state->header().seq();
+          const bool complete = (*fresh)[0] && (*fresh)[1] && (*fresh)[2] && reference->header().seq() == seq &&
+                                action->header().seq() == seq;
+          if (!complete) return;
+          *fresh = {false, false, false};
+          if (watch->advance(seq, ctx.counters)) ++ctx.counters.cycles;
+          tracking::TrackingInput in;
+          in.estimate = runtime::to_estimate(*state);
+          in.reference = runtime::to_reference(*reference);
+          in.trolley_anti_swing_action = action->trolley_action();
+          in.slew_anti_swing_action = action->slew_action();
+          tracking::TrackingOutput result;
+          if (controller->step(in, result) != common::StepStatus::ok) {
+            ++ctx.counters.nonfinite_rejected;
+          }
+          out->trolley_voltage(result.command.trolley_voltage);
+          out->slew_voltage(result.command.slew_voltage);
+          out->hoist_speed(result.command.hoist_speed);
+          out->trolley_tracking_action(result.trolley_tracking_action);
+          out->slew_tracking_action(result.slew_tracking_action);
+          runtime::stamp_header(out->header(), seq, state->header().origin());
+          writer->write(*out);
+          runtime::record_latency(ctx.latency, out->header());
+        };
+      });
+}

@@ -1,0 +1,118 @@
+#pragma once
+// Point-to-point reference generator for the trolley, slew and hoist axes (section 3.3.1 of
+// H. M. Omar, "Control of Gantry and Tower Cranes", 2003). Each axis runs its own profile from
+// the position at the start of the move; the move ends when the slowest axis arrives.
+//
+// Real-time: start_move(), hold() and step() are noexcept and allocate nothing; all profiles are
+// held by value.
+
+#include <cstdint>
+
+#include "crane/common/crane_signals.hpp"
+#include "crane/trajectory_planner/step_profile.hpp"
+#include "crane/trajectory_planner/trapezoid_profile.hpp"
+
+namespace crane::trajectory_planner {
+
+/// Profile shapes. Later: zv, zvd, ei, time_optimal (add an AxisProfile implementation and a case).
+enum class ProfileKind {
+  step,       // target at once
+  trapezoid,  // (3.43)
+};
+
+/// Travel limits of the crane, checked against every goal.
+struct TrajectoryPlannerParams {
+  double trolley_min_position{0.1};   // [m] along the jib
+  double trolley_max_position{1.2};   // [m]
+  double slew_min_angle{-6.283185307179586};  // [rad]
+  double slew_max_angle{6.283185307179586};   // [rad]
+  double cable_min_length{0.2};       // [m]
+  double cable_max_length{5.0};       // [m]
+};
+
+/// A move request.
+struct MoveGoal {
+  std::uint64_t request_id{0};
+  ProfileKind profile{ProfileKind::trapezoid};
+  double trolley_target{0.25};  // [m]
+  double slew_target{0.0};      // [rad]
+  double cable_target{1.0};     // [m]
+  AxisLimits trolley_limits{0.4982, 0.9929};  // [m/s], [m/s^2]   (3.54)
+  AxisLimits slew_limits{1.0435, 2.0796};     // [rad/s], [rad/s^2] (3.55)
+  AxisLimits cable_limits{0.2, 0.5};          // [m/s], [m/s^2]
+};
+
+/// Why a goal was refused (the planner then keeps what it was doing).
+enum class [[nodiscard]] GoalStatus {
+  accepted,
+  rejected_nonfinite,             // a target, limit or start position is NaN/Inf
+  rejected_trolley_out_of_range,  // trolley_target outside [trolley_min_position, trolley_max_position]
+  rejected_slew_out_of_range,     // slew_target outside [slew_min_angle, slew_max_angle]
+  rejected_cable_out_of_range,    // cable_target outside [cable_min_length, cable_max_length]
+  rejected_invalid_limits,        // a trapezoid limit is <= 0
+};
+
+enum class MovePhase {
+  holding,  // no move yet (or after hold()): the reference holds a position
+  moving,
+  arrived,  // the last move finished; the reference holds its targets
+};
+
+struct PlannerOutput {
+  common::MotionReference reference;
+  MovePhase phase{MovePhase::holding};
+  std::uint64_t request_id{0};  // of the current/last move, 0 if none
+  double time_in_move{0.0};     // [s] since the move started
+  double move_duration{0.0};    // [s] planned duration of the current/last move
+};
+
+class TrajectoryPlanner {
+ public:
+  /// Throws common::ConfigError naming the field unless every bound is finite and min < max,
+  /// cable_min_length > 0.
+  explicit TrajectoryPlanner(const TrajectoryPlannerParams& params);
+
+  /// Hold the given position (phase holding). Non-finite positions -> rejected_nonfinite.
+  [[nodiscard]] GoalStatus hold(const common::CraneStateEstimate& current) noexcept;
+
+  /// Start a move from `current` (trolley_position [m], slew_angle [rad], cable_length [m]).
+  /// On rejection nothing changes.
+  [[nodiscard]] GoalStatus start_move(const MoveGoal& goal,
+                                      const common::CraneStateEstimate& current) noexcept;
+
+  /// Advance time by `dt` [s] (>= 0) and sample the reference at the new time.
+  /// not_ready before the first hold()/start_move() (output untouched); rejected_nonfinite if dt is
+  /// NaN/Inf or negative (time not advanced, output untouched).
+  [[nodiscard]] common::StepStatus step(double dt, PlannerOutput& output) noexcept;
+
+  /// Back to not_ready.
+  void reset() noexcept;
+
+  [[nodiscard]] const TrajectoryPlannerParams& params() const noexcept { return params_; }
+
+ private:
+  struct Axis {
+    TrapezoidProfile trapezoid;
+    StepProfile step;
+    ProfileKind kind{ProfileKind::step};
+    // Indexing by kind (not a stored pointer) keeps the planner safely copyable.
+    [[nodiscard]] const AxisProfile& active() const noexcept {
+      if (kind == ProfileKind::trapezoid) return trapezoid;
+      return step;
+    }
+  };
+  void plan_axis(Axis& axis, ProfileKind kind, double start, double target,
+                 const AxisLimits& limits) noexcept;
+
+  TrajectoryPlannerParams params_;
+  Axis trolley_;
+  Axis slew_;
+  Axis cable_;
+  bool ready_{false};
+  MovePhase phase_{MovePhase::holding};
+  std::uint64_t request_id_{0};
+  double time_in_move_{0.0};
+  double move_duration_{0.0};
+};
+
+}  // namespace crane::trajectory_planner

@@ -1,0 +1,97 @@
+// trajectory_planner process: rt/crane/planner/goal (MoveRequest) and rt/crane/state/estimate ->
+// reference trajectory (step or the trapezoid of (3.43)) -> rt/crane/planner/reference, once per
+// cycle, same seq and origin. Holds the first measured position until a goal arrives.
+#include <spdlog/spdlog.h>
+
+#include "crane/runtime/stage_node.hpp"
+#include "crane/trajectory_planner/trajectory_planner.hpp"
+
+namespace {
+using namespace crane;
+namespace tp = transport::topics;
+
+trajectory_planner::MoveGoal to_goal(const tp::msgs::MoveRequest_& r, const common::CraneStateEstimate& current) {
+  trajectory_planner::MoveGoal g;
+  g.request_id = r.request_id();
+  g.profile = r.profile() == 0 ? trajectory_planner::ProfileKind::step : trajectory_planner::ProfileKind::trapezoid;
+  // An axis not named in `axes` keeps its current position.
+  g.trolley_target = (r.axes() & 0x1) != 0 ? r.trolley_target() : current.trolley_position;
+  g.slew_target = (r.axes() & 0x2) != 0 ? r.slew_target() : current.slew_angle;
+  g.cable_target = (r.axes() & 0x4) != 0 ? r.cable_length_target() : current.cable_length;
+  if (r.trolley_max_velocity() > 0.0) g.trolley_limits.max_velocity = r.trolley_max_velocity();
+  if (r.trolley_max_acceleration() > 0.0) g.trolley_limits.max_acceleration = r.trolley_max_acceleration();
+  if (r.slew_max_velocity() > 0.0) g.slew_limits.max_velocity = r.slew_max_velocity();
+  if (r.slew_max_acceleration() > 0.0) g.slew_limits.max_acceleration = r.slew_max_acceleration();
+  return g;
+}
+
+const char* goal_status_name(trajectory_planner::GoalStatus s) {
+  using trajectory_planner::GoalStatus;
+  switch (s) {
+    case GoalStatus::accepted: return "accepted";
+    case GoalStatus::rejected_nonfinite: return "rejected: non-finite field";
+    case GoalStatus::rejected_trolley_out_of_range: return "rejected: trolley target outside the travel limits";
+    case GoalStatus::rejected_slew_out_of_range: return "rejected: slew target outside the slew range";
+    case GoalStatus::rejected_cable_out_of_range: return "rejected: cable length target outside its range";
+    case GoalStatus::rejected_invalid_limits: return "rejected: velocity or acceleration limit <= 0";
+  }
+  return "unknown";
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runtime::run_stage(
+      argc, argv, runtime::ProcessId::trajectory_planner,
+      "trajectory_planner: move requests to reference trajectories (step, trapezoid (3.43))", {},
+      [](runtime::StageContext& ctx) -> std::function<void()> {
+        auto planner = std::make_shared<trajectory_planner::TrajectoryPlanner>(ctx.config.trajectory_planner);
+        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
+        auto goals = std::shared_ptr(ctx.participant.make_reader<tp::Goal>(&ctx.wakeup));
+        auto writer = std::shared_ptr(ctx.participant.make_writer<tp::Reference>());
+        auto watch = std::make_shared<runtime::SequenceWatch>();
+        auto out = std::make_shared<tp::msgs::Reference_>();
+        auto output = std::make_shared<trajectory_planner::PlannerOutput>();
+        auto holding = std::make_shared<bool>(false);
+        auto last_request = std::make_shared<std::uint32_t>(0);
+        const double dt = ctx.config.plant.sample_period;
+        return [=, &ctx] {
+          tp::msgs::CraneState_ state;
+          while (states->take_next(state)) {
+            if (!runtime::all_finite(state)) {
+              ++ctx.counters.nonfinite_rejected;
+              continue;
+            }
+            const auto current = runtime::to_estimate(state);
+            if (!*holding) {
+              *holding = planner->hold(current) == trajectory_planner::GoalStatus::accepted;
+              if (!*holding) continue;
+            }
+            tp::msgs::MoveRequest_ request;
+            while (goals->take_next(request)) {
+              if (!runtime::all_finite(request)) {
+                ++ctx.counters.nonfinite_rejected;
+                spdlog::warn("move request {} rejected: non-finite field", request.request_id());
+                continue;
+              }
+              // Operators re-send a request until they see it executed: ids only increase.
+              if (request.request_id() <= *last_request) continue;
+              *last_request = request.request_id();
+              const auto status = planner->start_move(to_goal(request, current), current);
+              spdlog::info("move request {} to x = {} m, gamma = {} rad: {}", request.request_id(),
+                           request.trolley_target(), request.slew_target(), goal_status_name(status));
+            }
+            const bool new_cycle = watch->advance(state.header().seq(), ctx.counters);
+            if (planner->step(new_cycle ? dt : 0.0, *output) != common::StepStatus::ok) continue;
+            if (new_cycle) ++ctx.counters.cycles;
+            runtime::from_reference(output->reference, *out);
+            out->request_id(static_cast<std::uint32_t>(output->request_id));
+            out->phase(static_cast<std::uint8_t>(output->phase));
+            out->time_in_move(output->time_in_move);
+            out->move_duration(output->move_duration);
+            runtime::stamp_header(out->header(), state.header().seq(), state.header().origin());
+            writer->write(*out);
+            runtime::record_latency(ctx.latency, out->header());
+          }
+        };
+      });
+}

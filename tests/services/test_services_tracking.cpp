@@ -1,0 +1,157 @@
+// Tests of the tracking controller core, (3.37)-(3.42).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "crane/common/validation.hpp"
+#include "crane/tracking/tracking_controller.hpp"
+
+namespace tr = crane::tracking;
+using crane::common::StepStatus;
+
+namespace {
+const double kT = 2.0 * std::numbers::pi * std::sqrt(1.0 / 9.8);  // 2.0071 s for L = 1 m
+const double kT2 = kT * kT;                                        // 4.0284 s^2
+
+tr::TrackingInput base_input() {
+  tr::TrackingInput in;
+  in.estimate.cable_length = 1.0;
+  in.estimate.trolley_position = 0.5;
+  in.reference.trolley.position = 0.5;
+  in.estimate.slew_angle = 0.0;
+  in.reference.slew.position = 0.0;
+  return in;
+}
+}  // namespace
+
+TEST(TrackingController, TrolleyHandCase) {
+  // L = 1, e = 0.01 m, e_dot = 0, phi = 0: V_xp = (1/L)(100*0.01) = 1 (3.40), V_bar_x = 1,
+  // V_x = (1/K_mx)(L/T^2) V_bar_x = (1/2)(1/4.0284)(1) = 0.12412 V (3.37).
+  tr::TrackingController controller(tr::TrackingParams{});
+  auto in = base_input();
+  in.reference.trolley.position = 0.51;
+  tr::TrackingOutput out;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_tracking_action, 1.0, 1e-12);
+  EXPECT_NEAR(out.command.trolley_voltage, 0.5 / kT2, 1e-12);
+  EXPECT_NEAR(out.command.trolley_voltage, 0.12412, 1e-5);
+  EXPECT_NEAR(out.swing_period, 2.0071, 1e-4);
+
+  // Add phi = 0.05 rad: + m_t g phi / K_mx = 0.09*9.8*0.05/2 = 0.02205 V.
+  in.estimate.swing_in_plane = 0.05;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.command.trolley_voltage, 0.5 / kT2 + 0.02205, 1e-12);
+
+  // Velocity error 0.1 m/s, e = 0: V_xp = T K_dx e_dot / L = 2.0071*20*0.1 = 4.0142.
+  in = base_input();
+  in.reference.trolley.velocity = 0.1;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_tracking_action, kT * 20.0 * 0.1, 1e-12);
+
+  // The anti-swing action adds in normalized units: V_bar_x = V_xp + V_xs.
+  in = base_input();
+  in.trolley_anti_swing_action = -9.0;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_normalized_action, -9.0, 1e-12);
+  EXPECT_NEAR(out.command.trolley_voltage, 0.5 * -9.0 / kT2, 1e-12);
+}
+
+TEST(TrackingController, SlewHandCase338) {
+  // L = 1, x = 0.9 m, gamma_ref - gamma = 0.01 rad, rates 0, theta = 0:
+  // e_y_bar = -(x/L)(0.01) = -0.009, V_yp = 100*(-0.009) = -0.9,
+  // V_gamma = (1/1.14)[-L(1 + 0.27*0.81)/(0.9 T^2)(-0.9)] = 1.2187/(1.14*4.0284) = 0.26538 V.
+  tr::TrackingController controller(tr::TrackingParams{});
+  auto in = base_input();
+  in.estimate.trolley_position = 0.9;
+  in.reference.trolley.position = 0.9;
+  in.reference.slew.position = 0.01;
+  tr::TrackingOutput out;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.slew_tracking_action, -0.9, 1e-12);
+  const double expected = (1.0 + 0.27 * 0.81) / kT2 / 1.14;
+  EXPECT_NEAR(out.command.slew_voltage, expected, 1e-12);
+  EXPECT_NEAR(out.command.slew_voltage, 0.26538, 1e-5);
+
+  // theta = 0.02 rad adds -m_r g x theta / K_mgamma = -0.28*9.8*0.9*0.02/1.14 = -0.043326 V
+  // (x in metres, not x/L: with L = 2 the term is unchanged while (3.38)-as-printed would halve it).
+  in.estimate.swing_out_of_plane = 0.02;
+  in.reference.slew.position = 0.0;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.command.slew_voltage, -0.28 * 9.8 * 0.9 * 0.02 / 1.14, 1e-12);
+  in.estimate.cable_length = 2.0;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.command.slew_voltage, -0.28 * 9.8 * 0.9 * 0.02 / 1.14, 1e-12);
+}
+
+TEST(TrackingController, MinRadiusGuardAndClamp) {
+  tr::TrackingController controller(tr::TrackingParams{});
+  auto in = base_input();
+  in.estimate.trolley_position = 0.0;  // on the slew axis: |x| floored at 0.1 m
+  in.reference.trolley.position = 0.0;
+  in.reference.slew.position = 0.01;
+  tr::TrackingOutput out;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  // x = 0.1: V_yp = -100*0.1*0.01 = -0.1; V_gamma = (1+0.27*0.01)/(0.1 T^2)*0.1/1.14
+  EXPECT_NEAR(out.command.slew_voltage, (1.0 + 0.27 * 0.01) / kT2 / 1.14, 1e-12);
+  EXPECT_TRUE(std::isfinite(out.command.slew_voltage));
+
+  in = base_input();
+  in.reference.trolley.position = 1.5;  // e = 1 m -> V_x = 0.5*100/T^2 = 12.4 V > 10 V
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_EQ(out.command.trolley_voltage, 10.0);
+  EXPECT_TRUE(out.trolley_saturated);
+  in.reference.cable_length.velocity = -0.2;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_EQ(out.command.hoist_speed, -0.2);
+}
+
+TEST(TrackingController, NonFiniteRejected) {
+  tr::TrackingController controller(tr::TrackingParams{});
+  tr::TrackingOutput out;
+  out.command.trolley_voltage = 3.0;
+  auto in = base_input();
+  in.estimate.swing_in_plane = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(controller.step(in, out), StepStatus::rejected_nonfinite);
+  EXPECT_EQ(out.command.trolley_voltage, 0.0);
+  in = base_input();
+  in.slew_anti_swing_action = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(controller.step(in, out), StepStatus::rejected_nonfinite);
+  in = base_input();
+  in.reference.trolley.velocity = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(controller.step(in, out), StepStatus::rejected_nonfinite);
+}
+
+TEST(TrackingController, BadParamsThrowNamingField) {
+  auto expect_throw = [](const tr::TrackingParams& p, const std::string& field) {
+    try {
+      tr::TrackingController controller(p);
+      FAIL() << "no throw for " << field;
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+    }
+  };
+  tr::TrackingParams p;
+  p.trolley_drive_gain = 0.0;
+  expect_throw(p, "trolley_drive_gain");
+  p = {};
+  p.min_radius = -1.0;
+  expect_throw(p, "min_radius");
+  p = {};
+  p.proportional_gain = std::numeric_limits<double>::quiet_NaN();
+  expect_throw(p, "proportional_gain");
+  p = {};
+  p.voltage_limit = 0.0;
+  expect_throw(p, "voltage_limit");
+}
+
+TEST(TrackingController, ParamsFromCraneParameters) {
+  const auto p = tr::tracking_params_from(crane::common::CraneParameters{});
+  EXPECT_NEAR(p.mass_ratio, 0.09, 1e-4);
+  EXPECT_NEAR(p.load_inertia_ratio, 0.28, 1e-3);
+  EXPECT_NEAR(p.trolley_inertia_ratio, 0.27, 1e-3);
+  EXPECT_EQ(p.trolley_drive_gain, 2.0);
+  EXPECT_EQ(p.slew_drive_gain, 1.14);
+}
