@@ -107,7 +107,8 @@ int main(int argc, char** argv) {
     tp::msgs::SupervisorStatus_ incoming_status;
     Clock::time_point status_received{};
     bool have_status = false;
-    bool started = false;  // lockstep: the chain has answered once
+    bool started = false;      // the chain has answered once
+    bool chain_ready = false;  // and the supervisor has seen every stage alive: overruns count from here
     std::uint64_t seq = 0;
     builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
     std::int64_t origin_ns = runtime::to_nanoseconds(origin);
@@ -144,12 +145,15 @@ int main(int argc, char** argv) {
           status = incoming_status;
           status_received = Clock::now();
           have_status = true;
+          chain_ready = chain_ready || status.stages_alive() == 0x3FU;
         }
         if (got && !realtime) break;
         const auto now = Clock::now();
         if (now >= deadline) break;
         if (!realtime && !started && now >= next_republish) {
-          // Start-up: keep offering cycle 0 until the chain answers (not an overrun).
+          // Start-up: keep offering this cycle, freshly sampled, until the chain answers (not an overrun).
+          origin = runtime::now_stamp();
+          origin_ns = runtime::to_nanoseconds(origin);
           fill_sensors(sample, simulator.output(), seq, origin);
           sensors->write(sample);
           next_republish = now + republish;
@@ -161,7 +165,9 @@ int main(int argc, char** argv) {
         cycle_start = Clock::now();
         continue;
       }
-      const bool count_overrun = !got && started;  // realtime start-up: advance, but not an overrun
+      // Until the whole chain is matched and alive, a missing command is start-up (the stages still
+      // discover each other), not an overrun; brakes are on then anyway.
+      const bool count_overrun = !got && started && chain_ready;
       if (got) started = true;
 
       plant::DriveInput input;  // default: 0 V, brakes engaged
@@ -177,6 +183,8 @@ int main(int argc, char** argv) {
         }
       } else if (count_overrun) {
         ++counters.overruns;
+        spdlog::warn("overrun: no command for cycle {} within {} ms; 0 V and brakes for this cycle", seq,
+                     realtime ? cfg.plant.sample_period * 1e3 : cfg.plant.lockstep_timeout * 1e3);
       }
       const auto step_status = simulator.step(input);
       if (step_status != common::StepStatus::ok) {
@@ -198,7 +206,7 @@ int main(int argc, char** argv) {
       diagnostics.maybe_publish(counters, &latency);
     }
 
-    diagnostics.publish(counters, &latency);
+    diagnostics.publish_final(counters, &latency);
     spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} non-finite commands rejected, latency p50 {:.0f} "
                  "us p99 {:.0f} us max {:.0f} us, {} friction events",
                  simulator.time(), counters.cycles, counters.overruns, counters.nonfinite_rejected,

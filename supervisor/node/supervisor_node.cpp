@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
       }
       diagnostics.maybe_publish(counters, nullptr);
     }
-    diagnostics.publish(counters, nullptr);
+    diagnostics.publish_final(counters, nullptr);
     spdlog::info("stopping: {} cycles, {} overruns, {} non-finite samples rejected", counters.cycles,
                  counters.overruns, counters.nonfinite_rejected);
   } catch (const std::exception& error) {

@@ -62,7 +62,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       std::fabs(in.slew_voltage) > params_.voltage_limit + 1e-9) {
     active |= kFaultVoltage;
   }
-  if (in.sensors_valid && std::fabs(in.swing_in_plane) > params_.max_swing || std::fabs(in.swing_out_of_plane) > params_.max_swing) {
+  if (in.sensors_valid &&
+      (std::fabs(in.swing_in_plane) > params_.max_swing || std::fabs(in.swing_out_of_plane) > params_.max_swing)) {
     active |= kFaultSwing;
   }
   if (in.nonfinite_seen) active |= kFaultNonFinite;

@@ -65,6 +65,7 @@ struct RunResult {
   std::vector<double> latencies_us;
   std::vector<ProcessRecord> processes;
   bool diagnostics_complete{false};
+  std::vector<std::string> diagnostics_missing;  // stages whose final loop diagnostics never arrived
 };
 
 // Everything the operator records in one run, keyed by cycle.
@@ -191,12 +192,20 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     result.processes.push_back(ProcessRecord{spec.name, pid, options.dds, run_name});
   }
 
-  // 1. Wait until every stage is matched and alive and the supervisor is ready.
+  // 1. Wait until every stage is matched and alive, the supervisor is ready, and this operator
+  //    itself receives every stream it records from this run's processes (its own discovery of a
+  //    fresh stack can lag the stages' discovery of each other by up to an announcement period,
+  //    which in lockstep is hundreds of cycles).
+  const auto plant_pid = result.processes.back().pid;  // the plant starts last
+  Recording rec;
   const auto ready_deadline = Clock::now() + std::chrono::duration<double>(options.ready_timeout);
   while (true) {
     check_children(group);
     const auto status = op.latest_status();
-    if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0) break;
+    op.record(rec);
+    const bool recording = !rec.sensors.empty() && rec.sensors.rbegin()->second.writer_pid() == static_cast<std::uint32_t>(plant_pid) &&
+                           !rec.references.empty() && !rec.linear.empty() && !rec.actuators.empty();
+    if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0 && recording) break;
     if (Clock::now() > ready_deadline) {
       throw RunFailure(run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
                        " s (stages_alive=" + (status ? std::to_string(status->stages_alive()) : "none") +
@@ -205,10 +214,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
 
-  // 2. Send the move.
-  Recording rec;
-  op.record(rec);
-  rec = Recording{};
+  // 2. Send the move. The recording so far is kept: the first cycle of the move may be in it.
   tp::msgs::MoveRequest_ goal;
   runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
   goal.request_id(request_id);
@@ -268,7 +274,10 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   std::size_t reported = 0;
   for (const auto& p : result.processes) {
     const auto found = diagnostics.find(static_cast<std::uint32_t>(p.pid));
-    if (found == diagnostics.end()) continue;
+    if (found == diagnostics.end()) {
+      result.diagnostics_missing.push_back(p.name);
+      continue;
+    }
     ++reported;
     result.overruns += found->second.overruns();
     result.nonfinite_rejected += found->second.nonfinite_rejected();
@@ -327,7 +336,19 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
         << (a != rec.actuators.end() ? a->second.slew_voltage() : nan) << ','
         << (next->second.brakes_engaged() ? 1 : 0) << '\n';
   }
-  if (cycles.empty()) throw RunFailure(run_name + ": no cycle was recorded");
+  if (result.missing > 0) {
+    spdlog::warn("{}: {} of {} cycles missing from the recording (move started at cycle {}, {} sensor samples from "
+                 "cycle {} to {})",
+                 run_name, result.missing, cycles_needed + 1, *start_seq, rec.sensors.size(),
+                 rec.sensors.empty() ? 0 : rec.sensors.begin()->first,
+                 rec.sensors.empty() ? 0 : rec.sensors.rbegin()->first);
+  }
+  if (cycles.empty()) {
+    throw RunFailure(run_name + ": no cycle was recorded (move started at cycle " + std::to_string(*start_seq) +
+                     ", " + std::to_string(rec.sensors.size()) + " sensor samples from cycle " +
+                     (rec.sensors.empty() ? std::string("-") : std::to_string(rec.sensors.begin()->first)) + " to " +
+                     (rec.sensors.empty() ? std::string("-") : std::to_string(rec.sensors.rbegin()->first)) + ")");
+  }
   result.samples = cycles.size();
   result.csv = csv_path.filename().string();
   result.metrics = launch::evaluate_maneuver(cycles, m.trolley_target, m.slew_target);
@@ -427,6 +448,7 @@ int main(int argc, char** argv) {
       j["csv"] = r.csv;
       j["plant_cycles"] = r.cycles;
       j["overruns"] = r.overruns;
+      j["diagnostics_missing"] = r.diagnostics_missing;
       maneuvers.push_back(j);
       all_latencies.insert(all_latencies.end(), r.latencies_us.begin(), r.latencies_us.end());
       cycles += r.cycles;

@@ -71,6 +71,11 @@ dds::DataReaderQos reader_qos(QosKind kind, std::int32_t history_depth) {
   apply_common(p, qos);
   qos.resource_limits().max_samples = std::max(p.history_depth, 1);
   qos.resource_limits().max_samples_per_instance = std::max(p.history_depth, 1);
+  if (history_depth > 0) {
+    // A recorder keeps many samples: with data sharing it would only hold references into the
+    // writer's keep-last-1 pool, which the next sample overwrites. Receive copies instead.
+    qos.data_sharing().off();
+  }
   qos.deadline().period = to_duration(p.reader_deadline);
   return qos;
 }

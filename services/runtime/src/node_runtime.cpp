@@ -9,6 +9,7 @@
 #include <csignal>
 #include <ctime>
 #include <stdexcept>
+#include <thread>
 
 namespace crane::runtime {
 
@@ -128,6 +129,11 @@ void DiagnosticsPublisher::maybe_publish(const LoopCounters& counters, const Lat
   const auto now = std::chrono::steady_clock::now();
   if (now < next_) return;
   publish(counters, latency);
+}
+
+void DiagnosticsPublisher::publish_final(const LoopCounters& counters, const LatencyStatistics* latency) {
+  publish(counters, latency);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
 }
 
 void DiagnosticsPublisher::publish(const LoopCounters& counters, const LatencyStatistics* latency) {

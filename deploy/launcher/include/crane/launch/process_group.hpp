@@ -36,7 +36,9 @@ class ProcessGroup {
   ProcessGroup(const ProcessGroup&) = delete;
   ProcessGroup& operator=(const ProcessGroup&) = delete;
 
-  /// Starts one process; throws std::runtime_error naming the executable if fork or exec fails.
+  /// Starts one process; throws std::runtime_error naming it if fork fails. An exec failure happens
+  /// in the child, which then exits with code 127 (seen by poll()) after writing "exec failed" to
+  /// its log.
   pid_t start(const ProcessSpec& spec);
   /// Reaps one child that exited, if any (non-blocking).
   std::optional<ChildExit> poll();

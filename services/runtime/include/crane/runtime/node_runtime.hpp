@@ -98,8 +98,11 @@ class DiagnosticsPublisher {
   DiagnosticsPublisher(transport::Participant& participant, ProcessId process);
   /// Publishes if at least one second passed since the last publication.
   void maybe_publish(const LoopCounters& counters, const LatencyStatistics* latency);
-  /// Publishes now (used once more on the way out, so the last figures are not lost).
+  /// Publishes now.
   void publish(const LoopCounters& counters, const LatencyStatistics* latency);
+  /// Publishes once more on the way out and gives the best-effort sample 100 ms to be delivered
+  /// before the participant is destroyed, so the last figures are not lost.
+  void publish_final(const LoopCounters& counters, const LatencyStatistics* latency);
 
  private:
   ProcessId process_;

@@ -1,0 +1,99 @@
+// crane_launch: runs the simulated stack until Ctrl-C. Starts every stage as its own OS process,
+// waits until all are matched and alive (the supervisor reports every stage alive), then watches:
+// on Ctrl-C (SIGINT/SIGTERM) or on the death of any stage it stops all of them by pid (SIGTERM,
+// then SIGKILL after a grace period) and exits. Goals are sent by any DDS participant on
+// rt/crane/planner/goal (for example crane_demo, or a ROS 2 node).
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <thread>
+
+#include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
+#include "crane/supervisor/supervisor.hpp"
+
+int main(int argc, char** argv) {
+  using namespace crane;
+  namespace tp = transport::topics;
+  using Clock = std::chrono::steady_clock;
+  CLI::App app{"crane_launch: run the simulated crane stack (each stage its own process) until Ctrl-C"};
+  launch::StackOptions stack;
+  bool lockstep = false;
+  bool no_compensation = false;
+  double ready_timeout = 60.0;
+  std::string log_dir = "crane-logs";
+  bool simulated = true;
+  app.add_flag("--sim", simulated, "simulated plant as the sensor writer (the default; the hardware bridge comes later)");
+  app.add_option("--config", stack.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone");
+  app.add_option("--domain", stack.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
+  app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
+  app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
+  app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
+  app.add_option("--log-dir", log_dir, "one <stage>.log per process");
+  app.add_option("--ready-timeout", ready_timeout, "[s] longest wait for the stack to become ready");
+  CLI11_PARSE(app, argc, argv);
+  stack.lockstep = lockstep;
+  stack.friction_compensation = !no_compensation;
+
+  try {
+    runtime::configure_logging("info", "launch");
+    std::filesystem::create_directories(log_dir);
+    stack.config_path = std::filesystem::absolute(stack.config_path).string();
+    stack.log_directory = std::filesystem::absolute(log_dir).string();
+    stack.binary_directory = launch::executable_directory();
+
+    runtime::NodeOptions node;
+    node.dds = stack.dds;
+    node.domain_id = stack.domain_id;
+    auto participant = runtime::make_participant(node, "launcher");
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+    auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
+
+    launch::ProcessGroup group;
+    for (const auto& spec : launch::simulated_stack(stack)) {
+      const pid_t pid = group.start(spec);
+      spdlog::info("started {} (pid {}), log {}", spec.name, pid, spec.log_path);
+    }
+    tp::msgs::SupervisorStatus_ status;
+    bool ready = false;
+    int exit_code = 0;
+    const auto ready_deadline = Clock::now() + std::chrono::duration<double>(ready_timeout);
+    auto next_report = Clock::now();
+    while (!runtime::stop_requested()) {
+      if (auto exit = group.poll()) {
+        spdlog::error("{}: stopping the stack", exit->describe());
+        exit_code = 1;
+        break;
+      }
+      status_reader->take_latest(status);
+      if (!ready && status.stages_alive() == 0x3FU) {
+        ready = true;
+        spdlog::info("all stages matched and alive, supervisor mode {}; Ctrl-C stops the stack",
+                     supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())));
+      }
+      if (!ready && Clock::now() > ready_deadline) {
+        spdlog::error("the stack did not become ready within {} s (stages alive 0x{:x}); see {}", ready_timeout,
+                      status.stages_alive(), log_dir);
+        exit_code = 1;
+        break;
+      }
+      if (ready && Clock::now() >= next_report) {
+        next_report = Clock::now() + std::chrono::seconds(5);
+        spdlog::info("mode {}, stages alive 0x{:x}, latched faults 0x{:x}, cycle {}",
+                     supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())), status.stages_alive(),
+                     status.latched_faults(), status.header().seq());
+      }
+      wakeup.wait_until(Clock::now() + std::chrono::milliseconds(50));
+    }
+    for (const auto& exit : group.stop_all()) spdlog::info("{}", exit.describe());
+    return exit_code;
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+}

@@ -1,0 +1,272 @@
+// Tests of crane::config: the real lab configuration against the dissertation (H. M. Omar,
+// "Control of Gantry and Tower Cranes", Virginia Tech 2003), and the messages of bad files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "crane/common/validation.hpp"
+#include "crane/config/stack_config.hpp"
+
+namespace cfg = crane::config;
+
+namespace {
+
+const std::string kLabConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml";
+
+std::string read_text(const std::string& path) {
+  std::ifstream file(path);
+  EXPECT_TRUE(file.good()) << "cannot open " << path;
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream stream(text);
+  for (std::string line; std::getline(stream, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string trim_left(const std::string& line) {
+  const auto first = line.find_first_not_of(' ');
+  return first == std::string::npos ? std::string() : line.substr(first);
+}
+
+struct Edit {
+  std::string text;       // the edited file
+  std::size_t line{0};    // 1-based number of the edited line
+};
+
+/// Finds the first line whose content (after indentation) starts with `key`, searching from the
+/// first line that starts with `anchor` (empty: from the top). Replaces that line's content by
+/// `replacement`, keeping its indentation, or deletes the line when `replacement` is nullopt.
+/// Fails the test if no such line exists.
+Edit edit_line(const std::string& text, const std::string& anchor, const std::string& key,
+               const std::optional<std::string>& replacement) {
+  auto lines = split_lines(text);
+  std::size_t i = 0;
+  if (!anchor.empty()) {
+    while (i < lines.size() && trim_left(lines[i]).rfind(anchor, 0) != 0) ++i;
+  }
+  while (i < lines.size() && trim_left(lines[i]).rfind(key, 0) != 0) ++i;
+  EXPECT_LT(i, lines.size()) << "no line '" << key << "' after '" << anchor << "'";
+  Edit edit;
+  edit.line = i + 1;
+  if (i < lines.size()) {
+    if (replacement) {
+      const std::string indent = lines[i].substr(0, lines[i].size() - trim_left(lines[i]).size());
+      lines[i] = indent + *replacement;
+    } else {
+      lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+  for (const auto& line : lines) edit.text += line + "\n";
+  return edit;
+}
+
+/// The ConfigError message of parsing `text` as "test.yaml", or a marker if nothing was thrown.
+std::string error_of(const std::string& text) {
+  try {
+    (void)cfg::parse_stack_config(text, "test.yaml");
+  } catch (const crane::common::ConfigError& error) {
+    return error.what();
+  }
+  return "<no ConfigError thrown>";
+}
+
+bool starts_with(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+class LabConfigText : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    text_ = read_text(kLabConfig);
+    ASSERT_FALSE(text_.empty());
+  }
+  std::string text_;
+};
+
+}  // namespace
+
+TEST(LabConfig, LoadsAndMatchesTheDissertation) {
+  const auto c = cfg::load_stack_config(kLabConfig);
+
+  // Section 4.5: m = 2 kg, L = 1 m.
+  EXPECT_DOUBLE_EQ(c.crane.load_mass, 2.0);
+  EXPECT_DOUBLE_EQ(c.crane.cable_length, 1.0);
+  EXPECT_DOUBLE_EQ(c.crane.gravity, 9.8);
+  // (4.17): m_t = m/M = 2/22.222 = 0.0900009.
+  EXPECT_NEAR(c.crane.mass_ratio(), 0.09, 1e-3);
+  // (4.17): m_r = m/J_o = 2/7.143 = 0.27999.
+  EXPECT_NEAR(c.crane.load_inertia_ratio(), 0.28, 1e-3);
+  // (4.6): M_r = M/J_o = 1.93/7.143 = 0.27020.
+  EXPECT_NEAR(c.crane.trolley_inertia_ratio(), 0.27, 2e-3);
+  // (4.4), (4.5): drive gains.
+  EXPECT_DOUBLE_EQ(c.crane.trolley_drive_gain, 2.0);
+  EXPECT_DOUBLE_EQ(c.crane.slew_drive_gain, 1.14);
+
+  // Trolley friction (4.12), static (4.13), in volt-equivalents.
+  const auto& tf = c.crane.trolley_friction;
+  EXPECT_DOUBLE_EQ(tf.viscous_positive, 1.5);
+  EXPECT_DOUBLE_EQ(tf.viscous_negative, 6.0);
+  EXPECT_DOUBLE_EQ(tf.coulomb_positive, 0.9);
+  EXPECT_DOUBLE_EQ(tf.coulomb_negative, 1.2);
+  EXPECT_DOUBLE_EQ(tf.static_positive, 1.0);
+  EXPECT_DOUBLE_EQ(tf.static_negative, 1.2);
+  // Slew friction (4.16), static (4.15).
+  const auto& sf = c.crane.slew_friction;
+  EXPECT_DOUBLE_EQ(sf.viscous_positive, 1.5);
+  EXPECT_DOUBLE_EQ(sf.viscous_negative, 0.05);
+  EXPECT_DOUBLE_EQ(sf.coulomb_positive, 0.7);
+  EXPECT_DOUBLE_EQ(sf.coulomb_negative, 0.6);
+  EXPECT_DOUBLE_EQ(sf.static_positive, 0.7);
+  EXPECT_DOUBLE_EQ(sf.static_negative, 0.6);
+
+  // The compensator's model is the configured crane's friction (cross-check of the wiring).
+  EXPECT_DOUBLE_EQ(c.friction_compensation.trolley.friction.viscous_negative, tf.viscous_negative);
+  EXPECT_DOUBLE_EQ(c.friction_compensation.slew.friction.coulomb_positive, sf.coulomb_positive);
+  // The tracking controller's model ratios are the crane's.
+  EXPECT_DOUBLE_EQ(c.tracking.mass_ratio, c.crane.mass_ratio());
+  EXPECT_DOUBLE_EQ(c.tracking.load_inertia_ratio, c.crane.load_inertia_ratio());
+  EXPECT_DOUBLE_EQ(c.tracking.trolley_inertia_ratio, c.crane.trolley_inertia_ratio());
+  // 100 Hz: the estimator's sample rate is 1 / sample_period = 1 / 0.01.
+  EXPECT_NEAR(c.state_estimator.sample_rate, 100.0, 1e-9);
+
+  // Section 3.3.3: trolley (3.54), slew (3.55), combined.
+  ASSERT_EQ(c.maneuvers.size(), 3U);
+  EXPECT_EQ(c.maneuvers[0].name, "trolley");
+  EXPECT_EQ(c.maneuvers[1].name, "slew");
+  EXPECT_EQ(c.maneuvers[2].name, "combined");
+  // trolley: 0.25 -> 1.0 m, no slew.
+  EXPECT_DOUBLE_EQ(c.maneuvers[0].initial_trolley_position, 0.25);
+  EXPECT_DOUBLE_EQ(c.maneuvers[0].trolley_target, 1.0);
+  EXPECT_DOUBLE_EQ(c.maneuvers[0].slew_target, 0.0);
+  // slew: 90 deg = 90 * pi/180 = pi/2 rad, at x = 0.9 m.
+  EXPECT_NEAR(c.maneuvers[1].slew_target, std::numbers::pi / 2.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c.maneuvers[1].trolley_target, 0.9);
+  // combined: both.
+  EXPECT_NEAR(c.maneuvers[2].slew_target, std::numbers::pi / 2.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c.maneuvers[2].trolley_target, 1.0);
+}
+
+TEST_F(LabConfigText, UneditedTextParses) {
+  // Control for the edits below: the same text through parse_stack_config is accepted.
+  EXPECT_NO_THROW((void)cfg::parse_stack_config(text_, "test.yaml"));
+}
+
+TEST_F(LabConfigText, MissingField) {
+  auto message = error_of(edit_line(text_, "crane:", "load_mass:", std::nullopt).text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "missing field crane.load_mass")) << message;
+
+  // Nested two levels: friction_compensation.trolley.stiction_slope (the first stiction_slope after
+  // "friction_compensation:" is the trolley's).
+  message = error_of(edit_line(text_, "friction_compensation:", "stiction_slope:", std::nullopt).text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "missing field friction_compensation.trolley.stiction_slope")) << message;
+
+  // A whole section.
+  message = error_of(edit_line(text_, "", "arm_on_start:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field supervisor.arm_on_start")) << message;
+
+  // A field of a maneuver names its list index.
+  message = error_of(edit_line(text_, "- name: slew", "duration:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field maneuvers[1].duration")) << message;
+}
+
+TEST_F(LabConfigText, OutOfRange) {
+  // cable_length must be in [0.05, 200].
+  auto message = error_of(edit_line(text_, "crane:", "cable_length:", "cable_length: -1").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "crane.cable_length = -1")) << message;
+  EXPECT_TRUE(contains(message, "must be in")) << message;
+  EXPECT_TRUE(contains(message, "[0.05, 200]")) << message;
+
+  // Nested: crane.trolley_friction.coulomb_positive must be in [0, 10].
+  message = error_of(edit_line(text_, "trolley_friction:", "coulomb_positive:", "coulomb_positive: 11").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "crane.trolley_friction.coulomb_positive = 11")) << message;
+  EXPECT_TRUE(contains(message, "[0, 10]")) << message;
+
+  // supervisor.stage_timeout must be in [0.005, 5].
+  message = error_of(edit_line(text_, "supervisor:", "stage_timeout:", "stage_timeout: 0.001").text);
+  EXPECT_TRUE(contains(message, "supervisor.stage_timeout = 0.001")) << message;
+  EXPECT_TRUE(contains(message, "[0.005, 5]")) << message;
+
+  // An integer field given a fraction.
+  message = error_of(edit_line(text_, "crane:", "dac_bits:", "dac_bits: 12.5").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "crane.dac_bits = 12.5 is not an integer")) << message;
+}
+
+TEST_F(LabConfigText, NotANumber) {
+  auto message = error_of(edit_line(text_, "crane:", "load_mass:", "load_mass: two").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "crane.load_mass")) << message;
+  EXPECT_TRUE(contains(message, "'two'")) << message;
+  EXPECT_TRUE(contains(message, "not a number")) << message;
+
+  // A boolean field given a number.
+  message = error_of(edit_line(text_, "supervisor:", "arm_on_start:", "arm_on_start: 3").text);
+  EXPECT_TRUE(contains(message, "supervisor.arm_on_start")) << message;
+  EXPECT_TRUE(contains(message, "not a boolean")) << message;
+}
+
+TEST_F(LabConfigText, UnknownField) {
+  // A typo'd extra field inside a section.
+  auto message = error_of(edit_line(text_, "crane:", "load_mass:", "load_mass: 2.0\n  load_mas: 2.0").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "unknown field")) << message;
+  EXPECT_TRUE(contains(message, "crane.load_mas")) << message;
+
+  // An extra top-level section.
+  message = error_of(text_ + "hoist:\n  speed: 1.0\n");
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "unknown field hoist")) << message;
+}
+
+TEST_F(LabConfigText, InvalidEnumListsAllowedValues) {
+  auto message = error_of(edit_line(text_, "anti_swing:", "controller:", "controller: foo").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "anti_swing.controller")) << message;
+  EXPECT_TRUE(contains(message, "'foo'")) << message;
+  for (const char* allowed : {"none", "pd", "delayed_feedback"}) {
+    EXPECT_TRUE(contains(message, allowed)) << message;
+  }
+
+  message = error_of(
+      edit_line(text_, "friction_compensation:", "velocity_source:", "velocity_source: smoothed").text);
+  EXPECT_TRUE(contains(message, "friction_compensation.trolley.velocity_source")) << message;
+  EXPECT_TRUE(contains(message, "raw")) << message;
+  EXPECT_TRUE(contains(message, "filtered")) << message;
+}
+
+TEST_F(LabConfigText, YamlSyntaxErrorNamesTheLine) {
+  // "key: value: more" is an illegal map value; yaml-cpp reports the line of the edit.
+  const auto edit = edit_line(text_, "crane:", "load_mass:", "load_mass: 2.0: 3");
+  const auto message = error_of(edit.text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "YAML syntax error at line " + std::to_string(edit.line))) << message;
+}
+
+TEST(LabConfig, MissingFileNamesThePath) {
+  const std::string path = std::string(CRANE_SOURCE_DIR) + "/deploy/config/no_such_crane.yaml";
+  try {
+    (void)cfg::load_stack_config(path);
+    ADD_FAILURE() << "no ConfigError for " << path;
+  } catch (const crane::common::ConfigError& error) {
+    EXPECT_TRUE(contains(error.what(), path)) << error.what();
+  }
+}
+
+TEST(LabConfig, EmptyDocumentIsRefused) {
+  const auto message = error_of("");
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+}

@@ -1,0 +1,182 @@
+// Integration tests: the real stage executables as separate processes over Fast DDS.
+// Run them inside a private network namespace (deploy/crane test does); otherwise every participant
+// is bound to loopback by default.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace tp = crane::transport::topics;
+using crane::launch::ProcessGroup;
+using Clock = std::chrono::steady_clock;
+
+const std::string kBin = CRANE_BIN_DIR;
+const std::string kConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml";
+
+fs::path fresh_directory(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("crane_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The main job on one maneuver: every stage its own process, the move sent over DDS, the
+// acceptance figures of the issue read back from summary.json.
+TEST(Stack, TrolleyManeuverThroughEveryProcess) {
+  const fs::path out = fresh_directory("demo");
+  ProcessGroup group;
+  group.start({"crane_demo", kBin + "/crane_demo",
+               {"--config", kConfig, "--out", out.string(), "--maneuver", "trolley", "--friction-compensation",
+                "on", "--domain", "11"},
+               (out / "demo.log").string()});
+  std::optional<crane::launch::ChildExit> exit;
+  const auto deadline = Clock::now() + std::chrono::seconds(240);
+  while (!(exit = group.poll()) && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(exit.has_value()) << "crane_demo did not finish within 240 s; see " << out;
+  ASSERT_TRUE(WIFEXITED(exit->status) && WEXITSTATUS(exit->status) == 0) << exit->describe() << "; see " << out;
+
+  std::ifstream file(out / "summary.json");
+  ASSERT_TRUE(file) << "no summary.json in " << out;
+  const auto summary = nlohmann::json::parse(file);
+  ASSERT_EQ(summary["maneuvers"].size(), 1U);
+  const auto& m = summary["maneuvers"][0];
+  EXPECT_EQ(m["name"], "trolley");
+  EXPECT_EQ(m["friction_compensation"], true);
+  EXPECT_LT(m["final_position_error_m"].get<double>(), 0.005);
+  EXPECT_LT(m["residual_swing_rad"].get<double>(), 0.5 * M_PI / 180.0);
+  EXPECT_FALSE(m["settle_time_s"].is_null()) << "the move never settled";
+  EXPECT_EQ(m["missing_samples"].get<int>(), 0);
+  // The move is 0.75 m with a_max 0.9929 m/s^2 under +-10 V: the drive must have been used, within range.
+  EXPECT_GT(m["max_voltage_V"].get<double>(), 0.5);
+  EXPECT_LE(m["max_voltage_V"].get<double>(), 10.0);
+
+  const auto& loop = summary["loop"];
+  EXPECT_EQ(loop["overruns"].get<int>(), 0) << "lockstep must not overrun";
+  EXPECT_TRUE(loop["diagnostics_complete"].get<bool>());
+  EXPECT_GT(loop["latency_us"]["p50"].get<double>(), 0.0);
+  EXPECT_GE(loop["latency_us"]["max"].get<double>(), loop["latency_us"]["p99"].get<double>());
+  // Seven stage processes plus the operator, each a distinct OS process.
+  std::set<std::string> names;
+  std::set<int> pids;
+  for (const auto& p : loop["processes"]) {
+    names.insert(p["name"].get<std::string>());
+    pids.insert(p["pid"].get<int>());
+  }
+  for (const auto* name : {"plant", "state_estimator", "trajectory_planner", "anti_swing", "tracking",
+                           "friction_compensation", "supervisor", "operator"}) {
+    EXPECT_EQ(names.count(name), 1U) << name << " missing from summary.json";
+  }
+  EXPECT_EQ(pids.size(), loop["processes"].size()) << "two entries share a pid";
+}
+
+// NaN and Inf injected on the bus by a rogue participant are rejected where they enter, counted,
+// and never reach a drive: the voltages the plant applies stay finite and in range.
+TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
+  const fs::path logs = fresh_directory("nonfinite");
+  crane::launch::StackOptions options;
+  options.config_path = kConfig;
+  options.binary_directory = kBin;
+  options.log_directory = logs.string();
+  options.domain_id = 12;
+  options.lockstep = false;  // realtime: the rogue samples interleave with the real ones
+  ProcessGroup group;
+  std::map<int, std::string> stage_of_pid;
+  for (const auto& spec : crane::launch::simulated_stack(options)) stage_of_pid[group.start(spec)] = spec.name;
+
+  crane::transport::ParticipantOptions p;
+  p.name = "rogue";
+  p.domain_id = 12;
+  crane::transport::Participant participant(p);
+  crane::transport::Wakeup wakeup;
+  auto status_reader = participant.make_reader<tp::SafetyStatus>(&wakeup);
+  auto sensors_reader = participant.make_recording_reader<tp::Sensors>(&wakeup, 4096);
+  auto diagnostics_reader = participant.make_recording_reader<tp::LoopDiagnostics>(&wakeup, 256);
+
+  // Wait until the chain is up.
+  tp::msgs::SupervisorStatus_ status;
+  const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
+  while (status.stages_alive() != 0x3FU && Clock::now() < ready_deadline) {
+    ASSERT_FALSE(group.poll().has_value()) << "a stage died during start-up; see " << logs;
+    status_reader->take_latest(status);
+    wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(status.stages_alive(), 0x3FU) << "stack not ready; see " << logs;
+
+  // Rogue writers on the topics each stage reads (not the sensors: a second sensor writer is a
+  // separate supervisor fault).
+  auto actuators = participant.make_writer<tp::Actuators>();
+  auto linear = participant.make_writer<tp::LinearCommand>();
+  auto estimate = participant.make_writer<tp::StateEstimate>();
+  auto goal = participant.make_writer<tp::Goal>();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery of the new writers
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 50; ++i) {
+    tp::msgs::ActuatorCommand_ a;
+    a.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    a.trolley_voltage(i % 2 ? nan : inf);
+    actuators->write(a);
+    tp::msgs::LinearCommand_ l;
+    l.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    l.slew_voltage(nan);
+    linear->write(l);
+    tp::msgs::CraneState_ e;
+    e.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    e.swing_in_plane(nan);
+    estimate->write(e);
+    tp::msgs::MoveRequest_ g;
+    g.request_id(1000 + static_cast<std::uint32_t>(i));
+    g.trolley_target(nan);
+    goal->write(g);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // at least one diagnostics period
+
+  // Every applied voltage the plant reported stayed finite and within the DAC range.
+  tp::msgs::SensorSample_ s;
+  int samples = 0;
+  while (sensors_reader->take_next(s)) {
+    ++samples;
+    ASSERT_TRUE(std::isfinite(s.applied_trolley_voltage()) && std::isfinite(s.applied_slew_voltage()));
+    ASSERT_LE(std::fabs(s.applied_trolley_voltage()), 10.0);
+    ASSERT_LE(std::fabs(s.applied_slew_voltage()), 10.0);
+  }
+  EXPECT_GT(samples, 100);
+
+  std::map<std::string, std::uint64_t> rejected;
+  tp::msgs::LoopDiagnostics_ d;
+  while (diagnostics_reader->take_next(d)) {
+    const auto found = stage_of_pid.find(static_cast<int>(d.pid()));
+    if (found != stage_of_pid.end()) rejected[found->second] = d.nonfinite_rejected();
+  }
+  // Where each rogue stream enters: actuators -> plant (and supervisor), linear -> friction
+  // compensation, estimate -> planner, anti-swing, tracking, friction compensation; goal -> planner.
+  for (const auto* stage : {"plant", "friction_compensation", "trajectory_planner", "anti_swing", "tracking",
+                            "supervisor"}) {
+    EXPECT_GT(rejected[stage], 0U) << stage << " did not count the non-finite samples it received";
+  }
+  // The supervisor saw the NaN and latched the fault: brakes stay engaged until a reset.
+  status_reader->take_latest(status);
+  EXPECT_NE(status.latched_faults() & (1U << 3), 0U);
+  EXPECT_FALSE(status.brakes_released());
+  for (const auto& e : group.stop_all()) {
+    EXPECT_TRUE(WIFEXITED(e.status) && WEXITSTATUS(e.status) == 0) << e.describe();
+  }
+}
+
+}  // namespace

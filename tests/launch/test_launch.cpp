@@ -1,0 +1,318 @@
+// Tests of the launcher library: maneuver figures of merit (hand-built recordings with known
+// answers) and the process group (real fork/exec of /bin/sleep, /bin/true, /bin/bash).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "crane/launch/maneuver_metrics.hpp"
+#include "crane/launch/process_group.hpp"
+
+namespace la = crane::launch;
+using namespace std::chrono_literals;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kTrolleyTarget = 1.0;             // [m]
+constexpr double kSlewTarget = std::numbers::pi / 2.0;  // [rad]
+
+/// `count` cycles every `dt` seconds from t = 0, all exactly at the targets, no swing, no voltage.
+std::vector<la::RecordedCycle> settled_run(std::size_t count, double dt) {
+  std::vector<la::RecordedCycle> cycles(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    cycles[i].time = static_cast<double>(i) * dt;
+    cycles[i].trolley_position = kTrolleyTarget;
+    cycles[i].slew_angle = kSlewTarget;
+  }
+  return cycles;
+}
+
+// ---------------------------------------------------------------------------------------------
+// maneuver_metrics
+
+TEST(ManeuverMetrics, SettledFromTheStart) {
+  const auto cycles = settled_run(501, 0.01);  // 0 .. 5 s
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_EQ(m.settle_time, 0.0);  // no violation at all: settled at the first cycle, t = 0
+  EXPECT_EQ(m.final_position_error, 0.0);
+  EXPECT_EQ(m.final_slew_error, 0.0);
+  EXPECT_EQ(m.max_swing, 0.0);
+  EXPECT_EQ(m.residual_swing, 0.0);
+  EXPECT_EQ(m.max_voltage, 0.0);
+}
+
+TEST(ManeuverMetrics, SettleTimeIsTheSampleAfterTheLastSwingViolation) {
+  // Cycles every 0.1 s over 0 .. 6 s; swing 1 deg (> 0.5 deg tolerance) up to and including
+  // t = 3.2 s (cycle 32), 0.2 deg afterwards. Position and slew on target throughout. The last
+  // violation is cycle 32, so the run settles for good at cycle 33, t = 3.3 s.
+  auto cycles = settled_run(61, 0.1);
+  for (std::size_t i = 0; i < cycles.size(); ++i) {
+    cycles[i].swing_in_plane = (i <= 32 ? 1.0 : 0.2) * kDeg * (i % 2 == 0 ? 1.0 : -1.0);
+  }
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_DOUBLE_EQ(m.settle_time, cycles[33].time);
+  EXPECT_NEAR(m.settle_time, 3.3, 1e-12);
+  EXPECT_NEAR(m.max_swing, 1.0 * kDeg, 1e-15);
+  // Last 2 s is t in [4, 6]: only the 0.2 deg tail.
+  EXPECT_NEAR(m.residual_swing, 0.2 * kDeg, 1e-15);
+
+  // The same with the violation in the out-of-plane swing.
+  for (auto& c : cycles) std::swap(c.swing_in_plane, c.swing_out_of_plane);
+  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).settle_time, cycles[33].time);
+}
+
+TEST(ManeuverMetrics, TransientViolationAfterSettlingMovesTheSettleTime) {
+  // Settled throughout except a single 6 mm position excursion at cycle 40 (t = 4.0 s): "for good"
+  // means the settle time is the next cycle, t = 4.1 s, not the first good cycle.
+  auto cycles = settled_run(61, 0.1);
+  cycles[40].trolley_position = kTrolleyTarget + 0.006;
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_DOUBLE_EQ(m.settle_time, cycles[41].time);
+  EXPECT_EQ(m.final_position_error, 0.0);
+}
+
+TEST(ManeuverMetrics, SlewToleranceCounts) {
+  // Slew 6 mrad (> 5 mrad) off until cycle 10 (t = 1.0 s), then on target: settles at t = 1.1 s.
+  auto cycles = settled_run(31, 0.1);
+  for (std::size_t i = 0; i <= 10; ++i) cycles[i].slew_angle = kSlewTarget - 0.006;
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_DOUBLE_EQ(m.settle_time, cycles[11].time);
+}
+
+TEST(ManeuverMetrics, NeverWithinToleranceIsNaN) {
+  // 6 mm short of the target the whole run (tolerance 5 mm): never settled.
+  auto cycles = settled_run(301, 0.01);
+  for (auto& c : cycles) c.trolley_position = kTrolleyTarget - 0.006;
+  auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_TRUE(std::isnan(m.settle_time));
+  EXPECT_NEAR(m.final_position_error, 0.006, 1e-12);
+
+  // Within tolerance everywhere except the very last cycle: still never settled "for good".
+  cycles = settled_run(301, 0.01);
+  cycles.back().trolley_position = kTrolleyTarget + 0.006;
+  m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_TRUE(std::isnan(m.settle_time));
+}
+
+TEST(ManeuverMetrics, ResidualSwingOnlyOverTheLastTwoSeconds) {
+  // Cycles every 0.25 s (exact in binary) over 0 .. 10 s. The residual window is t >= 8 s.
+  // A 0.1 rad swing at t = 7.75 s lies outside it (counts for max_swing only); inside it the
+  // largest is |-0.03| out of plane at t = 9.5 s.
+  auto cycles = settled_run(41, 0.25);
+  cycles[31].swing_in_plane = 0.1;        // t = 7.75
+  cycles[34].swing_in_plane = 0.02;       // t = 8.5
+  cycles[38].swing_out_of_plane = -0.03;  // t = 9.5
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_DOUBLE_EQ(m.max_swing, 0.1);
+  EXPECT_DOUBLE_EQ(m.residual_swing, 0.03);
+
+  // A shorter window (1 s: t >= 9) drops the 0.02 too but keeps the 0.03.
+  la::SettleCriteria criteria;
+  criteria.residual_window = 1.0;
+  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.03);
+  criteria.residual_window = 0.25;  // t >= 9.75: nothing
+  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.0);
+}
+
+TEST(ManeuverMetrics, MaxVoltageOverBothDrivesAndFinalErrors) {
+  auto cycles = settled_run(11, 0.1);
+  cycles[2].trolley_voltage = 3.0;
+  cycles[3].trolley_voltage = -4.0;
+  cycles[5].slew_voltage = -7.5;  // the largest magnitude, on the slew drive
+  cycles[6].slew_voltage = 6.0;
+  cycles.back().trolley_position = kTrolleyTarget - 0.002;
+  cycles.back().slew_angle = kSlewTarget + 0.003;
+  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  EXPECT_DOUBLE_EQ(m.max_voltage, 7.5);
+  EXPECT_NEAR(m.final_position_error, 0.002, 1e-12);
+  EXPECT_NEAR(m.final_slew_error, 0.003, 1e-12);
+
+  // Trolley drive the largest: |-8| > 7.5.
+  cycles[3].trolley_voltage = -8.0;
+  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).max_voltage, 8.0);
+}
+
+TEST(ManeuverMetrics, EmptyRecordingThrows) {
+  EXPECT_THROW((void)la::evaluate_maneuver({}, kTrolleyTarget, kSlewTarget), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// process_group
+
+class ProcessGroupTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = std::filesystem::temp_directory_path() /
+                 ("crane_test_launch_" + std::to_string(getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(directory_);
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  std::string log(const std::string& name) const { return (directory_ / (name + ".log")).string(); }
+
+  static std::string read_text(const std::string& path) {
+    std::ifstream file(path);
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+  }
+
+  /// Polls until one child exits or `timeout` passes.
+  static std::optional<la::ChildExit> poll_until_exit(la::ProcessGroup& group,
+                                                      std::chrono::milliseconds timeout = 5000ms) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (auto exit = group.poll()) return exit;
+      std::this_thread::sleep_for(5ms);
+    }
+    return std::nullopt;
+  }
+
+  /// Waits until the file at `path` contains `text` or `timeout` passes.
+  static bool wait_for_text(const std::string& path, const std::string& text,
+                            std::chrono::milliseconds timeout = 5000ms) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (read_text(path).find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(5ms);
+    }
+    return false;
+  }
+
+  std::filesystem::path directory_;
+};
+
+TEST_F(ProcessGroupTest, PollReportsExitAndStopAllTerminatesTheRest) {
+  la::ProcessGroup group;
+  const pid_t a = group.start({"sleep_a", "/bin/sleep", {"30"}, ""});
+  const pid_t b = group.start({"sleep_b", "/bin/sleep", {"30"}, ""});
+  const pid_t t = group.start({"true", "/bin/true", {}, ""});
+  EXPECT_GT(a, 0);
+  EXPECT_GT(b, 0);
+  EXPECT_GT(t, 0);
+  ASSERT_EQ(group.children().size(), 3U);
+
+  const auto exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value()) << "/bin/true did not exit within 5 s";
+  EXPECT_EQ(exit->name, "true");
+  EXPECT_EQ(exit->pid, t);
+  ASSERT_TRUE(WIFEXITED(exit->status));
+  EXPECT_EQ(WEXITSTATUS(exit->status), 0);
+  EXPECT_NE(exit->describe().find("exited with code 0"), std::string::npos) << exit->describe();
+  EXPECT_NE(exit->describe().find("true (pid " + std::to_string(t) + ")"), std::string::npos) << exit->describe();
+
+  // The sleeps are still running.
+  EXPECT_FALSE(group.poll().has_value());
+
+  // /bin/sleep dies on SIGTERM at once: well inside a 3 s grace, and no SIGKILL needed.
+  const auto grace = 3000ms;
+  const auto begin = std::chrono::steady_clock::now();
+  const auto exits = group.stop_all(grace);
+  const auto elapsed = std::chrono::steady_clock::now() - begin;
+  EXPECT_LT(elapsed, grace);
+  ASSERT_EQ(exits.size(), 2U);
+  for (const auto& e : exits) {
+    SCOPED_TRACE(e.describe());
+    EXPECT_TRUE(e.pid == a || e.pid == b);
+    ASSERT_TRUE(WIFSIGNALED(e.status));
+    EXPECT_EQ(WTERMSIG(e.status), SIGTERM);
+    EXPECT_NE(e.describe().find("killed by signal 15"), std::string::npos);
+  }
+  for (const auto& child : group.children()) EXPECT_FALSE(child.running) << child.name;
+  // Nothing left to reap and nothing left to stop.
+  EXPECT_FALSE(group.poll().has_value());
+  EXPECT_TRUE(group.stop_all(100ms).empty());
+}
+
+TEST_F(ProcessGroupTest, ChildIgnoringSigtermIsKilledAfterTheGrace) {
+  la::ProcessGroup group;
+  // bash ignores TERM, says so, then becomes `sleep 30` (exec keeps TERM ignored, and leaves no
+  // orphan behind when it is SIGKILLed). Waiting for "ready" makes sure the trap is in place
+  // before stop_all sends SIGTERM.
+  const std::string log_path = log("stubborn");
+  const pid_t pid =
+      group.start({"stubborn", "/bin/bash", {"-c", "trap '' TERM; echo ready; exec /bin/sleep 30"}, log_path});
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for_text(log_path, "ready")) << read_text(log_path);
+
+  const auto grace = 500ms;
+  const auto begin = std::chrono::steady_clock::now();
+  const auto exits = group.stop_all(grace);
+  const auto elapsed = std::chrono::steady_clock::now() - begin;
+  // SIGTERM is ignored, so stop_all waits the whole grace, then SIGKILLs: grace <= elapsed, and
+  // (generous margin for a loaded machine) elapsed < grace + 2 s.
+  EXPECT_GE(elapsed, grace);
+  EXPECT_LT(elapsed, grace + 2000ms);
+  ASSERT_EQ(exits.size(), 1U);
+  EXPECT_EQ(exits[0].pid, pid);
+  ASSERT_TRUE(WIFSIGNALED(exits[0].status)) << exits[0].describe();
+  EXPECT_EQ(WTERMSIG(exits[0].status), SIGKILL);
+  EXPECT_NE(exits[0].describe().find("killed by signal 9"), std::string::npos) << exits[0].describe();
+}
+
+TEST_F(ProcessGroupTest, NonexistentExecutableExitsWith127) {
+  la::ProcessGroup group;
+  const std::string log_path = log("missing");
+  // fork succeeds, so start() returns a pid; the exec fails in the child, which exits 127 (the
+  // shell convention for "command not found").
+  const pid_t pid = group.start({"missing", "/nonexistent/crane_no_such_binary", {"--flag"}, log_path});
+  ASSERT_GT(pid, 0);
+  const auto exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value());
+  EXPECT_EQ(exit->pid, pid);
+  ASSERT_TRUE(WIFEXITED(exit->status)) << exit->describe();
+  EXPECT_EQ(WEXITSTATUS(exit->status), 127);
+  EXPECT_NE(exit->describe().find("exited with code 127"), std::string::npos) << exit->describe();
+  EXPECT_NE(read_text(log_path).find("exec failed"), std::string::npos) << read_text(log_path);
+}
+
+TEST_F(ProcessGroupTest, LogPathCapturesStdoutAndStderrAppending) {
+  la::ProcessGroup group;
+  const std::string log_path = log("echo");
+  group.start({"echo", "/bin/echo", {"hello", "crane"}, log_path});
+  auto exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value());
+  EXPECT_EQ(WEXITSTATUS(exit->status), 0);
+  EXPECT_EQ(read_text(log_path), "hello crane\n");
+
+  // stderr goes to the same file, and a second process appends rather than truncates.
+  group.start({"both", "/bin/bash", {"-c", "echo out; echo err >&2; exit 3"}, log_path});
+  exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value());
+  ASSERT_TRUE(WIFEXITED(exit->status));
+  EXPECT_EQ(WEXITSTATUS(exit->status), 3);
+  EXPECT_NE(exit->describe().find("exited with code 3"), std::string::npos) << exit->describe();
+  EXPECT_EQ(read_text(log_path), "hello crane\nout\nerr\n");
+}
+
+TEST_F(ProcessGroupTest, DestructorStopsRunningChildren) {
+  pid_t pid = 0;
+  {
+    la::ProcessGroup group;
+    pid = group.start({"sleep", "/bin/sleep", {"30"}, ""});
+    ASSERT_GT(pid, 0);
+  }
+  // The destructor reaped it: the pid is no longer our child.
+  int status = 0;
+  EXPECT_EQ(waitpid(pid, &status, WNOHANG), -1);
+  EXPECT_EQ(errno, ECHILD);
+}
+
+}  // namespace

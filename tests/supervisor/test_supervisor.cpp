@@ -1,0 +1,526 @@
+// Tests of the safety supervisor core (supervisor/include/crane/supervisor/supervisor.hpp).
+//
+// Rules under test (header comment of supervisor.hpp):
+//  - brakes released and motion enabled only in ready/operating, and only while every stage is
+//    alive: alive && seconds_since_sample <= stage_timeout;
+//  - a stage going silent after start-up, a limit exceeded or a non-finite value: fault, brakes
+//    engaged, fault latched until a reset with a healthy chain;
+//  - an emergency stop engages the brakes at once and needs a reset.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "crane/common/validation.hpp"
+#include "crane/supervisor/supervisor.hpp"
+
+namespace sv = crane::supervisor;
+
+namespace {
+
+// Randomized property test size (STYLE.md habit 11: the count is a parameter).
+constexpr int kRandomSequences = 400;
+constexpr int kStepsPerSequence = 250;
+constexpr std::uint32_t kRandomSeed = 20031103U;
+
+constexpr std::uint32_t kAllStages = (1U << sv::kStageCount) - 1U;  // 0b111111 = 63
+
+/// Every stage alive, a sample 10 ms old (< 50 ms default timeout), trolley mid-jib, no faults.
+sv::SupervisorInput healthy_input() {
+  sv::SupervisorInput in;
+  for (auto& s : in.stages) {
+    s.alive = true;
+    s.seconds_since_sample = 0.01;
+  }
+  in.sensors_valid = true;
+  in.trolley_position = 0.5;  // inside [0.05, 1.30]
+  return in;
+}
+
+sv::SupervisorOutput step(sv::Supervisor& supervisor, const sv::SupervisorInput& in) {
+  sv::SupervisorOutput out;
+  supervisor.step(in, out);
+  return out;
+}
+
+sv::SupervisorInput with_command(sv::SupervisorInput in, sv::Command command) {
+  in.command = command;
+  return in;
+}
+
+/// A supervisor (default params, arm_on_start) that has reached ready.
+sv::Supervisor ready_supervisor(const sv::SupervisorParams& params = {}) {
+  sv::Supervisor supervisor(params);
+  const auto out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  return supervisor;
+}
+
+void expect_stopped(const sv::SupervisorOutput& out) {
+  EXPECT_FALSE(out.brakes_released);
+  EXPECT_FALSE(out.motion_enabled);
+}
+
+std::string config_error_message(const sv::SupervisorParams& params) {
+  try {
+    sv::validate(params);
+  } catch (const crane::common::ConfigError& error) {
+    return error.what();
+  }
+  return "<no ConfigError thrown>";
+}
+
+}  // namespace
+
+TEST(Supervisor, StartingUntilAllSixStagesAlive) {
+  sv::Supervisor supervisor(sv::SupervisorParams{});  // arm_on_start = true, stage_timeout = 0.05
+  // Nothing observed yet: starting, brakes on, and no fault (a stage silent during start-up only
+  // keeps us waiting).
+  auto out = step(supervisor, sv::SupervisorInput{});
+  EXPECT_EQ(out.mode, sv::Mode::starting);
+  expect_stopped(out);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.latched_faults, 0U);
+  EXPECT_EQ(out.stages_alive, 0U);
+
+  for (std::size_t dead = 0; dead < sv::kStageCount; ++dead) {
+    SCOPED_TRACE(sv::stage_name(static_cast<sv::Stage>(dead)));
+    // Liveliness lost: stage `dead` missing from the mask, five of six is not enough.
+    auto in = healthy_input();
+    in.stages[dead].alive = false;
+    out = step(supervisor, in);
+    EXPECT_EQ(out.mode, sv::Mode::starting);
+    expect_stopped(out);
+    EXPECT_EQ(out.stages_alive, kAllStages & ~(1U << dead));
+    EXPECT_EQ(out.latched_faults, 0U);
+
+    // Liveliness asserted but the last sample is 51 ms old > stage_timeout = 50 ms: not alive.
+    in = healthy_input();
+    in.stages[dead].seconds_since_sample = 0.051;
+    out = step(supervisor, in);
+    EXPECT_EQ(out.mode, sv::Mode::starting);
+    expect_stopped(out);
+    EXPECT_EQ(out.stages_alive, kAllStages & ~(1U << dead));
+  }
+
+  // All six alive, the oldest sample exactly at the timeout (the rule is <=): ready at once.
+  auto in = healthy_input();
+  in.stages[3].seconds_since_sample = 0.05;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.stages_alive, kAllStages);
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.fault_count, 0U);
+}
+
+TEST(Supervisor, WithoutArmOnStartStaysInStandbyUntilArmed) {
+  sv::SupervisorParams params;
+  params.arm_on_start = false;
+  sv::Supervisor supervisor(params);
+  for (int i = 0; i < 10; ++i) {
+    const auto out = step(supervisor, healthy_input());
+    EXPECT_EQ(out.mode, sv::Mode::standby);
+    expect_stopped(out);
+    EXPECT_EQ(out.latched_faults, 0U);
+  }
+  auto out = step(supervisor, with_command(healthy_input(), sv::Command::arm));
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
+  // Armed stays armed without repeating the command.
+  out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  // Disarm: back to standby, brakes on.
+  out = step(supervisor, with_command(healthy_input(), sv::Command::disarm));
+  EXPECT_EQ(out.mode, sv::Mode::standby);
+  expect_stopped(out);
+}
+
+TEST(Supervisor, ArmCommandBeforeChainHealthyDoesNotReleaseBrakes) {
+  sv::SupervisorParams params;
+  params.arm_on_start = false;
+  sv::Supervisor supervisor(params);
+  auto in = with_command(healthy_input(), sv::Command::arm);
+  in.stages[0].alive = false;  // sensors not up yet
+  auto out = step(supervisor, in);
+  EXPECT_EQ(out.mode, sv::Mode::starting);
+  expect_stopped(out);
+}
+
+TEST(Supervisor, SilentStageAfterReadyFaultsAndLatches) {
+  auto supervisor = ready_supervisor();
+
+  // Tracking's last sample is 60 ms old > 50 ms: silent.
+  auto silent = healthy_input();
+  silent.stages[static_cast<std::size_t>(sv::Stage::tracking)].seconds_since_sample = 0.06;
+  auto out = step(supervisor, silent);
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultStageSilent));
+  EXPECT_EQ(out.latched_faults, static_cast<std::uint32_t>(sv::kFaultStageSilent));
+  EXPECT_EQ(supervisor.newly_raised(), static_cast<std::uint32_t>(sv::kFaultStageSilent));
+  EXPECT_EQ(out.fault_count, 1U);
+
+  // Still silent: the same fault is not new and not counted again.
+  out = step(supervisor, silent);
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  EXPECT_EQ(supervisor.newly_raised(), 0U);
+  EXPECT_EQ(out.fault_count, 1U);
+
+  // Reset while the stage is still silent: nothing is cleared.
+  out = step(supervisor, with_command(silent, sv::Command::reset));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+  EXPECT_EQ(out.latched_faults, static_cast<std::uint32_t>(sv::kFaultStageSilent));
+
+  // The stage is back: the fault is no longer active but stays latched until a reset.
+  out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.latched_faults, static_cast<std::uint32_t>(sv::kFaultStageSilent));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+
+  // Reset with a healthy chain: cleared, back to ready (armed on start), brakes released.
+  out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
+  EXPECT_EQ(out.latched_faults, 0U);
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_EQ(out.fault_count, 1U);  // the history is kept
+}
+
+TEST(Supervisor, StageLosingLivelinessAfterReadyFaults) {
+  for (std::size_t dead = 0; dead < sv::kStageCount; ++dead) {
+    SCOPED_TRACE(sv::stage_name(static_cast<sv::Stage>(dead)));
+    auto supervisor = ready_supervisor();
+    auto in = healthy_input();
+    in.stages[dead].alive = false;
+    const auto out = step(supervisor, in);
+    EXPECT_EQ(out.mode, sv::Mode::fault);
+    expect_stopped(out);
+    EXPECT_TRUE(out.latched_faults & sv::kFaultStageSilent);
+  }
+}
+
+TEST(Supervisor, TravelLimitCheckedOnlyOnceSensorsValid) {
+  // Limits [0.05, 1.30] m.
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.sensors_valid = false;
+  in.trolley_position = 2.0;  // stale/default value before the first sensor sample
+  auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+
+  in.trolley_position = 1.30;  // exactly on the bound: allowed
+  in.sensors_valid = true;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, 0U);
+
+  in.trolley_position = 1.31;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyTravel));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+
+  // Below the lower bound as well.
+  auto low = ready_supervisor();
+  in.trolley_position = 0.04;
+  out = step(low, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyTravel));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+}
+
+TEST(Supervisor, VoltageLimitOnEitherDrive) {
+  // |V| <= 10 V allowed on both drives.
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.trolley_voltage = 10.0;
+  in.slew_voltage = -10.0;
+  auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, 0U);
+
+  in.trolley_voltage = 10.5;
+  in.slew_voltage = 0.0;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultVoltage));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+
+  auto slew = ready_supervisor();
+  in.trolley_voltage = 0.0;
+  in.slew_voltage = -10.5;
+  out = step(slew, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultVoltage));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+}
+
+TEST(Supervisor, SwingLimitInEitherPlane) {
+  // max_swing = 0.35 rad.
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.swing_in_plane = 0.35;
+  in.swing_out_of_plane = -0.35;
+  auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, 0U);
+
+  in.swing_in_plane = 0.36;
+  in.swing_out_of_plane = 0.0;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultSwing));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+
+  auto out_of_plane = ready_supervisor();
+  in.swing_in_plane = 0.0;
+  in.swing_out_of_plane = -0.36;
+  out = step(out_of_plane, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultSwing));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+}
+
+// Regression: the swing check once read `valid && |in_plane| > max || |out_of_plane| > max`, which
+// parses as (valid && in_plane) || out_of_plane and checked the out-of-plane swing before any
+// sensor sample, unlike the in-plane swing and the travel limit (SupervisorInput::sensors_valid).
+TEST(Supervisor, SwingLimitCheckedOnlyOnceSensorsValid) {
+  for (const bool out_of_plane : {false, true}) {
+    SCOPED_TRACE(out_of_plane ? "out of plane" : "in plane");
+    auto supervisor = ready_supervisor();
+    auto in = healthy_input();
+    in.sensors_valid = false;
+    (out_of_plane ? in.swing_out_of_plane : in.swing_in_plane) = 0.5;  // > 0.35, but no sample yet
+    const auto out = step(supervisor, in);
+    EXPECT_EQ(out.active_faults, 0U);
+    EXPECT_EQ(out.mode, sv::Mode::ready);
+  }
+}
+
+TEST(Supervisor, MultipleSensorWriters) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.sensor_writers = 2;  // e.g. a plant and a hardware bridge both running
+  const auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultMultipleSensorWriters));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+}
+
+TEST(Supervisor, NonFiniteSampleFlag) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.nonfinite_seen = true;
+  const auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultNonFinite));
+  EXPECT_EQ(out.latched_faults, static_cast<std::uint32_t>(sv::kFaultNonFinite));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+}
+
+TEST(Supervisor, SeveralFaultsInOneStepAreCountedEach) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.trolley_position = 1.5;  // travel
+  in.slew_voltage = 12.0;     // voltage
+  in.nonfinite_seen = true;   // non-finite
+  const auto out = step(supervisor, in);
+  const std::uint32_t expected = sv::kFaultTrolleyTravel | sv::kFaultVoltage | sv::kFaultNonFinite;
+  EXPECT_EQ(out.active_faults, expected);
+  EXPECT_EQ(supervisor.newly_raised(), expected);
+  EXPECT_EQ(out.fault_count, 3U);  // popcount of three new bits
+}
+
+TEST(Supervisor, EmergencyStopCommandBrakesAtOnceAndNeedsReset) {
+  auto supervisor = ready_supervisor();
+  auto moving = healthy_input();
+  moving.move_in_progress = true;
+  ASSERT_EQ(step(supervisor, moving).mode, sv::Mode::operating);
+
+  // The very step that carries the command already has the brakes on.
+  auto out = step(supervisor, with_command(moving, sv::Command::emergency_stop));
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+  EXPECT_TRUE(out.latched_faults & sv::kFaultEmergencyStop);
+  EXPECT_EQ(supervisor.newly_raised(), static_cast<std::uint32_t>(sv::kFaultEmergencyStop));
+
+  // The command is gone but the stop holds.
+  out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+  // Arming does not override it.
+  out = step(supervisor, with_command(healthy_input(), sv::Command::arm));
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+
+  out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
+}
+
+TEST(Supervisor, EmergencyStopInputHeldBlocksReset) {
+  auto supervisor = ready_supervisor();
+  auto pressed = healthy_input();
+  pressed.emergency_stop_input = true;
+  auto out = step(supervisor, pressed);
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultEmergencyStop));
+
+  // Reset while the button is still pressed: refused.
+  out = step(supervisor, with_command(pressed, sv::Command::reset));
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+
+  // Released: still stopped until a reset.
+  out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.mode, sv::Mode::emergency_stop);
+  expect_stopped(out);
+
+  out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_EQ(out.latched_faults, 0U);
+  EXPECT_EQ(out.fault_count, 1U);
+}
+
+TEST(Supervisor, EmergencyStopTakesPrecedenceOverOtherFaults) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.trolley_voltage = 20.0;
+  ASSERT_EQ(step(supervisor, in).mode, sv::Mode::fault);
+  in.emergency_stop_input = true;
+  EXPECT_EQ(step(supervisor, in).mode, sv::Mode::emergency_stop);
+}
+
+TEST(Supervisor, MoveInProgressIsOperating) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.move_in_progress = true;
+  auto out = step(supervisor, in);
+  EXPECT_EQ(out.mode, sv::Mode::operating);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_TRUE(out.motion_enabled);
+  in.move_in_progress = false;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
+}
+
+TEST(Supervisor, ModeAndStageNames) {
+  EXPECT_STREQ(sv::mode_name(sv::Mode::emergency_stop), "emergency_stop");
+  EXPECT_STREQ(sv::mode_name(sv::Mode::operating), "operating");
+  EXPECT_STREQ(sv::stage_name(sv::Stage::friction_compensation), "friction_compensation");
+  EXPECT_STREQ(sv::stage_name(sv::Stage::sensors), "sensors");
+}
+
+TEST(Supervisor, DefaultParamsAreValid) {
+  EXPECT_NO_THROW(sv::validate(sv::SupervisorParams{}));
+}
+
+TEST(Supervisor, InvalidParamsNameFieldAndValue) {
+  struct Case {
+    const char* expected;  // field = value, as format_value (%.10g) prints it
+    void (*edit)(sv::SupervisorParams&);
+  };
+  const Case cases[] = {
+      {"supervisor.stage_timeout = 0.001", [](sv::SupervisorParams& p) { p.stage_timeout = 0.001; }},   // < 0.005
+      {"supervisor.stage_timeout = 10", [](sv::SupervisorParams& p) { p.stage_timeout = 10.0; }},       // > 5
+      {"supervisor.stage_timeout = nan",
+       [](sv::SupervisorParams& p) { p.stage_timeout = std::numeric_limits<double>::quiet_NaN(); }},
+      {"supervisor.trolley_min = 200", [](sv::SupervisorParams& p) { p.trolley_min = 200.0; }},         // > 100
+      {"supervisor.trolley_max = 0.05", [](sv::SupervisorParams& p) { p.trolley_max = 0.05; }},         // <= min
+      {"supervisor.voltage_limit = 0", [](sv::SupervisorParams& p) { p.voltage_limit = 0.0; }},         // < 0.1
+      {"supervisor.max_swing = 2", [](sv::SupervisorParams& p) { p.max_swing = 2.0; }},                 // > 1.5
+      {"supervisor.max_swing = -0.2", [](sv::SupervisorParams& p) { p.max_swing = -0.2; }},             // < 0.01
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.expected);
+    sv::SupervisorParams params;
+    c.edit(params);
+    const std::string message = config_error_message(params);
+    EXPECT_NE(message.find(c.expected), std::string::npos) << message;
+    EXPECT_NE(message.find("out of range"), std::string::npos) << message;
+    // The constructor validates as well.
+    EXPECT_THROW(sv::Supervisor{params}, crane::common::ConfigError);
+  }
+  // The bound is named too: stage_timeout must be in [0.005, 5].
+  sv::SupervisorParams params;
+  params.stage_timeout = 0.001;
+  EXPECT_NE(config_error_message(params).find("[0.005, 5]"), std::string::npos) << config_error_message(params);
+}
+
+// Seeded randomized property: brakes are never released unless, in that very step, all six stages
+// were alive (recomputed here from the input: alive && seconds_since_sample <= stage_timeout) and
+// nothing is latched. Also: motion_enabled == brakes_released, fault_count grows by exactly the
+// popcount of newly_raised(), and an emergency stop in the input always means brakes on.
+TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
+  std::mt19937 rng(kRandomSeed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto chance = [&](double p) { return unit(rng) < p; };
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+
+  long released_steps = 0;
+  long fault_steps = 0;
+  for (int sequence = 0; sequence < kRandomSequences; ++sequence) {
+    sv::SupervisorParams params;
+    params.arm_on_start = chance(0.5);
+    params.stage_timeout = uniform(0.01, 0.1);
+    sv::Supervisor supervisor(params);
+    // Per-sequence disturbance rate: some sequences are mostly healthy, some chaotic.
+    const double disturbance = uniform(0.0, 0.3);
+    std::uint32_t previous_count = 0;
+    for (int k = 0; k < kStepsPerSequence; ++k) {
+      auto in = healthy_input();
+      for (auto& s : in.stages) {
+        s.seconds_since_sample = uniform(0.0, params.stage_timeout);
+        if (chance(disturbance * 0.2)) s.alive = false;
+        if (chance(disturbance * 0.2)) s.seconds_since_sample = uniform(0.0, 2.0 * params.stage_timeout);
+      }
+      if (chance(disturbance * 0.1)) in.stages[0].seconds_since_sample = params.stage_timeout;  // boundary
+      if (chance(disturbance * 0.1)) in.sensors_valid = false;
+      if (chance(disturbance * 0.1)) in.trolley_position = uniform(-0.2, 1.6);
+      if (chance(disturbance * 0.1)) in.swing_in_plane = uniform(-0.5, 0.5);
+      if (chance(disturbance * 0.1)) in.swing_out_of_plane = uniform(-0.5, 0.5);
+      if (chance(disturbance * 0.1)) in.trolley_voltage = uniform(-12.0, 12.0);
+      if (chance(disturbance * 0.1)) in.slew_voltage = uniform(-12.0, 12.0);
+      if (chance(disturbance * 0.02)) in.emergency_stop_input = true;
+      if (chance(disturbance * 0.05)) in.sensor_writers = 2;
+      if (chance(disturbance * 0.05)) in.nonfinite_seen = true;
+      in.move_in_progress = chance(0.3);
+      const double c = unit(rng);
+      in.command = c < 0.15   ? sv::Command::reset
+                   : c < 0.25 ? sv::Command::arm
+                   : c < 0.27 ? sv::Command::disarm
+                   : c < 0.28 ? sv::Command::emergency_stop
+                              : sv::Command::none;
+
+      bool all_alive = true;
+      for (const auto& s : in.stages) all_alive = all_alive && s.alive && s.seconds_since_sample <= params.stage_timeout;
+
+      sv::SupervisorOutput out;
+      supervisor.step(in, out);
+
+      if (out.brakes_released) {
+        ++released_steps;
+        ASSERT_TRUE(all_alive) << "sequence " << sequence << " step " << k;
+        ASSERT_EQ(out.latched_faults, 0U) << "sequence " << sequence << " step " << k;
+      } else {
+        ++fault_steps;
+      }
+      ASSERT_EQ(out.motion_enabled, out.brakes_released) << "sequence " << sequence << " step " << k;
+      ASSERT_EQ(out.fault_count, previous_count + static_cast<std::uint32_t>(std::popcount(supervisor.newly_raised())))
+          << "sequence " << sequence << " step " << k;
+      if (in.emergency_stop_input || in.command == sv::Command::emergency_stop) {
+        ASSERT_FALSE(out.brakes_released) << "sequence " << sequence << " step " << k;
+        ASSERT_EQ(out.mode, sv::Mode::emergency_stop) << "sequence " << sequence << " step " << k;
+      }
+      previous_count = out.fault_count;
+    }
+  }
+  // The property must not hold vacuously: both outcomes occur many times.
+  EXPECT_GT(released_steps, kRandomSequences * kStepsPerSequence / 10);
+  EXPECT_GT(fault_steps, kRandomSequences * kStepsPerSequence / 10);
+}
