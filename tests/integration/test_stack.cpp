@@ -117,12 +117,16 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
   }
   ASSERT_EQ(status.stages_alive(), 0x3FU) << "stack not ready; see " << logs;
 
-  // Rogue writers on the topics each stage reads (not the sensors: a second sensor writer is a
-  // separate supervisor fault).
+  // Rogue writers on every topic a stage reads. (A second sensor writer is also a supervisor fault
+  // of its own.)
   auto actuators = participant.make_writer<tp::Actuators>();
   auto linear = participant.make_writer<tp::LinearCommand>();
   auto estimate = participant.make_writer<tp::StateEstimate>();
   auto goal = participant.make_writer<tp::Goal>();
+  auto sensors = participant.make_writer<tp::Sensors>();
+  auto reference = participant.make_writer<tp::Reference>();
+  auto anti_swing = participant.make_writer<tp::AntiSwing>();
+  auto safety = participant.make_writer<tp::SafetyStatus>();
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // discovery of the new writers
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -143,6 +147,23 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
     g.request_id(1000 + static_cast<std::uint32_t>(i));
     g.trolley_target(nan);
     goal->write(g);
+    tp::msgs::SensorSample_ bad_sensor;
+    bad_sensor.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    bad_sensor.trolley_position(i % 2 ? nan : -inf);
+    sensors->write(bad_sensor);
+    tp::msgs::Reference_ r;
+    r.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    r.trolley_velocity(nan);
+    reference->write(r);
+    tp::msgs::AntiSwingCommand_ as;
+    as.header().seq(status.header().seq() + static_cast<std::uint64_t>(i));
+    as.trolley_action(inf);
+    anti_swing->write(as);
+    tp::msgs::SupervisorStatus_ st;
+    st.brakes_released(true);
+    st.motion_enabled(true);
+    st.trolley_voltage_limit(nan);
+    safety->write(st);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // at least one diagnostics period
@@ -164,10 +185,12 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
     const auto found = stage_of_pid.find(static_cast<int>(d.pid()));
     if (found != stage_of_pid.end()) rejected[found->second] = d.nonfinite_rejected();
   }
-  // Where each rogue stream enters: actuators -> plant (and supervisor), linear -> friction
-  // compensation, estimate -> planner, anti-swing, tracking, friction compensation; goal -> planner.
-  for (const auto* stage : {"plant", "friction_compensation", "trajectory_planner", "anti_swing", "tracking",
-                            "supervisor"}) {
+  // Where each rogue stream enters: sensors -> estimator (and supervisor); actuators, safety status
+  // -> plant; linear -> friction compensation; estimate -> planner, anti-swing, tracking, friction
+  // compensation; goal -> planner; reference, anti-swing action -> tracking; all but the goal and
+  // the status -> supervisor.
+  for (const auto* stage : {"state_estimator", "plant", "friction_compensation", "trajectory_planner", "anti_swing",
+                            "tracking", "supervisor"}) {
     EXPECT_GT(rejected[stage], 0U) << stage << " did not count the non-finite samples it received";
   }
   // The supervisor saw the NaN and latched the fault: brakes stay engaged until a reset.
@@ -177,6 +200,12 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
   for (const auto& e : group.stop_all()) {
     EXPECT_TRUE(WIFEXITED(e.status) && WEXITSTATUS(e.status) == 0) << e.describe();
   }
+  // Readers first: Fast DDS 2.9 delivers samples between a writer and a reader of the same process
+  // by reference into the writer's payload pool, so a reader that outlives such a writer crashes
+  // when it frees its cache (seen here on the safety-status reader).
+  status_reader.reset();
+  sensors_reader.reset();
+  diagnostics_reader.reset();
 }
 
 }  // namespace

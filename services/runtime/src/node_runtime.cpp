@@ -32,8 +32,9 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
   app.add_option("--config", options.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--dds", options.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
-  app.add_flag("--lan{false},--loopback-only{true}", options.loopback_only,
-               "bind DDS to loopback only (default) or to every interface (--lan)");
+  app.add_flag_callback(
+      "--lan", [&options] { options.loopback_only = false; },
+      "let DDS use every interface (default: loopback 127.0.0.1 only, unicast discovery)");
   app.add_option("--log-level", options.log_level, "trace | debug | info | warn | error");
 }
 
