@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
     tp::msgs::SupervisorStatus_ incoming_status;
     Clock::time_point status_received{};
     bool have_status = false;
+    bool have_command = false;
+    std::uint64_t last_command_seq = 0;
     bool started = false;      // the chain has answered once
     bool chain_ready = false;  // and the supervisor has seen every stage alive: overruns count from here
     std::uint64_t seq = 0;
@@ -170,21 +172,32 @@ int main(int argc, char** argv) {
       const bool count_overrun = !got && started && chain_ready;
       if (got) started = true;
 
-      plant::DriveInput input;  // default: 0 V, brakes engaged
+      // A late command is replaced by the last valid one while that is younger than
+      // plant.command_timeout (the drive amplifier holds its input); after that: 0 V and brakes.
       if (got) {
+        last_command_seq = seq;
+        have_command = true;
         latency.record(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
-        if (latency_log.size() < latency_log.capacity()) latency_log.push_back(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
-        const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
-        if (status_fresh && status.brakes_released() && status.motion_enabled()) {
-          input.trolley_voltage = command.trolley_voltage();
-          input.slew_voltage = command.slew_voltage();
-          input.hoist_speed = command.hoist_speed();
-          input.brakes_engaged = false;
+        if (latency_log.size() < latency_log.capacity()) {
+          latency_log.push_back(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
         }
-      } else if (count_overrun) {
+      }
+      const bool command_valid =
+          have_command && static_cast<double>(seq - last_command_seq) * cfg.plant.sample_period <=
+                              cfg.plant.command_timeout + 1e-9;
+      const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
+      plant::DriveInput input;  // default: 0 V, brakes engaged
+      if (command_valid && status_fresh && status.brakes_released() && status.motion_enabled()) {
+        input.trolley_voltage = command.trolley_voltage();
+        input.slew_voltage = command.slew_voltage();
+        input.hoist_speed = command.hoist_speed();
+        input.brakes_engaged = false;
+      }
+      if (count_overrun) {
         ++counters.overruns;
-        spdlog::warn("overrun: no command for cycle {} within {} ms; 0 V and brakes for this cycle", seq,
-                     realtime ? cfg.plant.sample_period * 1e3 : cfg.plant.lockstep_timeout * 1e3);
+        spdlog::warn("overrun: no command for cycle {} within {} ms; {}", seq,
+                     realtime ? cfg.plant.sample_period * 1e3 : cfg.plant.lockstep_timeout * 1e3,
+                     command_valid ? "the last command is held" : "0 V and brakes for this cycle");
       }
       const auto step_status = simulator.step(input);
       if (step_status != common::StepStatus::ok) {

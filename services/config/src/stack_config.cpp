@@ -61,6 +61,7 @@ PlantConfig read_plant(YamlSection s) {
   p.min_cable_length = s.number("min_cable_length", 0.05, 200.0);
   p.max_cable_length = s.number("max_cable_length", p.min_cable_length, 200.0);
   p.lockstep_timeout = s.number("lockstep_timeout", 0.01, 60.0);
+  p.command_timeout = s.number("command_timeout", 0.0, 1.0);
   p.safety_status_timeout = s.number("safety_status_timeout", 0.01, 10.0);
   s.finish();
   return p;

@@ -99,7 +99,8 @@ void stamp_header(msgs::CycleHeader_& header, std::uint64_t seq,
   header.origin(origin);
 }
 
-LatencyStatistics::LatencyStatistics(std::size_t capacity) : window_(std::max<std::size_t>(capacity, 1)) {}
+LatencyStatistics::LatencyStatistics(std::size_t capacity)
+    : window_(std::max<std::size_t>(capacity, 1)), scratch_(window_.size()) {}
 
 void LatencyStatistics::record(double microseconds) noexcept {
   window_[next_] = microseconds;
@@ -108,16 +109,14 @@ void LatencyStatistics::record(double microseconds) noexcept {
   maximum_ = std::max(maximum_, microseconds);
 }
 
-double LatencyStatistics::percentile(double p) const {
+double LatencyStatistics::percentile(double p) const noexcept {
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(count_, window_.size()));
   if (n == 0) return 0.0;
-  std::vector<double> sorted(window_.begin(), window_.begin() + static_cast<std::ptrdiff_t>(n));
-  std::sort(sorted.begin(), sorted.end());
+  std::copy_n(window_.begin(), n, scratch_.begin());
   const double rank = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(n - 1);
-  const auto lower = static_cast<std::size_t>(std::floor(rank));
-  const auto upper = std::min(lower + 1, n - 1);
-  const double fraction = rank - static_cast<double>(lower);
-  return sorted[lower] + fraction * (sorted[upper] - sorted[lower]);
+  const auto nth = scratch_.begin() + static_cast<std::ptrdiff_t>(std::lround(rank));
+  std::nth_element(scratch_.begin(), nth, scratch_.begin() + static_cast<std::ptrdiff_t>(n));
+  return *nth;
 }
 
 DiagnosticsPublisher::DiagnosticsPublisher(transport::Participant& participant, ProcessId process)
