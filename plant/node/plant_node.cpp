@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "crane/config/stack_config.hpp"
+#include "crane/config/simulator_parameters.hpp"
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
@@ -66,19 +66,11 @@ int main(int argc, char** argv) {
   try {
     runtime::configure_logging(options.log_level, "plant");
     const config::StackConfig cfg = config::load_stack_config(options.config_path);
-    plant::SimulatorParameters sim_params;
-    sim_params.crane = cfg.crane;
-    sim_params.sample_period = cfg.plant.sample_period;
-    sim_params.relative_tolerance = cfg.plant.relative_tolerance;
-    sim_params.absolute_tolerance = cfg.plant.absolute_tolerance;
-    sim_params.brake_holding_factor = cfg.plant.brake_holding_factor;
-    sim_params.hoist_max_acceleration = cfg.plant.hoist_max_acceleration;
-    sim_params.min_cable_length = cfg.plant.min_cable_length;
-    sim_params.max_cable_length = cfg.plant.max_cable_length;
-    sim_params.initial_state.trolley_position = initial_trolley;
-    sim_params.initial_state.slew_angle = initial_slew;
-    sim_params.initial_state.swing_in_plane = initial_swing;
-    sim_params.initial_state.cable_length = cfg.crane.cable_length;
+    plant::PlantState initial;
+    initial.trolley_position = initial_trolley;
+    initial.slew_angle = initial_slew;
+    initial.swing_in_plane = initial_swing;
+    const auto sim_params = config::simulator_parameters(cfg, initial);
     plant::CraneSimulator simulator(sim_params);
 
     auto participant = runtime::make_participant(options, "plant");

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "crane/anti_swing/anti_swing.hpp"
+#include "crane/config/simulator_parameters.hpp"
 #include "crane/config/stack_config.hpp"
 #include "crane/friction_compensation/friction_compensation.hpp"
 #include "crane/launch/maneuver_metrics.hpp"
@@ -118,23 +119,13 @@ inline TailStatistics tail_statistics(const Trace& trace, double window) {
   return s;
 }
 
-/// Plant parameters exactly as plant_node.cpp builds them, starting at the maneuver's position.
+/// Plant parameters as the plant process builds them, starting at the maneuver's position.
 inline plant::SimulatorParameters simulator_parameters(const config::StackConfig& cfg,
                                                        const config::ManeuverConfig& maneuver) {
-  plant::SimulatorParameters p;
-  p.crane = cfg.crane;
-  p.sample_period = cfg.plant.sample_period;
-  p.relative_tolerance = cfg.plant.relative_tolerance;
-  p.absolute_tolerance = cfg.plant.absolute_tolerance;
-  p.brake_holding_factor = cfg.plant.brake_holding_factor;
-  p.hoist_max_acceleration = cfg.plant.hoist_max_acceleration;
-  p.min_cable_length = cfg.plant.min_cable_length;
-  p.max_cable_length = cfg.plant.max_cable_length;
-  p.initial_state.trolley_position = maneuver.initial_trolley_position;
-  p.initial_state.slew_angle = maneuver.initial_slew_angle;
-  p.initial_state.swing_in_plane = 0.0;
-  p.initial_state.cable_length = cfg.crane.cable_length;
-  return p;
+  plant::PlantState initial;
+  initial.trolley_position = maneuver.initial_trolley_position;
+  initial.slew_angle = maneuver.initial_slew_angle;
+  return config::simulator_parameters(cfg, initial);
 }
 
 /// Runs `maneuver` through the whole stack configured by `cfg`; `friction_compensation` = false is

@@ -21,11 +21,7 @@ int main(int argc, char** argv) {
                                                                                                                  : 2);
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
-          while (states->take_next(state)) {
-            if (!runtime::all_finite(state)) {
-              ++ctx.counters.nonfinite_rejected;
-              continue;
-            }
+          while (runtime::take_finite(*states, state, ctx.counters)) {
             if (watch->advance(state.header().seq(), ctx.counters)) {
               // not_ready (delay line still filling) gives a zero action: that is the safe value.
               if (controller->step(runtime::to_estimate(state), *action) == common::StepStatus::rejected_nonfinite) {

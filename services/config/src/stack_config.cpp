@@ -126,20 +126,14 @@ anti_swing::AntiSwingParams read_anti_swing(YamlSection s, double sample_period,
 
 tracking::TrackingParams read_tracking(YamlSection s, const common::CraneParameters& crane, double voltage_limit,
                                        const PlantConfig& plant) {
-  tracking::TrackingParams p;
+  // The controller's model is the configured crane (section 3.3: (3.37)-(3.38) need K_m, m_t,
+  // m_r, M_r and g).
+  tracking::TrackingParams p = tracking::tracking_params_from(crane);
   p.proportional_gain = s.number("proportional_gain", 0.0, 1.0e4);
   p.derivative_gain = s.number("derivative_gain", 0.0, 1.0e3);
   p.min_radius = s.number("min_radius", 1e-3, 100.0);
   p.slew_enabled = s.flag("slew_enabled");
   s.finish();
-  // The controller's model is the configured crane (section 3.3: (3.37)-(3.38) need K_m, m_t,
-  // m_r, M_r and g).
-  p.trolley_drive_gain = crane.trolley_drive_gain;
-  p.slew_drive_gain = crane.slew_drive_gain;
-  p.mass_ratio = crane.mass_ratio();
-  p.load_inertia_ratio = crane.load_inertia_ratio();
-  p.trolley_inertia_ratio = crane.trolley_inertia_ratio();
-  p.gravity = crane.gravity;
   p.min_cable_length = plant.min_cable_length;
   p.voltage_limit = voltage_limit;
   return p;

@@ -31,19 +31,11 @@ int main(int argc, char** argv) {
         auto pending = std::make_shared<std::optional<tp::msgs::LinearCommand_>>();
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
-          while (states->take_next(state)) {
-            if (!runtime::all_finite(state)) {
-              ++ctx.counters.nonfinite_rejected;
-              continue;
-            }
+          while (runtime::take_finite(*states, state, ctx.counters)) {
             (*recent)[state.header().seq() % recent->size()] = state;
           }
           tp::msgs::LinearCommand_ command;
-          while (commands->take_next(command)) {
-            if (!runtime::all_finite(command)) {
-              ++ctx.counters.nonfinite_rejected;
-              continue;
-            }
+          while (runtime::take_finite(*commands, command, ctx.counters)) {
             *pending = command;
           }
           if (!pending->has_value()) return;

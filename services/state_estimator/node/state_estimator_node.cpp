@@ -18,11 +18,7 @@ int main(int argc, char** argv) {
         auto estimate = std::make_shared<common::CraneStateEstimate>();
         return [=, &ctx] {
           tp::msgs::SensorSample_ sample;
-          while (sensors->take_next(sample)) {
-            if (!runtime::all_finite(sample)) {
-              ++ctx.counters.nonfinite_rejected;
-              continue;
-            }
+          while (runtime::take_finite(*sensors, sample, ctx.counters)) {
             // A repeated cycle (the plant re-offering cycle 0 at start-up) is answered again
             // without feeding the filters twice.
             if (watch->advance(sample.header().seq(), ctx.counters)) {

@@ -25,11 +25,7 @@ int main(int argc, char** argv) {
         return [=, &ctx] {
           auto take = [&](auto& reader, auto& latest, bool& flag) {
             typename std::remove_reference_t<decltype(latest)> sample;
-            while (reader.take_next(sample)) {
-              if (!runtime::all_finite(sample)) {
-                ++ctx.counters.nonfinite_rejected;
-                continue;
-              }
+            while (runtime::take_finite(reader, sample, ctx.counters)) {
               latest = sample;
               flag = true;
             }

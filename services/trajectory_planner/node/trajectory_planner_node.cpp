@@ -56,11 +56,7 @@ int main(int argc, char** argv) {
         const double dt = ctx.config.plant.sample_period;
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
-          while (states->take_next(state)) {
-            if (!runtime::all_finite(state)) {
-              ++ctx.counters.nonfinite_rejected;
-              continue;
-            }
+          while (runtime::take_finite(*states, state, ctx.counters)) {
             const auto current = runtime::to_estimate(state);
             if (!*holding) {
               *holding = planner->hold(current) == trajectory_planner::GoalStatus::accepted;

@@ -36,6 +36,17 @@ class SequenceWatch {
   std::uint64_t last_{0};
 };
 
+/// The NaN/Inf gate at a topic's entry: takes the next sample whose every floating-point field is
+/// finite into `message` (true), counting and dropping the others; false when none is waiting.
+template <class ReaderT, class Message>
+bool take_finite(ReaderT& reader, Message& message, LoopCounters& counters) noexcept {
+  while (reader.take_next(message)) {
+    if (all_finite(message)) return true;
+    ++counters.nonfinite_rejected;
+  }
+  return false;
+}
+
 /// Records (now - origin) of a header in microseconds.
 void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header) noexcept;
 
