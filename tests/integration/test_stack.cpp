@@ -61,6 +61,7 @@ TEST(Stack, TrolleyManeuverThroughEveryProcess) {
   EXPECT_LT(m["residual_swing_rad"].get<double>(), 0.5 * M_PI / 180.0);
   EXPECT_FALSE(m["settle_time_s"].is_null()) << "the move never settled";
   EXPECT_EQ(m["missing_samples"].get<int>(), 0);
+  EXPECT_EQ(m["braked_cycles"].get<int>(), 0) << "the brakes were on during the move";
   // The move is 0.75 m with a_max 0.9929 m/s^2 under +-10 V: the drive must have been used, within range.
   EXPECT_GT(m["max_voltage_V"].get<double>(), 0.5);
   EXPECT_LE(m["max_voltage_V"].get<double>(), 10.0);

@@ -53,11 +53,12 @@ struct ProcessRecord {
 
 struct RunResult {
   std::string maneuver;
-  bool friction_compensation;
+  bool friction_compensation{true};
   launch::ManeuverMetrics metrics;
-  double swing_period;
-  std::size_t samples;
-  std::size_t missing;
+  double swing_period{0.0};      // [s] T = 2 pi sqrt(L/g)
+  std::size_t samples{0};        // cycles recorded and evaluated
+  std::size_t missing{0};        // cycles of the move missing from the recording
+  std::size_t braked_cycles{0};  // cycles of the move during which the plant had its brakes on
   std::string csv;
   std::uint64_t cycles{0};
   std::uint64_t overruns{0};
@@ -203,8 +204,11 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     check_children(group);
     const auto status = op.latest_status();
     op.record(rec);
-    const bool recording = !rec.sensors.empty() && rec.sensors.rbegin()->second.writer_pid() == static_cast<std::uint32_t>(plant_pid) &&
-                           !rec.references.empty() && !rec.linear.empty() && !rec.actuators.empty();
+    // The plant itself reports brakes released: the supervisor's "ready" has reached it.
+    const bool recording = !rec.sensors.empty() &&
+                           rec.sensors.rbegin()->second.writer_pid() == static_cast<std::uint32_t>(plant_pid) &&
+                           !rec.sensors.rbegin()->second.brakes_engaged() && !rec.references.empty() &&
+                           !rec.linear.empty() && !rec.actuators.empty();
     if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0 && recording) break;
     if (Clock::now() > ready_deadline) {
       throw RunFailure(run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
@@ -335,6 +339,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
         << (a != rec.actuators.end() ? a->second.trolley_voltage() : nan) << ','
         << (a != rec.actuators.end() ? a->second.slew_voltage() : nan) << ','
         << (next->second.brakes_engaged() ? 1 : 0) << '\n';
+    if (next->second.brakes_engaged()) ++result.braked_cycles;
   }
   if (result.missing > 0) {
     spdlog::warn("{}: {} of {} cycles missing from the recording (move started at cycle {}, {} sensor samples from "
@@ -445,6 +450,7 @@ int main(int argc, char** argv) {
       j["max_voltage_V"] = r.metrics.max_voltage;
       j["samples"] = r.samples;
       j["missing_samples"] = r.missing;
+      j["braked_cycles"] = r.braked_cycles;
       j["csv"] = r.csv;
       j["plant_cycles"] = r.cycles;
       j["overruns"] = r.overruns;
