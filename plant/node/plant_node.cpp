@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
     Clock::time_point status_received{};
     bool have_status = false;
     bool have_command = false;
+    auto next_brake_report = Clock::now() + std::chrono::seconds(2);
     std::uint64_t last_command_seq = 0;
     bool started = false;      // the chain has answered once
     bool chain_ready = false;  // and the supervisor has seen every stage alive: overruns count from here
@@ -184,6 +185,17 @@ int main(int argc, char** argv) {
         input.slew_voltage = command.slew_voltage();
         input.hoist_speed = command.hoist_speed();
         input.brakes_engaged = false;
+      }
+      if (input.brakes_engaged && Clock::now() >= next_brake_report) {
+        // Off the hot path: at most once every 2 s while the brakes stay on.
+        next_brake_report = Clock::now() + std::chrono::seconds(2);
+        const auto health = safety->health();
+        spdlog::info("brakes on at cycle {}: supervisor status {} (matched writers {}, alive {}, samples {}), "
+                     "motion {}, command {}",
+                     seq, have_status ? (status_fresh ? "fresh" : "stale") : "never received", health.matched_writers,
+                     health.alive_writers, health.samples,
+                     have_status && status.motion_enabled() ? "enabled" : "disabled",
+                     command_valid ? "valid" : "missing");
       }
       if (count_overrun) {
         ++counters.overruns;

@@ -211,9 +211,16 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
                            !rec.linear.empty() && !rec.actuators.empty();
     if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0 && recording) break;
     if (Clock::now() > ready_deadline) {
-      throw RunFailure(run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
-                       " s (stages_alive=" + (status ? std::to_string(status->stages_alive()) : "none") +
-                       ", see " + log_dir.string() + ")");
+      throw RunFailure(
+          run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
+          " s (stages alive " + (status ? std::to_string(status->stages_alive()) : "none") + " of 63, supervisor mode " +
+          (status ? std::to_string(status->mode()) : "none") + ", planner matched to our goal writer " +
+          std::to_string(op.goal_matches()) + ", recorded sensors " + std::to_string(rec.sensors.size()) +
+          (rec.sensors.empty() ? std::string()
+                               : std::string(" (last from pid ") + std::to_string(rec.sensors.rbegin()->second.writer_pid()) +
+                                     ", brakes " + (rec.sensors.rbegin()->second.brakes_engaged() ? "on" : "off") + ")") +
+          ", references " + std::to_string(rec.references.size()) + ", linear " + std::to_string(rec.linear.size()) +
+          ", actuators " + std::to_string(rec.actuators.size()) + "; see " + log_dir.string() + ")");
     }
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }

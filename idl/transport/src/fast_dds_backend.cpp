@@ -58,6 +58,7 @@ dds::DataWriterQos writer_qos(QosKind kind) {
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
   apply_common(p, qos);
   qos.deadline().period = to_duration(p.writer_deadline);
+  qos.data_sharing().off();  // see reader_qos()
   if (p.reliability == Reliability::best_effort) {
     qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
   }
@@ -69,13 +70,16 @@ dds::DataReaderQos reader_qos(QosKind kind, std::int32_t history_depth) {
   if (history_depth > 0) p.history_depth = history_depth;
   dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
   apply_common(p, qos);
-  qos.resource_limits().max_samples = std::max(p.history_depth, 1);
-  qos.resource_limits().max_samples_per_instance = std::max(p.history_depth, 1);
-  if (history_depth > 0) {
-    // A recorder keeps many samples: with data sharing it would only hold references into the
-    // writer's keep-last-1 pool, which the next sample overwrites. Receive copies instead.
-    qos.data_sharing().off();
-  }
+  // Room for more than the kept history: a reliable reader also stores samples that arrive ahead
+  // of a missing one; with room for only one it can wait forever for the gap to be filled (seen
+  // here: a safety-status reader matched and alive, 0 samples delivered, in about 1 run of 15).
+  qos.resource_limits().max_samples = std::max(p.history_depth, 256);
+  qos.resource_limits().max_samples_per_instance = std::max(p.history_depth, 256);
+  // Data sharing off (writers too): a deep reader history would only hold references into the
+  // writer's keep-last-1 pool, which the next sample overwrites; and a reader whose remote writer's
+  // process has exited crashed here when freeing its cache (Fast DDS 2.9, CacheChangePool
+  // destructor). Samples still travel through the shared-memory transport on one host.
+  qos.data_sharing().off();
   qos.deadline().period = to_duration(p.reader_deadline);
   return qos;
 }
