@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <thread>
@@ -88,8 +89,9 @@ int main(int argc, char** argv) {
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
     const auto lockstep_timeout = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(cfg.plant.lockstep_timeout));
-    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(cfg.plant.safety_status_timeout));
+    // In lockstep the supervisor's status may lag simulated time by up to lockstep_timeout.
+    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+        realtime ? cfg.plant.safety_status_timeout : std::max(cfg.plant.safety_status_timeout, cfg.plant.lockstep_timeout)));
     const auto republish = std::chrono::milliseconds(10);
 
     tp::msgs::SensorSample_ sample;
@@ -100,6 +102,7 @@ int main(int argc, char** argv) {
     Clock::time_point status_received{};
     bool have_status = false;
     bool have_command = false;
+    std::uint64_t reoffered = 0;  // lockstep cycles offered again after a lost sample
     auto next_brake_report = Clock::now() + std::chrono::seconds(2);
     std::uint64_t last_command_seq = 0;
     bool started = false;      // the chain has answered once
@@ -145,10 +148,17 @@ int main(int argc, char** argv) {
         if (got && !realtime) break;
         const auto now = Clock::now();
         if (now >= deadline) break;
-        if (!realtime && !started && now >= next_republish) {
-          // Start-up: keep offering this cycle, freshly sampled, until the chain answers (not an overrun).
-          origin = runtime::now_stamp();
-          origin_ns = runtime::to_nanoseconds(origin);
+        if (!realtime && now >= next_republish) {
+          // Lockstep: offer this cycle again until the chain answers. At start-up the stages are
+          // still discovering each other; later a best-effort sample was lost on the way. Stages
+          // answer a repeated cycle without stepping their cores twice, so the run stays
+          // deterministic. Not an overrun unless lockstep_timeout passes.
+          if (started) {
+            ++reoffered;
+          } else {  // start-up: a fresh sample time, so latency counts from when the chain is up
+            origin = runtime::now_stamp();
+            origin_ns = runtime::to_nanoseconds(origin);
+          }
           fill_sensors(sample, simulator.output(), seq, origin);
           sensors->write(sample);
           next_republish = now + republish;
@@ -224,13 +234,14 @@ int main(int argc, char** argv) {
     }
 
     diagnostics.publish_final(counters, &latency);
-    spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} non-finite commands rejected, latency p50 {:.0f} "
-                 "us p99 {:.0f} us max {:.0f} us, {} friction events",
-                 simulator.time(), counters.cycles, counters.overruns, counters.nonfinite_rejected,
+    spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} cycles offered again, {} non-finite commands "
+                 "rejected, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us, {} friction events",
+                 simulator.time(), counters.cycles, counters.overruns, reoffered, counters.nonfinite_rejected,
                  latency.percentile(50), latency.percentile(99), latency.maximum(), simulator.friction_event_count());
     if (!stats_path.empty()) {
       std::ofstream out(stats_path);
       out << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns
+          << ", \"reoffered\": " << reoffered
           << ", \"nonfinite_rejected\": " << counters.nonfinite_rejected << ", \"latency_us\": [";
       for (std::size_t i = 0; i < latency_log.size(); ++i) out << (i ? "," : "") << latency_log[i];
       out << "]}\n";

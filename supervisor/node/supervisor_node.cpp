@@ -19,9 +19,10 @@ using Clock = std::chrono::steady_clock;
 struct Watched {
   Clock::time_point last_sample{};
   bool seen{false};
-  supervisor::StageObservation observe(Clock::time_point now, const transport::ReaderHealth& health) const {
+  supervisor::StageObservation observe(Clock::time_point now, const transport::ReaderHealth& health,
+                                       bool lockstep) const {
     supervisor::StageObservation o;
-    o.alive = health.alive_writers > 0;
+    o.alive = lockstep ? health.matched_writers > 0 : health.alive_writers > 0;
     o.seconds_since_sample = seen ? std::chrono::duration<double>(now - last_sample).count() : 1e9;
     return o;
   }
@@ -52,11 +53,17 @@ int main(int argc, char** argv) {
   CLI::App app{"supervisor: modes, brakes, limits and watchdogs of the crane stack"};
   runtime::NodeOptions options;
   runtime::add_node_options(app, options);
+  bool lockstep = false;
+  app.add_flag("--lockstep", lockstep,
+               "the plant runs in lockstep: a stage is dead after lockstep_stage_timeout of silence, and DDS "
+               "liveliness (a wall-clock lease) is not required");
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "supervisor");
     const config::StackConfig cfg = config::load_stack_config(options.config_path);
-    supervisor::Supervisor core(cfg.supervisor);
+    supervisor::SupervisorParams params = cfg.supervisor;
+    if (lockstep) params.stage_timeout = params.lockstep_stage_timeout;
+    supervisor::Supervisor core(params);
 
     auto participant = runtime::make_participant(options, "supervisor");
     transport::Wakeup wakeup;
@@ -106,12 +113,12 @@ int main(int argc, char** argv) {
             nonfinite);
 
       supervisor::SupervisorInput in;
-      in.stages[0] = watched[0].observe(now, sensors->health());
-      in.stages[1] = watched[1].observe(now, estimate->health());
-      in.stages[2] = watched[2].observe(now, reference->health());
-      in.stages[3] = watched[3].observe(now, anti_swing->health());
-      in.stages[4] = watched[4].observe(now, linear->health());
-      in.stages[5] = watched[5].observe(now, actuators->health());
+      in.stages[0] = watched[0].observe(now, sensors->health(), lockstep);
+      in.stages[1] = watched[1].observe(now, estimate->health(), lockstep);
+      in.stages[2] = watched[2].observe(now, reference->health(), lockstep);
+      in.stages[3] = watched[3].observe(now, anti_swing->health(), lockstep);
+      in.stages[4] = watched[4].observe(now, linear->health(), lockstep);
+      in.stages[5] = watched[5].observe(now, actuators->health(), lockstep);
       in.sensors_valid = watched[0].seen;
       in.trolley_position = last_sensors.trolley_position();
       in.swing_in_plane = last_sensors.swing_in_plane();

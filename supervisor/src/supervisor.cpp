@@ -38,6 +38,7 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.voltage_limit", p.voltage_limit, 0.1, 100.0);
   require_in_range("supervisor.max_swing", p.max_swing, 0.01, 1.5);
   require_in_range("supervisor.stage_timeout", p.stage_timeout, 0.005, 5.0);
+  require_in_range("supervisor.lockstep_stage_timeout", p.lockstep_stage_timeout, p.stage_timeout, 60.0);
 }
 
 Supervisor::Supervisor(const SupervisorParams& params) : params_(params) { validate(params_); }

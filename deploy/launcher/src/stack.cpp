@@ -34,6 +34,7 @@ std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
       if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
     }
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
+    if (name == "supervisor" && o.lockstep) spec.arguments.push_back("--lockstep");
     if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
     specs.push_back(std::move(spec));
   }

@@ -74,6 +74,7 @@ supervisor::SupervisorParams read_supervisor(YamlSection s) {
   p.voltage_limit = s.number("voltage_limit", 0.1, 100.0);
   p.max_swing = s.number("max_swing", 0.01, 1.5);
   p.stage_timeout = s.number("stage_timeout", 0.005, 5.0);
+  p.lockstep_stage_timeout = s.number("lockstep_stage_timeout", p.stage_timeout, 60.0);
   p.arm_on_start = s.flag("arm_on_start");
   s.finish();
   supervisor::validate(p);

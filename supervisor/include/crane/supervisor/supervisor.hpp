@@ -50,6 +50,8 @@ struct SupervisorParams {
   double voltage_limit{10.0};        // [V] magnitude limit on both drive commands
   double max_swing{0.35};            // [rad] swing angle beyond which the crane stops
   double stage_timeout{0.05};        // [s] a stage silent for longer is dead (5 cycles at 100 Hz)
+  double lockstep_stage_timeout{1.0};  // [s] the same when the plant runs in lockstep: simulated time
+                                       // waits for a slow stage, so only a long silence is a death
   bool arm_on_start{true};           // arm by itself once the chain is healthy (simulation); a
                                      // real crane sets false and waits for an explicit arm command
 };
