@@ -1,7 +1,10 @@
-// Tests of the trajectory planner core: trapezoid (3.43) against the maneuvers (3.54)-(3.55).
+// Tests of the trajectory planner core: trapezoid (3.43) against the maneuvers (3.54)-(3.55), and
+// the swing-aware kinds (ZV, ZVD, EI shapers, time-optimal) through the planner.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -201,4 +204,247 @@ TEST(TrajectoryPlanner, BadParamsThrowNamingField) {
   } catch (const crane::common::ConfigError& error) {
     EXPECT_NE(std::string(error.what()).find("max_velocity"), std::string::npos);
   }
+}
+
+// ---- Swing-aware profiles through the planner: zv, zvd, ei (ShapedProfile) and time_optimal ----
+
+namespace {
+// The (3.54)-(3.55) move from x = 0.25 m, gamma = 0 to x = 1 m, gamma = pi/2 with L = 1 m.
+tp::MoveGoal swing_goal(tp::ProfileKind kind, std::uint64_t id = 11) {
+  tp::MoveGoal goal;
+  goal.request_id = id;
+  goal.profile = kind;
+  goal.trolley_target = 1.0;
+  goal.slew_target = std::numbers::pi / 2.0;
+  goal.cable_target = 1.0;
+  return goal;
+}
+
+tp::ShaperParams shaper_for(tp::ProfileKind kind, double length,
+                            const tp::TrajectoryPlannerParams& params = {}) {
+  tp::ShaperParams shaper;
+  shaper.kind = kind == tp::ProfileKind::zv    ? tp::ShaperKind::zv
+                : kind == tp::ProfileKind::zvd ? tp::ShaperKind::zvd
+                                               : tp::ShaperKind::ei;
+  shaper.natural_frequency = std::sqrt(params.gravity / length);
+  shaper.damping_ratio = params.swing_damping_ratio;
+  shaper.vibration_tolerance = params.ei_vibration_tolerance;
+  return shaper;
+}
+
+// The duration the profile classes give on their own for the goal's trolley and slew axes.
+double expected_duration(tp::ProfileKind kind, const tp::MoveGoal& goal, const CraneStateEstimate& from,
+                         const tp::TrajectoryPlannerParams& params = {}) {
+  const double w = std::sqrt(params.gravity / from.cable_length);
+  double trolley = 0.0, slew = 0.0;
+  if (kind == tp::ProfileKind::time_optimal) {
+    trolley = tp::TimeOptimalProfile(from.trolley_position, goal.trolley_target, goal.trolley_limits, w).duration();
+    slew = tp::TimeOptimalProfile(from.slew_angle, goal.slew_target, goal.slew_limits, w).duration();
+  } else {
+    const auto shaper = shaper_for(kind, from.cable_length, params);
+    trolley = tp::ShapedProfile(from.trolley_position, goal.trolley_target, goal.trolley_limits, shaper).duration();
+    slew = tp::ShapedProfile(from.slew_angle, goal.slew_target, goal.slew_limits, shaper).duration();
+  }
+  const double cable = tp::TrapezoidProfile(from.cable_length, goal.cable_target, goal.cable_limits).duration();
+  return std::max({trolley, slew, cable});
+}
+
+bool within(const crane::common::AxisReference& r, const tp::AxisLimits& limits) {
+  return std::abs(r.velocity) <= limits.max_velocity * (1 + 1e-9) &&
+         std::abs(r.acceleration) <= limits.max_acceleration * (1 + 1e-9);
+}
+
+// Runs the planner to arrival on a 1 ms grid, checking the limits on the way. Returns the steps.
+int run_to_arrival(tp::TrajectoryPlanner& planner, const tp::MoveGoal& goal, tp::PlannerOutput& out) {
+  int steps = 0;
+  do {
+    EXPECT_EQ(planner.step(0.001, out), StepStatus::ok);
+    EXPECT_TRUE(within(out.reference.trolley, goal.trolley_limits)) << "t = " << out.time_in_move;
+    EXPECT_TRUE(within(out.reference.slew, goal.slew_limits)) << "t = " << out.time_in_move;
+    EXPECT_TRUE(within(out.reference.cable_length, goal.cable_limits)) << "t = " << out.time_in_move;
+    ++steps;
+  } while (out.phase == tp::MovePhase::moving && steps < 100000);
+  return steps;
+}
+}  // namespace
+
+TEST(TrajectoryPlanner, SwingAwareKindsReachTargetsAtRest) {
+  for (const auto kind : {tp::ProfileKind::zv, tp::ProfileKind::zvd, tp::ProfileKind::ei,
+                          tp::ProfileKind::time_optimal}) {
+    SCOPED_TRACE(static_cast<int>(kind));
+    tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+    const auto from = at(0.25, 0.0, 1.0);
+    const auto goal = swing_goal(kind);
+    ASSERT_EQ(planner.start_move(goal, from), tp::GoalStatus::accepted);
+    tp::PlannerOutput out;
+    run_to_arrival(planner, goal, out);
+    EXPECT_EQ(out.phase, tp::MovePhase::arrived);
+    EXPECT_EQ(out.request_id, 11u);
+    EXPECT_NEAR(out.move_duration, expected_duration(kind, goal, from), 1e-12);
+    EXPECT_GE(out.time_in_move, out.move_duration);
+    EXPECT_NEAR(out.reference.trolley.position, 1.0, 1e-12);
+    EXPECT_NEAR(out.reference.slew.position, std::numbers::pi / 2.0, 1e-12);
+    EXPECT_NEAR(out.reference.cable_length.position, 1.0, 1e-12);
+    EXPECT_EQ(out.reference.trolley.velocity, 0.0);
+    EXPECT_EQ(out.reference.slew.velocity, 0.0);
+    EXPECT_EQ(out.reference.trolley.acceleration, 0.0);
+    EXPECT_EQ(out.reference.slew.acceleration, 0.0);
+  }
+}
+
+TEST(TrajectoryPlanner, ZvAddsHalfASwingPeriod) {
+  // ZV delays the (3.54)/(3.55) trapezoids (t_f = 2.0072 s) by T/2, T = 2 pi sqrt(L/g), L = 1 m.
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto goal = swing_goal(tp::ProfileKind::zv);
+  ASSERT_EQ(planner.start_move(goal, at(0.25, 0.0, 1.0)), tp::GoalStatus::accepted);
+  tp::PlannerOutput out;
+  ASSERT_EQ(planner.step(0.0, out), StepStatus::ok);
+  const double trapezoid = 0.75 / 0.4982 + 0.4982 / 0.9929;  // the slower of the two axes
+  EXPECT_NEAR(out.move_duration, trapezoid + kPeriodL1 / 2.0, 1e-12);
+  // ZVD and EI add a full period.
+  ASSERT_EQ(planner.start_move(swing_goal(tp::ProfileKind::zvd, 12), at(0.25, 0.0, 1.0)),
+            tp::GoalStatus::accepted);
+  ASSERT_EQ(planner.step(0.0, out), StepStatus::ok);
+  EXPECT_NEAR(out.move_duration, trapezoid + kPeriodL1, 1e-12);
+}
+
+TEST(TrajectoryPlanner, SwingFrequencyFollowsCableLength) {
+  // L = 2.5 m: T = 2 pi sqrt(2.5/9.8); the hoist (1 m -> 2.5 m) uses the trapezoid.
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto from = at(0.25, 0.0, 2.5);
+  auto goal = swing_goal(tp::ProfileKind::zv);
+  goal.slew_target = 0.0;
+  goal.cable_target = 2.5;
+  ASSERT_EQ(planner.start_move(goal, from), tp::GoalStatus::accepted);
+  tp::PlannerOutput out;
+  ASSERT_EQ(planner.step(0.0, out), StepStatus::ok);
+  const double period = 2.0 * std::numbers::pi * std::sqrt(2.5 / 9.8);
+  EXPECT_NEAR(out.move_duration, 0.75 / 0.4982 + 0.4982 / 0.9929 + period / 2.0, 1e-12);
+}
+
+TEST(TrajectoryPlanner, HoistUsesTrapezoidForSwingAwareKinds) {
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto from = at(0.5, 0.0, 1.0);
+  auto goal = swing_goal(tp::ProfileKind::time_optimal);
+  goal.trolley_target = 0.5;
+  goal.slew_target = 0.0;
+  goal.cable_target = 2.0;  // hoist only
+  ASSERT_EQ(planner.start_move(goal, from), tp::GoalStatus::accepted);
+  tp::PlannerOutput out;
+  run_to_arrival(planner, goal, out);
+  EXPECT_NEAR(out.move_duration, tp::TrapezoidProfile(1.0, 2.0, goal.cable_limits).duration(), 1e-12);
+  EXPECT_NEAR(out.reference.cable_length.position, 2.0, 1e-12);
+  EXPECT_EQ(out.reference.trolley.position, 0.5);
+}
+
+TEST(TrajectoryPlanner, TimeOptimalTrolleyManeuver354) {
+  // Trolley alone, (3.54) limits, L = 1 m: the time-optimal swing-free move takes 2.2543 s.
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  auto goal = swing_goal(tp::ProfileKind::time_optimal);
+  goal.slew_target = 0.0;
+  ASSERT_EQ(planner.start_move(goal, at(0.25, 0.0, 1.0)), tp::GoalStatus::accepted);
+  tp::PlannerOutput out;
+  run_to_arrival(planner, goal, out);
+  EXPECT_NEAR(out.move_duration, 2.2543, 1e-3);
+  EXPECT_EQ(out.phase, tp::MovePhase::arrived);
+  EXPECT_NEAR(out.reference.trolley.position, 1.0, 1e-12);
+  EXPECT_EQ(out.reference.trolley.velocity, 0.0);
+}
+
+TEST(TrajectoryPlanner, ShaperUsesDampingAndTolerance) {
+  tp::TrajectoryPlannerParams params;
+  params.swing_damping_ratio = 0.1;
+  params.ei_vibration_tolerance = 0.1;
+  params.gravity = 9.81;
+  for (const auto kind : {tp::ProfileKind::zv, tp::ProfileKind::zvd, tp::ProfileKind::ei}) {
+    SCOPED_TRACE(static_cast<int>(kind));
+    tp::TrajectoryPlanner planner(params);
+    const auto from = at(0.25, 0.0, 1.5);
+    const auto goal = swing_goal(kind);
+    ASSERT_EQ(planner.start_move(goal, from), tp::GoalStatus::accepted);
+    tp::PlannerOutput out;
+    run_to_arrival(planner, goal, out);
+    EXPECT_NEAR(out.move_duration, expected_duration(kind, goal, from, params), 1e-12);
+    EXPECT_NEAR(out.reference.trolley.position, 1.0, 1e-12);
+  }
+}
+
+TEST(TrajectoryPlanner, RejectedGoalLeavesRunningMoveUntouched) {
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  ASSERT_EQ(planner.start_move(swing_goal(tp::ProfileKind::zvd, 5), at(0.25, 0.0, 1.0)),
+            tp::GoalStatus::accepted);
+  tp::PlannerOutput out;
+  for (int k = 0; k < 500; ++k) ASSERT_EQ(planner.step(0.001, out), StepStatus::ok);
+  const tp::TrajectoryPlanner reference_planner = planner;  // the move as it would continue
+
+  // A failed plan: a non-positive measured cable length gives no swing frequency.
+  const auto bad_state = at(0.5, 0.2, 0.0);
+  for (const auto kind : {tp::ProfileKind::zv, tp::ProfileKind::zvd, tp::ProfileKind::ei,
+                          tp::ProfileKind::time_optimal}) {
+    EXPECT_EQ(planner.start_move(swing_goal(kind, 6), bad_state), tp::GoalStatus::rejected_invalid_limits);
+  }
+  // Non-positive limits for a swing-aware kind.
+  auto goal = swing_goal(tp::ProfileKind::time_optimal, 7);
+  goal.slew_limits.max_velocity = -1.0;
+  EXPECT_EQ(planner.start_move(goal, at(0.5, 0.2, 1.0)), tp::GoalStatus::rejected_invalid_limits);
+  goal = swing_goal(tp::ProfileKind::ei, 8);
+  goal.cable_limits.max_acceleration = 0.0;
+  EXPECT_EQ(planner.start_move(goal, at(0.5, 0.2, 1.0)), tp::GoalStatus::rejected_invalid_limits);
+  // A value outside the enum (e.g. cast from an unknown wire code).
+  goal = swing_goal(static_cast<tp::ProfileKind>(42), 9);
+  EXPECT_EQ(planner.start_move(goal, at(0.5, 0.2, 1.0)), tp::GoalStatus::rejected_unknown_profile);
+  // Out of range for a swing-aware kind.
+  goal = swing_goal(tp::ProfileKind::zv, 10);
+  goal.trolley_target = 5.0;
+  EXPECT_EQ(planner.start_move(goal, at(0.5, 0.2, 1.0)), tp::GoalStatus::rejected_trolley_out_of_range);
+
+  tp::TrajectoryPlanner continued = reference_planner;
+  tp::PlannerOutput expected;
+  for (int k = 0; k < 4000; ++k) {  // ZVD move: 2 x 2.007 s
+    ASSERT_EQ(planner.step(0.001, out), StepStatus::ok);
+    ASSERT_EQ(continued.step(0.001, expected), StepStatus::ok);
+    ASSERT_EQ(out.request_id, 5u);
+    ASSERT_EQ(out.phase, expected.phase);
+    ASSERT_EQ(out.time_in_move, expected.time_in_move);
+    ASSERT_EQ(out.move_duration, expected.move_duration);
+    ASSERT_EQ(out.reference.trolley.position, expected.reference.trolley.position);
+    ASSERT_EQ(out.reference.slew.position, expected.reference.slew.position);
+    ASSERT_EQ(out.reference.cable_length.position, expected.reference.cable_length.position);
+  }
+  EXPECT_EQ(out.phase, tp::MovePhase::arrived);
+  EXPECT_EQ(out.reference.trolley.position, 1.0);
+}
+
+TEST(TrajectoryPlanner, BadSwingParamsThrowNamingField) {
+  auto expect_throw = [](const tp::TrajectoryPlannerParams& p, const std::string& field) {
+    try {
+      tp::TrajectoryPlanner planner(p);
+      FAIL() << "no throw for " << field;
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("trajectory_planner." + field), std::string::npos)
+          << error.what();
+    }
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  tp::TrajectoryPlannerParams p;
+  for (const double bad : {-0.01, 0.31, nan}) {
+    p = {};
+    p.swing_damping_ratio = bad;
+    expect_throw(p, "swing_damping_ratio");
+  }
+  for (const double bad : {0.0, -0.05, 0.21, nan}) {
+    p = {};
+    p.ei_vibration_tolerance = bad;
+    expect_throw(p, "ei_vibration_tolerance");
+  }
+  for (const double bad : {0.0, -9.8, nan, std::numeric_limits<double>::infinity()}) {
+    p = {};
+    p.gravity = bad;
+    expect_throw(p, "gravity");
+  }
+  // The bounds themselves are accepted.
+  p = {};
+  p.swing_damping_ratio = 0.3;
+  p.ei_vibration_tolerance = 0.2;
+  EXPECT_NO_THROW(tp::TrajectoryPlanner{p});
 }

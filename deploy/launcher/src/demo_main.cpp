@@ -42,6 +42,8 @@ struct DemoOptions {
   std::string plot_script;
   std::string python{"/usr/bin/python3"};
   double ready_timeout{60.0};
+  std::string profile{"trapezoid"};
+  std::uint8_t profile_code{1};
 };
 
 struct ProcessRecord {
@@ -230,7 +232,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   tp::msgs::MoveRequest_ goal;
   runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
   goal.request_id(request_id);
-  goal.profile(1);  // trapezoid (3.43)
+  goal.profile(options.profile_code);  // MoveRequest_.profile code (idl/crane_msgs.idl)
   goal.axes(0x3);
   goal.trolley_target(m.trolley_target);
   goal.slew_target(m.slew_target);
@@ -394,7 +396,15 @@ int main(int argc, char** argv) {
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
+  app.add_option("--profile", options.profile,
+                 "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal")
+      ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
   CLI11_PARSE(app, argc, argv);
+  {
+    static const std::vector<std::string> kProfiles{"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"};
+    options.profile_code = static_cast<std::uint8_t>(
+        std::find(kProfiles.begin(), kProfiles.end(), options.profile) - kProfiles.begin());
+  }
 
   try {
     runtime::configure_logging("info", "demo");
@@ -440,6 +450,7 @@ int main(int argc, char** argv) {
     summary["config"] = fs::absolute(options.config_path).string();
     summary["clock"] = options.realtime ? "realtime" : "lockstep";
     summary["dds"] = options.dds;
+    summary["profile"] = options.profile;
     json maneuvers = json::array();
     std::vector<double> all_latencies;
     std::uint64_t cycles = 0, overruns = 0, supervisor_overruns = 0, nonfinite = 0;

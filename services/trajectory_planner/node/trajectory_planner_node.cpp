@@ -1,5 +1,6 @@
 // trajectory_planner process: rt/crane/planner/goal (MoveRequest) and rt/crane/state/estimate ->
-// reference trajectory (step or the trapezoid of (3.43)) -> rt/crane/planner/reference, once per
+// reference trajectory (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the time-optimal
+// swing-free profile) -> rt/crane/planner/reference, once per
 // cycle, same seq and origin. Holds the first measured position until a goal arrives.
 #include <spdlog/spdlog.h>
 
@@ -13,7 +14,20 @@ namespace tp = transport::topics;
 trajectory_planner::MoveGoal to_goal(const tp::msgs::MoveRequest_& r, const common::CraneStateEstimate& current) {
   trajectory_planner::MoveGoal g;
   g.request_id = r.request_id();
-  g.profile = r.profile() == 0 ? trajectory_planner::ProfileKind::step : trajectory_planner::ProfileKind::trapezoid;
+  using trajectory_planner::ProfileKind;
+  switch (r.profile()) {
+    case 0: g.profile = ProfileKind::step; break;
+    case 1: g.profile = ProfileKind::trapezoid; break;
+    case 2: g.profile = ProfileKind::zv; break;
+    case 3: g.profile = ProfileKind::zvd; break;
+    case 4: g.profile = ProfileKind::ei; break;
+    case 5: g.profile = ProfileKind::time_optimal; break;
+    default:
+      // Not a ProfileKind: start_move() answers rejected_unknown_profile and keeps the running move.
+      spdlog::warn("move request {} rejected: unknown profile code {}", r.request_id(), r.profile());
+      g.profile = static_cast<ProfileKind>(-1);
+      break;
+  }
   // An axis not named in `axes` keeps its current position.
   g.trolley_target = (r.axes() & 0x1) != 0 ? r.trolley_target() : current.trolley_position;
   g.slew_target = (r.axes() & 0x2) != 0 ? r.slew_target() : current.slew_angle;
@@ -33,7 +47,8 @@ const char* goal_status_name(trajectory_planner::GoalStatus s) {
     case GoalStatus::rejected_trolley_out_of_range: return "rejected: trolley target outside the travel limits";
     case GoalStatus::rejected_slew_out_of_range: return "rejected: slew target outside the slew range";
     case GoalStatus::rejected_cable_out_of_range: return "rejected: cable length target outside its range";
-    case GoalStatus::rejected_invalid_limits: return "rejected: velocity or acceleration limit <= 0";
+    case GoalStatus::rejected_invalid_limits: return "rejected: velocity or acceleration limit <= 0, or no profile";
+    case GoalStatus::rejected_unknown_profile: return "rejected: unknown profile code";
   }
   return "unknown";
 }
@@ -42,7 +57,8 @@ const char* goal_status_name(trajectory_planner::GoalStatus s) {
 int main(int argc, char** argv) {
   return runtime::run_stage(
       argc, argv, runtime::ProcessId::trajectory_planner,
-      "trajectory_planner: move requests to reference trajectories (step, trapezoid (3.43))", {},
+      "trajectory_planner: move requests to reference trajectories (step, trapezoid (3.43), ZV/ZVD/EI input shaping, "
+      "time-optimal swing-free)", {},
       [](runtime::StageContext& ctx) -> std::function<void()> {
         auto planner = std::make_shared<trajectory_planner::TrajectoryPlanner>(ctx.config.trajectory_planner);
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));

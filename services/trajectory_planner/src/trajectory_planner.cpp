@@ -20,6 +20,24 @@ bool positive_limits(const AxisLimits& limits) {
   return limits.max_velocity > 0.0 && limits.max_acceleration > 0.0;
 }
 
+bool known_profile(ProfileKind kind) {
+  switch (kind) {
+    case ProfileKind::step:
+    case ProfileKind::trapezoid:
+    case ProfileKind::zv:
+    case ProfileKind::zvd:
+    case ProfileKind::ei:
+    case ProfileKind::time_optimal: return true;
+  }
+  return false;
+}
+
+ShaperKind shaper_kind(ProfileKind kind) {
+  if (kind == ProfileKind::zv) return ShaperKind::zv;
+  if (kind == ProfileKind::ei) return ShaperKind::ei;
+  return ShaperKind::zvd;
+}
+
 }  // namespace
 
 TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : params_(params) {
@@ -30,20 +48,39 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   common::require_greater("trajectory_planner.cable_min_length", params.cable_min_length, 0.0);
   require_ordered("trajectory_planner.cable_min_length", params.cable_min_length,
                   "trajectory_planner.cable_max_length", params.cable_max_length);
+  common::require_greater("trajectory_planner.gravity", params.gravity, 0.0);
+  common::require_in_range("trajectory_planner.swing_damping_ratio", params.swing_damping_ratio, 0.0, 0.3);
+  common::require_greater("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance, 0.0);
+  common::require_in_range("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance,
+                           0.0, 0.2);
 }
 
-void TrajectoryPlanner::plan_axis(Axis& axis, ProfileKind kind, double start, double target,
-                                  const AxisLimits& limits) noexcept {
+bool TrajectoryPlanner::plan_axis(Axis& axis, ProfileKind kind, double start, double target,
+                                  const AxisLimits& limits, double swing_frequency) const noexcept {
+  bool planned = false;  // stays false for a value outside the enum
   switch (kind) {
-    case ProfileKind::trapezoid:
-      axis.trapezoid.plan(start, target, limits);
-      axis.kind = ProfileKind::trapezoid;
-      break;
     case ProfileKind::step:
       axis.step.plan(target);
-      axis.kind = ProfileKind::step;
+      planned = true;
+      break;
+    case ProfileKind::trapezoid:
+      axis.trapezoid.plan(start, target, limits);
+      planned = true;
+      break;
+    case ProfileKind::zv:
+    case ProfileKind::zvd:
+    case ProfileKind::ei: {
+      const ShaperParams shaper{shaper_kind(kind), swing_frequency, params_.swing_damping_ratio,
+                                params_.ei_vibration_tolerance};
+      planned = axis.shaped.plan(start, target, limits, shaper) == ProfileStatus::ok;
+      break;
+    }
+    case ProfileKind::time_optimal:
+      planned = axis.time_optimal.plan(start, target, limits, swing_frequency) == ProfileStatus::ok;
       break;
   }
+  if (planned) axis.kind = kind;
+  return planned;
 }
 
 GoalStatus TrajectoryPlanner::hold(const common::CraneStateEstimate& current) noexcept {
@@ -75,9 +112,7 @@ GoalStatus TrajectoryPlanner::start_move(const MoveGoal& goal,
       !finite_limits(goal.cable_limits)) {
     return GoalStatus::rejected_nonfinite;
   }
-  if (goal.profile != ProfileKind::step && goal.profile != ProfileKind::trapezoid) {
-    return GoalStatus::rejected_invalid_limits;
-  }
+  if (!known_profile(goal.profile)) return GoalStatus::rejected_unknown_profile;
   if (goal.trolley_target < params_.trolley_min_position ||
       goal.trolley_target > params_.trolley_max_position) {
     return GoalStatus::rejected_trolley_out_of_range;
@@ -88,14 +123,32 @@ GoalStatus TrajectoryPlanner::start_move(const MoveGoal& goal,
   if (goal.cable_target < params_.cable_min_length || goal.cable_target > params_.cable_max_length) {
     return GoalStatus::rejected_cable_out_of_range;
   }
-  if (goal.profile == ProfileKind::trapezoid &&
+  if (goal.profile != ProfileKind::step &&
       (!positive_limits(goal.trolley_limits) || !positive_limits(goal.slew_limits) ||
        !positive_limits(goal.cable_limits))) {
     return GoalStatus::rejected_invalid_limits;
   }
-  plan_axis(trolley_, goal.profile, current.trolley_position, goal.trolley_target, goal.trolley_limits);
-  plan_axis(slew_, goal.profile, current.slew_angle, goal.slew_target, goal.slew_limits);
-  plan_axis(cable_, goal.profile, current.cable_length, goal.cable_target, goal.cable_limits);
+  // Load swing w = sqrt(g/L) for the trolley (in-plane) and the slew (out-of-plane, same w). A
+  // non-positive measured length gives w = 0, which the swing-aware profiles reject.
+  const double swing_frequency =
+      current.cable_length > 0.0 ? std::sqrt(params_.gravity / current.cable_length) : 0.0;
+  const ProfileKind cable_kind =
+      goal.profile == ProfileKind::step ? ProfileKind::step : ProfileKind::trapezoid;
+  // Plan into temporaries (held by value, no allocation) and commit only if every axis succeeds.
+  Axis trolley = trolley_;
+  Axis slew = slew_;
+  Axis cable = cable_;
+  if (!plan_axis(trolley, goal.profile, current.trolley_position, goal.trolley_target,
+                 goal.trolley_limits, swing_frequency) ||
+      !plan_axis(slew, goal.profile, current.slew_angle, goal.slew_target, goal.slew_limits,
+                 swing_frequency) ||
+      !plan_axis(cable, cable_kind, current.cable_length, goal.cable_target, goal.cable_limits,
+                 swing_frequency)) {
+    return GoalStatus::rejected_invalid_limits;
+  }
+  trolley_ = trolley;
+  slew_ = slew;
+  cable_ = cable;
   move_duration_ = std::max({trolley_.active().duration(), slew_.active().duration(),
                              cable_.active().duration()});
   time_in_move_ = 0.0;

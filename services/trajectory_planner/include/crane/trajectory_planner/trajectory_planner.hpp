@@ -9,15 +9,24 @@
 #include <cstdint>
 
 #include "crane/common/crane_signals.hpp"
+#include "crane/trajectory_planner/shaped_profile.hpp"
 #include "crane/trajectory_planner/step_profile.hpp"
+#include "crane/trajectory_planner/time_optimal_profile.hpp"
 #include "crane/trajectory_planner/trapezoid_profile.hpp"
 
 namespace crane::trajectory_planner {
 
-/// Profile shapes. Later: zv, zvd, ei, time_optimal (add an AxisProfile implementation and a case).
+/// Profile shapes. The swing-aware kinds (zv, zvd, ei, time_optimal) apply to the trolley and slew
+/// axes, tuned to w = sqrt(g/L) with L the cable length at the start of the move (the slew's
+/// out-of-plane swing has the same frequency); the hoist (cable) axis uses the trapezoid for every
+/// kind other than step.
 enum class ProfileKind {
-  step,       // target at once
-  trapezoid,  // (3.43)
+  step,          // target at once
+  trapezoid,     // (3.43)
+  zv,            // trapezoid convolved with a ZV shaper (ShapedProfile)
+  zvd,           // trapezoid convolved with a ZVD shaper
+  ei,            // trapezoid convolved with an EI shaper
+  time_optimal,  // time-optimal swing-free rest-to-rest (TimeOptimalProfile)
 };
 
 /// Travel limits of the crane, checked against every goal.
@@ -28,6 +37,9 @@ struct TrajectoryPlannerParams {
   double slew_max_angle{6.283185307179586};   // [rad]
   double cable_min_length{0.2};       // [m]
   double cable_max_length{5.0};       // [m]
+  double gravity{9.8};                // [m/s^2] swing model, w = sqrt(gravity / cable_length)
+  double swing_damping_ratio{0.0};    // [-] swing damping used by the zv/zvd/ei shapers, 0..0.3
+  double ei_vibration_tolerance{0.05};  // [-] EI residual-vibration tolerance V, (0, 0.2]
 };
 
 /// A move request.
@@ -49,7 +61,8 @@ enum class [[nodiscard]] GoalStatus {
   rejected_trolley_out_of_range,  // trolley_target outside [trolley_min_position, trolley_max_position]
   rejected_slew_out_of_range,     // slew_target outside [slew_min_angle, slew_max_angle]
   rejected_cable_out_of_range,    // cable_target outside [cable_min_length, cable_max_length]
-  rejected_invalid_limits,        // a trapezoid limit is <= 0
+  rejected_invalid_limits,        // a limit is <= 0, or an axis profile could not be planned
+  rejected_unknown_profile,       // the goal's profile is not a ProfileKind (e.g. an unknown wire code)
 };
 
 enum class MovePhase {
@@ -69,14 +82,16 @@ struct PlannerOutput {
 class TrajectoryPlanner {
  public:
   /// Throws common::ConfigError naming the field unless every bound is finite and min < max,
-  /// cable_min_length > 0.
+  /// cable_min_length > 0, gravity > 0, 0 <= swing_damping_ratio <= 0.3 and
+  /// 0 < ei_vibration_tolerance <= 0.2.
   explicit TrajectoryPlanner(const TrajectoryPlannerParams& params);
 
   /// Hold the given position (phase holding). Non-finite positions -> rejected_nonfinite.
   [[nodiscard]] GoalStatus hold(const common::CraneStateEstimate& current) noexcept;
 
   /// Start a move from `current` (trolley_position [m], slew_angle [rad], cable_length [m]).
-  /// On rejection nothing changes.
+  /// Every axis is planned into a temporary first and committed only if all succeed: on rejection
+  /// nothing changes (the running move, if any, continues).
   [[nodiscard]] GoalStatus start_move(const MoveGoal& goal,
                                       const common::CraneStateEstimate& current) noexcept;
 
@@ -94,15 +109,26 @@ class TrajectoryPlanner {
   struct Axis {
     TrapezoidProfile trapezoid;
     StepProfile step;
+    ShapedProfile shaped;
+    TimeOptimalProfile time_optimal;
     ProfileKind kind{ProfileKind::step};
     // Indexing by kind (not a stored pointer) keeps the planner safely copyable.
     [[nodiscard]] const AxisProfile& active() const noexcept {
-      if (kind == ProfileKind::trapezoid) return trapezoid;
+      switch (kind) {
+        case ProfileKind::trapezoid: return trapezoid;
+        case ProfileKind::zv:
+        case ProfileKind::zvd:
+        case ProfileKind::ei: return shaped;
+        case ProfileKind::time_optimal: return time_optimal;
+        case ProfileKind::step: break;
+      }
       return step;
     }
   };
-  void plan_axis(Axis& axis, ProfileKind kind, double start, double target,
-                 const AxisLimits& limits) noexcept;
+  /// Plans `axis` (a temporary) with `kind`; `swing_frequency` [rad/s] is used by the shaped and
+  /// time-optimal kinds. False if the profile rejected its arguments (axis then unspecified).
+  [[nodiscard]] bool plan_axis(Axis& axis, ProfileKind kind, double start, double target,
+                               const AxisLimits& limits, double swing_frequency) const noexcept;
 
   TrajectoryPlannerParams params_;
   Axis trolley_;
