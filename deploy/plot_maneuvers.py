@@ -17,6 +17,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+CONTROLLER_TITLES = {
+    "gain_scheduling_partial": "gain-scheduling partial state feedback (3.19)",
+    "gain_scheduling_full": "gain-scheduling full state feedback (3.26)",
+    "pd": "PD anti-swing (3.45) + PD tracking",
+    "delay1": "delayed-feedback anti-swing (3.47) + PD tracking",
+    "delay2": "delayed-feedback reference correction (3.50) + PD tracking",
+    "fuzzy": "fuzzy anti-swing + PD tracking",
+}
+
+
 def read_csv(path):
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
@@ -31,6 +41,7 @@ def main():
     args = parser.parse_args()
     with open(os.path.join(args.out, "summary.json")) as f:
         summary = json.load(f)
+    controller_title = CONTROLLER_TITLES.get(summary.get("controller", "delay1"), summary.get("controller", "delay1"))
     by_name = {}
     for m in summary["maneuvers"]:
         by_name.setdefault(m["name"], []).append(m)
@@ -61,7 +72,7 @@ def main():
         for ax in axes:
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=7, loc="best")
-        fig.suptitle(f"maneuver '{name}': delayed-feedback anti-swing + PD tracking, simulated plant over DDS")
+        fig.suptitle(f"maneuver '{name}': {controller_title}, simulated plant over DDS")
         fig.tight_layout()
         path = os.path.join(args.out, f"{name}.png")
         fig.savefig(path, dpi=90)

@@ -44,6 +44,9 @@ struct DemoOptions {
   double ready_timeout{60.0};
   std::string profile{"trapezoid"};
   std::uint8_t profile_code{1};
+  std::string controller{"delay1"};   // --controller, see main()
+  std::string anti_swing_controller;  // derived from controller
+  std::string tracking_controller;    // derived from controller
 };
 
 struct ProcessRecord {
@@ -182,6 +185,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.initial_slew_angle = m.initial_slew_angle;
   stack.friction_compensation = compensation;
   stack.plant_stats_path = (log_dir / "plant_stats.json").string();
+  stack.anti_swing_controller = options.anti_swing_controller;
+  stack.tracking_controller = options.tracking_controller;
 
   RunResult result;
   result.maneuver = m.name;
@@ -396,10 +401,25 @@ int main(int argc, char** argv) {
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
-  app.add_option("--profile", options.profile,
-                 "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal")
-      ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
+  auto* profile_option =
+      app.add_option("--profile", options.profile,
+                     "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal "
+                     "(default trapezoid; step with a gain_scheduling controller)")
+          ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
+  app.add_option("--controller", options.controller,
+                 "controller of the stack: gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (no "
+                 "anti-swing) | pd (3.45) | delay1 (3.47) | delay2 (3.50) | fuzzy (anti-swing with PD tracking)")
+      ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "pd", "delay1", "delay2", "fuzzy"}));
   CLI11_PARSE(app, argc, argv);
+  if (options.controller.rfind("gain_scheduling", 0) == 0) {
+    options.tracking_controller = options.controller;
+    options.anti_swing_controller = "none";
+    // The dissertation drives the gain-scheduling controller with step references (section 3.2).
+    if (profile_option->count() == 0) options.profile = "step";
+  } else {
+    options.tracking_controller = "tracking";
+    options.anti_swing_controller = options.controller;
+  }
   {
     static const std::vector<std::string> kProfiles{"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"};
     options.profile_code = static_cast<std::uint8_t>(
@@ -451,6 +471,7 @@ int main(int argc, char** argv) {
     summary["clock"] = options.realtime ? "realtime" : "lockstep";
     summary["dds"] = options.dds;
     summary["profile"] = options.profile;
+    summary["controller"] = options.controller;
     json maneuvers = json::array();
     std::vector<double> all_latencies;
     std::uint64_t cycles = 0, overruns = 0, supervisor_overruns = 0, nonfinite = 0;

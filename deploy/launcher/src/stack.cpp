@@ -35,6 +35,12 @@ std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
     }
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
     if (name == "supervisor" && o.lockstep) spec.arguments.push_back("--lockstep");
+    if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
+      spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});
+    }
+    if (name == "tracking" && !o.tracking_controller.empty()) {
+      spec.arguments.insert(spec.arguments.end(), {"--controller", o.tracking_controller});
+    }
     if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
     specs.push_back(std::move(spec));
   }

@@ -189,7 +189,11 @@ bool all_finite(const msgs::Reference_& m) noexcept {
                 m.slew_acceleration(), m.cable_length(), m.cable_length_rate(), m.cable_length_acceleration(),
                 m.time_in_move(), m.move_duration());
 }
-bool all_finite(const msgs::AntiSwingCommand_& m) noexcept { return finite(m.trolley_action(), m.slew_action()); }
+bool all_finite(const msgs::AntiSwingCommand_& m) noexcept {
+  return finite(m.trolley_action(), m.slew_action(), m.trolley_reference_correction(),
+                m.trolley_reference_rate_correction(), m.slew_reference_correction(),
+                m.slew_reference_rate_correction());
+}
 bool all_finite(const msgs::LinearCommand_& m) noexcept {
   return finite(m.trolley_voltage(), m.slew_voltage(), m.hoist_speed(), m.trolley_tracking_action(),
                 m.slew_tracking_action());

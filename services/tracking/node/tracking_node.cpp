@@ -1,17 +1,43 @@
 // tracking process: joins rt/crane/state/estimate, rt/crane/planner/reference and
 // rt/crane/control/anti_swing of the same cycle -> PD tracking (3.40)-(3.42) with the voltage
 // mapping (3.37)-(3.38) -> rt/crane/control/linear.
+//
+// --controller selects the law (default tracking):
+//   tracking                 PD tracking plus the anti-swing action; the anti-swing message's
+//                            reference corrections (Masoud's configuration (3.50)) are added to the
+//                            trolley and slew reference position and velocity first
+//   gain_scheduling_partial  gain-scheduling state feedback (3.19) on the reference position
+//   gain_scheduling_full     gain-scheduling state feedback (3.26) on the reference position
+// The gain-scheduling laws do not use the anti-swing message, but the stage still joins on it so
+// the chain (and its timing) is the same for every controller.
+#include "crane/gain_scheduling/gain_scheduling_controller.hpp"
 #include "crane/runtime/stage_node.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
 int main(int argc, char** argv) {
   using namespace crane;
   namespace tp = transport::topics;
+  auto controller_name = std::make_shared<std::string>("tracking");
   return runtime::run_stage(
       argc, argv, runtime::ProcessId::tracking,
-      "tracking: PD tracking (3.40)-(3.42) plus the anti-swing action, mapped to drive voltages (3.37)-(3.38)", {},
-      [](runtime::StageContext& ctx) -> std::function<void()> {
+      "tracking: PD tracking (3.40)-(3.42) plus the anti-swing action, mapped to drive voltages (3.37)-(3.38), "
+      "or gain-scheduling state feedback (3.19)/(3.26)",
+      [controller_name](CLI::App& app) {
+        app.add_option("--controller", *controller_name,
+                       "tracking | gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (default tracking)")
+            ->check(CLI::IsMember({"tracking", "gain_scheduling_partial", "gain_scheduling_full"}));
+      },
+      [controller_name](runtime::StageContext& ctx) -> std::function<void()> {
         auto controller = std::make_shared<tracking::TrackingController>(ctx.config.tracking);
+        std::shared_ptr<gain_scheduling::GainSchedulingController> scheduled;
+        if (*controller_name != "tracking") {
+          auto p = gain_scheduling::gain_scheduling_params_from(ctx.config.crane);
+          p.kind = *controller_name == "gain_scheduling_full" ? gain_scheduling::FeedbackKind::full
+                                                              : gain_scheduling::FeedbackKind::partial;
+          p.voltage_limit = ctx.config.tracking.voltage_limit;
+          p.slew_enabled = ctx.config.tracking.slew_enabled;
+          scheduled = std::make_shared<gain_scheduling::GainSchedulingController>(p);
+        }
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
         auto references = std::shared_ptr(ctx.participant.make_reader<tp::Reference>(&ctx.wakeup));
         auto actions = std::shared_ptr(ctx.participant.make_reader<tp::AntiSwing>(&ctx.wakeup));
@@ -42,11 +68,21 @@ int main(int argc, char** argv) {
           tracking::TrackingInput in;
           in.estimate = runtime::to_estimate(*state);
           in.reference = runtime::to_reference(*reference);
-          in.trolley_anti_swing_action = action->trolley_action();
-          in.slew_anti_swing_action = action->slew_action();
           tracking::TrackingOutput result;
-          if (controller->step(in, result) != common::StepStatus::ok) {
-            ++ctx.counters.nonfinite_rejected;
+          if (scheduled) {
+            if (scheduled->step(in.estimate, in.reference, result.command) != common::StepStatus::ok) {
+              ++ctx.counters.nonfinite_rejected;
+            }
+          } else {
+            in.reference.trolley.position += action->trolley_reference_correction();
+            in.reference.trolley.velocity += action->trolley_reference_rate_correction();
+            in.reference.slew.position += action->slew_reference_correction();
+            in.reference.slew.velocity += action->slew_reference_rate_correction();
+            in.trolley_anti_swing_action = action->trolley_action();
+            in.slew_anti_swing_action = action->slew_action();
+            if (controller->step(in, result) != common::StepStatus::ok) {
+              ++ctx.counters.nonfinite_rejected;
+            }
           }
           out->trolley_voltage(result.command.trolley_voltage);
           out->slew_voltage(result.command.slew_voltage);

@@ -22,6 +22,9 @@ struct StackOptions {
   bool friction_compensation{true};
   std::string plant_stats_path;       // plant writes its loop statistics here on exit (optional)
   std::string log_level{"info"};
+  std::string anti_swing_controller;  // anti_swing --controller (none|pd|delay1|delay2|fuzzy); empty: its default
+  std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
+                                      // empty: its default
 };
 
 /// The seven stage processes of the simulated stack (the plant replaces the hardware bridge), in
