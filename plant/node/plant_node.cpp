@@ -27,8 +27,11 @@ using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 
+// `cable_length_reading_factor` scales the reported cable length: 1 normally; 1/f when the plant's
+// cable is f times the configured one but the crane (like the lab crane, which has no hoist
+// encoder) reports the configured length, so every controller keeps assuming it.
 void fill_sensors(tp::msgs::SensorSample_& s, const plant::SimulatorOutput& o, std::uint64_t seq,
-                  const builtin_interfaces::msg::dds_::Time_& origin) {
+                  const builtin_interfaces::msg::dds_::Time_& origin, double cable_length_reading_factor = 1.0) {
   runtime::stamp_header(s.header(), seq, origin);
   s.source(1);
   s.writer_pid(static_cast<std::uint32_t>(getpid()));
@@ -36,7 +39,7 @@ void fill_sensors(tp::msgs::SensorSample_& s, const plant::SimulatorOutput& o, s
   s.slew_angle(o.measurement.slew_angle);
   s.swing_in_plane(o.measurement.swing_in_plane);
   s.swing_out_of_plane(o.measurement.swing_out_of_plane);
-  s.cable_length(o.measurement.cable_length);
+  s.cable_length(o.measurement.cable_length * cable_length_reading_factor);
   s.applied_trolley_voltage(o.applied_trolley_voltage);
   s.applied_slew_voltage(o.applied_slew_voltage);
   s.applied_hoist_speed(o.applied_hoist_speed);
@@ -62,6 +65,15 @@ int main(int argc, char** argv) {
   app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle");
   app.add_option("--initial-swing", initial_swing, "[rad] initial in-plane swing");
   app.add_option("--stats-out", stats_path, "write loop statistics (JSON) here on exit");
+  double cable_length_factor = 1.0;
+  double load_mass_factor = 1.0;
+  app.add_option("--cable-length-factor", cable_length_factor,
+                 "the simulated crane's cable length is this times the configured one, while the sensors still "
+                 "report the configured length (robustness studies)")
+      ->check(CLI::Range(0.1, 10.0));
+  app.add_option("--load-mass-factor", load_mass_factor,
+                 "the simulated load mass is this times the configured one (controllers unaware)")
+      ->check(CLI::Range(0.0, 10.0));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -71,7 +83,14 @@ int main(int argc, char** argv) {
     initial.trolley_position = initial_trolley;
     initial.slew_angle = initial_slew;
     initial.swing_in_plane = initial_swing;
-    const auto sim_params = config::simulator_parameters(cfg, initial);
+    config::StackConfig truth = cfg;  // what the plant simulates; the controllers read cfg itself
+    truth.crane.cable_length *= cable_length_factor;
+    truth.crane.load_mass *= load_mass_factor;
+    const auto sim_params = config::simulator_parameters(truth, initial);
+    if (cable_length_factor != 1.0 || load_mass_factor != 1.0) {
+      spdlog::warn("plant differs from the configuration: L = {} m, m = {} kg (configured {} m, {} kg)",
+                   truth.crane.cable_length, truth.crane.load_mass, cfg.crane.cable_length, cfg.crane.load_mass);
+    }
     plant::CraneSimulator simulator(sim_params);
 
     auto participant = runtime::make_participant(options, "plant");
@@ -110,7 +129,7 @@ int main(int argc, char** argv) {
     std::uint64_t seq = 0;
     builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
     std::int64_t origin_ns = runtime::to_nanoseconds(origin);
-    fill_sensors(sample, simulator.output(), seq, origin);
+    fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
     sensors->write(sample);
     auto cycle_start = Clock::now();
     auto next_deadline = cycle_start + period;
@@ -159,7 +178,7 @@ int main(int argc, char** argv) {
             origin = runtime::now_stamp();
             origin_ns = runtime::to_nanoseconds(origin);
           }
-          fill_sensors(sample, simulator.output(), seq, origin);
+          fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
           sensors->write(sample);
           next_republish = now + republish;
         }
@@ -228,7 +247,7 @@ int main(int argc, char** argv) {
       cycle_start = Clock::now();
       origin = runtime::now_stamp();
       origin_ns = runtime::to_nanoseconds(origin);
-      fill_sensors(sample, simulator.output(), seq, origin);
+      fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
       sensors->write(sample);
       diagnostics.maybe_publish(counters, &latency);
     }

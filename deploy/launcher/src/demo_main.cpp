@@ -47,6 +47,8 @@ struct DemoOptions {
   std::string controller{"delay1"};   // --controller, see main()
   std::string anti_swing_controller;  // derived from controller
   std::string tracking_controller;    // derived from controller
+  double plant_cable_length_factor{1.0};
+  double plant_load_mass_factor{1.0};
 };
 
 struct ProcessRecord {
@@ -185,6 +187,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.initial_slew_angle = m.initial_slew_angle;
   stack.friction_compensation = compensation;
   stack.plant_stats_path = (log_dir / "plant_stats.json").string();
+  stack.plant_cable_length_factor = options.plant_cable_length_factor;
+  stack.plant_load_mass_factor = options.plant_load_mass_factor;
   stack.anti_swing_controller = options.anti_swing_controller;
   stack.tracking_controller = options.tracking_controller;
 
@@ -402,7 +406,14 @@ int main(int argc, char** argv) {
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
   auto* profile_option =
-      app.add_option("--profile", options.profile,
+      app.add_option("--plant-cable-length-factor", options.plant_cable_length_factor,
+                 "robustness: the simulated cable is this times the configured length, which every controller "
+                 "still assumes")
+      ->check(CLI::Range(0.1, 10.0));
+  app.add_option("--plant-load-mass-factor", options.plant_load_mass_factor,
+                 "robustness: the simulated load mass (so m_t, m_r) is this times the configured one")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--profile", options.profile,
                      "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal "
                      "(default trapezoid; step with a gain_scheduling controller)")
           ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
@@ -471,6 +482,8 @@ int main(int argc, char** argv) {
     summary["clock"] = options.realtime ? "realtime" : "lockstep";
     summary["dds"] = options.dds;
     summary["profile"] = options.profile;
+    summary["plant_cable_length_factor"] = options.plant_cable_length_factor;
+    summary["plant_load_mass_factor"] = options.plant_load_mass_factor;
     summary["controller"] = options.controller;
     json maneuvers = json::array();
     std::vector<double> all_latencies;

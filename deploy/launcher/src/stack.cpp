@@ -32,6 +32,10 @@ std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),
                                                    "--initial-slew", number(o.initial_slew_angle)});
       if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
+      if (o.plant_cable_length_factor != 1.0 || o.plant_load_mass_factor != 1.0) {
+        spec.arguments.insert(spec.arguments.end(), {"--cable-length-factor", number(o.plant_cable_length_factor),
+                                                     "--load-mass-factor", number(o.plant_load_mass_factor)});
+      }
     }
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
     if (name == "supervisor" && o.lockstep) spec.arguments.push_back("--lockstep");

@@ -21,6 +21,8 @@ struct StackOptions {
   double initial_slew_angle{0.0};         // [rad]
   bool friction_compensation{true};
   std::string plant_stats_path;       // plant writes its loop statistics here on exit (optional)
+  double plant_cable_length_factor{1.0};  // simulated L = factor * configured L (robustness)
+  double plant_load_mass_factor{1.0};     // simulated m = factor * configured m (robustness)
   std::string log_level{"info"};
   std::string anti_swing_controller;  // anti_swing --controller (none|pd|delay1|delay2|fuzzy); empty: its default
   std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
