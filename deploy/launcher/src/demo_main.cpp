@@ -405,15 +405,15 @@ int main(int argc, char** argv) {
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
-  auto* profile_option =
-      app.add_option("--plant-cable-length-factor", options.plant_cable_length_factor,
+  app.add_option("--plant-cable-length-factor", options.plant_cable_length_factor,
                  "robustness: the simulated cable is this times the configured length, which every controller "
                  "still assumes")
       ->check(CLI::Range(0.1, 10.0));
   app.add_option("--plant-load-mass-factor", options.plant_load_mass_factor,
                  "robustness: the simulated load mass (so m_t, m_r) is this times the configured one")
       ->check(CLI::Range(0.0, 10.0));
-  app.add_option("--profile", options.profile,
+  auto* profile_option =
+      app.add_option("--profile", options.profile,
                      "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal "
                      "(default trapezoid; step with a gain_scheduling controller)")
           ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
