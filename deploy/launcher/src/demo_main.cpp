@@ -419,8 +419,9 @@ int main(int argc, char** argv) {
           ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
   app.add_option("--controller", options.controller,
                  "controller of the stack: gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (no "
-                 "anti-swing) | pd (3.45) | delay1 (3.47) | delay2 (3.50) | fuzzy (anti-swing with PD tracking)")
-      ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "pd", "delay1", "delay2", "fuzzy"}));
+                 "anti-swing) | none (PD tracking alone) | pd (3.45) | delay1 (3.47) | delay2 (3.50) | fuzzy (anti-swing with PD "
+                 "tracking)")
+      ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "none", "pd", "delay1", "delay2", "fuzzy"}));
   CLI11_PARSE(app, argc, argv);
   if (options.controller.rfind("gain_scheduling", 0) == 0) {
     options.tracking_controller = options.controller;
