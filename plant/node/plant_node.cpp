@@ -8,6 +8,13 @@
 //               not arrived by the deadline is an overrun, treated the same way.
 // Brakes are released and the command applied only while the supervisor's latest status, no older
 // than safety_status_timeout, says so. Non-finite commands are rejected and counted.
+//
+//   --board shm:NAME  the plant sits behind the emulated interface board instead of the DDS bus
+//               (hardware-in-the-loop): it creates the shared-memory board, writes the encoder
+//               counters from its simulated motion and applies what the hardware bridge writes to
+//               the analog and digital outputs (the board holds its outputs, as a real DAC does).
+//               Lockstep: the board's sample clock waits for the bridge's outputs of each sample;
+//               realtime: absolute 10 ms deadlines, the outputs read as they are.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -19,7 +26,9 @@
 #include <vector>
 
 #include "crane/config/simulator_parameters.hpp"
+#include "crane/hardware_bridge/shm_board.hpp"
 #include "crane/plant/crane_simulator.hpp"
+#include "crane/plant/drives_and_sensors.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
 namespace {
@@ -47,6 +56,86 @@ void fill_sensors(tp::msgs::SensorSample_& s, const plant::SimulatorOutput& o, s
   s.emergency_stop_input(false);
   s.limit_switches(0);
 }
+// The plant behind the emulated board (--board shm:NAME).
+int run_behind_board(const std::string& board_name, const config::StackConfig& cfg, const config::StackConfig& truth,
+                     plant::CraneSimulator& simulator, bool realtime, const runtime::NodeOptions& options,
+                     const std::string& stats_path) {
+  namespace hb = hardware_bridge;
+  auto board = hb::ShmBoardEmulator::create(board_name, cfg.crane, cfg.hardware_bridge.board.counter_bits);
+  const plant::DrivesAndSensors sensors_model(truth.crane);
+  auto participant = runtime::make_participant(options, "plant");
+  transport::Wakeup wakeup;
+  runtime::install_stop_handlers(&wakeup);
+  runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::plant);
+  runtime::LoopCounters counters;
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
+  const auto lockstep_timeout =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_timeout));
+  auto publish = [&] {
+    const auto& m = simulator.output().measurement;
+    return board.publish_sample({plant::position_to_encoder_counts(m.trolley_position, sensors_model.trolley_resolution()),
+                                 plant::position_to_encoder_counts(m.slew_angle, sensors_model.slew_resolution()),
+                                 plant::position_to_encoder_counts(m.swing_in_plane, sensors_model.swing_resolution()),
+                                 plant::position_to_encoder_counts(m.swing_out_of_plane, sensors_model.swing_resolution())});
+  };
+  const auto bit = [](hb::DigitalOutput line) { return 1U << static_cast<unsigned>(line); };
+  spdlog::info("behind the emulated board {} ({} clock): counters {} bits, DAC [{}, {}] V", board.segment_path(),
+               realtime ? "realtime" : "board-paced lockstep", board.counter_bits(),
+               board.analog_range(hb::AnalogOutput::trolley_drive).min_volts,
+               board.analog_range(hb::AnalogOutput::trolley_drive).max_volts);
+  std::uint64_t tick = publish();
+  bool answered_once = false;
+  auto next_deadline = Clock::now() + period;
+  while (!runtime::stop_requested()) {
+    if (realtime) {
+      std::this_thread::sleep_until(next_deadline);
+      next_deadline += period;
+      if (Clock::now() > next_deadline) ++counters.overruns;  // the plant itself fell behind
+    } else {
+      // Board-paced lockstep: wait for the bridge's outputs of this sample. Before the first answer
+      // the bridge (or the chain behind it) is still starting: wait without stepping.
+      const auto deadline = Clock::now() + (answered_once ? lockstep_timeout : std::chrono::milliseconds(100));
+      if (!board.wait_for_outputs(tick, deadline)) {
+        if (!answered_once) continue;
+        ++counters.overruns;
+        spdlog::warn("no board outputs for sample {} within {} s: the outputs as they are are applied",
+                     tick, cfg.plant.lockstep_timeout);
+      } else {
+        answered_once = true;
+      }
+    }
+    const auto outputs = board.read_outputs();
+    const std::uint32_t digital = outputs.outputs.digital_outputs;
+    const bool drives_enabled = (digital & bit(hb::DigitalOutput::drive_enable)) != 0;
+    plant::DriveInput input;
+    input.brakes_engaged = (digital & bit(hb::DigitalOutput::brake_release_trolley)) == 0 ||
+                           (digital & bit(hb::DigitalOutput::brake_release_slew)) == 0;
+    if (drives_enabled) {
+      input.trolley_voltage = board.output_volts(outputs, hb::AnalogOutput::trolley_drive);
+      input.slew_voltage = board.output_volts(outputs, hb::AnalogOutput::slew_drive);
+      if ((digital & bit(hb::DigitalOutput::brake_release_hoist)) != 0) {
+        input.hoist_speed = board.output_volts(outputs, hb::AnalogOutput::hoist_speed) *
+                            cfg.hardware_bridge.bridge.hoist_speed_per_volt;
+      }
+    }
+    if (simulator.step(input) != common::StepStatus::ok) {
+      spdlog::error("plant step at sample {} failed", tick);
+    }
+    ++counters.cycles;
+    counters.last_seq = counters.cycles;
+    tick = publish();
+    diagnostics.maybe_publish(counters, nullptr);
+  }
+  diagnostics.publish_final(counters, nullptr);
+  spdlog::info("stopping at t = {:.2f} s: {} samples, {} overruns, {} friction events", simulator.time(),
+               counters.cycles, counters.overruns, simulator.friction_event_count());
+  if (!stats_path.empty()) {
+    std::ofstream out(stats_path);
+    out << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns << "}\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -74,6 +163,10 @@ int main(int argc, char** argv) {
   app.add_option("--load-mass-factor", load_mass_factor,
                  "the simulated load mass is this times the configured one (controllers unaware)")
       ->check(CLI::Range(0.0, 10.0));
+  std::string board_uri;
+  app.add_option("--board", board_uri,
+                 "shm:NAME: sit behind the emulated interface board (the hardware bridge reads and writes it) "
+                 "instead of publishing sensors and reading actuators on DDS");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -92,6 +185,12 @@ int main(int argc, char** argv) {
                    truth.crane.cable_length, truth.crane.load_mass, cfg.crane.cable_length, cfg.crane.load_mass);
     }
     plant::CraneSimulator simulator(sim_params);
+    if (!board_uri.empty()) {
+      if (board_uri.rfind("shm:", 0) != 0) {
+        throw std::invalid_argument("--board " + board_uri + ": the plant can only sit behind an emulated board, shm:NAME");
+      }
+      return run_behind_board(board_uri.substr(4), cfg, truth, simulator, realtime, options, stats_path);
+    }
 
     auto participant = runtime::make_participant(options, "plant");
     transport::Wakeup wakeup;
@@ -210,8 +309,10 @@ int main(int argc, char** argv) {
       const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
       plant::DriveInput input;  // default: 0 V, brakes engaged
       if (command_valid && status_fresh && status.brakes_released() && status.motion_enabled()) {
-        input.trolley_voltage = command.trolley_voltage();
-        input.slew_voltage = command.slew_voltage();
+        // The supervisor's current limits (lowered near a travel limit: approach margins).
+        input.trolley_voltage = std::clamp(command.trolley_voltage(), -status.trolley_voltage_limit(),
+                                           status.trolley_voltage_limit());
+        input.slew_voltage = std::clamp(command.slew_voltage(), -status.slew_voltage_limit(), status.slew_voltage_limit());
         input.hoist_speed = command.hoist_speed();
         input.brakes_engaged = false;
       }

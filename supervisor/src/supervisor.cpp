@@ -1,7 +1,9 @@
 #include "crane/supervisor/supervisor.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <string>
 
 #include "crane/common/validation.hpp"
 
@@ -31,57 +33,188 @@ const char* mode_name(Mode mode) noexcept {
   return "unknown";
 }
 
+const char* fault_name(std::uint32_t fault_bit) noexcept {
+  switch (fault_bit) {
+    case kFaultStageSilent: return "stage_silent";
+    case kFaultTrolleyTravel: return "trolley_travel";
+    case kFaultVoltage: return "voltage";
+    case kFaultNonFinite: return "non_finite";
+    case kFaultEmergencyStop: return "emergency_stop";
+    case kFaultMultipleSensorWriters: return "multiple_sensor_writers";
+    case kFaultSwing: return "swing";
+    case kFaultSlewRange: return "slew_range";
+    case kFaultTrolleyOverspeed: return "trolley_overspeed";
+    case kFaultSlewOverspeed: return "slew_overspeed";
+    case kFaultVoltageRate: return "voltage_rate";
+    case kFaultMultipleActuatorWriters: return "multiple_actuator_writers";
+    case kFaultSensorSource: return "sensor_source";
+    case kFaultLimitSwitch: return "limit_switch";
+    default: return "unknown";
+  }
+}
+
+namespace {
+
+void validate_axis(const char* prefix, const char* speed_name, const AxisLimits& a) {
+  using common::require_in_range;
+  const std::string p = std::string("supervisor.") + prefix;
+  const double span = a.max - a.min;
+  require_in_range(p + "_approach_margin", a.approach_margin, 0.0, 0.5 * span);
+  require_in_range(p + "_stop_margin", a.stop_margin, 0.0, a.approach_margin);
+  require_in_range(p + "_" + speed_name, a.max_speed, 1e-3, 1e3);
+  require_in_range(p + "_approach_" + (speed_name == std::string("max_speed") ? "speed" : "rate"), a.approach_speed,
+                   0.0, a.max_speed);
+}
+
+struct AxisVerdict {
+  bool range_fault{false};     // outside the hard limits, or inside the stop margin moving toward one
+  bool overspeed{false};
+  bool approaching{false};     // inside the approach margin, moving toward the limit
+  bool speed_limited{false};   // and faster than the approach speed allows there
+};
+
+// Travel/slew limiter with approach margins (header: "approach margins").
+AxisVerdict check_axis(const AxisLimits& a, double position, double velocity) noexcept {
+  AxisVerdict v;
+  if (position < a.min || position > a.max) v.range_fault = true;
+  if (std::fabs(velocity) > a.max_speed) v.overspeed = true;
+  // "Moving toward": faster than a tenth of the approach speed (encoder quantization and the
+  // friction compensator's dither at rest stay below it).
+  const double moving = 0.1 * std::max(a.approach_speed, 1e-6);
+  double distance = 1e300;
+  if (velocity > moving) distance = a.max - position;
+  if (velocity < -moving) distance = position - a.min;
+  if (distance < a.stop_margin) v.range_fault = true;
+  if (distance < a.approach_margin) {
+    v.approaching = true;
+    const double width = a.approach_margin - a.stop_margin;
+    const double fraction = width > 0.0 ? std::clamp((distance - a.stop_margin) / width, 0.0, 1.0) : 0.0;
+    const double allowed = a.approach_speed + (a.max_speed - a.approach_speed) * fraction;
+    if (std::fabs(velocity) > allowed) v.speed_limited = true;
+  }
+  return v;
+}
+
+}  // namespace
+
 void validate(const SupervisorParams& p) {
   using common::require_in_range;
   require_in_range("supervisor.trolley_min", p.trolley_min, -100.0, 100.0);
   require_in_range("supervisor.trolley_max", p.trolley_max, p.trolley_min + 1e-3, 100.0);
+  validate_axis("trolley", "max_speed", p.trolley());
+  require_in_range("supervisor.slew_min", p.slew_min, -100.0, 100.0);
+  require_in_range("supervisor.slew_max", p.slew_max, p.slew_min + 1e-3, 100.0);
+  validate_axis("slew", "max_rate", p.slew());
   require_in_range("supervisor.voltage_limit", p.voltage_limit, 0.1, 100.0);
+  require_in_range("supervisor.approach_voltage_limit", p.approach_voltage_limit, 0.0, p.voltage_limit);
+  require_in_range("supervisor.max_voltage_rate", p.max_voltage_rate, 1.0, 1e6);
   require_in_range("supervisor.max_swing", p.max_swing, 0.01, 1.5);
   require_in_range("supervisor.stage_timeout", p.stage_timeout, 0.005, 5.0);
   require_in_range("supervisor.lockstep_stage_timeout", p.lockstep_stage_timeout, p.stage_timeout, 60.0);
+  require_in_range("supervisor.sample_period", p.sample_period, 1e-4, 1.0);
+  require_in_range("supervisor.expected_sensor_source", p.expected_sensor_source, 0.0, 2.0);
 }
 
 Supervisor::Supervisor(const SupervisorParams& params) : params_(params) { validate(params_); }
 
 void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept {
   std::uint32_t alive_mask = 0;
+  std::uint32_t warnings = 0;
   for (std::size_t i = 0; i < kStageCount; ++i) {
     const auto& s = in.stages[i];
     if (s.alive && s.seconds_since_sample <= params_.stage_timeout) alive_mask |= 1U << i;
+    if (s.deadline_missed) warnings |= kWarningStageLate;
   }
   const std::uint32_t all_alive = (1U << kStageCount) - 1U;
   const bool chain_healthy = alive_mask == all_alive;
 
+  // Velocities from the sensor stream itself (seq differences), not from the state estimator.
+  const bool finite_sensors = std::isfinite(in.trolley_position) && std::isfinite(in.slew_angle);
+  if (in.sensors_valid && finite_sensors) {
+    if (have_previous_sample_ && in.sensor_seq > previous_sensor_seq_) {
+      const double dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
+      trolley_velocity_ = (in.trolley_position - previous_trolley_) / dt;
+      slew_rate_ = (in.slew_angle - previous_slew_) / dt;
+    } else if (!have_previous_sample_ || in.sensor_seq < previous_sensor_seq_) {
+      trolley_velocity_ = 0.0;  // first sample, or the sensor writer restarted
+      slew_rate_ = 0.0;
+    }
+    have_previous_sample_ = true;
+    previous_sensor_seq_ = in.sensor_seq;
+    previous_trolley_ = in.trolley_position;
+    previous_slew_ = in.slew_angle;
+  }
+
   std::uint32_t active = 0;
   // A stage that dies after the chain was up is a fault; during start-up it only keeps us waiting.
   if (!chain_healthy && mode_ != Mode::starting) active |= kFaultStageSilent;
-  if (in.sensors_valid && std::isfinite(in.trolley_position) &&
-      (in.trolley_position < params_.trolley_min || in.trolley_position > params_.trolley_max)) {
-    active |= kFaultTrolleyTravel;
+  double trolley_limit = params_.voltage_limit;
+  double slew_limit = params_.voltage_limit;
+  if (in.sensors_valid && finite_sensors) {
+    const AxisVerdict trolley = check_axis(params_.trolley(), in.trolley_position, trolley_velocity_);
+    const AxisVerdict slew = check_axis(params_.slew(), in.slew_angle, slew_rate_);
+    if (trolley.range_fault) active |= kFaultTrolleyTravel;
+    if (trolley.overspeed) active |= kFaultTrolleyOverspeed;
+    if (slew.range_fault) active |= kFaultSlewRange;
+    if (slew.overspeed) active |= kFaultSlewOverspeed;
+    if (trolley.approaching) warnings |= kWarningTrolleyApproach;
+    if (slew.approaching) warnings |= kWarningSlewApproach;
+    if (trolley.speed_limited) trolley_limit = params_.approach_voltage_limit;
+    if (slew.speed_limited) slew_limit = params_.approach_voltage_limit;
+    if (trolley.speed_limited || slew.speed_limited) warnings |= kWarningSpeedLimited;
+    if (std::fabs(in.swing_in_plane) > params_.max_swing || std::fabs(in.swing_out_of_plane) > params_.max_swing) {
+      active |= kFaultSwing;
+    }
+    if (in.limit_switches != 0) active |= kFaultLimitSwitch;
+    if (params_.expected_sensor_source != 0 && in.sensor_source != params_.expected_sensor_source) {
+      active |= kFaultSensorSource;
+    }
   }
-  if (std::fabs(in.trolley_voltage) > params_.voltage_limit + 1e-9 ||
-      std::fabs(in.slew_voltage) > params_.voltage_limit + 1e-9) {
-    active |= kFaultVoltage;
-  }
-  if (in.sensors_valid &&
-      (std::fabs(in.swing_in_plane) > params_.max_swing || std::fabs(in.swing_out_of_plane) > params_.max_swing)) {
-    active |= kFaultSwing;
+  if (in.actuators_valid) {
+    if (std::fabs(in.trolley_voltage) > params_.voltage_limit + 1e-9 ||
+        std::fabs(in.slew_voltage) > params_.voltage_limit + 1e-9) {
+      active |= kFaultVoltage;
+    }
+    if (have_previous_command_ && in.actuator_seq > previous_actuator_seq_) {
+      const double dt = static_cast<double>(in.actuator_seq - previous_actuator_seq_) * params_.sample_period;
+      const double rate = std::max(std::fabs(in.trolley_voltage - previous_trolley_voltage_),
+                                   std::fabs(in.slew_voltage - previous_slew_voltage_)) / dt;
+      if (rate > params_.max_voltage_rate) active |= kFaultVoltageRate;
+    }
+    if (std::isfinite(in.trolley_voltage) && std::isfinite(in.slew_voltage)) {
+      have_previous_command_ = true;
+      previous_actuator_seq_ = in.actuator_seq;
+      previous_trolley_voltage_ = in.trolley_voltage;
+      previous_slew_voltage_ = in.slew_voltage;
+    }
   }
   if (in.nonfinite_seen) active |= kFaultNonFinite;
   if (in.emergency_stop_input || in.command == Command::emergency_stop) active |= kFaultEmergencyStop;
   if (in.sensor_writers > 1) active |= kFaultMultipleSensorWriters;
+  if (in.actuator_writers > 1) active |= kFaultMultipleActuatorWriters;
 
   newly_raised_ = active & ~previous_active_;
+  newly_cleared_ = previous_active_ & ~active;
   fault_count_ += static_cast<std::uint32_t>(std::popcount(newly_raised_));
+  if (newly_raised_ != 0) {
+    last_fault_ = std::bit_floor(newly_raised_);  // the highest-numbered new bit when several at once
+    last_fault_seq_ = in.sensor_seq;
+  }
   previous_active_ = active;
   latched_ |= active;
 
+  bool refused = false;
   switch (in.command) {
-    case Command::arm: armed_ = true; break;
+    case Command::arm:
+      // Arming needs a healthy chain and nothing latched (a reset comes first).
+      refused = !chain_healthy || latched_ != 0;
+      if (!refused) armed_ = true;
+      break;
     case Command::disarm: armed_ = false; break;
     case Command::reset:
       // A reset clears latched faults only when nothing is active and the chain is healthy.
-      if (active == 0 && chain_healthy) latched_ = 0;
+      refused = active != 0 || !chain_healthy;
+      if (!refused) latched_ = 0;
       break;
     case Command::emergency_stop:
     case Command::none: break;
@@ -103,11 +236,21 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   const bool enabled = mode_ == Mode::ready || mode_ == Mode::operating;
   out.mode = mode_;
   out.motion_enabled = enabled;
-  out.brakes_released = enabled;
+  // The brakes open one cycle after the drives were enabled, with the chain still alive.
+  out.brakes_released = enabled && drives_enabled_previous_;
+  drives_enabled_previous_ = enabled;
   out.active_faults = active;
   out.latched_faults = latched_;
   out.fault_count = fault_count_;
   out.stages_alive = alive_mask;
+  out.warnings = warnings;
+  out.last_fault = last_fault_;
+  out.last_fault_seq = last_fault_seq_;
+  out.trolley_voltage_limit = enabled ? trolley_limit : 0.0;
+  out.slew_voltage_limit = enabled ? slew_limit : 0.0;
+  out.trolley_velocity = trolley_velocity_;
+  out.slew_rate = slew_rate_;
+  out.command_refused = refused;
 }
 
 }  // namespace crane::supervisor

@@ -38,6 +38,7 @@ sv::SupervisorInput healthy_input() {
   }
   in.sensors_valid = true;
   in.trolley_position = 0.5;  // inside [0.05, 1.30]
+  in.actuators_valid = true;
   return in;
 }
 
@@ -55,8 +56,12 @@ sv::SupervisorInput with_command(sv::SupervisorInput in, sv::Command command) {
 /// A supervisor (default params, arm_on_start) that has reached ready.
 sv::Supervisor ready_supervisor(const sv::SupervisorParams& params = {}) {
   sv::Supervisor supervisor(params);
-  const auto out = step(supervisor, healthy_input());
+  auto out = step(supervisor, healthy_input());
   EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_FALSE(out.brakes_released) << "brakes open only a cycle after the drives are enabled";
+  out = step(supervisor, healthy_input());
+  EXPECT_TRUE(out.brakes_released);
   return supervisor;
 }
 
@@ -107,12 +112,16 @@ TEST(Supervisor, StartingUntilAllSixStagesAlive) {
     EXPECT_EQ(out.stages_alive, kAllStages & ~(1U << dead));
   }
 
-  // All six alive, the oldest sample exactly at the timeout (the rule is <=): ready at once.
+  // All six alive, the oldest sample exactly at the timeout (the rule is <=): ready at once, drives
+  // enabled; the brakes open in the next cycle with the chain still alive.
   auto in = healthy_input();
   in.stages[3].seconds_since_sample = 0.05;
   out = step(supervisor, in);
   EXPECT_EQ(out.stages_alive, kAllStages);
   EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_FALSE(out.brakes_released);
+  EXPECT_TRUE(out.motion_enabled);
+  out = step(supervisor, in);
   EXPECT_TRUE(out.brakes_released);
   EXPECT_TRUE(out.motion_enabled);
   EXPECT_EQ(out.active_faults, 0U);
@@ -131,10 +140,13 @@ TEST(Supervisor, WithoutArmOnStartStaysInStandbyUntilArmed) {
   }
   auto out = step(supervisor, with_command(healthy_input(), sv::Command::arm));
   EXPECT_EQ(out.mode, sv::Mode::ready);
-  EXPECT_TRUE(out.brakes_released);
-  // Armed stays armed without repeating the command.
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_FALSE(out.brakes_released);
+  EXPECT_FALSE(out.command_refused);
+  // Armed stays armed without repeating the command; the brakes open one cycle after the drives.
   out = step(supervisor, healthy_input());
   EXPECT_EQ(out.mode, sv::Mode::ready);
+  EXPECT_TRUE(out.brakes_released);
   // Disarm: back to standby, brakes on.
   out = step(supervisor, with_command(healthy_input(), sv::Command::disarm));
   EXPECT_EQ(out.mode, sv::Mode::standby);
@@ -185,12 +197,14 @@ TEST(Supervisor, SilentStageAfterReadyFaultsAndLatches) {
   EXPECT_EQ(out.mode, sv::Mode::fault);
   expect_stopped(out);
 
-  // Reset with a healthy chain: cleared, back to ready (armed on start), brakes released.
+  // Reset with a healthy chain: cleared, back to ready (armed on start), drives enabled, brakes
+  // released in the next cycle.
   out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
   EXPECT_EQ(out.latched_faults, 0U);
   EXPECT_EQ(out.mode, sv::Mode::ready);
-  EXPECT_TRUE(out.brakes_released);
   EXPECT_TRUE(out.motion_enabled);
+  out = step(supervisor, healthy_input());
+  EXPECT_TRUE(out.brakes_released);
   EXPECT_EQ(out.fault_count, 1U);  // the history is kept
 }
 
@@ -358,7 +372,8 @@ TEST(Supervisor, EmergencyStopCommandBrakesAtOnceAndNeedsReset) {
 
   out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
   EXPECT_EQ(out.mode, sv::Mode::ready);
-  EXPECT_TRUE(out.brakes_released);
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_TRUE(step(supervisor, healthy_input()).brakes_released);
 }
 
 TEST(Supervisor, EmergencyStopInputHeldBlocksReset) {
@@ -472,6 +487,7 @@ TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
     // Per-sequence disturbance rate: some sequences are mostly healthy, some chaotic.
     const double disturbance = uniform(0.0, 0.3);
     std::uint32_t previous_count = 0;
+    bool previous_enabled = false;
     for (int k = 0; k < kStepsPerSequence; ++k) {
       auto in = healthy_input();
       for (auto& s : in.stages) {
@@ -510,7 +526,11 @@ TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
       } else {
         ++fault_steps;
       }
-      ASSERT_EQ(out.motion_enabled, out.brakes_released) << "sequence " << sequence << " step " << k;
+      // Brakes open only with the drives enabled in this and the previous cycle.
+      if (out.brakes_released) {
+        ASSERT_TRUE(out.motion_enabled && previous_enabled) << "sequence " << sequence << " step " << k;
+      }
+      previous_enabled = out.motion_enabled;
       ASSERT_EQ(out.fault_count, previous_count + static_cast<std::uint32_t>(std::popcount(supervisor.newly_raised())))
           << "sequence " << sequence << " step " << k;
       if (in.emergency_stop_input || in.command == sv::Command::emergency_stop) {
@@ -523,4 +543,223 @@ TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
   // The property must not hold vacuously: both outcomes occur many times.
   EXPECT_GT(released_steps, kRandomSequences * kStepsPerSequence / 10);
   EXPECT_GT(fault_steps, kRandomSequences * kStepsPerSequence / 10);
+}
+
+// ---- Protective functions with approach margins (header: "approach margins") ----
+
+namespace {
+
+/// Feeds two sensor samples one cycle apart so that the supervisor's own differentiation sees
+/// `velocity` [m/s] at `position` [m] (trolley), returns the second step's output.
+sv::SupervisorOutput trolley_at(sv::Supervisor& supervisor, double position, double velocity, std::uint64_t& seq) {
+  auto in = healthy_input();
+  seq += 100000;  // a long gap first: whatever came before differentiates to a negligible velocity
+  in.sensor_seq = seq++;
+  in.trolley_position = position - velocity * 0.01;
+  step(supervisor, in);
+  in.sensor_seq = seq++;
+  in.trolley_position = position;
+  return step(supervisor, in);
+}
+
+}  // namespace
+
+TEST(SupervisorLimits, VelocityIsDifferentiatedFromTheSensorSamples) {
+  auto supervisor = ready_supervisor();
+  std::uint64_t seq = 100;
+  const auto out = trolley_at(supervisor, 0.6, 0.3, seq);
+  EXPECT_NEAR(out.trolley_velocity, 0.3, 1e-9);
+  // A gap of three cycles: the difference is divided by 3 sample periods.
+  auto in = healthy_input();
+  in.sensor_seq = seq + 2;
+  in.trolley_position = 0.6 + 3 * 0.01 * (-0.2);
+  in.slew_angle = 0.03;  // from 0 over 3 cycles: 1 rad/s
+  const auto later = step(supervisor, in);
+  EXPECT_NEAR(later.trolley_velocity, -0.2, 1e-9);
+  EXPECT_NEAR(later.slew_rate, 1.0, 1e-9);
+}
+
+TEST(SupervisorLimits, ApproachMarginLowersTheVoltageLimitOnlyWhenTooFastTowardTheLimit) {
+  // trolley_max 1.30, approach 0.15, stop 0.03, approach speed 0.1, max speed 0.8: at 1.21 m the
+  // distance is 0.09 m, half way through the band: allowed 0.1 + 0.7 * 0.5 = 0.45 m/s.
+  const sv::SupervisorParams p;
+  std::uint64_t seq = 1;
+  auto supervisor = ready_supervisor();
+  auto out = trolley_at(supervisor, 1.21, 0.40, seq);  // below the allowed speed
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_TRUE(out.warnings & sv::kWarningTrolleyApproach);
+  EXPECT_FALSE(out.warnings & sv::kWarningSpeedLimited);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  out = trolley_at(supervisor, 1.21, 0.50, seq);  // above it: the drive may only brake
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.approach_voltage_limit);
+  EXPECT_DOUBLE_EQ(out.slew_voltage_limit, p.voltage_limit);
+  EXPECT_TRUE(out.brakes_released);
+  // Moving away from the limit at the same place: no warning, full voltage.
+  out = trolley_at(supervisor, 1.21, -0.50, seq);
+  EXPECT_EQ(out.warnings & (sv::kWarningTrolleyApproach | sv::kWarningSpeedLimited), 0U);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  // Near the lower limit, moving toward it: the same rule mirrored (0.14 m: 0.09 m from 0.05 m).
+  out = trolley_at(supervisor, 0.14, -0.50, seq);
+  EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.approach_voltage_limit);
+}
+
+TEST(SupervisorLimits, InsideTheStopMarginMovingTowardTheLimitIsAProtectiveStop) {
+  std::uint64_t seq = 1;
+  auto supervisor = ready_supervisor();
+  // 1.28 m: 0.02 m from trolley_max, inside the 0.03 m stop margin, but standing still (the
+  // compensator's dither is far below 0.1 * approach speed): allowed to stay there.
+  auto out = trolley_at(supervisor, 1.28, 0.001, seq);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_TRUE(out.brakes_released);
+  // Moving away: fine.
+  out = trolley_at(supervisor, 1.28, -0.05, seq);
+  EXPECT_EQ(out.active_faults, 0U);
+  // Creeping toward it: protective stop, latched.
+  out = trolley_at(supervisor, 1.28, 0.02, seq);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyTravel));
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+  EXPECT_EQ(out.trolley_voltage_limit, 0.0);
+  EXPECT_EQ(out.last_fault, static_cast<std::uint32_t>(sv::kFaultTrolleyTravel));
+  EXPECT_EQ(out.last_fault_seq, seq - 1);
+}
+
+TEST(SupervisorLimits, SlewRangeAndOverspeed) {
+  const sv::SupervisorParams p;  // slew [-3.3, 3.3] rad, max rate 1.6 rad/s
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.sensor_seq = 100000;  // long after the last sample: a negligible rate from the jump to 3 rad
+  in.slew_angle = 3.2;
+  step(supervisor, in);
+  in.sensor_seq = 100001;
+  // 1.5 rad/s toward the limit, 0.085 rad from it: allowed 0.2 + 1.4 * (0.085 - 0.05) / 0.25 = 0.396 rad/s.
+  in.slew_angle = 3.2 + 0.01 * 1.5;
+  auto out = step(supervisor, in);
+  EXPECT_TRUE(out.warnings & sv::kWarningSlewApproach);
+  EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
+  EXPECT_DOUBLE_EQ(out.slew_voltage_limit, p.approach_voltage_limit);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  EXPECT_EQ(out.active_faults, 0U);
+  in.sensor_seq = 100002;
+  in.slew_angle += 0.01 * 1.7;  // 1.7 rad/s > 1.6: overspeed
+  out = step(supervisor, in);
+  EXPECT_TRUE(out.active_faults & sv::kFaultSlewOverspeed);
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+
+  auto range = ready_supervisor();
+  in = healthy_input();
+  in.slew_angle = -3.31;
+  out = step(range, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultSlewRange));
+}
+
+TEST(SupervisorLimits, TrolleyOverspeed) {
+  std::uint64_t seq = 1;
+  auto supervisor = ready_supervisor();
+  EXPECT_EQ(trolley_at(supervisor, 0.6, 0.79, seq).active_faults, 0U);
+  const auto out = trolley_at(supervisor, 0.6, -0.81, seq);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed));
+  expect_stopped(out);
+}
+
+TEST(SupervisorLimits, VoltageRateOfChange) {
+  // max_voltage_rate 1500 V/s: 15 V between consecutive cycles.
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.actuator_seq = 10;
+  in.trolley_voltage = 10.0;
+  EXPECT_EQ(step(supervisor, in).active_faults, 0U);
+  in.actuator_seq = 11;
+  in.trolley_voltage = -4.9;  // 14.9 V in one cycle: allowed
+  EXPECT_EQ(step(supervisor, in).active_faults, 0U);
+  in.actuator_seq = 13;
+  in.trolley_voltage = 10.0;  // 14.9 V over two cycles: 745 V/s
+  EXPECT_EQ(step(supervisor, in).active_faults, 0U);
+  in.actuator_seq = 14;
+  in.slew_voltage = -5.5;
+  in.trolley_voltage = 10.0;  // slew 5.5 V: fine
+  EXPECT_EQ(step(supervisor, in).active_faults, 0U);
+  in.actuator_seq = 15;
+  in.slew_voltage = 9.6;  // 15.1 V in one cycle on the slew
+  const auto out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultVoltageRate));
+  expect_stopped(out);
+}
+
+TEST(SupervisorLimits, SingleWriterSourceAndLimitSwitchChecks) {
+  struct Case {
+    const char* name;
+    void (*apply)(sv::SupervisorInput&);
+    std::uint32_t fault;
+  };
+  const Case cases[] = {
+      {"second actuator writer", [](sv::SupervisorInput& in) { in.actuator_writers = 2; },
+       sv::kFaultMultipleActuatorWriters},
+      {"second sensor writer", [](sv::SupervisorInput& in) { in.sensor_writers = 2; }, sv::kFaultMultipleSensorWriters},
+      {"limit switch", [](sv::SupervisorInput& in) { in.limit_switches = 0x2; }, sv::kFaultLimitSwitch},
+      {"plant where the bridge is expected", [](sv::SupervisorInput& in) { in.sensor_source = 1; },
+       sv::kFaultSensorSource},
+  };
+  sv::SupervisorParams params;
+  params.expected_sensor_source = 2;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    sv::Supervisor supervisor(params);
+    auto healthy = healthy_input();
+    healthy.sensor_source = 2;
+    step(supervisor, healthy);
+    ASSERT_TRUE(step(supervisor, healthy).brakes_released);
+    auto in = healthy;
+    c.apply(in);
+    const auto out = step(supervisor, in);
+    EXPECT_EQ(out.active_faults, c.fault);
+    EXPECT_EQ(out.last_fault, c.fault);
+    EXPECT_STREQ(sv::fault_name(c.fault), sv::fault_name(out.last_fault));
+    expect_stopped(out);
+  }
+}
+
+TEST(SupervisorLimits, ArmAndResetAreRefusedWhileUnsafe) {
+  sv::SupervisorParams params;
+  params.arm_on_start = false;
+  sv::Supervisor supervisor(params);
+  auto dead = healthy_input();
+  dead.stages[2].alive = false;
+  auto out = step(supervisor, with_command(dead, sv::Command::arm));
+  EXPECT_TRUE(out.command_refused);
+  out = step(supervisor, healthy_input());
+  EXPECT_EQ(out.mode, sv::Mode::standby) << "a refused arm is not remembered";
+  out = step(supervisor, with_command(healthy_input(), sv::Command::arm));
+  EXPECT_FALSE(out.command_refused);
+  auto tilted = healthy_input();
+  tilted.swing_in_plane = 0.5;
+  out = step(supervisor, with_command(tilted, sv::Command::reset));
+  EXPECT_TRUE(out.command_refused) << "reset with the swing fault still active";
+  out = step(supervisor, with_command(healthy_input(), sv::Command::arm));
+  EXPECT_TRUE(out.command_refused) << "arm with a latched fault";
+  out = step(supervisor, with_command(healthy_input(), sv::Command::reset));
+  EXPECT_FALSE(out.command_refused);
+  EXPECT_EQ(out.mode, sv::Mode::ready);
+}
+
+TEST(SupervisorLimits, NamesOfEveryFaultBit) {
+  for (int bit = 0; bit < sv::kFaultBits; ++bit) {
+    EXPECT_STRNE(sv::fault_name(1U << bit), "unknown") << "bit " << bit;
+  }
+  EXPECT_STREQ(sv::fault_name(1U << sv::kFaultBits), "unknown");
+  EXPECT_STREQ(sv::fault_name(3U), "unknown");
+}
+
+TEST(SupervisorLimits, ValidationNamesTheMarginField) {
+  sv::SupervisorParams params;
+  params.trolley_stop_margin = 0.2;  // larger than the approach margin 0.15
+  EXPECT_NE(config_error_message(params).find("supervisor.trolley_stop_margin"), std::string::npos)
+      << config_error_message(params);
+  params = {};
+  params.slew_approach_rate = 2.0;  // above slew_max_rate 1.6
+  EXPECT_NE(config_error_message(params).find("supervisor.slew_approach_rate"), std::string::npos)
+      << config_error_message(params);
 }

@@ -38,6 +38,7 @@ struct DemoOptions {
   std::vector<std::string> maneuvers;
   std::string compensation{"both"};
   bool realtime{false};
+  std::string hardware;  // empty: plant on DDS; "shm": hardware_bridge + emulated board + plant behind it
   unsigned domain_id{0};
   std::string plot_script;
   std::string python{"/usr/bin/python3"};
@@ -191,6 +192,9 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.plant_load_mass_factor = options.plant_load_mass_factor;
   stack.anti_swing_controller = options.anti_swing_controller;
   stack.tracking_controller = options.tracking_controller;
+  stack.fault_log_path = (log_dir / "faults.jsonl").string();
+  // One emulated board per run, named after this process so parallel demos do not share one.
+  if (options.hardware == "shm") stack.hardware = "shm:demo_" + std::to_string(getpid());
 
   RunResult result;
   result.maneuver = m.name;
@@ -200,7 +204,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   launch::ProcessGroup group;
   op.drain_all();
   op.forget_status();
-  for (const auto& spec : launch::simulated_stack(stack)) {
+  for (const auto& spec : launch::stack_processes(stack)) {
     const pid_t pid = group.start(spec);
     result.processes.push_back(ProcessRecord{spec.name, pid, options.dds, run_name});
   }
@@ -209,7 +213,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   //    itself receives every stream it records from this run's processes (its own discovery of a
   //    fresh stack can lag the stages' discovery of each other by up to an announcement period,
   //    which in lockstep is hundreds of cycles).
-  const auto plant_pid = result.processes.back().pid;  // the plant starts last
+  const auto plant_pid = result.processes.back().pid;  // the sensor writer (plant or bridge) starts last
   Recording rec;
   const auto ready_deadline = Clock::now() + std::chrono::duration<double>(options.ready_timeout);
   while (true) {
@@ -305,7 +309,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     // The supervisor runs on its own wall-clock timer, outside the data-driven chain.
     (p.name == "supervisor" ? result.supervisor_timer_overruns : result.overruns) += found->second.overruns();
     result.nonfinite_rejected += found->second.nonfinite_rejected();
-    if (p.name == "plant") result.cycles = found->second.cycles();
+    if (p.name == (stack.hardware.empty() ? "plant" : "hardware_bridge")) result.cycles = found->second.cycles();
   }
   result.diagnostics_complete = reported == result.processes.size();
   {
@@ -401,6 +405,10 @@ int main(int argc, char** argv) {
   app.add_option("--friction-compensation", options.compensation, "on | off | both")
       ->check(CLI::IsMember({"on", "off", "both"}));
   app.add_flag("--realtime", options.realtime, "plant on absolute 10 ms deadlines instead of lockstep");
+  app.add_option("--hardware", options.hardware,
+                 "shm: run through the real hardware_bridge process against the emulated board, with the plant "
+                 "behind it (hardware-in-the-loop), instead of the plant on DDS")
+      ->check(CLI::IsMember({"shm"}));
   app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
@@ -481,6 +489,7 @@ int main(int argc, char** argv) {
     json summary;
     summary["config"] = fs::absolute(options.config_path).string();
     summary["clock"] = options.realtime ? "realtime" : "lockstep";
+    summary["sensor_writer"] = options.hardware.empty() ? "plant" : "hardware_bridge (emulated board, plant behind it)";
     summary["dds"] = options.dds;
     summary["profile"] = options.profile;
     summary["plant_cable_length_factor"] = options.plant_cable_length_factor;

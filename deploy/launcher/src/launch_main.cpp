@@ -1,4 +1,6 @@
-// crane_launch: runs the simulated stack until Ctrl-C. Starts every stage as its own OS process,
+// crane_launch: runs the crane stack until Ctrl-C, on the simulated plant (--sim, the default) or
+// on a board through the hardware bridge (--hardware comedi:/dev/comediN, or --hardware shm:NAME
+// which also starts the simulated plant behind the emulated board). Starts every stage as its own OS process,
 // waits until all are matched and alive (the supervisor reports every stage alive), then watches:
 // on Ctrl-C (SIGINT/SIGTERM) or on the death of any stage it stops all of them by pid (SIGTERM,
 // then SIGKILL after a grace period) and exits. Goals are sent by any DDS participant on
@@ -18,14 +20,20 @@ int main(int argc, char** argv) {
   using namespace crane;
   namespace tp = transport::topics;
   using Clock = std::chrono::steady_clock;
-  CLI::App app{"crane_launch: run the simulated crane stack (each stage its own process) until Ctrl-C"};
+  CLI::App app{"crane_launch: run the crane stack (each stage its own process) until Ctrl-C"};
   launch::StackOptions stack;
   bool lockstep = false;
   bool no_compensation = false;
   double ready_timeout = 60.0;
   std::string log_dir = "crane-logs";
-  bool simulated = true;
-  app.add_flag("--sim", simulated, "simulated plant as the sensor writer (the default; the hardware bridge comes later)");
+  bool simulated = false;
+  auto* sim_flag = app.add_flag("--sim", simulated, "simulated plant as the sensor writer on DDS (the default)");
+  app.add_option("--hardware", stack.hardware,
+                 "the hardware bridge on this board: comedi:/dev/comediN (a DAQ board) or shm:NAME (the emulated "
+                 "board, with the simulated plant behind it)")
+      ->excludes(sim_flag);
+  std::string fault_log;
+  app.add_option("--fault-log", fault_log, "the supervisor's fault log (JSON lines; default <log-dir>/faults.jsonl)");
   app.add_option("--config", stack.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone");
   app.add_option("--domain", stack.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
@@ -44,6 +52,9 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(log_dir);
     stack.config_path = std::filesystem::absolute(stack.config_path).string();
     stack.log_directory = std::filesystem::absolute(log_dir).string();
+    stack.fault_log_path =
+        std::filesystem::absolute(fault_log.empty() ? std::filesystem::path(log_dir) / "faults.jsonl"
+                                                     : std::filesystem::path(fault_log)).string();
     stack.binary_directory = launch::executable_directory();
 
     runtime::NodeOptions node;
@@ -55,7 +66,7 @@ int main(int argc, char** argv) {
     auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
 
     launch::ProcessGroup group;
-    for (const auto& spec : launch::simulated_stack(stack)) {
+    for (const auto& spec : launch::stack_processes(stack)) {
       const pid_t pid = group.start(spec);
       spdlog::info("started {} (pid {}), log {}", spec.name, pid, spec.log_path);
     }

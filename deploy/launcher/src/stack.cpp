@@ -1,14 +1,9 @@
 #include "crane/launch/stack.hpp"
 
 #include <cstdio>
+#include <stdexcept>
 
 namespace crane::launch {
-
-const std::vector<std::string>& simulated_stage_names() {
-  static const std::vector<std::string> names{"supervisor", "friction_compensation", "tracking", "anti_swing",
-                                              "trajectory_planner", "state_estimator", "plant"};
-  return names;
-}
 
 namespace {
 std::string number(double value) {
@@ -16,11 +11,33 @@ std::string number(double value) {
   std::snprintf(buffer, sizeof(buffer), "%.17g", value);
   return buffer;
 }
+
+bool is_shm(const std::string& hardware) { return hardware.rfind("shm:", 0) == 0 && hardware.size() > 4; }
+bool is_comedi(const std::string& hardware) { return hardware.rfind("comedi:", 0) == 0 && hardware.size() > 7; }
 }  // namespace
 
-std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
+std::vector<std::string> stack_process_names(const StackOptions& o) {
+  std::vector<std::string> names{"supervisor",         "friction_compensation", "tracking", "anti_swing",
+                                 "trajectory_planner", "state_estimator"};
+  if (o.hardware.empty()) {
+    names.push_back("plant");
+  } else if (is_shm(o.hardware)) {
+    names.push_back("plant");  // behind the emulated board: it must exist before the bridge opens it
+    names.push_back("hardware_bridge");
+  } else if (is_comedi(o.hardware)) {
+    names.push_back("hardware_bridge");
+  } else {
+    throw std::invalid_argument("hardware '" + o.hardware +
+                                "' is not a board: use shm:NAME (emulated board, plant behind it) or "
+                                "comedi:/dev/comediN (a DAQ board)");
+  }
+  return names;
+}
+
+std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
   std::vector<ProcessSpec> specs;
-  for (const auto& name : simulated_stage_names()) {
+  const bool bridge = !o.hardware.empty();
+  for (const auto& name : stack_process_names(o)) {
     ProcessSpec spec;
     spec.name = name;
     spec.executable = o.binary_directory + "/" + name;
@@ -31,14 +48,27 @@ std::vector<ProcessSpec> simulated_stack(const StackOptions& o) {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),
                                                    "--initial-slew", number(o.initial_slew_angle)});
-      if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
+      if (!bridge && !o.plant_stats_path.empty()) {
+        spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
+      }
       if (o.plant_cable_length_factor != 1.0 || o.plant_load_mass_factor != 1.0) {
         spec.arguments.insert(spec.arguments.end(), {"--cable-length-factor", number(o.plant_cable_length_factor),
                                                      "--load-mass-factor", number(o.plant_load_mass_factor)});
       }
+      if (bridge) spec.arguments.insert(spec.arguments.end(), {"--board", o.hardware});
+    }
+    if (name == "hardware_bridge") {
+      spec.arguments.insert(spec.arguments.end(), {"--board", o.hardware});
+      // Behind the emulated board in lockstep, the board's sample clock paces the bridge.
+      spec.arguments.insert(spec.arguments.end(), {"--clock", is_shm(o.hardware) && o.lockstep ? "board" : "timer"});
+      if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
     }
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
-    if (name == "supervisor" && o.lockstep) spec.arguments.push_back("--lockstep");
+    if (name == "supervisor") {
+      if (o.lockstep) spec.arguments.push_back("--lockstep");
+      spec.arguments.insert(spec.arguments.end(), {"--sensor-source", bridge ? "bridge" : "plant"});
+      if (!o.fault_log_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--fault-log", o.fault_log_path});
+    }
     if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});
     }

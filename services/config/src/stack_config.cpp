@@ -67,11 +67,24 @@ PlantConfig read_plant(YamlSection s) {
   return p;
 }
 
-supervisor::SupervisorParams read_supervisor(YamlSection s) {
+supervisor::SupervisorParams read_supervisor(YamlSection s, double sample_period) {
   supervisor::SupervisorParams p;
+  p.sample_period = sample_period;
   p.trolley_min = s.number("trolley_min", -100.0, 100.0);
   p.trolley_max = s.number("trolley_max", -100.0, 100.0);
+  p.trolley_approach_margin = s.number("trolley_approach_margin", 0.0, 100.0);
+  p.trolley_stop_margin = s.number("trolley_stop_margin", 0.0, 100.0);
+  p.trolley_approach_speed = s.number("trolley_approach_speed", 0.0, 100.0);
+  p.trolley_max_speed = s.number("trolley_max_speed", 1e-3, 100.0);
+  p.slew_min = s.number("slew_min", -100.0, 100.0);
+  p.slew_max = s.number("slew_max", -100.0, 100.0);
+  p.slew_approach_margin = s.number("slew_approach_margin", 0.0, 100.0);
+  p.slew_stop_margin = s.number("slew_stop_margin", 0.0, 100.0);
+  p.slew_approach_rate = s.number("slew_approach_rate", 0.0, 100.0);
+  p.slew_max_rate = s.number("slew_max_rate", 1e-3, 100.0);
   p.voltage_limit = s.number("voltage_limit", 0.1, 100.0);
+  p.approach_voltage_limit = s.number("approach_voltage_limit", 0.0, 100.0);
+  p.max_voltage_rate = s.number("max_voltage_rate", 1.0, 1e6);
   p.max_swing = s.number("max_swing", 0.01, 1.5);
   p.stage_timeout = s.number("stage_timeout", 0.005, 5.0);
   p.lockstep_stage_timeout = s.number("lockstep_stage_timeout", p.stage_timeout, 60.0);
@@ -183,17 +196,66 @@ ManeuverConfig read_maneuver(YamlSection s) {
   return m;
 }
 
+HardwareBridgeConfig read_hardware_bridge(YamlSection s, const PlantConfig& plant, double voltage_limit) {
+  namespace hb = hardware_bridge;
+  HardwareBridgeConfig c;
+  c.bridge.sample_period = plant.sample_period;
+  c.bridge.max_drive_voltage = voltage_limit;
+  c.bridge.watchdog_timeout = s.number("watchdog_timeout", plant.sample_period, 1.0);
+  c.bridge.status_timeout = s.number("status_timeout", plant.sample_period, 1.0);
+  c.bridge.hoist_speed_limit = s.number("hoist_speed_limit", 1e-3, 100.0);
+  c.bridge.hoist_speed_per_volt = s.number("hoist_speed_per_volt", 1e-4, 100.0);
+  auto& b = c.board;
+  b.counter_bits = s.integer("counter_bits", 2, 32);
+  auto comedi = s.child("comedi");
+  auto counters = comedi.child("counters");
+  for (std::size_t i = 0; i < hb::kCounterCount; ++i) {
+    auto channel = counters.child(hb::channel_name(static_cast<hb::CounterChannel>(i)));
+    b.counters[i].subdevice = channel.integer("subdevice", 0, 255);
+    b.counters[i].channel = channel.integer("channel", 0, 255);
+    channel.finish();
+  }
+  counters.finish();
+  auto analog = comedi.child("analog_outputs");
+  b.analog_output_subdevice = analog.integer("subdevice", 0, 255);
+  b.analog_output_range = analog.integer("range", 0, 255);
+  for (std::size_t i = 0; i < hb::kAnalogOutputCount; ++i) {
+    b.analog_output_channels[i] = analog.integer(hb::channel_name(static_cast<hb::AnalogOutput>(i)), 0, 255);
+  }
+  analog.finish();
+  auto outputs = comedi.child("digital_outputs");
+  b.digital_output_subdevice = outputs.integer("subdevice", 0, 255);
+  for (std::size_t i = 0; i < hb::kDigitalOutputCount; ++i) {
+    b.digital_output_bits[i] = outputs.integer(hb::line_name(static_cast<hb::DigitalOutput>(i)), 0, 31);
+  }
+  outputs.finish();
+  auto inputs = comedi.child("digital_inputs");
+  b.digital_input_subdevice = inputs.integer("subdevice", 0, 255);
+  b.digital_inputs_active_low = inputs.flag("active_low");
+  for (std::size_t i = 0; i < hb::kDigitalInputCount; ++i) {
+    b.digital_input_bits[i] = inputs.integer(hb::line_name(static_cast<hb::DigitalInput>(i)), 0, 31);
+  }
+  inputs.finish();
+  comedi.finish();
+  s.finish();
+  hb::validate(c.bridge, "hardware_bridge");
+  hb::validate(c.board, "hardware_bridge.comedi");
+  return c;
+}
+
 StackConfig read_stack(YamlSection root) {
   StackConfig c;
   c.crane = read_crane(root.child("crane"));
   c.plant = read_plant(root.child("plant"));
-  c.supervisor = read_supervisor(root.child("supervisor"));
+  c.supervisor = read_supervisor(root.child("supervisor"), c.plant.sample_period);
   c.state_estimator = read_estimator(root.child("state_estimator"), c.plant.sample_period);
   c.trajectory_planner = read_planner(root.child("trajectory_planner"));
   c.anti_swing = read_anti_swing(root.child("anti_swing"), c.plant.sample_period, c.crane.gravity, c.plant);
   c.tracking = read_tracking(root.child("tracking"), c.crane, c.supervisor.voltage_limit, c.plant);
   c.friction_compensation =
       read_compensation(root.child("friction_compensation"), c.crane, c.supervisor.voltage_limit);
+  c.hardware_bridge =
+      read_hardware_bridge(root.child("hardware_bridge"), c.plant, c.supervisor.voltage_limit);
   for (auto& item : root.list("maneuvers")) c.maneuvers.push_back(read_maneuver(item));
   root.finish();
   // Each core validates its own invariants as well (same message format).

@@ -199,7 +199,7 @@ bool all_finite(const msgs::LinearCommand_& m) noexcept {
                 m.slew_tracking_action());
 }
 bool all_finite(const msgs::SupervisorStatus_& m) noexcept {
-  return finite(m.trolley_voltage_limit(), m.slew_voltage_limit());
+  return finite(m.trolley_voltage_limit(), m.slew_voltage_limit(), m.trolley_velocity(), m.slew_rate());
 }
 
 }  // namespace crane::runtime

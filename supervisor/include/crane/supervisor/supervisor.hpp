@@ -1,17 +1,29 @@
 #pragma once
-// Safety supervisor core: modes, brakes, travel and voltage limits, stage watchdogs.
+// Safety supervisor core: modes, brakes, protective functions (limits), stage watchdogs.
 //
 // Pure logic (no DDS, no clock): the node feeds it what it observed of every stage of the chain and
-// the latest sensor and actuator values; it answers whether drives may be energized and brakes
-// opened. Modes follow the OPC UA for Cranes and Hoists vocabulary where it fits (standby, ready,
-// operating, fault, emergency stop).
+// the latest sensor and actuator values; it answers whether drives may be energized, whether brakes
+// may be opened and the voltage each drive may receive. Vocabulary after the OPC UA Companion
+// Specification for Cranes and Hoists where it fits: operation modes (standby, ready, operating),
+// protective functions (travel limiter, slew limiter, overspeed, sway limiter, ...), protective stop
+// (a fault: brakes engaged, drives off) and emergency stop.
 //
 // Rules (docs/architecture.md, "Safety"):
-//  - brakes released and motion enabled only in ready/operating, and only while every stage of the
-//    chain is alive (liveliness asserted and a sample received within stage_timeout);
-//  - the moment a stage goes silent, a limit is exceeded or a non-finite value arrives: fault, brakes
-//    engaged, drives at zero; the fault stays latched until an explicit reset with a healthy chain;
-//  - an emergency stop engages the brakes at once and needs a reset.
+//  - motion (drives) is enabled only in ready/operating, and only while every stage of the chain is
+//    alive: DDS liveliness asserted and a sample received within stage_timeout. The brakes are
+//    released only in a cycle after the one that enabled the drives, with the chain still alive
+//    (the drives hold the load before the brakes let go);
+//  - the moment a stage goes silent, a limit is exceeded, a non-finite value arrives or a second
+//    writer appears: protective stop (fault), brakes engaged, drives at zero; the fault stays
+//    latched until an explicit reset command arrives with a healthy chain and nothing active;
+//  - an emergency stop (input or command) engages the brakes at once and needs a reset;
+//  - approach margins: within approach_margin of a travel/slew limit, moving toward it, the axis
+//    may not move faster than a speed that falls linearly from max to approach speed; when it does,
+//    the voltage limit of that drive drops to approach_voltage_limit so the drive can only brake
+//    (friction decelerates it); inside stop_margin of the limit, still moving toward it: protective
+//    stop, so the brakes hold it before the hard limit.
+// The axis velocities are differentiated here from the sensor samples (seq and positions), not
+// taken from the state estimator: the supervisor does not trust the control processes.
 
 #include <array>
 #include <cstdint>
@@ -30,38 +42,94 @@ enum class Stage : std::uint8_t {
 inline constexpr std::size_t kStageCount = 6;
 [[nodiscard]] const char* stage_name(Stage stage) noexcept;
 
+/// Operation modes (SupervisorStatus_.mode).
 enum class Mode : std::uint8_t { starting = 0, standby = 1, ready = 2, operating = 3, fault = 4, emergency_stop = 5 };
 [[nodiscard]] const char* mode_name(Mode mode) noexcept;
 
-/// Fault codes: one bit each in SupervisorStatus_.active_faults / latched_faults.
+/// Fault codes (protective functions that tripped): one bit each in SupervisorStatus_.active_faults /
+/// latched_faults / last_fault.
 enum Fault : std::uint32_t {
   kFaultStageSilent = 1U << 0,          // a stage of the chain stopped publishing or lost liveliness
-  kFaultTrolleyTravel = 1U << 1,        // trolley position outside [trolley_min, trolley_max]
+  kFaultTrolleyTravel = 1U << 1,        // travel limiter: outside [trolley_min, trolley_max] or inside the
+                                        // stop margin moving toward it
   kFaultVoltage = 1U << 2,              // an actuator command beyond the voltage limit
   kFaultNonFinite = 1U << 3,            // NaN or Inf arrived on a watched topic
   kFaultEmergencyStop = 1U << 4,        // emergency stop commanded or input pressed
   kFaultMultipleSensorWriters = 1U << 5,  // more than one writer on rt/crane/hw/sensors
-  kFaultSwing = 1U << 6,                // swing angle beyond max_swing
+  kFaultSwing = 1U << 6,                // sway limiter: swing angle beyond max_swing
+  kFaultSlewRange = 1U << 7,            // slew limiter: outside [slew_min, slew_max] or inside its stop margin
+  kFaultTrolleyOverspeed = 1U << 8,     // |trolley velocity| > trolley_max_speed
+  kFaultSlewOverspeed = 1U << 9,        // |slew rate| > slew_max_rate
+  kFaultVoltageRate = 1U << 10,         // a drive command changed faster than max_voltage_rate
+  kFaultMultipleActuatorWriters = 1U << 11,  // more than one writer on rt/crane/hw/actuators
+  kFaultSensorSource = 1U << 12,        // sensors come from another source than the launch mode expects
+  kFaultLimitSwitch = 1U << 13,         // a hardware limit switch input is active
+};
+inline constexpr int kFaultBits = 14;
+/// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
+[[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
+
+/// Warnings (SupervisorStatus_.warnings): reported, motion continues.
+enum Warning : std::uint32_t {
+  kWarningTrolleyApproach = 1U << 0,    // trolley inside its approach margin, moving toward the limit
+  kWarningSlewApproach = 1U << 1,       // jib inside its approach margin, moving toward the limit
+  kWarningSpeedLimited = 1U << 2,       // an approach speed was exceeded: drive voltage limited
+  kWarningStageLate = 1U << 3,          // a DDS deadline was missed on a stage (late, not yet dead)
+};
+
+/// One axis's range and approach behaviour. Units: [m] and [m/s] for the trolley, [rad] and [rad/s]
+/// for the slew.
+struct AxisLimits {
+  double min{0.0};                // hard limit
+  double max{1.0};                // hard limit
+  double approach_margin{0.1};    // distance from a hard limit where slowing starts
+  double stop_margin{0.02};       // distance from a hard limit where motion toward it is stopped
+  double approach_speed{0.05};    // speed allowed at the stop margin (linear up to max_speed at the
+                                  // approach margin)
+  double max_speed{1.0};          // overspeed limit anywhere
 };
 
 struct SupervisorParams {
   double trolley_min{0.05};          // [m] hard travel limit
   double trolley_max{1.30};          // [m] hard travel limit
+  double trolley_approach_margin{0.15};  // [m]
+  double trolley_stop_margin{0.03};      // [m]
+  double trolley_approach_speed{0.1};    // [m/s]
+  double trolley_max_speed{0.8};         // [m/s]
+  double slew_min{-3.3};             // [rad] hard slew limit
+  double slew_max{3.3};              // [rad]
+  double slew_approach_margin{0.3};  // [rad]
+  double slew_stop_margin{0.05};     // [rad]
+  double slew_approach_rate{0.2};    // [rad/s]
+  double slew_max_rate{1.6};         // [rad/s]
   double voltage_limit{10.0};        // [V] magnitude limit on both drive commands
+  double approach_voltage_limit{0.5};  // [V] drive limit while an approach speed is exceeded
+  double max_voltage_rate{1500.0};   // [V/s] largest change of a drive command between two samples
   double max_swing{0.35};            // [rad] swing angle beyond which the crane stops
   double stage_timeout{0.05};        // [s] a stage silent for longer is dead (5 cycles at 100 Hz)
   double lockstep_stage_timeout{1.0};  // [s] the same when the plant runs in lockstep: simulated time
                                        // waits for a slow stage, so only a long silence is a death
+  double sample_period{0.01};        // [s] of the sensor stream (velocities from seq differences)
   bool arm_on_start{true};           // arm by itself once the chain is healthy (simulation); a
                                      // real crane sets false and waits for an explicit arm command
+  std::uint8_t expected_sensor_source{0};  // 0 any, 1 simulated plant, 2 hardware bridge
+
+  [[nodiscard]] AxisLimits trolley() const noexcept {
+    return {trolley_min, trolley_max, trolley_approach_margin, trolley_stop_margin, trolley_approach_speed,
+            trolley_max_speed};
+  }
+  [[nodiscard]] AxisLimits slew() const noexcept {
+    return {slew_min, slew_max, slew_approach_margin, slew_stop_margin, slew_approach_rate, slew_max_rate};
+  }
 };
-/// Throws crane::common::ConfigError naming the field, value and bound.
+/// Throws crane::common::ConfigError naming the field ("supervisor.<name>"), value and bound.
 void validate(const SupervisorParams& params);
 
 /// What the node observed of one stage since the last step.
 struct StageObservation {
   bool alive{false};                  // DDS liveliness asserted and matched
   double seconds_since_sample{1e9};   // [s] since the last valid sample was received
+  bool deadline_missed{false};        // a DDS requested-deadline-missed event since the last step
 };
 
 enum class Command : std::uint8_t { none = 0, arm = 1, disarm = 2, emergency_stop = 3, reset = 4 };
@@ -69,13 +137,20 @@ enum class Command : std::uint8_t { none = 0, arm = 1, disarm = 2, emergency_sto
 struct SupervisorInput {
   std::array<StageObservation, kStageCount> stages{};
   bool sensors_valid{false};          // a sensor sample has been received (limits are checked only then)
+  std::uint64_t sensor_seq{0};        // cycle number of the latest sensor sample
+  std::uint8_t sensor_source{0};      // SensorSample_.source
   double trolley_position{0.0};       // [m] from the latest sensor sample
+  double slew_angle{0.0};             // [rad]
   double swing_in_plane{0.0};         // [rad]
   double swing_out_of_plane{0.0};     // [rad]
+  std::uint8_t limit_switches{0};     // SensorSample_.limit_switches (bit 0 trolley min, 1 max, 2 slew min, 3 max)
+  bool actuators_valid{false};        // an actuator command has been received
+  std::uint64_t actuator_seq{0};      // cycle number of the latest actuator command
   double trolley_voltage{0.0};        // [V] latest actuator command
   double slew_voltage{0.0};           // [V]
   bool emergency_stop_input{false};   // hardware input
   int sensor_writers{1};              // writers matched on the sensors topic
+  int actuator_writers{1};            // writers matched on the actuators topic
   bool nonfinite_seen{false};         // a watched sample was rejected for NaN/Inf since last step
   bool move_in_progress{false};       // the planner reports a move (ready -> operating)
   Command command{Command::none};
@@ -89,16 +164,29 @@ struct SupervisorOutput {
   std::uint32_t latched_faults{0};
   std::uint32_t fault_count{0};
   std::uint32_t stages_alive{0};      // bit i set: Stage(i) alive
+  std::uint32_t warnings{0};          // Warning bits
+  std::uint32_t last_fault{0};        // the most recently raised fault bit (0: none yet)
+  std::uint64_t last_fault_seq{0};    // sensor cycle at which it was raised
+  double trolley_voltage_limit{0.0};  // [V] magnitude the trolley drive may receive now
+  double slew_voltage_limit{0.0};     // [V]
+  double trolley_velocity{0.0};       // [m/s] differentiated from the sensor samples
+  double slew_rate{0.0};              // [rad/s]
+  bool command_refused{false};        // the step's command was refused: arm with latched faults or an
+                                      // unhealthy chain, reset with a fault still active or an unhealthy chain
 };
 
 class Supervisor {
  public:
+  /// Throws crane::common::ConfigError for invalid params (validate()).
   explicit Supervisor(const SupervisorParams& params);
   /// One supervision cycle. Never throws, never allocates.
   void step(const SupervisorInput& input, SupervisorOutput& output) noexcept;
   [[nodiscard]] Mode mode() const noexcept { return mode_; }
   /// Faults raised in the last step that were not active before (for the fault log).
   [[nodiscard]] std::uint32_t newly_raised() const noexcept { return newly_raised_; }
+  /// Faults that were active before the last step and are not any more.
+  [[nodiscard]] std::uint32_t newly_cleared() const noexcept { return newly_cleared_; }
+  [[nodiscard]] const SupervisorParams& params() const noexcept { return params_; }
 
  private:
   SupervisorParams params_;
@@ -107,7 +195,23 @@ class Supervisor {
   std::uint32_t previous_active_{0};
   std::uint32_t fault_count_{0};
   std::uint32_t newly_raised_{0};
+  std::uint32_t newly_cleared_{0};
+  std::uint32_t last_fault_{0};
+  std::uint64_t last_fault_seq_{0};
   bool armed_{false};
+  bool drives_enabled_previous_{false};
+  // Velocity from successive sensor samples.
+  bool have_previous_sample_{false};
+  std::uint64_t previous_sensor_seq_{0};
+  double previous_trolley_{0.0};
+  double previous_slew_{0.0};
+  double trolley_velocity_{0.0};
+  double slew_rate_{0.0};
+  // Voltage rate from successive actuator commands.
+  bool have_previous_command_{false};
+  std::uint64_t previous_actuator_seq_{0};
+  double previous_trolley_voltage_{0.0};
+  double previous_slew_voltage_{0.0};
 };
 
 }  // namespace crane::supervisor

@@ -1,5 +1,10 @@
 #pragma once
-// The simulated crane stack as a set of processes: which executables, with which arguments.
+// The crane stack as a set of processes: which executables, with which arguments. Three modes:
+//   simulated (hardware empty): the plant is the sensor writer on the DDS bus;
+//   shm:NAME: the hardware bridge is the sensor writer, against the emulated board, with the
+//             simulated plant behind the board (hardware-in-the-loop; lockstep uses the board's
+//             sample clock);
+//   comedi:/dev/comediN: the hardware bridge against a real DAQ board, no plant.
 
 #include <map>
 #include <string>
@@ -20,20 +25,25 @@ struct StackOptions {
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]
   bool friction_compensation{true};
-  std::string plant_stats_path;       // plant writes its loop statistics here on exit (optional)
+  std::string plant_stats_path;       // the sensor writer (plant or hardware_bridge) writes its loop statistics
+                                      // (cycles, overruns, latency log) here on exit (optional)
   double plant_cable_length_factor{1.0};  // simulated L = factor * configured L (robustness)
   double plant_load_mass_factor{1.0};     // simulated m = factor * configured m (robustness)
   std::string log_level{"info"};
   std::string anti_swing_controller;  // anti_swing --controller (none|pd|delay1|delay2|fuzzy); empty: its default
   std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
                                       // empty: its default
+  std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
+                                      // hardware bridge on that board (see the file comment)
+  std::string fault_log_path;         // supervisor --fault-log (optional)
 };
 
-/// The seven stage processes of the simulated stack (the plant replaces the hardware bridge), in
-/// start order: supervisor first, the sensor writer last.
-std::vector<ProcessSpec> simulated_stack(const StackOptions& options);
+/// The processes of the stack in start order: supervisor first, the sensor writer (plant or
+/// hardware_bridge) last; with shm:NAME the plant behind the board comes just before the bridge.
+/// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH.
+std::vector<ProcessSpec> stack_processes(const StackOptions& options);
 
-/// Names of the stages, in the order simulated_stack() returns them.
-const std::vector<std::string>& simulated_stage_names();
+/// Names of the processes, in the order stack_processes() returns them.
+std::vector<std::string> stack_process_names(const StackOptions& options);
 
 }  // namespace crane::launch

@@ -14,6 +14,8 @@
 #include "crane/anti_swing/anti_swing.hpp"
 #include "crane/common/crane_parameters.hpp"
 #include "crane/friction_compensation/friction_compensation.hpp"
+#include "crane/hardware_bridge/board_config.hpp"
+#include "crane/hardware_bridge/bridge_core.hpp"
 #include "crane/state_estimator/state_estimator.hpp"
 #include "crane/supervisor/supervisor.hpp"
 #include "crane/tracking/tracking_controller.hpp"
@@ -33,6 +35,12 @@ struct PlantConfig {
   double lockstep_timeout{0.5};         // [s] lockstep: longest wait for a command and a fresh status
   double command_timeout{0.03};         // [s] a missing command is replaced by the last one this long
   double safety_status_timeout{0.1};    // [s] brakes on when the supervisor status is older
+};
+
+/// Hardware bridge settings: its watchdog and the interface board's channel map.
+struct HardwareBridgeConfig {
+  hardware_bridge::BridgeParams bridge;   // watchdog and status timeouts, hoist scaling
+  hardware_bridge::BoardConfig board;     // counter width, comedi subdevices/channels/bits
 };
 
 /// One demo maneuver (section 3.3.3).
@@ -58,6 +66,7 @@ struct StackConfig {
   anti_swing::AntiSwingParams anti_swing;
   tracking::TrackingParams tracking;
   friction_compensation::FrictionCompensationParams friction_compensation;
+  HardwareBridgeConfig hardware_bridge;
   std::vector<ManeuverConfig> maneuvers;
 };
 

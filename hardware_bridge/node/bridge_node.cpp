@@ -1,0 +1,303 @@
+// hardware_bridge process: the encoder/DAC/digital-IO board on the DDS bus. The sensor writer (and
+// the only clock) of the stack when it runs against a crane: at cycle k it reads the counters and
+// digital inputs, publishes rt/crane/hw/sensors{seq = k, source = 2}, and writes the outputs for the
+// actuator command of cycle k as soon as it arrives (BridgeCore: clamped to the supervisor's
+// limits, 0 V and brakes when its rules say so, its own watchdog).
+//
+//   --clock timer  absolute sample_period deadlines on the monotonic clock (a real board);
+//   --clock board  the emulated board's sample clock (shm only): each sample the simulated plant
+//                  publishes is answered once, so the plant can run in lockstep behind the board.
+//                  Times given to BridgeCore are then simulated (k * sample_period); the supervisor
+//                  status counts as fresh while younger than lockstep_timeout on the wall clock.
+//
+// Fail-safe: safe outputs (0 V, brakes engaged, drives disabled) are written right after the board
+// opens, whenever BridgeCore says so (no valid command for watchdog_timeout, no fresh supervisor
+// status, motion disabled, emergency stop input), on SIGINT/SIGTERM and on every exit path,
+// including exceptions.
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include "crane/config/stack_config.hpp"
+#include "crane/hardware_bridge/board.hpp"
+#include "crane/hardware_bridge/bridge_core.hpp"
+#include "crane/hardware_bridge/shm_board.hpp"
+#include "crane/runtime/node_runtime.hpp"
+
+namespace {
+
+using namespace crane;
+namespace hb = hardware_bridge;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point epoch, Clock::time_point t) {
+  return std::chrono::duration<double>(t - epoch).count();
+}
+
+// Writes the safe outputs when it goes out of scope, whatever the exit path.
+class SafeOnExit {
+ public:
+  SafeOnExit(hb::Board& board, const hb::BoardOutputs& safe) : board_(board), safe_(safe) {}
+  SafeOnExit(const SafeOnExit&) = delete;
+  SafeOnExit& operator=(const SafeOnExit&) = delete;
+  ~SafeOnExit() {
+    try {
+      board_.write_outputs(safe_);
+      spdlog::info("outputs safe: 0 V, brakes engaged, drives disabled");
+    } catch (const std::exception& error) {
+      spdlog::critical("could not write the safe outputs on exit: {}", error.what());
+    }
+  }
+
+ private:
+  hb::Board& board_;
+  hb::BoardOutputs safe_;
+};
+
+std::unique_ptr<hb::Board> open_with_retry(const std::string& uri, const hb::BoardConfig& config, double timeout) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  for (;;) {
+    try {
+      return hb::open_board(uri, config);
+    } catch (const hb::BoardError& error) {
+      // The emulated board appears when the plant behind it starts; a real device does not.
+      if (uri.rfind("shm:", 0) != 0 || Clock::now() >= deadline || runtime::stop_requested()) throw;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hardware_bridge: the crane's encoder/DAC/digital-IO board on the DDS bus, with its own watchdog"};
+  runtime::NodeOptions options;
+  runtime::add_node_options(app, options);
+  std::string board_uri;
+  std::string clock = "timer";
+  double open_timeout = 10.0;
+  std::string stats_path;
+  app.add_option("--board", board_uri, "comedi:/dev/comediN (a DAQ board) or shm:NAME (the emulated board)")
+      ->required();
+  app.add_option("--clock", clock, "timer (sample_period deadlines) | board (the emulated board's sample clock)")
+      ->check(CLI::IsMember({"timer", "board"}));
+  app.add_option("--open-timeout", open_timeout, "[s] wait this long for an emulated board to appear")
+      ->check(CLI::Range(0.0, 600.0));
+  app.add_option("--stats-out", stats_path, "write loop statistics (JSON) here on exit");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    runtime::configure_logging(options.log_level, "hardware_bridge");
+    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    if (clock == "board" && board_uri.rfind("shm:", 0) != 0) {
+      throw std::invalid_argument("--clock board needs the emulated board (shm:NAME), not " + board_uri);
+    }
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+    auto board = open_with_retry(board_uri, cfg.hardware_bridge.board, open_timeout);
+    hb::BridgeCore core(cfg.hardware_bridge.bridge, board->analog_ranges());
+    board->write_outputs(core.safe_outputs());
+    SafeOnExit safe_on_exit(*board, core.safe_outputs());
+    auto* shm_board = dynamic_cast<hb::ShmBoard*>(board.get());
+    spdlog::info("board {}: {} clock, watchdog {} ms, status timeout {} ms", board->describe(), clock,
+                 cfg.hardware_bridge.bridge.watchdog_timeout * 1e3, cfg.hardware_bridge.bridge.status_timeout * 1e3);
+
+    auto participant = runtime::make_participant(options, "hardware_bridge");
+    auto sensors = participant->make_writer<tp::Sensors>();
+    auto actuators = participant->make_reader<tp::Actuators>(&wakeup);
+    auto safety = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::hardware_bridge);
+    runtime::LatencyStatistics latency;
+    runtime::LoopCounters counters;
+    std::vector<double> latency_log;
+    latency_log.reserve(1 << 16);
+
+    const hb::EncoderScaling scaling(cfg.crane);
+    std::array<hb::CounterUnwrapper, hb::kCounterCount> unwrap{
+        hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
+        hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits())};
+    const double period_s = cfg.plant.sample_period;
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    const auto lockstep_timeout =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_timeout));
+    const auto republish = std::chrono::milliseconds(10);
+    const bool board_clock = clock == "board";
+    const auto epoch = Clock::now();
+
+    tp::msgs::SensorSample_ sample;
+    tp::msgs::ActuatorCommand_ incoming;
+    tp::msgs::SupervisorStatus_ incoming_status;
+    hb::BridgeInput in;
+    hb::BridgeOutput out;
+    out.board = core.safe_outputs();
+    Clock::time_point status_wall{};
+    std::uint64_t seq = 0;
+    std::uint64_t tick = 0;
+    std::uint64_t stale_commands = 0;  // commands for another cycle than the current one
+    bool started = false;              // a command has arrived once
+    hb::SafeStateReason logged_reason = hb::SafeStateReason::none;
+    auto next_deadline = Clock::now();
+
+    auto fill_sample = [&](std::uint64_t k) {
+      std::array<std::uint32_t, hb::kCounterCount> raw{};
+      board->read_counters(raw);
+      std::array<std::int64_t, hb::kCounterCount> counts{};
+      for (std::size_t i = 0; i < hb::kCounterCount; ++i) counts[i] = unwrap[i].update(raw[i]);
+      const std::uint32_t inputs = board->read_digital_inputs();
+      const auto m = scaling.measurement(counts, cfg.crane.cable_length);
+      runtime::stamp_header(sample.header(), k, runtime::now_stamp());
+      sample.source(2);
+      sample.writer_pid(static_cast<std::uint32_t>(getpid()));
+      sample.trolley_position(m.trolley_position);
+      sample.slew_angle(m.slew_angle);
+      sample.swing_in_plane(m.swing_in_plane);
+      sample.swing_out_of_plane(m.swing_out_of_plane);
+      sample.cable_length(m.cable_length);
+      sample.applied_trolley_voltage(out.applied_trolley_voltage);
+      sample.applied_slew_voltage(out.applied_slew_voltage);
+      sample.applied_hoist_speed(out.applied_hoist_speed);
+      sample.brakes_engaged(out.brakes_engaged);
+      const bool estop = (inputs >> static_cast<unsigned>(hb::DigitalInput::emergency_stop)) & 1U;
+      sample.emergency_stop_input(estop);
+      sample.limit_switches(static_cast<std::uint8_t>(inputs & 0x0FU));  // bits 0-3: the four limit switches
+      in.emergency_stop_pressed = estop;
+    };
+    // Takes what arrived; returns true once a valid command for cycle k went to the board.
+    auto drain = [&](std::uint64_t k, double now_s) {
+      while (safety->take_next(incoming_status)) {
+        if (!runtime::all_finite(incoming_status)) {
+          ++counters.nonfinite_rejected;
+          continue;
+        }
+        in.status_received = true;
+        in.status.motion_enabled = incoming_status.motion_enabled();
+        in.status.brakes_released = incoming_status.brakes_released();
+        in.status.trolley_voltage_limit = incoming_status.trolley_voltage_limit();
+        in.status.slew_voltage_limit = incoming_status.slew_voltage_limit();
+        in.status_arrival_time = now_s;
+        status_wall = Clock::now();
+      }
+      bool applied = false;
+      while (actuators->take_next(incoming)) {
+        if (incoming.header().seq() != k) {
+          ++stale_commands;
+          continue;
+        }
+        const std::int64_t arrival_ns = runtime::now_nanoseconds();
+        in.time = now_s;
+        in.command_received = true;
+        in.command = {incoming.trolley_voltage(), incoming.slew_voltage(), incoming.hoist_speed()};
+        in.command_arrival_time = now_s;
+        if (board_clock) {  // simulated time: the status is fresh while young on the wall clock
+          in.status_arrival_time = Clock::now() - status_wall <= lockstep_timeout ? now_s : -1e9;
+        }
+        const auto status = core.step(in, out);
+        in.command_received = false;
+        if (status != hb::CommandStatus::accepted) {
+          ++counters.nonfinite_rejected;  // counted by reason in core.counters()
+          continue;                       // a valid command for this cycle may still come
+        }
+        board->write_outputs(out.board);
+        applied = true;
+        started = true;
+        const double us = static_cast<double>(arrival_ns - runtime::to_nanoseconds(sample.header().origin())) / 1000.0;
+        latency.record(us);
+        if (latency_log.size() < latency_log.capacity()) latency_log.push_back(us);
+      }
+      return applied;
+    };
+    auto step_without_command = [&](double now_s) {
+      in.time = now_s;
+      in.command_received = false;
+      if (board_clock) in.status_arrival_time = Clock::now() - status_wall <= lockstep_timeout ? now_s : -1e9;
+      (void)core.step(in, out);
+      board->write_outputs(out.board);
+    };
+
+    while (!runtime::stop_requested()) {
+      double now_s = 0.0;
+      Clock::time_point cycle_deadline;
+      if (board_clock) {
+        if (!shm_board->wait_for_sample(tick, Clock::now() + std::chrono::milliseconds(100), tick)) {
+          if (shm_board->emulator_closed()) {
+            spdlog::warn("the emulated board was closed (the plant stopped)");
+            break;
+          }
+          continue;
+        }
+        now_s = static_cast<double>(seq) * period_s;
+        cycle_deadline = Clock::now() + lockstep_timeout;
+      } else {
+        next_deadline += period;
+        now_s = seconds_since(epoch, Clock::now());
+        cycle_deadline = next_deadline;
+      }
+      fill_sample(seq);
+      sensors->write(sample);
+      bool applied = false;
+      auto next_republish = Clock::now() + republish;
+      while (!runtime::stop_requested()) {
+        applied = drain(seq, board_clock ? now_s : seconds_since(epoch, Clock::now()));
+        if (applied) break;
+        const auto now = Clock::now();
+        if (board_clock && now >= next_republish) {
+          // As the plant in lockstep: offer the cycle again until the chain answers (start-up, or a
+          // best-effort sample lost); before the first answer wait as long as it takes.
+          runtime::stamp_header(sample.header(), seq, runtime::now_stamp());
+          sensors->write(sample);
+          next_republish = now + republish;
+          if (!started) cycle_deadline = now + lockstep_timeout;
+        }
+        if (now >= cycle_deadline) break;
+        wakeup.wait_until(std::min(cycle_deadline, next_republish));
+      }
+      if (runtime::stop_requested()) break;
+      if (!applied) {
+        if (started) ++counters.overruns;
+        step_without_command(board_clock ? now_s : seconds_since(epoch, Clock::now()));
+      }
+      if (out.safe_state_reason != logged_reason) {
+        if (out.safe_state_reason == hb::SafeStateReason::none) {
+          spdlog::info("cycle {}: commands applied, brakes released", seq);
+        } else {
+          spdlog::warn("cycle {}: outputs safe ({})", seq, hb::reason_name(out.safe_state_reason));
+        }
+        logged_reason = out.safe_state_reason;
+      }
+      ++counters.cycles;
+      counters.last_seq = seq;
+      ++seq;
+      diagnostics.maybe_publish(counters, &latency);
+      if (!board_clock) std::this_thread::sleep_until(next_deadline);
+    }
+
+    diagnostics.publish_final(counters, &latency);
+    const auto& c = core.counters();
+    spdlog::info("stopping: {} cycles, {} overruns, {} commands accepted, rejected {} non-finite and {} out of range, "
+                 "{} stale, {} watchdog trips, {} safe cycles, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us",
+                 counters.cycles, counters.overruns, c.accepted_commands, c.rejected_commands.non_finite,
+                 c.rejected_commands.out_of_range, stale_commands, c.watchdog_trips, c.safe_cycles,
+                 latency.percentile(50), latency.percentile(99), latency.maximum());
+    if (!stats_path.empty()) {
+      std::ofstream stats(stats_path);
+      stats << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns
+            << ", \"accepted_commands\": " << c.accepted_commands
+            << ", \"rejected_non_finite\": " << c.rejected_commands.non_finite
+            << ", \"rejected_out_of_range\": " << c.rejected_commands.out_of_range
+            << ", \"watchdog_trips\": " << c.watchdog_trips << ", \"safe_cycles\": " << c.safe_cycles
+            << ", \"latency_us\": [";
+      for (std::size_t i = 0; i < latency_log.size(); ++i) stats << (i ? "," : "") << latency_log[i];
+      stats << "]}\n";
+    }
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+  return 0;
+}

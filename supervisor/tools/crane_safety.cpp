@@ -1,0 +1,166 @@
+// crane_safety: the operator's commands to the supervisor, and its status.
+//
+//   crane_safety arm | disarm | estop | reset   send the command on rt/crane/safety/command and wait
+//                                              for the supervisor to answer it on the status topic
+//   crane_safety status [--json]                print the supervisor's latest status
+//
+// Exit codes: 0 done (command accepted / status printed), 1 no supervisor answered within
+// --timeout, 2 bad usage, 3 the supervisor refused the command (the reason is in its log: arm needs
+// a healthy chain and no latched fault, reset needs a healthy chain and no active fault).
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "crane/runtime/node_runtime.hpp"
+#include "crane/supervisor/supervisor.hpp"
+
+namespace {
+
+using namespace crane;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+
+std::string fault_list(std::uint32_t bits) {
+  std::string text;
+  for (int bit = 0; bit < supervisor::kFaultBits; ++bit) {
+    if ((bits & (1U << bit)) == 0) continue;
+    if (!text.empty()) text += ",";
+    text += supervisor::fault_name(1U << bit);
+  }
+  return text;
+}
+
+std::string quoted_list(std::uint32_t bits) {
+  std::string text;
+  for (int bit = 0; bit < supervisor::kFaultBits; ++bit) {
+    if ((bits & (1U << bit)) == 0) continue;
+    if (!text.empty()) text += ", ";
+    text += std::string("\"") + supervisor::fault_name(1U << bit) + "\"";
+  }
+  return "[" + text + "]";
+}
+
+std::string stage_list(std::uint32_t alive, bool want_alive) {
+  std::string text;
+  for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
+    if (((alive >> i) & 1U) != (want_alive ? 1U : 0U)) continue;
+    if (!text.empty()) text += ",";
+    text += supervisor::stage_name(static_cast<supervisor::Stage>(i));
+  }
+  return text;
+}
+
+void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
+  const auto mode = supervisor::mode_name(static_cast<supervisor::Mode>(s.mode()));
+  if (json) {
+    std::printf(
+        "{\"mode\": \"%s\", \"motion_enabled\": %s, \"brakes_released\": %s, \"active_faults\": %s, "
+        "\"latched_faults\": %s, \"fault_count\": %u, \"last_fault\": \"%s\", \"last_fault_seq\": %llu, "
+        "\"stages_alive\": %u, \"warnings\": %u, \"trolley_voltage_limit_V\": %g, \"slew_voltage_limit_V\": %g, "
+        "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu}\n",
+        mode, s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
+        quoted_list(s.active_faults()).c_str(), quoted_list(s.latched_faults()).c_str(), s.fault_count(),
+        s.last_fault() != 0 ? supervisor::fault_name(s.last_fault()) : "", static_cast<unsigned long long>(s.last_fault_seq()),
+        s.stages_alive(), s.warnings(), s.trolley_voltage_limit(), s.slew_voltage_limit(), s.trolley_velocity(),
+        s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()));
+    return;
+  }
+  std::printf("mode            %s\n", mode);
+  std::printf("motion          %s, brakes %s\n", s.motion_enabled() ? "enabled" : "disabled",
+              s.brakes_released() ? "released" : "engaged");
+  std::printf("active faults   %s\n", s.active_faults() ? fault_list(s.active_faults()).c_str() : "none");
+  std::printf("latched faults  %s\n", s.latched_faults() ? fault_list(s.latched_faults()).c_str() : "none");
+  std::printf("faults raised   %u, last: %s at cycle %llu\n", s.fault_count(),
+              s.last_fault() ? supervisor::fault_name(s.last_fault()) : "none",
+              static_cast<unsigned long long>(s.last_fault_seq()));
+  std::printf("stages alive    %s%s%s\n", stage_list(s.stages_alive(), true).c_str(),
+              s.stages_alive() != 0x3FU ? "; silent: " : "",
+              s.stages_alive() != 0x3FU ? stage_list(s.stages_alive(), false).c_str() : "");
+  std::printf("voltage limits  trolley %.2f V, slew %.2f V%s\n", s.trolley_voltage_limit(), s.slew_voltage_limit(),
+              (s.warnings() & supervisor::kWarningSpeedLimited) ? " (approach speed exceeded)" : "");
+  std::printf("speeds          trolley %.3f m/s, slew %.3f rad/s\n", s.trolley_velocity(), s.slew_rate());
+  std::printf("cycle           %llu\n", static_cast<unsigned long long>(s.header().seq()));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_safety: arm, disarm, emergency stop, reset and status of the crane supervisor"};
+  std::string action;
+  runtime::NodeOptions options;
+  double timeout = 3.0;
+  bool json = false;
+  app.add_option("action", action, "arm | disarm | estop | reset | status")
+      ->required()
+      ->check(CLI::IsMember({"arm", "disarm", "estop", "reset", "status"}));
+  app.add_option("--dds", options.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
+  app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--timeout", timeout, "[s] longest wait for the supervisor")->check(CLI::Range(0.1, 60.0));
+  app.add_flag("--json", json, "status as one JSON object");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    runtime::configure_logging("warn", "crane_safety");
+    auto participant = runtime::make_participant(options, "operator");
+    transport::Wakeup wakeup;
+    auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+    tp::msgs::SupervisorStatus_ status;
+
+    if (action == "status") {
+      while (Clock::now() < deadline) {
+        if (status_reader->take_latest(status)) {
+          print_status(status, json);
+          return 0;
+        }
+        wakeup.wait_until(std::min(deadline, Clock::now() + std::chrono::milliseconds(20)));
+      }
+      std::fprintf(stderr, "crane_safety: no supervisor status on domain %u within %.1f s\n", options.domain_id, timeout);
+      return 1;
+    }
+
+    const std::uint8_t code = action == "arm" ? 1 : action == "disarm" ? 2 : action == "estop" ? 3 : 4;
+    auto writer = participant->make_writer<tp::SafetyCommand>();
+    while (writer->health().matched_readers == 0 && Clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (writer->health().matched_readers == 0) {
+      std::fprintf(stderr, "crane_safety: no supervisor listens on rt/crane/safety/command (domain %u) within %.1f s\n",
+                   options.domain_id, timeout);
+      return 1;
+    }
+    tp::msgs::SupervisorCommand_ command;
+    const auto request_id = static_cast<std::uint32_t>(
+        (static_cast<std::uint64_t>(getpid()) << 16) ^ static_cast<std::uint64_t>(runtime::now_nanoseconds()));
+    runtime::stamp_header(command.header(), 0, runtime::now_stamp());
+    command.request_id(request_id);
+    command.command(code);
+    writer->write(command);
+    while (Clock::now() < deadline) {
+      while (status_reader->take_next(status)) {
+        if (status.last_request_id() != request_id) continue;
+        const bool accepted = status.last_request_result() == 1;
+        std::printf("%s %s: mode %s, brakes %s\n", action.c_str(), accepted ? "accepted" : "refused",
+                    supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())),
+                    status.brakes_released() ? "released" : "engaged");
+        if (!accepted) {
+          std::printf("  latched faults: %s; active: %s; silent stages: %s\n",
+                      status.latched_faults() ? fault_list(status.latched_faults()).c_str() : "none",
+                      status.active_faults() ? fault_list(status.active_faults()).c_str() : "none",
+                      status.stages_alive() == 0x3FU ? "none" : stage_list(status.stages_alive(), false).c_str());
+        }
+        return accepted ? 0 : 3;
+      }
+      wakeup.wait_until(std::min(deadline, Clock::now() + std::chrono::milliseconds(20)));
+    }
+    std::fprintf(stderr, "crane_safety: the supervisor did not answer request %u within %.1f s\n", request_id, timeout);
+    return 1;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_safety: %s\n", error.what());
+    return 1;
+  }
+}

@@ -1,0 +1,542 @@
+// Fault injection against the hardware-in-the-loop stack: the real hardware_bridge process on the
+// emulated interface board, the simulated plant behind the board, every stage its own process, all
+// on the wall clock (--realtime: the bridge's watchdog is a wall-clock matter). Each test prints its
+// figure. Run inside a private network namespace (deploy/crane test does); otherwise every
+// participant is bound to loopback.
+//
+// What is measured and how:
+//  - the board's outputs: a thread in this process maps the emulated board (ShmBoardEmulator::attach)
+//    and records every write of the bridge with its CLOCK_MONOTONIC time (written by the bridge);
+//  - "the last good command": this process also subscribes to rt/crane/hw/actuators and stamps the
+//    arrival of each command on the same clock; the last one before a fault is the last good one;
+//  - the load's travel after a fault: from the sensor samples the bridge keeps publishing.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "crane/hardware_bridge/shm_board.hpp"
+#include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
+#include "crane/supervisor/supervisor.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace tp = crane::transport::topics;
+namespace hb = crane::hardware_bridge;
+namespace sv = crane::supervisor;
+using crane::launch::ProcessGroup;
+using Clock = std::chrono::steady_clock;
+
+const std::string kBin = CRANE_BIN_DIR;
+const std::string kConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml";
+constexpr double kWatchdogTimeout = 0.030;  // [s] hardware_bridge.watchdog_timeout of kConfig
+constexpr double kStatusTimeout = 0.030;    // [s] hardware_bridge.status_timeout of kConfig
+
+fs::path fresh_directory(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("crane_fault_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Records every write of the bridge to the emulated board.
+class BoardMonitor {
+ public:
+  struct Write {
+    std::int64_t ns;          // CLOCK_MONOTONIC time of the write
+    std::uint32_t digital;    // logical digital output word
+    double trolley_volts;
+    double slew_volts;
+  };
+
+  explicit BoardMonitor(const std::string& name) : board_(attach(name)) {
+    thread_ = std::thread([this] { run(); });
+  }
+  BoardMonitor(const BoardMonitor&) = delete;
+  BoardMonitor& operator=(const BoardMonitor&) = delete;
+  ~BoardMonitor() {
+    stop_ = true;
+    thread_.join();
+  }
+  std::vector<Write> writes() const {
+    std::lock_guard lock(mutex_);
+    return writes_;
+  }
+  void set_emergency_stop(bool pressed) { board_.set_digital_input(hb::DigitalInput::emergency_stop, pressed); }
+
+ private:
+  static hb::ShmBoardEmulator attach(const std::string& name) {
+    const auto deadline = Clock::now() + std::chrono::seconds(20);
+    for (;;) {
+      try {
+        return hb::ShmBoardEmulator::attach(name);
+      } catch (const hb::BoardError&) {
+        if (Clock::now() > deadline) throw;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
+  }
+  void run() {
+    std::uint64_t seen = 0;
+    while (!stop_) {
+      try {
+        const auto o = board_.read_outputs();
+        if (o.write_count != seen) {
+          seen = o.write_count;
+          std::lock_guard lock(mutex_);
+          writes_.push_back({o.last_write_ns, o.outputs.digital_outputs,
+                             board_.output_volts(o, hb::AnalogOutput::trolley_drive),
+                             board_.output_volts(o, hb::AnalogOutput::slew_drive)});
+        }
+      } catch (const hb::BoardError&) {
+        // the bridge died in the middle of a write: keep watching
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  }
+  hb::ShmBoardEmulator board_;
+  mutable std::mutex mutex_;
+  std::vector<Write> writes_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+bool safe(const BoardMonitor::Write& w) { return w.digital == 0 && w.trolley_volts == 0.0 && w.slew_volts == 0.0; }
+bool energized(const BoardMonitor::Write& w) { return w.digital == hb::kAllOutputsEnergized; }
+
+/// The hardware-in-the-loop stack plus this process's participant (observer, operator, rogue).
+class HilStack {
+ public:
+  HilStack(const std::string& name, std::uint32_t domain, const std::string& config = kConfig,
+           double initial_trolley = 0.25)
+      : dir_(fresh_directory(name)), board_name_("fi_" + name + "_" + std::to_string(getpid())), domain_(domain) {
+    crane::launch::StackOptions options;
+    options.config_path = config;
+    options.binary_directory = kBin;
+    options.log_directory = dir_.string();
+    options.domain_id = domain;
+    options.lockstep = false;
+    options.hardware = "shm:" + board_name_;
+    options.initial_trolley_position = initial_trolley;
+    options.plant_stats_path = (dir_ / "bridge_stats.json").string();
+    options.fault_log_path = (dir_ / "faults.jsonl").string();
+    for (const auto& spec : crane::launch::stack_processes(options)) pids_[spec.name] = group_.start(spec);
+
+    crane::transport::ParticipantOptions p;
+    p.name = "fault_injection";
+    p.domain_id = domain;
+    participant_ = std::make_unique<crane::transport::Participant>(p);
+    status_reader_ = participant_->make_recording_reader<tp::SafetyStatus>(&wakeup_, 4096);
+    sensors_reader_ = participant_->make_recording_reader<tp::Sensors>(&wakeup_, 4096);
+    actuators_reader_ = participant_->make_recording_reader<tp::Actuators>(&wakeup_, 4096);
+    goal_writer_ = participant_->make_writer<tp::Goal>();
+    command_writer_ = participant_->make_writer<tp::SafetyCommand>();
+    monitor_ = std::make_unique<BoardMonitor>(board_name_);
+  }
+  HilStack(const HilStack&) = delete;
+  HilStack& operator=(const HilStack&) = delete;
+  ~HilStack() {
+    // Readers before writers of the same topic (transport note), then the processes.
+    monitor_.reset();
+    group_.stop_all();
+  }
+
+  const fs::path& dir() const { return dir_; }
+  BoardMonitor& monitor() { return *monitor_; }
+  std::uint32_t domain() const { return domain_; }
+  pid_t pid(const std::string& name) const { return pids_.at(name); }
+  crane::transport::Participant& participant() { return *participant_; }
+
+  /// Deletes this process's readers: before a rogue writer of the same topic is deleted (transport
+  /// note: readers before writers of one topic within a process).
+  void stop_observing() {
+    status_reader_.reset();
+    sensors_reader_.reset();
+    actuators_reader_.reset();
+  }
+  /// Takes everything that arrived, stamping actuator commands with their arrival time.
+  void pump() {
+    if (!status_reader_) return;
+    tp::msgs::SupervisorStatus_ s;
+    while (status_reader_->take_next(s)) {
+      status_ = s;
+      status_log_.push_back(s);
+    }
+    tp::msgs::SensorSample_ sample;
+    while (sensors_reader_->take_next(sample)) sensors_.push_back(sample);
+    tp::msgs::ActuatorCommand_ a;
+    while (actuators_reader_->take_next(a)) command_arrivals_.push_back(hb::monotonic_time_ns());
+  }
+  /// Pumps for `seconds`, failing the test if a process dies unexpectedly (except `expected_dead`).
+  void run_for(double seconds) {
+    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    while (Clock::now() < until) {
+      pump();
+      wakeup_.wait_until(std::min(until, Clock::now() + std::chrono::milliseconds(5)));
+    }
+  }
+  /// Waits until the chain is alive, the supervisor ready and the bridge applying commands.
+  ::testing::AssertionResult wait_ready(double timeout = 40.0) {
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+    while (Clock::now() < deadline) {
+      if (auto exit = group_.poll()) return ::testing::AssertionFailure() << exit->describe() << "; see " << dir_;
+      run_for(0.02);
+      const auto w = monitor_->writes();
+      if (status_ && status_->stages_alive() == 0x3FU && (status_->mode() == 2 || status_->mode() == 3) &&
+          status_->brakes_released() &&
+          !w.empty() && energized(w.back())) {
+        return ::testing::AssertionSuccess();
+      }
+    }
+    return ::testing::AssertionFailure() << "stack not ready within " << timeout << " s (stages alive "
+                                         << (status_ ? status_->stages_alive() : 0) << ", mode "
+                                         << (status_ ? static_cast<int>(status_->mode()) : -1) << "); see " << dir_;
+  }
+  /// Sends the trolley move of (3.54) to `target` [m] and waits until the trolley moves faster than
+  /// `speed` [m/s] (the supervisor's own velocity).
+  ::testing::AssertionResult start_move(double target, double speed = 0.3, double timeout = 10.0) {
+    tp::msgs::MoveRequest_ goal;
+    crane::runtime::stamp_header(goal.header(), 0, crane::runtime::now_stamp());
+    goal.request_id(7);
+    goal.profile(1);  // trapezoid (3.43)
+    goal.axes(0x3);
+    goal.trolley_target(target);
+    goal.slew_target(0.0);
+    goal.cable_length_target(1.0);
+    goal.trolley_max_velocity(0.4982);
+    goal.trolley_max_acceleration(0.9929);
+    goal.slew_max_velocity(1.0435);
+    goal.slew_max_acceleration(2.0796);
+    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+    while (Clock::now() < deadline) {
+      if (!status_ || status_->mode() != 3) goal_writer_->write(goal);  // until the move is under way
+      run_for(0.05);
+      if (status_ && std::fabs(status_->trolley_velocity()) > speed) return ::testing::AssertionSuccess();
+    }
+    return ::testing::AssertionFailure() << "the trolley did not reach " << speed << " m/s; see " << dir_;
+  }
+  void send_command(std::uint8_t code, std::uint32_t request_id) {
+    tp::msgs::SupervisorCommand_ c;
+    crane::runtime::stamp_header(c.header(), 0, crane::runtime::now_stamp());
+    c.request_id(request_id);
+    c.command(code);
+    command_writer_->write(c);
+  }
+
+  const std::optional<tp::msgs::SupervisorStatus_>& status() const { return status_; }
+  const std::vector<tp::msgs::SupervisorStatus_>& status_log() const { return status_log_; }
+  const std::vector<tp::msgs::SensorSample_>& sensors() const { return sensors_; }
+  /// Arrival time [ns, CLOCK_MONOTONIC] of the last actuator command received before `ns`.
+  std::optional<std::int64_t> last_command_before(std::int64_t ns) const {
+    std::optional<std::int64_t> last;
+    for (const auto t : command_arrivals_) {
+      if (t < ns) last = t;
+    }
+    return last;
+  }
+  std::string fault_log() const { return read_file(dir_ / "faults.jsonl"); }
+  nlohmann::json bridge_stats() {
+    group_.stop_all();  // the bridge writes its statistics on exit
+    std::ifstream in(dir_ / "bridge_stats.json");
+    return in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+  }
+
+ private:
+  fs::path dir_;
+  std::string board_name_;
+  std::uint32_t domain_;
+  ProcessGroup group_;
+  std::map<std::string, pid_t> pids_;
+  std::unique_ptr<crane::transport::Participant> participant_;
+  crane::transport::Wakeup wakeup_;
+  std::unique_ptr<crane::transport::Reader<tp::SafetyStatus>> status_reader_;
+  std::unique_ptr<crane::transport::Reader<tp::Sensors>> sensors_reader_;
+  std::unique_ptr<crane::transport::Reader<tp::Actuators>> actuators_reader_;
+  std::unique_ptr<crane::transport::Writer<tp::Goal>> goal_writer_;
+  std::unique_ptr<crane::transport::Writer<tp::SafetyCommand>> command_writer_;
+  std::unique_ptr<BoardMonitor> monitor_;
+  std::optional<tp::msgs::SupervisorStatus_> status_;
+  std::vector<tp::msgs::SupervisorStatus_> status_log_;
+  std::vector<tp::msgs::SensorSample_> sensors_;
+  std::vector<std::int64_t> command_arrivals_;
+};
+
+/// The first safe write at or after `ns`, and the last energized write before it.
+struct FailSafe {
+  std::optional<BoardMonitor::Write> last_energized;
+  std::optional<BoardMonitor::Write> first_safe;
+};
+FailSafe fail_safe_after(const std::vector<BoardMonitor::Write>& writes, std::int64_t ns) {
+  FailSafe f;
+  for (const auto& w : writes) {
+    if (w.ns < ns) {
+      if (energized(w)) f.last_energized = w;
+      continue;
+    }
+    if (safe(w)) {
+      f.first_safe = w;
+      break;
+    }
+    if (energized(w)) f.last_energized = w;
+  }
+  return f;
+}
+
+/// Trolley travel [m] from the sample nearest `ns` to the last sample.
+double travel_after(const std::vector<tp::msgs::SensorSample_>& sensors, std::int64_t wall_ns_at_fault) {
+  std::optional<double> at_fault;
+  for (const auto& s : sensors) {
+    if (crane::runtime::to_nanoseconds(s.header().origin()) >= wall_ns_at_fault) {
+      at_fault = s.trolley_position();
+      break;
+    }
+  }
+  if (!at_fault || sensors.empty()) return std::nan("");
+  return sensors.back().trolley_position() - *at_fault;
+}
+
+// ---- kill -9 of each stage of the chain in mid-move ----
+
+class KillStage : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(KillStage, BrakesAndZeroVoltsWithinTheWatchdogTimeout) {
+  const std::string stage = GetParam();
+  static std::uint32_t domain = 40;
+  HilStack stack("kill_" + stage, domain++);
+  ASSERT_TRUE(stack.wait_ready());
+  ASSERT_TRUE(stack.start_move(1.0));
+
+  const std::int64_t kill_ns = hb::monotonic_time_ns();
+  const std::int64_t kill_wall_ns = crane::runtime::now_nanoseconds();
+  ASSERT_EQ(::kill(stack.pid(stage), SIGKILL), 0);
+  stack.run_for(2.0);
+
+  const auto f = fail_safe_after(stack.monitor().writes(), kill_ns);
+  ASSERT_TRUE(f.first_safe.has_value()) << "the outputs never became safe; see " << stack.dir();
+  const auto last_command = stack.last_command_before(f.first_safe->ns);
+  ASSERT_TRUE(last_command.has_value());
+  const double after_command_ms = static_cast<double>(f.first_safe->ns - *last_command) / 1e6;
+  const double after_kill_ms = static_cast<double>(f.first_safe->ns - kill_ns) / 1e6;
+  const double travel_mm = travel_after(stack.sensors(), kill_wall_ns) * 1e3;
+  std::printf("[ figure   ] kill -9 %s in mid-move: brakes engaged and 0 V %.1f ms after the last good command "
+              "(%.1f ms after the kill); trolley travel after the fault %.1f mm\n",
+              stage.c_str(), after_command_ms, after_kill_ms, travel_mm);
+  EXPECT_LE(after_command_ms, kWatchdogTimeout * 1e3) << "the watchdog must act within 3 cycles";
+  EXPECT_GE(after_command_ms, 0.0);
+  // Nothing energized after the safe write: the outputs stay safe.
+  for (const auto& w : stack.monitor().writes()) {
+    if (w.ns > f.first_safe->ns) {
+      EXPECT_FALSE(energized(w)) << "outputs re-energized after the fault";
+    }
+  }
+  // The supervisor saw it too: the stage silent, on the status topic and in the fault log.
+  ASSERT_TRUE(stack.status().has_value());
+  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultStageSilent);
+  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::fault));
+  const auto log = stack.fault_log();
+  EXPECT_NE(log.find("\"fault\": \"stage_silent\""), std::string::npos) << log;
+  EXPECT_NE(log.find("\"" + stage + "\""), std::string::npos) << "the fault log must name the silent stage: " << log;
+}
+
+INSTANTIATE_TEST_SUITE_P(Chain, KillStage,
+                         ::testing::Values("state_estimator", "trajectory_planner", "anti_swing", "tracking",
+                                           "friction_compensation"));
+
+TEST(FaultInjection, SupervisorKilledTheBridgeFailsSafeByItself) {
+  HilStack stack("kill_supervisor", 50);
+  ASSERT_TRUE(stack.wait_ready());
+  ASSERT_TRUE(stack.start_move(1.0));
+  const std::int64_t kill_ns = hb::monotonic_time_ns();
+  const std::int64_t kill_wall_ns = crane::runtime::now_nanoseconds();
+  ASSERT_EQ(::kill(stack.pid("supervisor"), SIGKILL), 0);
+  stack.run_for(2.0);
+  const auto f = fail_safe_after(stack.monitor().writes(), kill_ns);
+  ASSERT_TRUE(f.first_safe.has_value()) << "the outputs never became safe; see " << stack.dir();
+  // The last status the bridge could rest on arrived before the kill.
+  const double after_kill_ms = static_cast<double>(f.first_safe->ns - kill_ns) / 1e6;
+  std::printf("[ figure   ] kill -9 supervisor in mid-move: outputs safe %.1f ms after the kill (status timeout "
+              "%.0f ms + up to one cycle), trolley travel after the fault %.1f mm\n",
+              after_kill_ms, kStatusTimeout * 1e3, travel_after(stack.sensors(), kill_wall_ns) * 1e3);
+  EXPECT_LE(after_kill_ms, (kStatusTimeout + 0.010) * 1e3);
+  // The chain is still alive and keeps commanding: only the bridge's own rule holds the brakes.
+  stack.run_for(0.3);
+  const auto w = stack.monitor().writes();
+  ASSERT_FALSE(w.empty());
+  EXPECT_TRUE(safe(w.back()));
+  EXPECT_TRUE(stack.last_command_before(hb::monotonic_time_ns()).value_or(0) > f.first_safe->ns)
+      << "the chain stopped commanding: this test would not show the bridge acting alone";
+}
+
+// ---- bad commands: NaN, Inf, out of range ----
+
+TEST(FaultInjection, NonFiniteAndOutOfRangeCommandsAreRejectedAndCounted) {
+  HilStack stack("bad_commands", 51);
+  ASSERT_TRUE(stack.wait_ready());
+  auto rogue = stack.participant().make_writer<tp::Actuators>();
+  stack.run_for(0.5);  // discovery of the rogue writer
+  const std::int64_t start_ns = hb::monotonic_time_ns();
+  const double values[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 50.0,
+                           -37.0};
+  for (int i = 0; i < 100; ++i) {
+    stack.pump();
+    tp::msgs::ActuatorCommand_ a;
+    const auto& s = stack.sensors();
+    a.header().seq(s.empty() ? 0 : s.back().header().seq());  // the current cycle: the bridge looks at it
+    a.trolley_voltage(values[i % 4]);
+    a.slew_voltage(values[(i + 1) % 4]);
+    rogue->write(a);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stack.run_for(0.3);
+  for (const auto& w : stack.monitor().writes()) {
+    if (w.ns < start_ns) continue;
+    ASSERT_TRUE(std::isfinite(w.trolley_volts) && std::isfinite(w.slew_volts));
+    EXPECT_LT(std::fabs(w.trolley_volts), 9.0) << "a rogue voltage reached the board";
+    EXPECT_LT(std::fabs(w.slew_volts), 9.0) << "a rogue voltage reached the board";
+  }
+  const auto writes = stack.monitor().writes();
+  ASSERT_FALSE(writes.empty());
+  EXPECT_TRUE(safe(writes.back())) << "a second actuator writer must stop motion";
+  ASSERT_TRUE(stack.status().has_value());
+  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultMultipleActuatorWriters);
+  const auto log = stack.fault_log();
+  EXPECT_NE(log.find("multiple_actuator_writers"), std::string::npos) << log;
+  const auto stats = stack.bridge_stats();
+  ASSERT_FALSE(stats.is_null()) << "no bridge statistics in " << stack.dir();
+  std::printf("[ figure   ] 100 rogue commands (NaN, Inf, 50 V, -37 V) on the current cycle: bridge rejected %d "
+              "non-finite and %d out of range; supervisor fault multiple_actuator_writers\n",
+              stats["rejected_non_finite"].get<int>(), stats["rejected_out_of_range"].get<int>());
+  EXPECT_GT(stats["rejected_non_finite"].get<int>(), 0);
+  EXPECT_GT(stats["rejected_out_of_range"].get<int>(), 0);
+  stack.stop_observing();
+}
+
+// ---- a move toward a travel limit ----
+
+TEST(FaultInjection, MoveTowardATravelLimitStopsBeforeIt) {
+  // The supervisor's hard limit at 0.9 m, the move to 1.0 m (the planner's own range allows it).
+  const fs::path dir = fresh_directory("limit_config");
+  std::string text = read_file(kConfig);
+  const std::string from = "trolley_max: 1.30";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "trolley_max: 0.90");
+  const fs::path config = dir / "limit.yaml";
+  std::ofstream(config) << text;
+
+  HilStack stack("travel_limit", 52, config.string());
+  ASSERT_TRUE(stack.wait_ready());
+  ASSERT_TRUE(stack.start_move(1.0));
+  stack.run_for(4.0);
+  double furthest = 0.0;
+  for (const auto& s : stack.sensors()) furthest = std::max(furthest, s.trolley_position());
+  bool limited = false;
+  for (const auto& s : stack.status_log()) limited = limited || (s.warnings() & sv::kWarningSpeedLimited);
+  const auto& last = *stack.status();
+  std::printf("[ figure   ] move to 1.0 m with the travel limit at 0.90 m: the trolley stopped at %.4f m, %.1f mm "
+              "before the limit (speed limited in the approach zone: %s; latched faults 0x%x)\n",
+              stack.sensors().back().trolley_position(), (0.90 - furthest) * 1e3, limited ? "yes" : "no",
+              last.latched_faults());
+  EXPECT_LT(furthest, 0.90) << "the trolley reached the hard limit";
+  EXPECT_TRUE(limited) << "the approach margin should have slowed the trolley";
+  EXPECT_LT(std::fabs(last.trolley_velocity()), 0.01) << "the trolley must have stopped";
+}
+
+// ---- a second sensor writer ----
+
+TEST(FaultInjection, SecondSensorWriterRefusesMotion) {
+  HilStack stack("second_sensor_writer", 53);
+  ASSERT_TRUE(stack.wait_ready());
+  auto rogue = stack.participant().make_writer<tp::Sensors>();
+  for (int i = 0; i < 50; ++i) {
+    stack.pump();
+    tp::msgs::SensorSample_ s;
+    if (!stack.sensors().empty()) s = stack.sensors().back();
+    s.writer_pid(static_cast<std::uint32_t>(getpid()));
+    rogue->write(s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  stack.run_for(0.3);
+  ASSERT_TRUE(stack.status().has_value());
+  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultMultipleSensorWriters);
+  EXPECT_FALSE(stack.status()->motion_enabled());
+  const auto writes = stack.monitor().writes();
+  ASSERT_FALSE(writes.empty());
+  EXPECT_TRUE(safe(writes.back()));
+  // A move is refused while the fault is latched.
+  EXPECT_FALSE(stack.start_move(1.0, 0.05, 3.0)) << "the trolley moved with two sensor writers";
+  EXPECT_NE(stack.fault_log().find("multiple_sensor_writers"), std::string::npos);
+  std::printf("[ figure   ] second writer on rt/crane/hw/sensors: supervisor mode %s, motion refused\n",
+              sv::mode_name(static_cast<sv::Mode>(stack.status()->mode())));
+  stack.stop_observing();
+}
+
+// ---- emergency stop: by command and by the board's input ----
+
+TEST(FaultInjection, EmergencyStopInputAndCommandBrakeAtOnce) {
+  HilStack stack("estop", 54);
+  ASSERT_TRUE(stack.wait_ready());
+  const std::string safety = kBin + "/crane_safety";
+  const std::string domain = " --domain " + std::to_string(stack.domain());
+  auto run = [](const std::string& command) { return WEXITSTATUS(std::system((command + " > /dev/null").c_str())); };
+
+  // The board's emergency-stop input (crane ready, brakes released): the bridge engages the brakes
+  // itself at its next cycle.
+  const std::int64_t pressed_ns = hb::monotonic_time_ns();
+  stack.monitor().set_emergency_stop(true);
+  stack.run_for(0.5);
+  auto f = fail_safe_after(stack.monitor().writes(), pressed_ns);
+  ASSERT_TRUE(f.first_safe.has_value());
+  const double input_ms = static_cast<double>(f.first_safe->ns - pressed_ns) / 1e6;
+  ASSERT_TRUE(stack.status().has_value());
+  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::emergency_stop));
+  // The operator's CLI: reset refused while the button is pressed (exit code 3), accepted once released.
+  EXPECT_EQ(run(safety + " status" + domain), 0);
+  EXPECT_EQ(run(safety + " reset" + domain), 3);
+  stack.monitor().set_emergency_stop(false);
+  stack.run_for(0.1);
+  EXPECT_EQ(run(safety + " reset" + domain), 0);
+  ASSERT_TRUE(stack.wait_ready(10.0));
+
+  // The operator's emergency stop in mid-move: supervisor, then the bridge.
+  ASSERT_TRUE(stack.start_move(1.0));
+  const std::int64_t command_ns = hb::monotonic_time_ns();
+  stack.send_command(3, 101);
+  stack.run_for(0.5);
+  f = fail_safe_after(stack.monitor().writes(), command_ns);
+  ASSERT_TRUE(f.first_safe.has_value());
+  const double command_ms = static_cast<double>(f.first_safe->ns - command_ns) / 1e6;
+  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::emergency_stop));
+  EXPECT_EQ(stack.status()->last_request_id(), 101U);
+  std::printf("[ figure   ] emergency stop: brakes engaged %.1f ms after the board's input was pressed, %.1f ms "
+              "after the operator's command\n",
+              input_ms, command_ms);
+  EXPECT_LE(input_ms, 20.0) << "the bridge reads the input every cycle";
+  EXPECT_LE(command_ms, 30.0) << "supervisor cycle + bridge cycle";
+  const auto log = stack.fault_log();
+  EXPECT_NE(log.find("\"fault\": \"emergency_stop\""), std::string::npos) << log;
+  EXPECT_NE(log.find("\"command\": \"reset\""), std::string::npos) << log;
+}
+
+}  // namespace
