@@ -277,6 +277,9 @@ int main(int argc, char** argv) {
       if (!board_clock) std::this_thread::sleep_until(next_deadline);
     }
 
+    // Stopping (signal, or the emulated board closed): safe outputs first, then the bookkeeping.
+    board->write_outputs(core.safe_outputs());
+    spdlog::info("outputs safe: 0 V, brakes engaged, drives disabled");
     diagnostics.publish_final(counters, &latency);
     const auto& c = core.counters();
     spdlog::info("stopping: {} cycles, {} overruns, {} commands accepted, rejected {} non-finite and {} out of range, "

@@ -389,6 +389,27 @@ TEST(FaultInjection, SupervisorKilledTheBridgeFailsSafeByItself) {
       << "the chain stopped commanding: this test would not show the bridge acting alone";
 }
 
+TEST(FaultInjection, BridgeStartsSafeAndLeavesSafeOnSigterm) {
+  HilStack stack("bridge_sigterm", 55);
+  ASSERT_TRUE(stack.wait_ready());
+  auto writes = stack.monitor().writes();
+  ASSERT_FALSE(writes.empty());
+  EXPECT_TRUE(safe(writes.front())) << "the bridge's first write must be the safe state";
+  ASSERT_TRUE(stack.start_move(1.0));
+  const std::int64_t term_ns = hb::monotonic_time_ns();
+  ASSERT_EQ(::kill(stack.pid("hardware_bridge"), SIGTERM), 0);
+  stack.run_for(1.0);
+  writes = stack.monitor().writes();
+  ASSERT_FALSE(writes.empty());
+  EXPECT_GT(writes.back().ns, term_ns) << "the bridge wrote nothing after SIGTERM";
+  EXPECT_TRUE(safe(writes.back())) << "the bridge exited with its outputs energized";
+  const auto f = fail_safe_after(writes, term_ns);
+  ASSERT_TRUE(f.first_safe.has_value());
+  const double term_ms = static_cast<double>(f.first_safe->ns - term_ns) / 1e6;
+  std::printf("[ figure   ] SIGTERM to the bridge in mid-move: outputs safe %.1f ms later\n", term_ms);
+  EXPECT_LE(term_ms, 30.0) << "the bridge must make its outputs safe before its DDS teardown";
+}
+
 // ---- bad commands: NaN, Inf, out of range ----
 
 TEST(FaultInjection, NonFiniteAndOutOfRangeCommandsAreRejectedAndCounted) {

@@ -155,3 +155,25 @@ TEST(TrackingController, ParamsFromCraneParameters) {
   EXPECT_EQ(p.trolley_drive_gain, 2.0);
   EXPECT_EQ(p.slew_drive_gain, 1.14);
 }
+
+// Acceleration feedforward (beyond (3.40)): the voltage grows by exactly a_ref / K_mx on the trolley
+// and (1 + M_r x^2) gamma''_ref / K_mgamma on the slew, whatever the PD and anti-swing actions are.
+TEST(TrackingController, AccelerationFeedforwardAddsTheReferenceAcceleration) {
+  tr::TrackingParams params;
+  params.voltage_limit = 1e3;  // no clamping in this comparison
+  tr::TrackingParams with = params;
+  with.acceleration_feedforward = true;
+  const tr::TrackingController plain(params), feedforward(with);
+  auto in = base_input();
+  in.reference.trolley.acceleration = 0.9929;
+  in.reference.slew.acceleration = -2.0796;
+  in.estimate.trolley_position = 0.9;
+  tr::TrackingOutput a, b;
+  ASSERT_EQ(plain.step(in, a), crane::common::StepStatus::ok);
+  ASSERT_EQ(feedforward.step(in, b), crane::common::StepStatus::ok);
+  EXPECT_NEAR(b.command.trolley_voltage - a.command.trolley_voltage, 0.9929 / params.trolley_drive_gain, 1e-12);
+  const double inertia = 1.0 + params.trolley_inertia_ratio * 0.9 * 0.9;
+  EXPECT_NEAR(b.command.slew_voltage - a.command.slew_voltage, inertia * -2.0796 / params.slew_drive_gain, 1e-12);
+  // Off by default: the dissertation's law.
+  EXPECT_FALSE(tr::TrackingParams{}.acceleration_feedforward);
+}

@@ -580,28 +580,28 @@ TEST(SupervisorLimits, VelocityIsDifferentiatedFromTheSensorSamples) {
 }
 
 TEST(SupervisorLimits, ApproachMarginLowersTheVoltageLimitOnlyWhenTooFastTowardTheLimit) {
-  // trolley_max 1.30, approach 0.15, stop 0.03, approach speed 0.1, max speed 0.8: at 1.21 m the
-  // distance is 0.09 m, half way through the band: allowed 0.1 + 0.7 * 0.5 = 0.45 m/s.
+  // trolley_max 1.30, approach 0.15, stop 0.03, approach speed 0.1, max speed 1.0: at 1.21 m the
+  // distance is 0.09 m, half way through the band: allowed 0.1 + 0.9 * 0.5 = 0.55 m/s.
   const sv::SupervisorParams p;
   std::uint64_t seq = 1;
   auto supervisor = ready_supervisor();
-  auto out = trolley_at(supervisor, 1.21, 0.40, seq);  // below the allowed speed
+  auto out = trolley_at(supervisor, 1.21, 0.50, seq);  // below the allowed speed
   EXPECT_EQ(out.active_faults, 0U);
   EXPECT_TRUE(out.warnings & sv::kWarningTrolleyApproach);
   EXPECT_FALSE(out.warnings & sv::kWarningSpeedLimited);
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
-  out = trolley_at(supervisor, 1.21, 0.50, seq);  // above it: the drive may only brake
+  out = trolley_at(supervisor, 1.21, 0.60, seq);  // above it: the drive may only brake
   EXPECT_EQ(out.active_faults, 0U);
   EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.approach_voltage_limit);
   EXPECT_DOUBLE_EQ(out.slew_voltage_limit, p.voltage_limit);
   EXPECT_TRUE(out.brakes_released);
   // Moving away from the limit at the same place: no warning, full voltage.
-  out = trolley_at(supervisor, 1.21, -0.50, seq);
+  out = trolley_at(supervisor, 1.21, -0.60, seq);
   EXPECT_EQ(out.warnings & (sv::kWarningTrolleyApproach | sv::kWarningSpeedLimited), 0U);
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
   // Near the lower limit, moving toward it: the same rule mirrored (0.14 m: 0.09 m from 0.05 m).
-  out = trolley_at(supervisor, 0.14, -0.50, seq);
+  out = trolley_at(supervisor, 0.14, -0.60, seq);
   EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.approach_voltage_limit);
 }
@@ -628,14 +628,14 @@ TEST(SupervisorLimits, InsideTheStopMarginMovingTowardTheLimitIsAProtectiveStop)
 }
 
 TEST(SupervisorLimits, SlewRangeAndOverspeed) {
-  const sv::SupervisorParams p;  // slew [-3.3, 3.3] rad, max rate 1.6 rad/s
+  const sv::SupervisorParams p;  // slew [-3.3, 3.3] rad, max rate 2.0 rad/s
   auto supervisor = ready_supervisor();
   auto in = healthy_input();
   in.sensor_seq = 100000;  // long after the last sample: a negligible rate from the jump to 3 rad
   in.slew_angle = 3.2;
   step(supervisor, in);
   in.sensor_seq = 100001;
-  // 1.5 rad/s toward the limit, 0.085 rad from it: allowed 0.2 + 1.4 * (0.085 - 0.05) / 0.25 = 0.396 rad/s.
+  // 1.5 rad/s toward the limit, 0.085 rad from it: allowed 0.2 + 1.8 * (0.085 - 0.05) / 0.25 = 0.452 rad/s.
   in.slew_angle = 3.2 + 0.01 * 1.5;
   auto out = step(supervisor, in);
   EXPECT_TRUE(out.warnings & sv::kWarningSlewApproach);
@@ -644,7 +644,7 @@ TEST(SupervisorLimits, SlewRangeAndOverspeed) {
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
   EXPECT_EQ(out.active_faults, 0U);
   in.sensor_seq = 100002;
-  in.slew_angle += 0.01 * 1.7;  // 1.7 rad/s > 1.6: overspeed
+  in.slew_angle += 0.01 * 2.1;  // 2.1 rad/s > 2.0: overspeed
   out = step(supervisor, in);
   EXPECT_TRUE(out.active_faults & sv::kFaultSlewOverspeed);
   EXPECT_EQ(out.mode, sv::Mode::fault);
@@ -659,8 +659,8 @@ TEST(SupervisorLimits, SlewRangeAndOverspeed) {
 TEST(SupervisorLimits, TrolleyOverspeed) {
   std::uint64_t seq = 1;
   auto supervisor = ready_supervisor();
-  EXPECT_EQ(trolley_at(supervisor, 0.6, 0.79, seq).active_faults, 0U);
-  const auto out = trolley_at(supervisor, 0.6, -0.81, seq);
+  EXPECT_EQ(trolley_at(supervisor, 0.6, 0.99, seq).active_faults, 0U);
+  const auto out = trolley_at(supervisor, 0.6, -1.01, seq);
   EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed));
   expect_stopped(out);
 }
@@ -759,7 +759,7 @@ TEST(SupervisorLimits, ValidationNamesTheMarginField) {
   EXPECT_NE(config_error_message(params).find("supervisor.trolley_stop_margin"), std::string::npos)
       << config_error_message(params);
   params = {};
-  params.slew_approach_rate = 2.0;  // above slew_max_rate 1.6
+  params.slew_approach_rate = 2.5;  // above slew_max_rate 2.0
   EXPECT_NE(config_error_message(params).find("supervisor.slew_approach_rate"), std::string::npos)
       << config_error_message(params);
 }

@@ -38,6 +38,7 @@ struct DemoOptions {
   std::vector<std::string> maneuvers;
   std::string compensation{"both"};
   bool realtime{false};
+  bool acceleration_feedforward{false};  // tracking --acceleration-feedforward
   std::string hardware;  // empty: plant on DDS; "shm": hardware_bridge + emulated board + plant behind it
   unsigned domain_id{0};
   std::string plot_script;
@@ -45,7 +46,7 @@ struct DemoOptions {
   double ready_timeout{60.0};
   std::string profile{"trapezoid"};
   std::uint8_t profile_code{1};
-  std::string controller{"delay1"};   // --controller, see main()
+  std::string controller;             // --controller, see main(); "auto" picks per maneuver (time_optimal)
   std::string anti_swing_controller;  // derived from controller
   std::string tracking_controller;    // derived from controller
   double plant_cable_length_factor{1.0};
@@ -61,6 +62,7 @@ struct ProcessRecord {
 
 struct RunResult {
   std::string maneuver;
+  std::string controller;        // anti-swing or gain-scheduling law of this run
   bool friction_compensation{true};
   launch::ManeuverMetrics metrics;
   double swing_period{0.0};      // [s] T = 2 pi sqrt(L/g)
@@ -193,11 +195,23 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.anti_swing_controller = options.anti_swing_controller;
   stack.tracking_controller = options.tracking_controller;
   stack.fault_log_path = (log_dir / "faults.jsonl").string();
+  stack.tracking_acceleration_feedforward = options.acceleration_feedforward;
+  if (options.controller == "auto") {
+    // The best measured for the time-optimal profile (docs/architecture.md): a trolley move is
+    // swing-free by itself and tracked by PD with acceleration feedforward, no anti-swing law to
+    // disturb it; a slew leaves swing the linear design does not foresee (centripetal coupling),
+    // which the second delayed-feedback law (3.50) damps without exceeding the speed limits.
+    const bool slews = std::fabs(m.slew_target - m.initial_slew_angle) > 1e-9;
+    stack.anti_swing_controller = slews ? "delay2" : "none";
+    stack.tracking_acceleration_feedforward = true;
+  }
   // One emulated board per run, named after this process so parallel demos do not share one.
   if (options.hardware == "shm") stack.hardware = "shm:demo_" + std::to_string(getpid());
 
   RunResult result;
   result.maneuver = m.name;
+  result.controller = stack.tracking_controller == "tracking" ? stack.anti_swing_controller : stack.tracking_controller;
+  if (stack.tracking_acceleration_feedforward) result.controller += "+feedforward";
   result.friction_compensation = compensation;
   result.swing_period = 2.0 * kPi * std::sqrt(cfg.crane.cable_length / cfg.crane.gravity);
 
@@ -405,6 +419,8 @@ int main(int argc, char** argv) {
   app.add_option("--friction-compensation", options.compensation, "on | off | both")
       ->check(CLI::IsMember({"on", "off", "both"}));
   app.add_flag("--realtime", options.realtime, "plant on absolute 10 ms deadlines instead of lockstep");
+  app.add_flag("--acceleration-feedforward", options.acceleration_feedforward,
+               "tracking adds the reference acceleration to its PD action (beyond the dissertation)");
   app.add_option("--hardware", options.hardware,
                  "shm: run through the real hardware_bridge process against the emulated board, with the plant "
                  "behind it (hardware-in-the-loop), instead of the plant on DDS")
@@ -428,9 +444,13 @@ int main(int argc, char** argv) {
   app.add_option("--controller", options.controller,
                  "controller of the stack: gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (no "
                  "anti-swing) | none (PD tracking alone) | pd (3.45) | delay1 (3.47) | delay2 (3.50) | fuzzy (anti-swing with PD "
-                 "tracking)")
-      ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "none", "pd", "delay1", "delay2", "fuzzy"}));
+                 "tracking) | auto (per maneuver the best measured with the time-optimal profile: none for a trolley "
+                 "move, delay2 when the jib slews, both with acceleration feedforward; the default with "
+                 "--profile time_optimal, else delay1)")
+      ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "none", "pd", "delay1", "delay2", "fuzzy",
+                             "auto"}));
   CLI11_PARSE(app, argc, argv);
+  if (options.controller.empty()) options.controller = options.profile == "time_optimal" ? "auto" : "delay1";
   if (options.controller.rfind("gain_scheduling", 0) == 0) {
     options.tracking_controller = options.controller;
     options.anti_swing_controller = "none";
@@ -503,6 +523,7 @@ int main(int argc, char** argv) {
     for (const auto& r : results) {
       json j;
       j["name"] = r.maneuver;
+      j["controller"] = r.controller;
       j["friction_compensation"] = r.friction_compensation;
       j["settle_time_s"] = std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time) : json(nullptr);
       j["settle_time_periods"] =

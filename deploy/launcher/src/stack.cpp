@@ -75,6 +75,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     if (name == "tracking" && !o.tracking_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.tracking_controller});
     }
+    if (name == "tracking" && o.tracking_acceleration_feedforward) spec.arguments.push_back("--acceleration-feedforward");
     if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
     specs.push_back(std::move(spec));
   }

@@ -18,17 +18,22 @@ int main(int argc, char** argv) {
   using namespace crane;
   namespace tp = transport::topics;
   auto controller_name = std::make_shared<std::string>("tracking");
+  auto feedforward = std::make_shared<bool>(false);
   return runtime::run_stage(
       argc, argv, runtime::ProcessId::tracking,
       "tracking: PD tracking (3.40)-(3.42) plus the anti-swing action, mapped to drive voltages (3.37)-(3.38), "
       "or gain-scheduling state feedback (3.19)/(3.26)",
-      [controller_name](CLI::App& app) {
+      [controller_name, feedforward](CLI::App& app) {
         app.add_option("--controller", *controller_name,
                        "tracking | gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (default tracking)")
             ->check(CLI::IsMember({"tracking", "gain_scheduling_partial", "gain_scheduling_full"}));
+        app.add_flag("--acceleration-feedforward", *feedforward,
+                     "tracking law: add the reference acceleration to the PD action (beyond (3.40))");
       },
-      [controller_name](runtime::StageContext& ctx) -> std::function<void()> {
-        auto controller = std::make_shared<tracking::TrackingController>(ctx.config.tracking);
+      [controller_name, feedforward](runtime::StageContext& ctx) -> std::function<void()> {
+        auto tracking_params = ctx.config.tracking;
+        tracking_params.acceleration_feedforward = *feedforward;
+        auto controller = std::make_shared<tracking::TrackingController>(tracking_params);
         std::shared_ptr<gain_scheduling::GainSchedulingController> scheduled;
         if (*controller_name != "tracking") {
           auto p = gain_scheduling::gain_scheduling_params_from(ctx.config.crane);

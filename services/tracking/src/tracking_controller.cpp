@@ -51,8 +51,8 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   const auto& ref = input.reference;
   const double used[] = {est.trolley_position, est.trolley_velocity, est.slew_angle, est.slew_rate,
                          est.swing_in_plane, est.swing_out_of_plane, est.cable_length,
-                         ref.trolley.position, ref.trolley.velocity, ref.slew.position,
-                         ref.slew.velocity, ref.cable_length.velocity,
+                         ref.trolley.position, ref.trolley.velocity, ref.trolley.acceleration,
+                         ref.slew.position, ref.slew.velocity, ref.slew.acceleration, ref.cable_length.velocity,
                          input.trolley_anti_swing_action, input.slew_anti_swing_action};
   for (const double value : used) {
     if (!std::isfinite(value)) {
@@ -73,7 +73,10 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   const double e_dot = ref.trolley.velocity - est.trolley_velocity;
   const double V_xp = (K_px * e + T * K_dx * e_dot) / L;
   const double V_bar_x = V_xp + input.trolley_anti_swing_action;
-  const double V_x = (L / T2 * V_bar_x + p.mass_ratio * g * est.swing_in_plane) / p.trolley_drive_gain;
+  // With feedforward the reference acceleration enters where the normalized action does (L/T^2 V_bar
+  // is an acceleration): the drive then follows the planned profile and the PD corrects what remains.
+  const double a_ff = p.acceleration_feedforward ? ref.trolley.acceleration : 0.0;
+  const double V_x = (L / T2 * V_bar_x + a_ff + p.mass_ratio * g * est.swing_in_plane) / p.trolley_drive_gain;
 
   // Slew in y = -(x/L) gamma (3.34), x frozen over the cycle; (3.38) with m_r g x theta.
   const double x = est.trolley_position;
@@ -85,8 +88,9 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   const double V_bar_y = V_yp + input.slew_anti_swing_action;
   const double M_r = p.trolley_inertia_ratio;
   const double m_r = p.load_inertia_ratio;
+  const double gamma_ff = p.acceleration_feedforward ? ref.slew.acceleration : 0.0;
   const double V_gamma =
-      (-L * (1.0 + M_r * x_safe * x_safe) / (x_safe * T2) * V_bar_y -
+      (-L * (1.0 + M_r * x_safe * x_safe) / (x_safe * T2) * V_bar_y + (1.0 + M_r * x_safe * x_safe) * gamma_ff -
        m_r * g * x_safe * est.swing_out_of_plane) / p.slew_drive_gain;
 
   output = TrackingOutput{};

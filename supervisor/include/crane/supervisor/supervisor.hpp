@@ -95,13 +95,13 @@ struct SupervisorParams {
   double trolley_approach_margin{0.15};  // [m]
   double trolley_stop_margin{0.03};      // [m]
   double trolley_approach_speed{0.1};    // [m/s]
-  double trolley_max_speed{0.8};         // [m/s]
+  double trolley_max_speed{1.0};         // [m/s]
   double slew_min{-3.3};             // [rad] hard slew limit
   double slew_max{3.3};              // [rad]
   double slew_approach_margin{0.3};  // [rad]
   double slew_stop_margin{0.05};     // [rad]
   double slew_approach_rate{0.2};    // [rad/s]
-  double slew_max_rate{1.6};         // [rad/s]
+  double slew_max_rate{2.0};         // [rad/s]
   double voltage_limit{10.0};        // [V] magnitude limit on both drive commands
   double approach_voltage_limit{0.5};  // [V] drive limit while an approach speed is exceeded
   double max_voltage_rate{1500.0};   // [V/s] largest change of a drive command between two samples

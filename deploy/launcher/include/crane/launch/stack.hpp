@@ -33,6 +33,7 @@ struct StackOptions {
   std::string anti_swing_controller;  // anti_swing --controller (none|pd|delay1|delay2|fuzzy); empty: its default
   std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
                                       // empty: its default
+  bool tracking_acceleration_feedforward{false};  // tracking --acceleration-feedforward
   std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
                                       // hardware bridge on that board (see the file comment)
   std::string fault_log_path;         // supervisor --fault-log (optional)

@@ -33,6 +33,9 @@ struct TrackingParams {
   double min_cable_length{0.1};        // [m] floor on the measured L, > 0
   double voltage_limit{10.0};          // [V] outputs clamped to +-voltage_limit, > 0
   bool slew_enabled{true};             // false: slew voltage 0 (gantry crane)
+  bool acceleration_feedforward{false};  // add the reference acceleration to the PD action (beyond the
+                                         // dissertation, whose (3.40) uses the reference velocity only):
+                                         // V_x += a_ref / K_mx, V_gamma += (1 + M_r x^2) gamma''_ref / K_mgamma
 };
 
 /// Model constants taken from the crane description; gains and limits keep their defaults.
