@@ -139,11 +139,14 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   // 100 Hz: the estimator's sample rate is 1 / sample_period = 1 / 0.01.
   EXPECT_NEAR(c.state_estimator.sample_rate, 100.0, 1e-9);
 
-  // Section 3.3.3: trolley (3.54), slew (3.55), combined.
-  ASSERT_EQ(c.maneuvers.size(), 3U);
+  // Section 3.3.3: trolley (3.54), slew (3.55), combined; then (3.54) while hoisting.
+  ASSERT_EQ(c.maneuvers.size(), 4U);
   EXPECT_EQ(c.maneuvers[0].name, "trolley");
   EXPECT_EQ(c.maneuvers[1].name, "slew");
   EXPECT_EQ(c.maneuvers[2].name, "combined");
+  EXPECT_EQ(c.maneuvers[3].name, "trolley_hoist");
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(c.maneuvers[i].cable_length_target, c.crane.cable_length);
+  EXPECT_DOUBLE_EQ(c.maneuvers[3].cable_length_target, 1.5);
   // trolley: 0.25 -> 1.0 m, no slew.
   EXPECT_DOUBLE_EQ(c.maneuvers[0].initial_trolley_position, 0.25);
   EXPECT_DOUBLE_EQ(c.maneuvers[0].trolley_target, 1.0);

@@ -89,7 +89,8 @@ TEST(Stack, TrolleyManeuverThroughEveryProcess) {
 nlohmann::json run_demo(const std::string& name, unsigned domain, const std::vector<std::string>& extra) {
   const fs::path out = fresh_directory(name);
   std::vector<std::string> arguments{"--config", kConfig, "--out", out.string(), "--friction-compensation", "on",
-                                     "--domain", std::to_string(domain)};
+                                     "--domain", std::to_string(domain), "--maneuver", "trolley", "--maneuver", "slew",
+                                     "--maneuver", "combined"};
   arguments.insert(arguments.end(), extra.begin(), extra.end());
   ProcessGroup group;
   group.start({"crane_demo", kBin + "/crane_demo", arguments, (out / "demo.log").string()});

@@ -448,3 +448,90 @@ TEST(TrajectoryPlanner, BadSwingParamsThrowNamingField) {
   p.ei_vibration_tolerance = 0.2;
   EXPECT_NO_THROW(tp::TrajectoryPlanner{p});
 }
+
+// ---- Waypoints: a chain of rest-to-rest segments ----
+
+TEST(TrajectoryPlannerWaypoints, PassesThroughEachWaypointAtRestAndEndsAtTheTarget) {
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  crane::common::CraneStateEstimate current;
+  current.trolley_position = 0.25;
+  current.cable_length = 1.0;
+  tp::MoveGoal goal;
+  goal.profile = tp::ProfileKind::zv;
+  goal.trolley_target = 1.0;
+  goal.slew_target = 0.0;
+  goal.cable_target = 1.0;
+  goal.waypoint_count = 2;
+  goal.waypoints[0] = {0.6, 0.5, 1.0};
+  goal.waypoints[1] = {0.4, 0.5, 1.4};  // back along the jib while lowering the load
+  ASSERT_EQ(planner.start_move(goal, current), tp::GoalStatus::accepted);
+
+  // Independent durations: each segment alone, from the previous targets.
+  auto single = [](double x0, double x1, double g0, double g1, double l0, double l1) {
+    tp::TrajectoryPlanner p(tp::TrajectoryPlannerParams{});
+    crane::common::CraneStateEstimate s;
+    s.trolley_position = x0;
+    s.slew_angle = g0;
+    s.cable_length = l0;
+    tp::MoveGoal g;
+    g.profile = tp::ProfileKind::zv;
+    g.trolley_target = x1;
+    g.slew_target = g1;
+    g.cable_target = l1;
+    EXPECT_EQ(p.start_move(g, s), tp::GoalStatus::accepted);
+    tp::PlannerOutput o;
+    EXPECT_EQ(p.step(0.0, o), crane::common::StepStatus::ok);
+    return o.move_duration;
+  };
+  const double d1 = single(0.25, 0.6, 0.0, 0.5, 1.0, 1.0);
+  const double d2 = single(0.6, 0.4, 0.5, 0.5, 1.0, 1.4);
+  const double d3 = single(0.4, 1.0, 0.5, 0.0, 1.4, 1.0);
+  tp::PlannerOutput out;
+  ASSERT_EQ(planner.step(0.0, out), crane::common::StepStatus::ok);
+  EXPECT_NEAR(out.move_duration, d1 + d2 + d3, 1e-12);
+
+  // At the end of each segment: at the waypoint, at rest.
+  ASSERT_EQ(planner.step(d1, out), crane::common::StepStatus::ok);
+  EXPECT_NEAR(out.reference.trolley.position, 0.6, 1e-9);
+  EXPECT_NEAR(out.reference.slew.position, 0.5, 1e-9);
+  EXPECT_NEAR(out.reference.trolley.velocity, 0.0, 1e-9);
+  EXPECT_EQ(out.phase, tp::MovePhase::moving);
+  ASSERT_EQ(planner.step(d2, out), crane::common::StepStatus::ok);
+  EXPECT_NEAR(out.reference.trolley.position, 0.4, 1e-9);
+  EXPECT_NEAR(out.reference.cable_length.position, 1.4, 1e-9);
+  ASSERT_EQ(planner.step(d3, out), crane::common::StepStatus::ok);
+  EXPECT_EQ(out.phase, tp::MovePhase::arrived);
+  EXPECT_DOUBLE_EQ(out.reference.trolley.position, 1.0);
+  EXPECT_DOUBLE_EQ(out.reference.slew.position, 0.0);
+  EXPECT_DOUBLE_EQ(out.reference.cable_length.position, 1.0);
+}
+
+TEST(TrajectoryPlannerWaypoints, BadWaypointsAreRejectedAndTheRunningMoveContinues) {
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  crane::common::CraneStateEstimate current;
+  current.trolley_position = 0.25;
+  current.cable_length = 1.0;
+  tp::MoveGoal goal;
+  goal.trolley_target = 1.0;
+  ASSERT_EQ(planner.start_move(goal, current), tp::GoalStatus::accepted);
+  tp::PlannerOutput before;
+  ASSERT_EQ(planner.step(0.5, before), crane::common::StepStatus::ok);
+
+  tp::MoveGoal bad = goal;
+  bad.request_id = 2;
+  bad.waypoint_count = 1;
+  bad.waypoints[0] = {1.5, 0.0, 1.0};  // beyond trolley_max_position 1.2
+  EXPECT_EQ(planner.start_move(bad, current), tp::GoalStatus::rejected_waypoint);
+  bad.waypoints[0] = {0.5, std::numeric_limits<double>::quiet_NaN(), 1.0};
+  EXPECT_EQ(planner.start_move(bad, current), tp::GoalStatus::rejected_waypoint);
+  bad.waypoints[0] = {0.5, 0.0, 0.1};  // below cable_min_length 0.2
+  EXPECT_EQ(planner.start_move(bad, current), tp::GoalStatus::rejected_waypoint);
+  bad.waypoints[0] = {0.5, 0.0, 1.0};
+  bad.waypoint_count = tp::kMaxWaypoints + 1;
+  EXPECT_EQ(planner.start_move(bad, current), tp::GoalStatus::rejected_waypoint);
+
+  tp::PlannerOutput after;
+  ASSERT_EQ(planner.step(0.0, after), crane::common::StepStatus::ok);
+  EXPECT_EQ(after.request_id, before.request_id);
+  EXPECT_DOUBLE_EQ(after.reference.trolley.position, before.reference.trolley.position);
+}

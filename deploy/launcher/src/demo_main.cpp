@@ -213,7 +213,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   result.controller = stack.tracking_controller == "tracking" ? stack.anti_swing_controller : stack.tracking_controller;
   if (stack.tracking_acceleration_feedforward) result.controller += "+feedforward";
   result.friction_compensation = compensation;
-  result.swing_period = 2.0 * kPi * std::sqrt(cfg.crane.cable_length / cfg.crane.gravity);
+  // Swing period at the cable length the move ends with (the one the load settles at).
+  result.swing_period = 2.0 * kPi * std::sqrt(m.cable_length_target / cfg.crane.gravity);
 
   launch::ProcessGroup group;
   op.drain_all();
@@ -260,10 +261,11 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
   goal.request_id(request_id);
   goal.profile(options.profile_code);  // MoveRequest_.profile code (idl/crane_msgs.idl)
-  goal.axes(0x3);
+  const bool hoists = m.cable_length_target != cfg.crane.cable_length;
+  goal.axes(hoists ? 0x7 : 0x3);  // bit 2: hoisting during the move
   goal.trolley_target(m.trolley_target);
   goal.slew_target(m.slew_target);
-  goal.cable_length_target(cfg.crane.cable_length);
+  goal.cable_length_target(m.cable_length_target);
   goal.trolley_max_velocity(m.trolley_max_velocity);
   goal.trolley_max_acceleration(m.trolley_max_acceleration);
   goal.slew_max_velocity(m.slew_max_velocity);

@@ -190,6 +190,7 @@ ManeuverConfig read_maneuver(YamlSection s) {
   m.trolley_max_velocity = s.number("trolley_max_velocity", 1e-4, 100.0);
   m.trolley_max_acceleration = s.number("trolley_max_acceleration", 1e-4, 100.0);
   m.slew_max_velocity = s.number("slew_max_velocity", 1e-4, 100.0);
+  m.cable_length_target = s.number("cable_length_target", 0.05, 200.0);
   m.slew_max_acceleration = s.number("slew_max_acceleration", 1e-4, 100.0);
   m.duration = s.number("duration", 0.5, 3600.0);
   s.finish();

@@ -2,6 +2,7 @@
 // reference trajectory (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the time-optimal
 // swing-free profile) -> rt/crane/planner/reference, once per
 // cycle, same seq and origin. Holds the first measured position until a goal arrives.
+#include <algorithm>
 #include <spdlog/spdlog.h>
 
 #include "crane/runtime/stage_node.hpp"
@@ -36,6 +37,14 @@ trajectory_planner::MoveGoal to_goal(const tp::msgs::MoveRequest_& r, const comm
   if (r.trolley_max_acceleration() > 0.0) g.trolley_limits.max_acceleration = r.trolley_max_acceleration();
   if (r.slew_max_velocity() > 0.0) g.slew_limits.max_velocity = r.slew_max_velocity();
   if (r.slew_max_acceleration() > 0.0) g.slew_limits.max_acceleration = r.slew_max_acceleration();
+  // Waypoints: an axis not named in `axes` stays where it is at every waypoint. More than
+  // kMaxWaypoints is passed on as such, and start_move() rejects it.
+  g.waypoint_count = r.waypoint_count();
+  for (std::size_t i = 0; i < std::min<std::size_t>(g.waypoint_count, trajectory_planner::kMaxWaypoints); ++i) {
+    g.waypoints[i].trolley = (r.axes() & 0x1) != 0 ? r.waypoint_trolley()[i] : current.trolley_position;
+    g.waypoints[i].slew = (r.axes() & 0x2) != 0 ? r.waypoint_slew()[i] : current.slew_angle;
+    g.waypoints[i].cable = (r.axes() & 0x4) != 0 ? r.waypoint_cable_length()[i] : current.cable_length;
+  }
   return g;
 }
 
@@ -49,6 +58,7 @@ const char* goal_status_name(trajectory_planner::GoalStatus s) {
     case GoalStatus::rejected_cable_out_of_range: return "rejected: cable length target outside its range";
     case GoalStatus::rejected_invalid_limits: return "rejected: velocity or acceleration limit <= 0, or no profile";
     case GoalStatus::rejected_unknown_profile: return "rejected: unknown profile code";
+    case GoalStatus::rejected_waypoint: return "rejected: more than 8 waypoints, or a waypoint non-finite or out of range";
   }
   return "unknown";
 }

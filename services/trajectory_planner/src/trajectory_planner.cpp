@@ -88,12 +88,16 @@ GoalStatus TrajectoryPlanner::hold(const common::CraneStateEstimate& current) no
       !std::isfinite(current.cable_length)) {
     return GoalStatus::rejected_nonfinite;
   }
-  trolley_.step.plan(current.trolley_position);
-  slew_.step.plan(current.slew_angle);
-  cable_.step.plan(current.cable_length);
-  trolley_.kind = ProfileKind::step;
-  slew_.kind = ProfileKind::step;
-  cable_.kind = ProfileKind::step;
+  Segment& s = segments_[0];
+  s.trolley.step.plan(current.trolley_position);
+  s.slew.step.plan(current.slew_angle);
+  s.cable.step.plan(current.cable_length);
+  s.trolley.kind = ProfileKind::step;
+  s.slew.kind = ProfileKind::step;
+  s.cable.kind = ProfileKind::step;
+  s.start_time = 0.0;
+  s.duration = 0.0;
+  segment_count_ = 1;
   phase_ = MovePhase::holding;
   time_in_move_ = 0.0;
   move_duration_ = 0.0;
@@ -128,34 +132,66 @@ GoalStatus TrajectoryPlanner::start_move(const MoveGoal& goal,
        !positive_limits(goal.cable_limits))) {
     return GoalStatus::rejected_invalid_limits;
   }
-  // Load swing w = sqrt(g/L) for the trolley (in-plane) and the slew (out-of-plane, same w). A
-  // non-positive measured length gives w = 0, which the swing-aware profiles reject.
-  const double swing_frequency =
-      current.cable_length > 0.0 ? std::sqrt(params_.gravity / current.cable_length) : 0.0;
+  if (goal.waypoint_count > kMaxWaypoints) return GoalStatus::rejected_waypoint;
+  for (std::size_t i = 0; i < goal.waypoint_count; ++i) {
+    const Waypoint& w = goal.waypoints[i];
+    if (!std::isfinite(w.trolley) || !std::isfinite(w.slew) || !std::isfinite(w.cable) ||
+        w.trolley < params_.trolley_min_position || w.trolley > params_.trolley_max_position ||
+        w.slew < params_.slew_min_angle || w.slew > params_.slew_max_angle || w.cable < params_.cable_min_length ||
+        w.cable > params_.cable_max_length) {
+      return GoalStatus::rejected_waypoint;
+    }
+  }
   const ProfileKind cable_kind =
       goal.profile == ProfileKind::step ? ProfileKind::step : ProfileKind::trapezoid;
-  // Plan into temporaries (held by value, no allocation) and commit only if every axis succeeds.
-  Axis trolley = trolley_;
-  Axis slew = slew_;
-  Axis cable = cable_;
-  if (!plan_axis(trolley, goal.profile, current.trolley_position, goal.trolley_target,
-                 goal.trolley_limits, swing_frequency) ||
-      !plan_axis(slew, goal.profile, current.slew_angle, goal.slew_target, goal.slew_limits,
-                 swing_frequency) ||
-      !plan_axis(cable, cable_kind, current.cable_length, goal.cable_target, goal.cable_limits,
-                 swing_frequency)) {
-    return GoalStatus::rejected_invalid_limits;
+  // Plan every segment into a temporary (held by value, no allocation) and commit only if all
+  // succeed. Each segment starts at rest where the previous one ends.
+  Segments planned = segments_;
+  Waypoint from{current.trolley_position, current.slew_angle, current.cable_length};
+  double start_time = 0.0;
+  const std::size_t count = goal.waypoint_count + 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Waypoint to = k < goal.waypoint_count ? goal.waypoints[k]
+                                                : Waypoint{goal.trolley_target, goal.slew_target, goal.cable_target};
+    // Load swing w = sqrt(g/L) at the segment's start for the trolley (in-plane) and the slew
+    // (out-of-plane, same w). A non-positive length gives w = 0, which the swing-aware profiles reject.
+    const double swing_frequency = from.cable > 0.0 ? std::sqrt(params_.gravity / from.cable) : 0.0;
+    Segment& s = planned[k];
+    if (!plan_axis(s.trolley, goal.profile, from.trolley, to.trolley, goal.trolley_limits, swing_frequency) ||
+        !plan_axis(s.slew, goal.profile, from.slew, to.slew, goal.slew_limits, swing_frequency) ||
+        !plan_axis(s.cable, cable_kind, from.cable, to.cable, goal.cable_limits, swing_frequency)) {
+      return GoalStatus::rejected_invalid_limits;
+    }
+    if (s.cable.kind == ProfileKind::trapezoid && to.cable != from.cable) {
+      // Hoisting during the segment: shaped profiles follow the swing period of L(t).
+      for (Axis* axis : {&s.trolley, &s.slew}) {
+        if (axis->kind == ProfileKind::zv || axis->kind == ProfileKind::zvd || axis->kind == ProfileKind::ei) {
+          if (axis->shaped.reschedule_for_hoisting(s.cable.trapezoid, params_.gravity) != ProfileStatus::ok) {
+            return GoalStatus::rejected_invalid_limits;
+          }
+        }
+      }
+    }
+    s.start_time = start_time;
+    s.duration = std::max({s.trolley.active().duration(), s.slew.active().duration(), s.cable.active().duration()});
+    start_time += s.duration;
+    from = to;
   }
-  trolley_ = trolley;
-  slew_ = slew;
-  cable_ = cable;
-  move_duration_ = std::max({trolley_.active().duration(), slew_.active().duration(),
-                             cable_.active().duration()});
+  segments_ = planned;
+  segment_count_ = count;
+  move_duration_ = start_time;
   time_in_move_ = 0.0;
   request_id_ = goal.request_id;
   phase_ = MovePhase::moving;
   ready_ = true;
   return GoalStatus::accepted;
+}
+
+const TrajectoryPlanner::Segment& TrajectoryPlanner::segment_at(double time_in_move) const noexcept {
+  for (std::size_t k = 0; k + 1 < segment_count_; ++k) {
+    if (time_in_move < segments_[k].start_time + segments_[k].duration) return segments_[k];
+  }
+  return segments_[segment_count_ - 1];
 }
 
 common::StepStatus TrajectoryPlanner::step(double dt, PlannerOutput& output) noexcept {
@@ -165,9 +201,11 @@ common::StepStatus TrajectoryPlanner::step(double dt, PlannerOutput& output) noe
     time_in_move_ += dt;
     if (time_in_move_ >= move_duration_) phase_ = MovePhase::arrived;
   }
-  output.reference.trolley = trolley_.active().sample(time_in_move_);
-  output.reference.slew = slew_.active().sample(time_in_move_);
-  output.reference.cable_length = cable_.active().sample(time_in_move_);
+  const Segment& s = segment_at(time_in_move_);
+  const double t = time_in_move_ - s.start_time;
+  output.reference.trolley = s.trolley.active().sample(t);
+  output.reference.slew = s.slew.active().sample(t);
+  output.reference.cable_length = s.cable.active().sample(t);
   output.phase = phase_;
   output.request_id = request_id_;
   output.time_in_move = time_in_move_;

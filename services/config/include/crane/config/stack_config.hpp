@@ -54,6 +54,7 @@ struct ManeuverConfig {
   double trolley_max_acceleration{0.9929};  // [m/s^2]
   double slew_max_velocity{1.0435};       // [rad/s]
   double slew_max_acceleration{2.0796};   // [rad/s^2]
+  double cable_length_target{1.0};        // [m] hoisting during the move when it differs from crane.cable_length
   double duration{15.0};                  // [s] recorded after the move starts
 };
 

@@ -6,6 +6,14 @@
 // velocity and acceleration stay within the base limits: the base trapezoid uses v_max and a_max
 // as given, and the shaped result respects them too. Duration = base duration + shaper length.
 //
+// Hoisting during the move: reschedule_for_hoisting() makes the impulse times follow the swing
+// period of the reference cable length L(t) instead of the length the shaper was designed for,
+//   t_i(t) = t_i T(L(t)) / T_design,  T(L) = 2 pi sqrt(L / g),
+//   x_shaped(t) = sum_i A_i x_base(t - t_i(t)),
+// with the velocity and acceleration differentiated through t_i(t) (chain rule). This is the usual
+// gain-scheduled ("adaptive") shaper for slowly varying L, not an exact zero-vibration condition
+// for a pendulum of varying length: tests/trajectory_profiles measures what it leaves.
+//
 // Held by value, no allocation; plan() is noexcept for run-time use.
 
 #include "crane/trajectory_planner/axis_profile.hpp"
@@ -26,6 +34,12 @@ class ShapedProfile final : public AxisProfile {
   ProfileStatus plan(double start, double target, const AxisLimits& limits,
                      const ShaperParams& shaper) noexcept;
 
+  /// Follow the reference cable length `cable_length` [m] over the move (see the file comment).
+  /// invalid_parameters (nothing changed) unless gravity [m/s^2] > 0 and the cable profile stays
+  /// > 0. Call after plan(); a later plan() drops the rescheduling.
+  ProfileStatus reschedule_for_hoisting(const TrapezoidProfile& cable_length, double gravity) noexcept;
+  [[nodiscard]] bool hoisting() const noexcept { return hoisting_; }
+
   [[nodiscard]] double duration() const noexcept override;
   [[nodiscard]] common::AxisReference sample(double time) const noexcept override;
 
@@ -35,6 +49,11 @@ class ShapedProfile final : public AxisProfile {
  private:
   TrapezoidProfile base_;
   InputShaper shaper_;
+  double design_period_{0.0};   // [s] 2 pi / natural_frequency of the shaper as designed
+  bool hoisting_{false};
+  TrapezoidProfile cable_;      // [m] reference cable length while hoisting_
+  double gravity_{9.8};         // [m/s^2]
+  double longest_period_{0.0};  // [s] T at the longest cable length of the move
 };
 
 }  // namespace crane::trajectory_planner

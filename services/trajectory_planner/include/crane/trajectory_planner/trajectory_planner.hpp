@@ -3,9 +3,21 @@
 // H. M. Omar, "Control of Gantry and Tower Cranes", 2003). Each axis runs its own profile from
 // the position at the start of the move; the move ends when the slowest axis arrives.
 //
+// Beyond the dissertation:
+//  - waypoints: a move may pass through up to kMaxWaypoints intermediate points; it is a chain of
+//    rest-to-rest segments (current -> waypoint 1 -> ... -> target), each planned with the goal's
+//    profile from the previous segment's targets, each starting when the previous one ends;
+//  - hoisting during the move: the cable axis runs a trapezoid alongside; the swing-aware profiles
+//    of a segment are tuned to the cable length at its start, and shaped (zv/zvd/ei) profiles
+//    reschedule their impulses with the reference cable length as it changes
+//    (ShapedProfile::reschedule_for_hoisting). The time-optimal profile keeps the length at the
+//    segment's start (its swing-free property holds for constant L only).
+//
 // Real-time: start_move(), hold() and step() are noexcept and allocate nothing; all profiles are
 // held by value.
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "crane/common/crane_signals.hpp"
@@ -42,6 +54,14 @@ struct TrajectoryPlannerParams {
   double ei_vibration_tolerance{0.05};  // [-] EI residual-vibration tolerance V, (0, 0.2]
 };
 
+/// An intermediate point of a move.
+struct Waypoint {
+  double trolley{0.25};  // [m]
+  double slew{0.0};      // [rad]
+  double cable{1.0};     // [m]
+};
+inline constexpr std::size_t kMaxWaypoints = 8;
+
 /// A move request.
 struct MoveGoal {
   std::uint64_t request_id{0};
@@ -52,6 +72,8 @@ struct MoveGoal {
   AxisLimits trolley_limits{0.4982, 0.9929};  // [m/s], [m/s^2]   (3.54)
   AxisLimits slew_limits{1.0435, 2.0796};     // [rad/s], [rad/s^2] (3.55)
   AxisLimits cable_limits{0.2, 0.5};          // [m/s], [m/s^2]
+  std::array<Waypoint, kMaxWaypoints> waypoints{};  // passed through in order, before the targets
+  std::size_t waypoint_count{0};              // valid entries of `waypoints`, <= kMaxWaypoints
 };
 
 /// Why a goal was refused (the planner then keeps what it was doing).
@@ -63,6 +85,7 @@ enum class [[nodiscard]] GoalStatus {
   rejected_cable_out_of_range,    // cable_target outside [cable_min_length, cable_max_length]
   rejected_invalid_limits,        // a limit is <= 0, or an axis profile could not be planned
   rejected_unknown_profile,       // the goal's profile is not a ProfileKind (e.g. an unknown wire code)
+  rejected_waypoint,              // more than kMaxWaypoints, or a waypoint non-finite or out of range
 };
 
 enum class MovePhase {
@@ -130,10 +153,20 @@ class TrajectoryPlanner {
   [[nodiscard]] bool plan_axis(Axis& axis, ProfileKind kind, double start, double target,
                                const AxisLimits& limits, double swing_frequency) const noexcept;
 
+  /// One rest-to-rest leg of a move (the whole move without waypoints).
+  struct Segment {
+    Axis trolley;
+    Axis slew;
+    Axis cable;
+    double start_time{0.0};  // [s] since the move started
+    double duration{0.0};    // [s] the slowest axis
+  };
+  using Segments = std::array<Segment, kMaxWaypoints + 1>;
+  [[nodiscard]] const Segment& segment_at(double time_in_move) const noexcept;
+
   TrajectoryPlannerParams params_;
-  Axis trolley_;
-  Axis slew_;
-  Axis cable_;
+  Segments segments_{};
+  std::size_t segment_count_{1};
   bool ready_{false};
   MovePhase phase_{MovePhase::holding};
   std::uint64_t request_id_{0};

@@ -1,0 +1,50 @@
+#pragma once
+// Hidden-effect generator for testing the model audit (model_audit.hpp): simulates maneuvers of a
+// plant with one catalog effect (audit_models.hpp) drawn at random (seeded, std::mt19937_64) with a
+// random magnitude in a realistic range, plus Gaussian sensor noise and encoder quantization.
+//
+// Axis: the section-3.1 experiment of Omar 2003 (as friction_experiment.hpp): the digital PD loop
+// (3.17) V = K (X_ref - x_meas - K_d (x_meas(k) - x_meas(k-1)) / T_s) tracks, after a 4 s slow
+// breakaway phase (a reference triangle at 0.03 m/s: stick thresholds and Stribeck speeds), the
+// persistently exciting reference (3.18) at T_s = 0.01 s, 16 s in all; the plant is the extended
+// axis model integrated with
+// 20 substeps per sample. Nominal K_m, b, c are themselves drawn around Tables 3.1-3.5
+// (K_m in [1.5, 2.0] m/s^2/V, b/K_m in [2.5, 4.5] V s/m, c/K_m in [0.8, 1.2] V).
+// Pendulum: free swings from several initial angles (one maneuver per "segment" id), cable length L
+// in [0.5, 3] m, nominal damping in [0.005, 0.03] 1/s, integrated with 20 RK4 substeps per sample.
+//
+// Magnitude ranges (main parameter first):
+//  coulomb_friction_asymmetry dc = +-[0.2, 0.5] c      viscous_friction_asymmetry db = +-[0.15, 0.4] b
+//  stiction Delta_s = [0.4, 1.0] c                     stribeck Delta = [0.4, 1.0] c, v_s in [0.02, 0.06] m/s
+//  deadzone d = [0.3, 0.8] c/K_m V                     saturation u_max = [0.45, 0.75] max|u| of the nominal run
+//  backlash w = [1, 4] mm                              input_delay tau = [5, 25] ms
+//  gain_error g = +-[0.1, 0.3]                         position_dependent_friction gamma = +-[0.3, 0.7] c / 0.6 m
+//  pendulum_viscous_damping d_v = [0.05, 0.3] 1/s      pendulum_coulomb_damping mu = [0.002, 0.006] g/L rad/s^2
+//  pendulum_quadratic_damping q = [0.1, 0.5] 1/rad     cable_length_error e = +-[0.05, 0.15]
+//  encoder_offset = +-[0.01, 0.05] rad
+// Sensors: axis noise sigma = 5 um, quantum 10 um; pendulum noise 1e-4 rad, quantum 2 pi / 40000 rad.
+// Offline, allocates; throws common::ConfigError for an unknown effect name.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "crane/model_audit/model_audit.hpp"
+
+namespace crane::model_audit {
+
+struct HiddenEffectCase {
+  std::string effect{"none"};                 // catalog name or "none"
+  std::string main_parameter;                 // name as reported by the audit ("" for none)
+  double main_value{0.0};                     // true value of the main parameter
+  std::map<std::string, double> nominal;      // nominal parameters to pass to the audit
+  AuditData data;
+};
+
+/// Draws and simulates one case. `effect` = catalog name, "none" (clean), or "random" (uniform over
+/// the plant's catalog). `duration` [s] per axis run or per pendulum swing.
+[[nodiscard]] HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string& effect,
+                                                           std::uint64_t seed, double duration = 0.0);
+
+}  // namespace crane::model_audit

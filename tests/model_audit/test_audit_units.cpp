@@ -1,0 +1,203 @@
+// Unit tests of the model-audit building blocks: the extended models against independent
+// computations, the residual statistics, option and data validation, and crane_audit end to end.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "crane/common/validation.hpp"
+#include "crane/model_audit/audit_models.hpp"
+#include "crane/model_audit/friction_experiment.hpp"
+#include "crane/model_audit/hidden_effect_generator.hpp"
+#include "crane/model_audit/model_audit.hpp"
+#include "crane/model_audit/residual_analysis.hpp"
+
+#ifndef CRANE_AUDIT_EXECUTABLE
+#error "CRANE_AUDIT_EXECUTABLE must name the crane_audit binary"
+#endif
+
+namespace ma = crane::model_audit;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Cross-check: the nominal extended axis equals the section-3.1 simulator's exact solution
+// (advance_friction_axis, symmetric friction b+ = b-, c+ = c-), two independent codes.
+TEST(AuditModels, NominalAxisMatchesFrictionExperimentIntegrator) {
+  ma::AxisModel model;
+  model.motor_constant = 1.7;
+  model.viscous = 2.8 * 1.7;
+  model.coulomb = 1.0 * 1.7;
+  ma::FrictionExperimentParams params;
+  params.viscous_negative = 2.8;
+  params.coulomb_negative = 1.0;
+  ma::AxisState state;
+  double position = 0.0;
+  double velocity = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double u = 3.0 * std::sin(0.05 * k) + (k % 50 < 25 ? 0.5 : -0.5);
+    ma::advance_axis(model, u, 0.01, 3, state);
+    ma::advance_friction_axis(params, u, 0.01, position, velocity);
+    ASSERT_NEAR(state.position, position, 1e-12) << k;
+    ASSERT_NEAR(state.velocity, velocity, 1e-12) << k;
+  }
+}
+
+// Stiction: with drive K_m u = 1.5 c the nominal axis moves, an axis with Delta_s = c stays put
+// (breakaway needs 2 c).
+TEST(AuditModels, StictionHoldsTheAxisBelowBreakaway) {
+  ma::AxisModel model;
+  const double u = 1.5 * model.coulomb / model.motor_constant;
+  ma::AxisState free_state;
+  ma::advance_axis(model, u, 0.1, 1, free_state);
+  EXPECT_GT(free_state.position, 0.0);
+  model.stiction = model.coulomb;
+  ma::AxisState stuck;
+  ma::advance_axis(model, u, 0.1, 1, stuck);
+  EXPECT_EQ(stuck.position, 0.0);
+}
+
+// Backlash: the measured side lags by half the gap once engaged: motor moving + at the end.
+TEST(AuditModels, BacklashLagsByHalfTheGap) {
+  ma::AxisModel model;
+  model.backlash = 0.004;
+  ma::AxisState state;
+  ma::advance_axis(model, 20.0, 0.5, 4, state);
+  EXPECT_NEAR(state.position - state.load_position, 0.002, 1e-12);
+}
+
+// Small-angle pendulum: period 2 pi sqrt(L / g); after one period the angle returns.
+TEST(AuditModels, PendulumSmallAnglePeriod) {
+  ma::PendulumModel model;
+  model.length = 2.0;
+  const double period = 2.0 * std::numbers::pi * std::sqrt(model.length / model.gravity);
+  ma::PendulumState state{1e-3, 0.0};
+  ma::advance_pendulum(model, 0.0, period, 2000, state);
+  EXPECT_NEAR(state.angle, 1e-3, 1e-8);  // (1 - cos) nonlinearity at 1 mrad is ~1e-7 relative
+}
+
+// Coulomb pendulum: the amplitude drops by 4 mu / omega^2 per cycle (linear decay).
+TEST(AuditModels, PendulumCoulombLinearDecay) {
+  ma::PendulumModel model;
+  model.length = 1.0;
+  model.coulomb = 0.02;
+  const double omega2 = model.gravity / model.length;
+  const double period = 2.0 * std::numbers::pi / std::sqrt(omega2);
+  ma::PendulumState state{0.05, 0.0};
+  ma::advance_pendulum(model, 0.0, period, 4000, state);
+  EXPECT_NEAR(state.angle, 0.05 - 4.0 * model.coulomb / omega2, 2e-5);  // small-angle estimate
+}
+
+TEST(ResidualAnalysis, ChiSquareAndLjungBox) {
+  EXPECT_NEAR(ma::chi_square_survival(3.841458820694124, 1.0), 0.05, 1e-9);
+  EXPECT_NEAR(ma::chi_square_survival(18.307038053275146, 10.0), 0.05, 1e-9);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<double> white(2000);
+  for (auto& e : white) e = normal(rng);
+  EXPECT_GT(ma::ljung_box(white, 20).p_value, 0.01);
+  std::vector<double> ar(2000);
+  for (std::size_t i = 1; i < ar.size(); ++i) ar[i] = 0.8 * ar[i - 1] + normal(rng);
+  const auto test = ma::ljung_box(ar, 20);
+  EXPECT_LT(test.p_value, 1e-9);
+  EXPECT_NEAR(test.autocorrelation[0], 0.8, 0.05);
+}
+
+TEST(AuditOptions, UnknownParameterAndCauseAreRefusedByName) {
+  ma::AuditOptions options;
+  options.parameters = {{"K_m", 1.7}, {"b", 4.0}, {"c", 1.7}, {"mass", 3.0}};
+  try {
+    ma::validate(options);
+    FAIL() << "unknown parameter accepted";
+  } catch (const crane::common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("'mass'"), std::string::npos) << e.what();
+  }
+  options.parameters.erase("mass");
+  options.causes = {"friction_of_the_gods"};
+  try {
+    ma::validate(options);
+    FAIL() << "unknown cause accepted";
+  } catch (const crane::common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("friction_of_the_gods"), std::string::npos) << e.what();
+  }
+  options.causes = {"stiction"};
+  EXPECT_NO_THROW(ma::validate(options));
+  options.parameters.erase("c");
+  EXPECT_THROW(ma::validate(options), crane::common::ConfigError);
+}
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / ("crane_audit_test_" + name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string rows(std::size_t n, const std::string& bad_row = "", std::size_t bad_at = 0) {
+  std::ostringstream out;
+  out << "# test\nt,u,x\n";
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!bad_row.empty() && k == bad_at) {
+      out << bad_row << "\n";
+      continue;
+    }
+    out << 0.01 * static_cast<double>(k) << ",0.5," << 1e-3 * static_cast<double>(k) << "\n";
+  }
+  return out.str();
+}
+
+void expect_refused(const fs::path& path, const std::string& needle) {
+  try {
+    (void)ma::read_audit_data(path, ma::AuditPlant::axis, "", 0.0);
+    FAIL() << "accepted " << path;
+  } catch (const ma::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(AuditData, BadInputIsRefusedNamingRowOrColumn) {
+  expect_refused(write_file("nan.csv", rows(100, "0.5,nan,0.0", 50)), "row 53");
+  expect_refused(write_file("time.csv", rows(100, "0.3,0.5,0.0", 50)), "row 53");
+  expect_refused(write_file("few.csv", rows(10)), "at least 50");
+  expect_refused(write_file("missing.csv", "t,u\n0,1\n0.01,1\n"), "'x'");
+  std::string uneven = rows(100);
+  uneven.replace(uneven.find("\n0.5,"), 5, "\n0.505,");
+  expect_refused(write_file("uneven.csv", uneven), "not uniform");
+  EXPECT_NO_THROW((void)ma::read_audit_data(write_file("good.csv", rows(100)), ma::AuditPlant::axis, "", 0.0));
+}
+
+int run_tool(const std::string& arguments) {
+  const std::string command = std::string(CRANE_AUDIT_EXECUTABLE) + " " + arguments + " > /dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(CraneAuditCli, WritesTheReportAndRefusesBadOptions) {
+  const fs::path dir = fs::temp_directory_path() / "crane_audit_cli_test";
+  fs::remove_all(dir);
+  const fs::path data = dir.string() + "_case.csv";
+  ASSERT_EQ(run_tool("generate --model axis --effect gain_error --seed 4 --out " + data.string()), 0);
+  const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::axis, "gain_error", 4);
+  std::string params;
+  for (const auto& [k, v] : c.nominal) params += " --param " + k + "=" + crane::common::format_value(v);
+  EXPECT_EQ(run_tool("--model axis --data " + data.string() + params + " --out " + dir.string()), 0);
+  std::ifstream report(dir / "report.json");
+  std::stringstream text;
+  text << report.rdbuf();
+  EXPECT_NE(text.str().find("\"cause\": \"gain_error\""), std::string::npos) << text.str().substr(0, 400);
+  EXPECT_NE(text.str().find("\"gain\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "report.md"));
+  EXPECT_EQ(run_tool("--model axis --data " + data.string() + params + " --param mass=3 --out " + dir.string()), 2);
+  EXPECT_EQ(run_tool("--model axis --data " + data.string() + params + " --cause nonsense --out " + dir.string()), 2);
+  EXPECT_EQ(run_tool("--model axis --data " + data.string() + params + " --columns t=time --out " + dir.string()), 2);
+  EXPECT_EQ(run_tool("--model crane --data " + data.string() + " --out " + dir.string()), 2);
+}
+
+}  // namespace

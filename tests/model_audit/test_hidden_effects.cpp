@@ -1,0 +1,131 @@
+// Hidden-effect acceptance test of the model audit: the generator (hidden_effect_generator.hpp)
+// simulates maneuvers with one catalog effect (seeded, random magnitude in a realistic range, noise
+// and quantization); the audit sees only the data and the nominal parameters and must name the
+// effect (>= 95 % of the cases), recover its main parameter within 10 %, and report "none" for
+// every clean case. Cases: env CRANE_AUDIT_CASES (effect cases, split over both models in
+// proportion to their catalogs, default 200) and CRANE_AUDIT_CLEAN_CASES (per model, default 10).
+// The confusion matrix is printed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "crane/model_audit/hidden_effect_generator.hpp"
+#include "crane/model_audit/model_audit.hpp"
+
+namespace ma = crane::model_audit;
+
+namespace {
+
+std::size_t env_count(const char* name, std::size_t fallback) {
+  const char* text = std::getenv(name);
+  if (text == nullptr || *text == '\0') return fallback;
+  return static_cast<std::size_t>(std::strtoul(text, nullptr, 10));
+}
+
+struct Tally {
+  std::map<std::string, std::map<std::string, int>> confusion;  // truth -> reported -> count
+  int cases{0};
+  int correct{0};
+  int parameter_checked{0};
+  int parameter_within{0};
+  double worst_parameter_error{0.0};
+  std::string worst_case;
+  int clean_cases{0};
+  int clean_none{0};
+};
+
+void print(const std::string& title, const Tally& tally, const std::vector<std::string>& catalog) {
+  std::printf("\n%s: %d/%d correct (%.1f %%); main parameter within 10 %%: %d/%d (worst %.1f %%, %s); clean: %d/%d none\n",
+              title.c_str(), tally.correct, tally.cases, tally.cases ? 100.0 * tally.correct / tally.cases : 0.0,
+              tally.parameter_within, tally.parameter_checked, 100.0 * tally.worst_parameter_error,
+              tally.worst_case.c_str(), tally.clean_none, tally.clean_cases);
+  std::vector<std::string> columns = catalog;
+  columns.push_back("none");
+  std::printf("%-28s", "truth \\ reported");
+  for (std::size_t i = 0; i < columns.size(); ++i) std::printf(" %3zu", i);
+  std::printf("\n");
+  for (const auto& truth : columns) {
+    const auto it = tally.confusion.find(truth);
+    if (it == tally.confusion.end()) continue;
+    std::printf("%-28s", truth.c_str());
+    for (const auto& reported : columns) {
+      const auto jt = it->second.find(reported);
+      std::printf(" %3d", jt == it->second.end() ? 0 : jt->second);
+    }
+    std::printf("\n");
+  }
+  for (std::size_t i = 0; i < columns.size(); ++i) std::printf("  %zu = %s\n", i, columns[i].c_str());
+}
+
+Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_cases, std::uint64_t seed_base) {
+  const auto& catalog = ma::audit_catalog(plant);
+  Tally tally;
+  for (std::size_t i = 0; i < effect_cases + clean_cases; ++i) {
+    const bool clean = i >= effect_cases;
+    const std::string effect = clean ? "none" : catalog[i % catalog.size()];  // every entry covered
+    const auto c = ma::generate_hidden_effect_case(plant, effect, seed_base + i);
+    ma::AuditOptions options;
+    options.plant = plant;
+    options.parameters = c.nominal;
+    const auto report = ma::run_audit(c.data, options);
+    tally.confusion[c.effect][report.cause] += 1;
+    if (clean) {
+      ++tally.clean_cases;
+      tally.clean_none += report.cause == "none" ? 1 : 0;
+      continue;
+    }
+    ++tally.cases;
+    if (report.cause != c.effect) {
+      std::printf("  missed: %s seed %llu %s=%g reported %s\n", c.effect.c_str(),
+                  static_cast<unsigned long long>(seed_base + i), c.main_parameter.c_str(), c.main_value,
+                  report.cause.c_str());
+      continue;
+    }
+    ++tally.correct;
+    for (const auto& p : report.parameters) {
+      if (p.name != c.main_parameter) continue;
+      const double error = std::abs(p.value - c.main_value) / std::abs(c.main_value);
+      ++tally.parameter_checked;
+      tally.parameter_within += error <= 0.10 ? 1 : 0;
+      if (error > 0.10) {
+        std::printf("  parameter off: %s seed %llu true %g fitted %g (%.1f %%)\n", c.effect.c_str(),
+                    static_cast<unsigned long long>(seed_base + i), c.main_value, p.value, 100.0 * error);
+      }
+      if (error > tally.worst_parameter_error) {
+        tally.worst_parameter_error = error;
+        tally.worst_case = c.effect + " seed " + std::to_string(seed_base + i) + " true " + std::to_string(c.main_value) +
+                           " fitted " + std::to_string(p.value);
+      }
+    }
+  }
+  return tally;
+}
+
+}  // namespace
+
+TEST(HiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
+  const std::size_t total = env_count("CRANE_AUDIT_CASES", 200);
+  const std::size_t clean = env_count("CRANE_AUDIT_CLEAN_CASES", 10);
+  const std::size_t axis_cases = total * 10 / 15;
+  const std::size_t pendulum_cases = total - axis_cases;
+  const Tally axis = run(ma::AuditPlant::axis, axis_cases, clean, 1000);
+  print("axis", axis, ma::audit_catalog(ma::AuditPlant::axis));
+  const Tally pendulum = run(ma::AuditPlant::pendulum, pendulum_cases, clean, 5000);
+  print("pendulum", pendulum, ma::audit_catalog(ma::AuditPlant::pendulum));
+  const int cases = axis.cases + pendulum.cases;
+  const int correct = axis.correct + pendulum.correct;
+  const int checked = axis.parameter_checked + pendulum.parameter_checked;
+  const int within = axis.parameter_within + pendulum.parameter_within;
+  std::printf("\ntotal: %d/%d correct (%.1f %%), parameter within 10 %%: %d/%d, clean none: %d/%d\n", correct, cases,
+              cases ? 100.0 * correct / cases : 0.0, within, checked, axis.clean_none + pendulum.clean_none,
+              axis.clean_cases + pendulum.clean_cases);
+  EXPECT_GE(correct, static_cast<int>(std::ceil(0.95 * cases)));
+  EXPECT_EQ(within, checked);
+  EXPECT_EQ(axis.clean_none, axis.clean_cases);
+  EXPECT_EQ(pendulum.clean_none, pendulum.clean_cases);
+}
