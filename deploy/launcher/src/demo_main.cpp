@@ -571,10 +571,10 @@ int main(int argc, char** argv) {
     std::ofstream(summary_path) << summary.dump(2) << '\n';
 
     // Table.
-    std::printf("\n%-9s %-9s %9s %7s %10s %11s %10s %12s %8s\n", "maneuver", "friction", "settle_s", "settle_T",
+    std::printf("\n%-13s %-9s %9s %7s %10s %11s %10s %12s %8s\n", "maneuver", "friction", "settle_s", "settle_T",
                 "pos_err_mm", "slew_err_mrad", "max_swing_deg", "resid_swing_deg", "max_V");
     for (const auto& r : results) {
-      std::printf("%-9s %-9s %9s %7s %10s %11s %10s %12s %8s\n", r.maneuver.c_str(),
+      std::printf("%-13s %-9s %9s %7s %10s %11s %10s %12s %8s\n", r.maneuver.c_str(),
                   r.friction_compensation ? "comp_on" : "comp_off", format_number(r.metrics.settle_time, 2).c_str(),
                   format_number(r.metrics.settle_time / r.swing_period, 2).c_str(),
                   format_number(r.metrics.final_position_error * 1e3, 2).c_str(), format_number(r.metrics.final_slew_error * 1e3, 2).c_str(),
