@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <thread>
 #include <vector>
@@ -139,7 +140,9 @@ int main(int argc, char** argv) {
     Clock::time_point status_wall{};
     std::uint64_t seq = 0;
     std::uint64_t tick = 0;
-    std::uint64_t stale_commands = 0;  // commands for another cycle than the current one
+    std::uint64_t stale_commands = 0;  // valid commands for another cycle than the current one
+    std::uint64_t rejected_non_finite = 0;   // NaN/Inf in a command, any cycle
+    std::uint64_t rejected_out_of_range = 0;  // beyond the hardware ranges, any cycle
     bool started = false;              // a command has arrived once
     hb::SafeStateReason logged_reason = hb::SafeStateReason::none;
     auto next_deadline = Clock::now();
@@ -185,6 +188,20 @@ int main(int argc, char** argv) {
       }
       bool applied = false;
       while (actuators->take_next(incoming)) {
+        // Every command is checked where it enters, whatever cycle it claims (BridgeCore checks the
+        // one it applies again).
+        if (!runtime::all_finite(incoming)) {
+          ++rejected_non_finite;
+          ++counters.nonfinite_rejected;
+          continue;
+        }
+        const auto& limits = cfg.hardware_bridge.bridge;
+        if (std::fabs(incoming.trolley_voltage()) > limits.max_drive_voltage ||
+            std::fabs(incoming.slew_voltage()) > limits.max_drive_voltage ||
+            std::fabs(incoming.hoist_speed()) > limits.hoist_speed_limit) {
+          ++rejected_out_of_range;
+          continue;
+        }
         if (incoming.header().seq() != k) {
           ++stale_commands;
           continue;
@@ -284,15 +301,17 @@ int main(int argc, char** argv) {
     const auto& c = core.counters();
     spdlog::info("stopping: {} cycles, {} overruns, {} commands accepted, rejected {} non-finite and {} out of range, "
                  "{} stale, {} watchdog trips, {} safe cycles, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us",
-                 counters.cycles, counters.overruns, c.accepted_commands, c.rejected_commands.non_finite,
-                 c.rejected_commands.out_of_range, stale_commands, c.watchdog_trips, c.safe_cycles,
+                 counters.cycles, counters.overruns, c.accepted_commands,
+                 rejected_non_finite + c.rejected_commands.non_finite,
+                 rejected_out_of_range + c.rejected_commands.out_of_range, stale_commands, c.watchdog_trips, c.safe_cycles,
                  latency.percentile(50), latency.percentile(99), latency.maximum());
     if (!stats_path.empty()) {
       std::ofstream stats(stats_path);
       stats << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns
             << ", \"accepted_commands\": " << c.accepted_commands
-            << ", \"rejected_non_finite\": " << c.rejected_commands.non_finite
-            << ", \"rejected_out_of_range\": " << c.rejected_commands.out_of_range
+            << ", \"rejected_non_finite\": " << rejected_non_finite + c.rejected_commands.non_finite
+            << ", \"rejected_out_of_range\": " << rejected_out_of_range + c.rejected_commands.out_of_range
+            << ", \"stale_commands\": " << stale_commands
             << ", \"watchdog_trips\": " << c.watchdog_trips << ", \"safe_cycles\": " << c.safe_cycles
             << ", \"latency_us\": [";
       for (std::size_t i = 0; i < latency_log.size(); ++i) stats << (i ? "," : "") << latency_log[i];

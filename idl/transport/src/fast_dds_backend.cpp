@@ -1,6 +1,7 @@
 // Fast DDS 2.9 adapter of the transport interface.
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -17,6 +18,8 @@
 #include <algorithm>
 #include <atomic>
 #include <map>
+#include <mutex>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -174,6 +177,87 @@ class FastReader final : public ReaderBackend, public dds::DataReaderListener {
   std::atomic<std::uint64_t> samples_{0};
 };
 
+std::string hex(const eprosima::fastrtps::rtps::GUID_t& guid) {
+  std::ostringstream out;
+  out << guid;
+  return out.str();
+}
+std::string hex(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  std::ostringstream out;
+  out << prefix;
+  return out.str();
+}
+
+// Keeps what discovery announces about the other participants' endpoints (crane topic list).
+class DiscoveryListener final : public dds::DomainParticipantListener {
+ public:
+  void on_participant_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard lock(mutex_);
+    using S = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    const auto prefix = hex(info.info.m_guid.guidPrefix);
+    if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) {
+      names_.erase(prefix);
+      for (auto it = endpoints_.begin(); it != endpoints_.end();) {
+        it = it->second.guid.rfind(prefix, 0) == 0 ? endpoints_.erase(it) : std::next(it);
+      }
+    } else {
+      names_[prefix] = info.info.m_participantName.to_string();
+    }
+  }
+  void on_publisher_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    using S = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    const auto& d = info.info;
+    update(hex(d.guid()), info.status == S::REMOVED_WRITER, d.topicName().to_string(),
+           d.typeName().to_string(), true, d.guid().guidPrefix, d.m_qos.m_reliability.kind == eprosima::fastrtps::RELIABLE_RELIABILITY_QOS,
+           d.m_qos.m_durability.kind == eprosima::fastrtps::TRANSIENT_LOCAL_DURABILITY_QOS, d.m_qos.m_deadline.period);
+  }
+  void on_subscriber_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    using S = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
+    const auto& d = info.info;
+    update(hex(d.guid()), info.status == S::REMOVED_READER, d.topicName().to_string(),
+           d.typeName().to_string(), false, d.guid().guidPrefix, d.m_qos.m_reliability.kind == eprosima::fastrtps::RELIABLE_RELIABILITY_QOS,
+           d.m_qos.m_durability.kind == eprosima::fastrtps::TRANSIENT_LOCAL_DURABILITY_QOS, d.m_qos.m_deadline.period);
+  }
+  std::vector<DiscoveredEndpoint> snapshot(const std::string& own_prefix) const {
+    std::lock_guard lock(mutex_);
+    std::vector<DiscoveredEndpoint> out;
+    for (const auto& [guid, e] : endpoints_) {
+      if (guid.rfind(own_prefix, 0) == 0) continue;
+      DiscoveredEndpoint copy = e;
+      const auto name = names_.find(guid.substr(0, own_prefix.size()));
+      copy.participant = name != names_.end() && !name->second.empty() ? name->second : guid.substr(0, own_prefix.size());
+      out.push_back(std::move(copy));
+    }
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+      return std::tie(a.topic, a.writer, a.participant) < std::tie(b.topic, b.writer, b.participant);
+    });
+    return out;
+  }
+
+ private:
+  void update(const std::string& guid, bool removed, std::string topic, std::string type, bool writer,
+              const eprosima::fastrtps::rtps::GuidPrefix_t&, bool reliable, bool transient_local,
+              const eprosima::fastrtps::Duration_t& deadline) {
+    std::lock_guard lock(mutex_);
+    if (removed) {
+      endpoints_.erase(guid);
+      return;
+    }
+    DiscoveredEndpoint e;
+    e.topic = std::move(topic);
+    e.type = std::move(type);
+    e.writer = writer;
+    e.guid = guid;
+    e.reliable = reliable;
+    e.transient_local = transient_local;
+    e.deadline = deadline == eprosima::fastrtps::c_TimeInfinite ? 0.0 : static_cast<double>(deadline.to_ns()) * 1e-9;
+    endpoints_[guid] = std::move(e);
+  }
+  mutable std::mutex mutex_;
+  std::map<std::string, std::string> names_;          // GUID prefix -> participant name
+  std::map<std::string, DiscoveredEndpoint> endpoints_;  // endpoint GUID -> endpoint
+};
+
 class FastParticipant final : public ParticipantBackend {
  public:
   explicit FastParticipant(const ParticipantOptions& options) {
@@ -201,8 +285,9 @@ class FastParticipant final : public ParticipantBackend {
       qos.wire_protocol().builtin.metatrafficUnicastLocatorList.push_back(meta);
       qos.wire_protocol().default_unicast_locator_list.push_back(meta);
     }
+    // Only the discovery callbacks go to the listener; data and status stay with each endpoint.
     participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
-        static_cast<dds::DomainId_t>(options.domain_id), qos);
+        static_cast<dds::DomainId_t>(options.domain_id), qos, &discovery_, dds::StatusMask::none());
     if (participant_ == nullptr) {
       throw std::runtime_error("fast dds: cannot create a participant in domain " +
                                std::to_string(options.domain_id));
@@ -214,8 +299,12 @@ class FastParticipant final : public ParticipantBackend {
     }
   }
   ~FastParticipant() override {
+    participant_->set_listener(nullptr);
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  std::vector<DiscoveredEndpoint> discovered_endpoints() const override {
+    return discovery_.snapshot(hex(participant_->guid().guidPrefix));
   }
   std::unique_ptr<WriterBackend> create_writer(const TopicDescriptor& topic) override {
     return std::make_unique<FastWriter>(publisher_, topic_for(topic), topic.qos);
@@ -241,6 +330,7 @@ class FastParticipant final : public ParticipantBackend {
     return created;
   }
 
+  DiscoveryListener discovery_;  // declared before participant_: outlives it
   dds::DomainParticipant* participant_{nullptr};
   dds::Publisher* publisher_{nullptr};
   dds::Subscriber* subscriber_{nullptr};

@@ -19,6 +19,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "crane/transport/qos.hpp"
@@ -53,6 +54,18 @@ struct ReaderHealth {
 struct WriterHealth {
   std::int32_t matched_readers{0};
   std::uint64_t deadline_missed{0};
+};
+
+/// A writer or reader of another participant, as DDS discovery announced it (crane topic list).
+struct DiscoveredEndpoint {
+  std::string topic;             // e.g. "rt/crane/hw/sensors"
+  std::string type;              // e.g. "crane_msgs::msg::dds_::SensorSample_"
+  bool writer{false};            // true: a DataWriter, false: a DataReader
+  std::string participant;       // the participant's name ("plant", ...), or its GUID prefix if unnamed
+  std::string guid;              // endpoint GUID, hex
+  bool reliable{false};          // RELIABLE (else BEST_EFFORT)
+  bool transient_local{false};   // TRANSIENT_LOCAL durability (else VOLATILE)
+  double deadline{0.0};          // [s] offered/requested deadline period, 0 = infinite
 };
 
 /// A wake-up shared by all readers of one process: readers notify it on data and status changes,
@@ -96,6 +109,7 @@ class ReaderBackend {
 class ParticipantBackend {
  public:
   virtual ~ParticipantBackend() = default;
+  [[nodiscard]] virtual std::vector<DiscoveredEndpoint> discovered_endpoints() const = 0;
   virtual std::unique_ptr<WriterBackend> create_writer(const TopicDescriptor& topic) = 0;
   /// history_depth > 0 overrides the profile's keep-last depth (a recorder that must not drop
   /// samples of a best-effort stream keeps more; the wire QoS stays compatible).
@@ -172,6 +186,9 @@ class Participant {
     return std::make_unique<Reader<T>>(backend_->create_reader(detail::describe<T>(), wakeup, history_depth));
   }
   [[nodiscard]] Vendor vendor() const noexcept { return options_.vendor; }
+  /// Writers and readers of the other participants discovered so far (this one's own excluded),
+  /// sorted by topic. Safe to call from any thread.
+  [[nodiscard]] std::vector<DiscoveredEndpoint> discovered_endpoints() const { return backend_->discovered_endpoints(); }
   [[nodiscard]] const ParticipantOptions& options() const noexcept { return options_; }
 
  private:

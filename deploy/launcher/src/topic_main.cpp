@@ -1,0 +1,294 @@
+// crane_topic: watch the crane's topics from any machine that reaches the DDS domain, with a
+// read-only participant (it creates readers only).
+//
+//   crane_topic list [--wait S] [--json]           topics from discovery: types, writers, readers, QoS
+//   crane_topic echo TOPIC [--count N] [--timeout S]   samples as JSON lines
+//   crane_topic hz TOPIC [--duration S] [--json]       rate and period jitter (receive time and the
+//                                                     writer's stamps)
+//   crane_topic record --out run.csv [--duration S]    the audit's CSV (t,u_x,u_gamma,x,gamma,phi,
+//                                                     theta,L, one row per sensor cycle) and every
+//                                                     sample of every topic in run.csv.samples.jsonl
+//
+// Common options: --dds fast|cyclone, --domain N, --lan (default: bound to loopback, as the stack).
+// Exit codes: 0 done, 1 nothing received within the time given, 2 bad usage (unknown topic...).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "crane/runtime/node_runtime.hpp"
+#include "topic_fields.hpp"
+
+namespace {
+
+using namespace crane;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+namespace topic_fields = crane::launch::topic_fields;
+
+const std::vector<std::string>& topic_names() {
+  static const std::vector<std::string> names{tp::Sensors::name,       tp::Actuators::name,    tp::StateEstimate::name,
+                                              tp::Goal::name,          tp::Reference::name,    tp::AntiSwing::name,
+                                              tp::LinearCommand::name, tp::SafetyStatus::name, tp::SafetyCommand::name,
+                                              tp::LoopDiagnostics::name};
+  return names;
+}
+
+/// Calls f.template operator()<Topic>() for the topic tag named `name`; false if none is.
+template <class F>
+bool with_topic(const std::string& name, F&& f) {
+  if (name == tp::Sensors::name) return f.template operator()<tp::Sensors>(), true;
+  if (name == tp::Actuators::name) return f.template operator()<tp::Actuators>(), true;
+  if (name == tp::StateEstimate::name) return f.template operator()<tp::StateEstimate>(), true;
+  if (name == tp::Goal::name) return f.template operator()<tp::Goal>(), true;
+  if (name == tp::Reference::name) return f.template operator()<tp::Reference>(), true;
+  if (name == tp::AntiSwing::name) return f.template operator()<tp::AntiSwing>(), true;
+  if (name == tp::LinearCommand::name) return f.template operator()<tp::LinearCommand>(), true;
+  if (name == tp::SafetyStatus::name) return f.template operator()<tp::SafetyStatus>(), true;
+  if (name == tp::SafetyCommand::name) return f.template operator()<tp::SafetyCommand>(), true;
+  if (name == tp::LoopDiagnostics::name) return f.template operator()<tp::LoopDiagnostics>(), true;
+  return false;
+}
+
+Clock::time_point after(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(v.size() - 1)));
+  return v[i];
+}
+
+json period_statistics(const std::vector<double>& times) {
+  std::vector<double> periods;
+  for (std::size_t i = 1; i < times.size(); ++i) periods.push_back(times[i] - times[i - 1]);
+  json j;
+  j["samples"] = times.size();
+  if (periods.empty()) return j;
+  double mean = 0.0;
+  for (const double p : periods) mean += p;
+  mean /= static_cast<double>(periods.size());
+  double variance = 0.0;
+  std::vector<double> deviation;
+  for (const double p : periods) {
+    variance += (p - mean) * (p - mean);
+    deviation.push_back(std::fabs(p - mean));
+  }
+  variance /= static_cast<double>(periods.size());
+  j["rate_hz"] = 1.0 / mean;
+  j["period_mean_ms"] = mean * 1e3;
+  j["period_std_ms"] = std::sqrt(variance) * 1e3;
+  j["period_min_ms"] = *std::min_element(periods.begin(), periods.end()) * 1e3;
+  j["period_max_ms"] = *std::max_element(periods.begin(), periods.end()) * 1e3;
+  j["jitter_p99_ms"] = percentile(deviation, 99) * 1e3;
+  return j;
+}
+
+template <class M>
+double origin_seconds(const M& m) {
+  if constexpr (requires { m.header(); }) {
+    return static_cast<double>(runtime::to_nanoseconds(m.header().origin())) * 1e-9;
+  } else {
+    return std::nan("");
+  }
+}
+
+int list(transport::Participant& participant, double wait, bool as_json) {
+  std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+  const auto endpoints = participant.discovered_endpoints();
+  if (as_json) {
+    json topics = json::object();
+    for (const auto& e : endpoints) {
+      auto& t = topics[e.topic];
+      t["type"] = e.type;
+      json endpoint{{"participant", e.participant}, {"guid", e.guid}, {"reliable", e.reliable},
+                    {"transient_local", e.transient_local}, {"deadline_s", e.deadline}};
+      t[e.writer ? "writers" : "readers"].push_back(endpoint);
+    }
+    for (auto& [name, t] : topics.items()) {
+      if (!t.contains("writers")) t["writers"] = json::array();
+      if (!t.contains("readers")) t["readers"] = json::array();
+    }
+    std::printf("%s\n", topics.dump(2).c_str());
+  } else {
+    std::string topic;
+    for (const auto& e : endpoints) {
+      if (e.topic != topic) {
+        topic = e.topic;
+        std::printf("%s  [%s]\n", e.topic.c_str(), e.type.c_str());
+      }
+      char deadline[32] = "none";
+      if (e.deadline > 0.0) std::snprintf(deadline, sizeof(deadline), "%.0f ms", e.deadline * 1e3);
+      std::printf("    %-6s %-24s %-11s %-15s deadline %s\n", e.writer ? "writer" : "reader", e.participant.c_str(),
+                  e.reliable ? "reliable" : "best_effort", e.transient_local ? "transient_local" : "volatile", deadline);
+    }
+    if (endpoints.empty()) std::printf("no other participant seen on this domain within %.1f s\n", wait);
+  }
+  return endpoints.empty() ? 1 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_topic: list, echo, measure and record the crane's DDS topics (read-only participant)"};
+  app.require_subcommand(1);
+  runtime::NodeOptions node;
+  bool lan = false;
+  auto common = [&](CLI::App* sub) {
+    sub->add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
+    sub->add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+    sub->add_flag("--lan", lan, "use every interface instead of loopback only");
+  };
+  auto* list_cmd = app.add_subcommand("list", "topics from discovery: types, writers, readers, QoS");
+  double wait = 2.0;
+  bool as_json = false;
+  list_cmd->add_option("--wait", wait, "[s] discovery time")->check(CLI::Range(0.1, 60.0));
+  list_cmd->add_flag("--json", as_json, "one JSON object");
+  common(list_cmd);
+  std::string topic;
+  auto* echo_cmd = app.add_subcommand("echo", "print samples as JSON lines");
+  int count = 0;
+  double timeout = 5.0;
+  echo_cmd->add_option("topic", topic, "topic name, e.g. rt/crane/hw/sensors")->required();
+  echo_cmd->add_option("--count", count, "stop after N samples (0: until Ctrl-C)")->check(CLI::Range(0, 1000000000));
+  echo_cmd->add_option("--timeout", timeout, "[s] give up when nothing arrives this long")->check(CLI::Range(0.1, 3600.0));
+  common(echo_cmd);
+  auto* hz_cmd = app.add_subcommand("hz", "rate and period jitter of a topic");
+  double duration = 5.0;
+  hz_cmd->add_option("topic", topic, "topic name")->required();
+  hz_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(0.1, 3600.0));
+  hz_cmd->add_flag("--json", as_json, "one JSON object");
+  common(hz_cmd);
+  auto* record_cmd = app.add_subcommand("record", "the audit's CSV and every sample (JSON lines)");
+  std::string out_path;
+  record_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L)")->required();
+  record_cmd->add_option("--duration", duration, "[s] recording time")->check(CLI::Range(0.1, 86400.0));
+  double sample_period = 0.01;
+  record_cmd->add_option("--sample-period", sample_period, "[s] of the sensor stream (t = cycle number * this)")
+      ->check(CLI::Range(1e-4, 1.0));
+  common(record_cmd);
+  CLI11_PARSE(app, argc, argv);
+  node.loopback_only = !lan;
+
+  try {
+    runtime::configure_logging("warn", "crane_topic");
+    auto participant = runtime::make_participant(node, "crane_topic");
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+    if (list_cmd->parsed()) return list(*participant, wait, as_json);
+
+    if (echo_cmd->parsed() || hz_cmd->parsed()) {
+      int status = 1;
+      const bool known = with_topic(topic, [&]<class T>() {
+        auto reader = participant->make_recording_reader<T>(&wakeup, 1024);
+        typename T::Message m;
+        std::vector<double> receive, origin;
+        int printed = 0;
+        const auto end = after(hz_cmd->parsed() ? duration : 1e9);
+        auto idle_deadline = after(timeout);
+        while (!runtime::stop_requested() && Clock::now() < end) {
+          while (reader->take_next(m)) {
+            status = 0;
+            if (echo_cmd->parsed()) {
+              std::printf("%s\n", topic_fields::to_json(m).dump().c_str());
+              std::fflush(stdout);
+              if (count > 0 && ++printed >= count) return;
+            } else {
+              receive.push_back(static_cast<double>(runtime::now_nanoseconds()) * 1e-9);
+              origin.push_back(origin_seconds(m));
+            }
+            idle_deadline = after(timeout);
+          }
+          if (echo_cmd->parsed() && Clock::now() > idle_deadline) return;
+          wakeup.wait_until(std::min(end, Clock::now() + std::chrono::milliseconds(50)));
+        }
+        if (hz_cmd->parsed()) {
+          json j{{"topic", topic}, {"duration_s", duration}, {"receive", period_statistics(receive)}};
+          if (!origin.empty() && std::isfinite(origin.front())) j["writer_stamps"] = period_statistics(origin);
+          if (as_json) {
+            std::printf("%s\n", j.dump(2).c_str());
+          } else if (receive.size() > 1) {
+            const auto& r = j["receive"];
+            std::printf("%s: %.2f Hz over %zu samples; period mean %.3f ms, std %.3f ms, min %.3f ms, max %.3f ms, "
+                        "jitter p99 %.3f ms\n",
+                        topic.c_str(), r["rate_hz"].get<double>(), receive.size(), r["period_mean_ms"].get<double>(),
+                        r["period_std_ms"].get<double>(), r["period_min_ms"].get<double>(),
+                        r["period_max_ms"].get<double>(), r["jitter_p99_ms"].get<double>());
+          } else {
+            std::printf("%s: %zu samples in %.1f s\n", topic.c_str(), receive.size(), duration);
+          }
+        }
+      });
+      if (!known) {
+        std::fprintf(stderr, "crane_topic: unknown topic '%s'; the crane's topics are:\n", topic.c_str());
+        for (const auto& n : topic_names()) std::fprintf(stderr, "  %s\n", n.c_str());
+        return 2;
+      }
+      return status;
+    }
+
+    // record: every topic to JSON lines; the sensor stream to the audit's CSV.
+    std::ofstream samples(out_path + ".samples.jsonl");
+    if (!samples) throw std::runtime_error("cannot write " + out_path + ".samples.jsonl");
+    std::map<std::uint64_t, tp::msgs::SensorSample_> sensors;
+    std::vector<std::function<void()>> drains;
+    std::vector<std::shared_ptr<void>> readers;
+    for (const auto& name : topic_names()) {
+      with_topic(name, [&]<class T>() {
+        auto reader = std::shared_ptr(participant->make_recording_reader<T>(&wakeup, 4096));
+        readers.push_back(reader);
+        drains.push_back([reader, &samples, &sensors, name] {
+          typename T::Message m;
+          while (reader->take_next(m)) {
+            samples << json{{"topic", name}, {"receive_ns", runtime::now_nanoseconds()}, {"sample", topic_fields::to_json(m)}}.dump()
+                    << '\n';
+            if constexpr (std::is_same_v<T, tp::Sensors>) sensors[m.header().seq()] = m;
+          }
+        });
+      });
+    }
+    const auto end = after(duration);
+    while (!runtime::stop_requested() && Clock::now() < end) {
+      for (auto& d : drains) d();
+      wakeup.wait_until(std::min(end, Clock::now() + std::chrono::milliseconds(20)));
+    }
+    for (auto& d : drains) d();
+    // Row k: the sensors of cycle k and the voltage applied during cycle k, which sample k+1 reports.
+    std::ofstream csv(out_path);
+    if (!csv) throw std::runtime_error("cannot write " + out_path);
+    csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,seq\n";
+    csv.precision(10);
+    std::size_t rows = 0;
+    // Time from the cycle number (the sensor writer is the clock; wall stamps jitter, and in
+    // lockstep they are not simulated time).
+    const std::uint64_t seq0 = sensors.empty() ? 0 : sensors.begin()->first;
+    for (auto it = sensors.begin(); it != sensors.end(); ++it) {
+      const auto next = std::next(it);
+      if (next == sensors.end() || next->first != it->first + 1) continue;
+      const auto& s = it->second;
+      const double t = static_cast<double>(it->first - seq0) * sample_period;
+      csv << t << ',' << next->second.applied_trolley_voltage() << ',' << next->second.applied_slew_voltage() << ','
+          << s.trolley_position() << ',' << s.slew_angle() << ',' << s.swing_in_plane() << ','
+          << s.swing_out_of_plane() << ',' << s.cable_length() << ',' << s.header().seq() << '\n';
+      ++rows;
+    }
+    std::fprintf(stderr, "crane_topic: %zu sensor cycles -> %s, every sample -> %s.samples.jsonl\n", rows,
+                 out_path.c_str(), out_path.c_str());
+    return rows > 0 ? 0 : 1;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_topic: %s\n", error.what());
+    return 1;
+  }
+}
