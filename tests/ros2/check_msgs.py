@@ -6,6 +6,8 @@ the same order, with the ROS 2 type that rosidl maps to the IDL type (so a ROS 2
 the package reads and writes our topics); no .msg may exist without its struct. Exit code 0 when
 they agree, 1 with one line per difference otherwise.
 Usage: check_msgs.py IDL_FILE MSG_DIR
+       check_msgs.py IDL_FILE --fields-header deploy/launcher/src/topic_fields.hpp
+(the second form checks crane_topic's JSON field tables against the IDL the same way)
 """
 import pathlib
 import re
@@ -54,9 +56,32 @@ def msg_fields(path):
     return fields
 
 
+def check_fields_header(structs, header):
+    text = header.read_text()
+    problems = []
+    for name, fields in structs.items():
+        if name == "CycleHeader":
+            continue
+        m = re.search(r"inline json to_json\(const msgs::%s_& m\) \{(.*?)\n\}" % name, text, re.S)
+        if not m:
+            problems.append(f"{header.name}: no to_json for {name}_")
+            continue
+        got = re.findall(r'j\["(\w+)"\]', m.group(1))
+        want = [f for _, f in fields]
+        if got != want:
+            problems.append(f"{header.name} {name}_: IDL fields {want}, table {got}")
+    for p in problems:
+        print(p)
+    print(f"{len(structs) - 1} field tables checked, {len(problems)} differences")
+    return 1 if problems else 0
+
+
 def main():
-    idl, msg_dir = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+    idl = pathlib.Path(sys.argv[1])
     structs = idl_structs(idl.read_text())
+    if sys.argv[2] == "--fields-header":
+        return check_fields_header(structs, pathlib.Path(sys.argv[3]))
+    msg_dir = pathlib.Path(sys.argv[2])
     problems = []
     for name, fields in structs.items():
         path = msg_dir / f"{name}.msg"
