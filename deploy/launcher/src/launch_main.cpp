@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
   app.add_option("--config", stack.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone");
   app.add_option("--domain", stack.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_flag("--lan", stack.lan, "every process uses all network interfaces (monitoring from another machine) "
+                                   "instead of loopback only");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
   app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
   app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     runtime::NodeOptions node;
     node.dds = stack.dds;
     node.domain_id = stack.domain_id;
+    node.loopback_only = !stack.lan;
     auto participant = runtime::make_participant(node, "launcher");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -44,6 +44,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     const auto vendor = o.dds_per_process.count(name) != 0 ? o.dds_per_process.at(name) : o.dds;
     spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
                       "--log-level", o.log_level};
+    if (o.lan) spec.arguments.push_back("--lan");
     if (name == "plant") {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),

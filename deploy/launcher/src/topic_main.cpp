@@ -149,7 +149,8 @@ int main(int argc, char** argv) {
   auto common = [&](CLI::App* sub) {
     sub->add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
     sub->add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
-    sub->add_flag("--lan", lan, "use every interface instead of loopback only");
+    sub->add_flag("--lan", lan, "use the network (UDP on every interface, no shared memory: as from another "
+                                "machine) instead of loopback only");
   };
   auto* list_cmd = app.add_subcommand("list", "topics from discovery: types, writers, readers, QoS");
   double wait = 2.0;
@@ -181,6 +182,7 @@ int main(int argc, char** argv) {
   common(record_cmd);
   CLI11_PARSE(app, argc, argv);
   node.loopback_only = !lan;
+  node.shared_memory = !lan;
 
   try {
     runtime::configure_logging("warn", "crane_topic");

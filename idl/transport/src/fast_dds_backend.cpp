@@ -284,6 +284,9 @@ class FastParticipant final : public ParticipantBackend {
       meta.kind = LOCATOR_KIND_UDPv4;
       qos.wire_protocol().builtin.metatrafficUnicastLocatorList.push_back(meta);
       qos.wire_protocol().default_unicast_locator_list.push_back(meta);
+    } else if (!options.shared_memory) {
+      qos.transport().use_builtin_transports = false;
+      qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
     }
     // Only the discovery callbacks go to the listener; data and status stay with each endpoint.
     participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(

@@ -43,6 +43,7 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
   p.name = name;
   p.domain_id = options.domain_id;
   p.loopback_only = options.loopback_only;
+  p.shared_memory = options.shared_memory;
   p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
   return std::make_unique<transport::Participant>(p);
 }

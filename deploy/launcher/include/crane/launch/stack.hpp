@@ -21,6 +21,7 @@ struct StackOptions {
   std::string dds{"fast"};            // vendor for every process unless overridden below
   std::map<std::string, std::string> dds_per_process;  // stage name -> vendor
   unsigned domain_id{0};
+  bool lan{false};                    // every process with --lan (all interfaces) instead of loopback only
   bool lockstep{true};                // plant clock: lockstep (default) or realtime
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]

@@ -38,6 +38,8 @@ struct ParticipantOptions {
   std::string name{"crane"};      // participant name shown by discovery tools
   std::uint32_t domain_id{0};     // DDS domain
   bool loopback_only{true};       // bind to 127.0.0.1 only, unicast discovery on loopback
+  bool shared_memory{true};       // with loopback_only false: also the shared-memory transport (false: UDP
+                                  // only, as a participant on another machine talks to the stack)
   Vendor vendor{Vendor::fast_dds};
 };
 

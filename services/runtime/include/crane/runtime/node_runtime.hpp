@@ -42,6 +42,7 @@ struct NodeOptions {
   std::string dds{};        // "fast" | "cyclone"; empty: CRANE_DDS, else fast
   std::uint32_t domain_id{0};
   bool loopback_only{true};
+  bool shared_memory{true};  // false: UDP only when not loopback_only (crane_topic --lan)
   std::string log_level{"info"};
 };
 
