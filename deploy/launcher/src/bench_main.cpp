@@ -1,0 +1,274 @@
+// crane_bench latency: end-to-end and per-hop latency of the running stack, the jitter of the
+// sensor stream, and a raw DDS ping-pong of the same message size as the floor, measured in the
+// same run.
+//
+//   crane_bench latency --config FILE [--rate HZ] [--duration S] [--json]
+//
+// The stack (plant on DDS, realtime) is started at `--rate` (the config's sample period replaced by
+// 1/rate), every stage its own process. Per hop: the `stamp` each stage writes into its output
+// header minus the stamp of its input, for the same cycle (all on this machine, one clock).
+// End-to-end: the plant's own measurement, sensor sample time to command arrival. Floor: two
+// participants of this process bounce an ActuatorCommand_ (the chain's message size) over the same
+// transport and QoS; one-way = round trip / 2.
+// Fast DDS only for now (the Cyclone adapter is issue 6). Run it inside a private network
+// namespace (deploy/crane bench does).
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
+
+namespace {
+
+using namespace crane;
+namespace fs = std::filesystem;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+double ns(const builtin_interfaces::msg::dds_::Time_& t) { return static_cast<double>(runtime::to_nanoseconds(t)); }
+
+json summary(std::vector<double> us) {
+  if (us.empty()) return json{{"samples", 0}};
+  std::sort(us.begin(), us.end());
+  auto at = [&](double p) { return us[static_cast<std::size_t>(std::lround(p / 100.0 * static_cast<double>(us.size() - 1)))]; };
+  return json{{"samples", us.size()}, {"p50_us", at(50)}, {"p99_us", at(99)}, {"max_us", us.back()}};
+}
+
+/// One-way latency [us] of a raw DDS ping-pong on the actuator topic's QoS: two participants, the
+/// echo side answers each sample; `count` round trips.
+std::vector<double> ping_pong(std::uint32_t domain, int count) {
+  // Ping on the actuator topic, pong on the linear-command topic (same stream QoS, 8 bytes less),
+  // in a domain of their own.
+  transport::ParticipantOptions a_options, b_options;
+  a_options.name = "bench_ping";
+  a_options.domain_id = domain;
+  b_options.name = "bench_pong";
+  b_options.domain_id = domain;
+  transport::Participant a(a_options), b(b_options);
+  transport::Wakeup a_wake, b_wake;
+  auto a_writer = a.make_writer<tp::Actuators>();
+  auto b_reader = b.make_reader<tp::Actuators>(&b_wake);
+  auto b_writer = b.make_writer<tp::LinearCommand>();
+  auto a_reader = a.make_reader<tp::LinearCommand>(&a_wake);
+  std::atomic<bool> stop{false};
+  std::thread echo([&] {
+    tp::msgs::ActuatorCommand_ in;
+    tp::msgs::LinearCommand_ out;
+    while (!stop) {
+      while (b_reader->take_next(in)) {
+        out.header(in.header());
+        b_writer->write(out);
+      }
+      b_wake.wait_until(Clock::now() + std::chrono::milliseconds(5));
+    }
+  });
+  const auto matched = Clock::now() + std::chrono::seconds(5);
+  while ((a_writer->health().matched_readers == 0 || b_writer->health().matched_readers == 0) && Clock::now() < matched) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::vector<double> one_way;
+  tp::msgs::ActuatorCommand_ ping;
+  tp::msgs::LinearCommand_ pong;
+  for (int i = 0; i < count; ++i) {
+    runtime::stamp_header(ping.header(), static_cast<std::uint64_t>(i), runtime::now_stamp());
+    const auto sent = Clock::now();
+    a_writer->write(ping);
+    const auto deadline = sent + std::chrono::milliseconds(100);
+    bool got = false;
+    while (!got && Clock::now() < deadline) {
+      while (a_reader->take_next(pong)) got = got || pong.header().seq() == static_cast<std::uint64_t>(i);
+      if (!got) a_wake.wait_until(deadline);
+    }
+    if (got) one_way.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent).count() / 2.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  stop = true;
+  echo.join();
+  a_reader.reset();
+  b_reader.reset();
+  return one_way;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_bench: latency of the stack and of raw DDS on this machine"};
+  app.require_subcommand(1);
+  auto* latency_cmd = app.add_subcommand("latency", "end-to-end and per-hop latency, sensor jitter, DDS floor");
+  std::string config_path;
+  double rate = 100.0;
+  double duration = 10.0;
+  bool as_json = false;
+  unsigned domain = 30;
+  latency_cmd->add_option("--config", config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+  latency_cmd->add_option("--rate", rate, "[Hz] sample rate of the stack")->check(CLI::Range(10.0, 2000.0));
+  latency_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(1.0, 3600.0));
+  latency_cmd->add_option("--domain", domain, "DDS domain (the floor uses domain + 1)")->check(CLI::Range(0, 231));
+  latency_cmd->add_flag("--json", as_json, "one JSON object");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    runtime::configure_logging("warn", "bench");
+    // The configuration at the requested rate.
+    std::ifstream in(config_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string yaml = text.str();
+    const std::string key = "sample_period:";
+    const auto at = yaml.find(key);
+    if (at == std::string::npos) throw std::invalid_argument(config_path + ": no plant.sample_period");
+    const auto end = yaml.find_first_of("#\n", at);
+    char period[64];
+    std::snprintf(period, sizeof(period), " %.9g ", 1.0 / rate);
+    yaml.replace(at + key.size(), end - at - key.size(), period);
+    const fs::path dir = fs::temp_directory_path() / ("crane_bench_" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    const fs::path config = dir / "bench.yaml";
+    std::ofstream(config) << yaml;
+
+    launch::StackOptions stack;
+    stack.config_path = config.string();
+    stack.binary_directory = launch::executable_directory();
+    stack.log_directory = dir.string();
+    stack.domain_id = domain;
+    stack.lockstep = false;
+    stack.plant_stats_path = (dir / "plant_stats.json").string();
+    launch::ProcessGroup group;
+    for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
+
+    runtime::NodeOptions node;
+    node.domain_id = domain;
+    auto participant = runtime::make_participant(node, "bench");
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+    auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    auto sensors = participant->make_recording_reader<tp::Sensors>(&wakeup, 8192);
+    auto estimate = participant->make_recording_reader<tp::StateEstimate>(&wakeup, 8192);
+    auto reference = participant->make_recording_reader<tp::Reference>(&wakeup, 8192);
+    auto anti_swing = participant->make_recording_reader<tp::AntiSwing>(&wakeup, 8192);
+    auto linear = participant->make_recording_reader<tp::LinearCommand>(&wakeup, 8192);
+    auto actuators = participant->make_recording_reader<tp::Actuators>(&wakeup, 8192);
+    tp::msgs::SupervisorStatus_ status;
+    const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
+    while (status.stages_alive() != 0x3FU && Clock::now() < ready_deadline) {
+      status_reader->take_latest(status);
+      wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+    }
+    if (status.stages_alive() != 0x3FU) throw std::runtime_error("the stack did not become ready; see " + dir.string());
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    // Forget what came before; record `duration` seconds.
+    std::map<std::uint64_t, std::array<double, 6>> stamps;  // seq -> write stamps [ns] per stage
+    auto drain = [&] {
+      auto take = [&](auto& reader, std::size_t index) {
+        typename std::remove_reference_t<decltype(*reader)>::Message m;
+        while (reader->take_next(m)) {
+          auto& row = stamps.try_emplace(m.header().seq(), std::array<double, 6>{NAN, NAN, NAN, NAN, NAN, NAN}).first->second;
+          if (std::isnan(row[index])) row[index] = ns(m.header().stamp());
+        }
+      };
+      take(sensors, 0);
+      take(estimate, 1);
+      take(reference, 2);
+      take(anti_swing, 3);
+      take(linear, 4);
+      take(actuators, 5);
+    };
+    drain();
+    stamps.clear();
+    const auto end_time = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(duration));
+    while (Clock::now() < end_time && !runtime::stop_requested()) {
+      drain();
+      wakeup.wait_until(std::min(end_time, Clock::now() + std::chrono::milliseconds(20)));
+    }
+    drain();
+    for (const auto& exit : group.stop_all()) {
+      if (!(WIFEXITED(exit.status) && WEXITSTATUS(exit.status) == 0)) spdlog::warn("{}", exit.describe());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+
+    // Hops: sensors -> estimator -> planner (needs the estimate) -> anti-swing (estimate) ->
+    // tracking (joins all three) -> friction compensation; the chain's own end.
+    const char* hop_names[] = {"sensors->state_estimator", "state_estimator->trajectory_planner",
+                               "state_estimator->anti_swing", "inputs->tracking", "tracking->friction_compensation"};
+    std::vector<double> hops[5], chain, sensor_stamps;
+    for (const auto& [seq, r] : stamps) {
+      if (std::isnan(r[0])) continue;
+      sensor_stamps.push_back(r[0]);
+      if (!std::isnan(r[1])) hops[0].push_back((r[1] - r[0]) / 1e3);
+      if (!std::isnan(r[2]) && !std::isnan(r[1])) hops[1].push_back((r[2] - r[1]) / 1e3);
+      if (!std::isnan(r[3]) && !std::isnan(r[1])) hops[2].push_back((r[3] - r[1]) / 1e3);
+      if (!std::isnan(r[4]) && !std::isnan(r[1]) && !std::isnan(r[2]) && !std::isnan(r[3])) {
+        hops[3].push_back((r[4] - std::max({r[1], r[2], r[3]})) / 1e3);
+      }
+      if (!std::isnan(r[5]) && !std::isnan(r[4])) hops[4].push_back((r[5] - r[4]) / 1e3);
+      if (!std::isnan(r[5])) chain.push_back((r[5] - r[0]) / 1e3);
+    }
+    std::vector<double> periods;
+    for (std::size_t i = 1; i < sensor_stamps.size(); ++i) periods.push_back((sensor_stamps[i] - sensor_stamps[i - 1]) / 1e3);
+    std::vector<double> jitter;
+    for (const double p : periods) jitter.push_back(std::fabs(p - 1e6 / rate));
+    std::vector<double> end_to_end;
+    json plant;
+    {
+      std::ifstream stats(stack.plant_stats_path);
+      if (stats) plant = json::parse(stats, nullptr, false);
+      if (plant.is_object()) end_to_end = plant.value("latency_us", std::vector<double>{});
+    }
+    const auto floor = ping_pong(domain + 1, 1000);
+
+    json j;
+    j["rate_hz"] = rate;
+    j["duration_s"] = duration;
+    j["dds"] = "fast";
+    j["end_to_end"] = summary(end_to_end);  // plant: sensor sample -> command arrival (all cycles of the run)
+    j["chain_sensors_to_actuators"] = summary(chain);
+    for (int h = 0; h < 5; ++h) j["hops"][hop_names[h]] = summary(hops[h]);
+    j["sensor_jitter"] = summary(jitter);
+    j["floor_one_way"] = summary(floor);
+    j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
+    if (!floor.empty() && !end_to_end.empty()) {
+      j["p99_ratio_to_floor"] = j["end_to_end"]["p99_us"].get<double>() / j["floor_one_way"]["p99_us"].get<double>();
+    }
+    if (as_json) {
+      std::printf("%s\n", j.dump(2).c_str());
+    } else {
+      auto line = [](const char* name, const json& s) {
+        if (s["samples"].get<int>() == 0) {
+          std::printf("%-38s no samples\n", name);
+          return;
+        }
+        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us  (%d)\n", name, s["p50_us"].get<double>(),
+                    s["p99_us"].get<double>(), s["max_us"].get<double>(), s["samples"].get<int>());
+      };
+      std::printf("Fast DDS, %.0f Hz, %.0f s, %d overruns\n", rate, duration, j["overruns"].get<int>());
+      line("end to end (sample -> command at plant)", j["end_to_end"]);
+      line("chain (sensor stamp -> actuator stamp)", j["chain_sensors_to_actuators"]);
+      for (int h = 0; h < 5; ++h) line(hop_names[h], j["hops"][hop_names[h]]);
+      line("sensor period jitter", j["sensor_jitter"]);
+      line("floor: DDS one-way (ping-pong / 2)", j["floor_one_way"]);
+      if (j.contains("p99_ratio_to_floor")) std::printf("end-to-end p99 / floor p99 = %.2f\n", j["p99_ratio_to_floor"].get<double>());
+    }
+    fs::remove_all(dir);
+    return 0;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_bench: %s\n", error.what());
+    return 1;
+  }
+}
