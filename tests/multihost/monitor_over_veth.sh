@@ -4,9 +4,13 @@
 # in the second and must discover every topic, measure the 100 Hz sensor stream and record it.
 # Both namespaces (and the veth pair with them) are private to this script and vanish with it;
 # nothing is sent anywhere else. Needs: unshare --net (root or user namespaces), ip, nsenter.
-# Usage: monitor_over_veth.sh BIN_DIR CONFIG OUT_DIR   (exit 0 = every check passed)
+# Usage: monitor_over_veth.sh BIN_DIR CONFIG OUT_DIR [multicast|unicast PROFILE.xml]
+#   multicast (default): --lan, multicast discovery over the pair;
+#   unicast PROFILE: multicast switched off on the pair, every process with a copy of the Fast DDS
+#   profile (deploy/dds/fastdds_lan_unicast.xml) whose peer addresses become the pair's.
+# Exit 0 = every check passed.
 set -euo pipefail
-BIN=$1 CONFIG=$2 OUT=$3
+BIN=$1 CONFIG=$2 OUT=$3 MODE=${4:-multicast} PROFILE=${5:-}
 mkdir -p "$OUT"
 if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
   # Re-run inside a fresh namespace "A" (the stack's host).
@@ -27,35 +31,44 @@ ip link add crane_a type veth peer name crane_b
 ip link set crane_b netns "$HOLDER"
 ip addr add 10.77.0.1/24 dev crane_a
 ip link set crane_a up
-ip link set crane_a multicast on
-ip route add 224.0.0.0/4 dev crane_a
 inb() { nsenter -t "$HOLDER" -n "$@"; }
 inb ip link set lo up
 inb ip addr add 10.77.0.2/24 dev crane_b
 inb ip link set crane_b up
-inb ip link set crane_b multicast on
-inb ip route add 224.0.0.0/4 dev crane_b
-inb ip addr show crane_b | grep -q 10.77.0.2
+if [ "$MODE" = multicast ]; then
+  ip link set crane_a multicast on
+  ip route add 224.0.0.0/4 dev crane_a
+  inb ip link set crane_b multicast on
+  inb ip route add 224.0.0.0/4 dev crane_b
+  NET=(--lan)
+else
+  ip link set crane_a multicast off
+  inb ip link set crane_b multicast off
+  sed -e 's/192\.168\.10\.1/10.77.0.1/' -e 's/192\.168\.10\.2/10.77.0.2/' "$PROFILE" > "$OUT/profile.xml"
+  NET=(--dds-profile "$OUT/profile.xml")
+fi
+inb ip addr show crane_b > "$OUT/address_b.txt"
+grep -q 10.77.0.2 "$OUT/address_b.txt"
 
-"$BIN/crane_launch" --config "$CONFIG" --lan --domain 21 --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
+"$BIN/crane_launch" --config "$CONFIG" "${NET[@]}" --domain 21 --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
 STACK=$!
 sleep 5
 status=0
-inb "$BIN/crane_topic" list --lan --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
-inb "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
-inb "$BIN/crane_topic" record --lan --domain 21 --duration 2 --out "$OUT/run.csv" 2> "$OUT/record.log" || status=1
+inb "$BIN/crane_topic" list "${NET[@]}" --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
+inb "$BIN/crane_topic" hz rt/crane/hw/sensors "${NET[@]}" --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
+inb "$BIN/crane_topic" record "${NET[@]}" --domain 21 --duration 2 --out "$OUT/run.csv" 2> "$OUT/record.log" || status=1
 # The monitor's participant has no shared memory: everything it got came over the veth pair.
 rx=$(inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])')
 echo "{\"veth_rx_bytes\": $rx}" > "$OUT/veth.json"
 [ "$rx" -gt 100000 ] || { echo "only $rx bytes crossed the veth pair"; status=1; }
-/usr/bin/python3 - "$OUT" <<'PY' || status=1
+/usr/bin/python3 - "$OUT" "$MODE" <<'PY' || status=1
 import json, sys
 out = sys.argv[1]
 topics = json.load(open(out + "/list.json"))
 hz = json.load(open(out + "/hz.json"))
 rows = sum(1 for _ in open(out + "/run.csv")) - 1
 rx = json.load(open(out + "/veth.json"))["veth_rx_bytes"]
-print("[ figure   ] monitor in a second namespace over veth: %d topics discovered, sensors %.2f Hz (jitter p99 %.2f ms), "
+print("[ figure   ] monitor in a second namespace over veth (" + sys.argv[2] + "): %d topics discovered, sensors %.2f Hz (jitter p99 %.2f ms), "
       "%d rows recorded, %d bytes received" % (len(topics), hz["receive"]["rate_hz"], hz["receive"]["jitter_p99_ms"], rows, rx))
 problems = []
 if "rt/crane/hw/sensors" not in topics or [w["participant"] for w in topics["rt/crane/hw/sensors"]["writers"]] != ["plant"]:

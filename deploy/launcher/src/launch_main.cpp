@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
   app.add_option("--config", stack.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone");
   app.add_option("--domain", stack.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--dds-profile", stack.dds_profile, "network profile of every process (deploy/dds/*.xml)")
+      ->check(CLI::ExistingFile);
   app.add_flag("--lan", stack.lan, "every process uses all network interfaces (monitoring from another machine) "
                                    "instead of loopback only");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
@@ -63,6 +65,8 @@ int main(int argc, char** argv) {
     node.dds = stack.dds;
     node.domain_id = stack.domain_id;
     node.loopback_only = !stack.lan;
+    if (!stack.dds_profile.empty()) stack.dds_profile = std::filesystem::absolute(stack.dds_profile).string();
+    node.dds_profile = stack.dds_profile;
     auto participant = runtime::make_participant(node, "launcher");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -45,6 +45,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
                       "--log-level", o.log_level};
     if (o.lan) spec.arguments.push_back("--lan");
+    if (!o.dds_profile.empty()) spec.arguments.insert(spec.arguments.end(), {"--dds-profile", o.dds_profile});
     if (name == "plant") {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),

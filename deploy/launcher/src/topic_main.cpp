@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
   auto common = [&](CLI::App* sub) {
     sub->add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
     sub->add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+    sub->add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
     sub->add_flag("--lan", lan, "use the network (UDP on every interface, no shared memory: as from another "
                                 "machine) instead of loopback only");
   };

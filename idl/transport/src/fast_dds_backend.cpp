@@ -267,7 +267,17 @@ class FastParticipant final : public ParticipantBackend {
     // deadline and liveliness anyway.
     qos.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(3, 0);
     qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = Duration_t(1, 0);
-    if (options.loopback_only) {
+    if (!options.profile_file.empty()) {
+      // A network profile (deploy/dds/): transports, discovery peers, lease from the XML.
+      auto* factory = dds::DomainParticipantFactory::get_instance();
+      if (factory->load_XML_profiles_file(options.profile_file) != ReturnCode_t::RETCODE_OK) {
+        throw std::runtime_error("fast dds: cannot load the network profile " + options.profile_file);
+      }
+      if (factory->get_participant_qos_from_profile("crane_participant", qos) != ReturnCode_t::RETCODE_OK) {
+        throw std::runtime_error("fast dds: " + options.profile_file + " has no participant profile \"crane_participant\"");
+      }
+      qos.name(options.name);
+    } else if (options.loopback_only) {
       qos.transport().use_builtin_transports = false;
       auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
       udp->interfaceWhiteList.emplace_back("127.0.0.1");

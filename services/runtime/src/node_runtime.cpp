@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <cstdlib>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -36,6 +38,9 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
       "--lan", [&options] { options.loopback_only = false; },
       "let DDS use every interface (default: loopback 127.0.0.1 only, unicast discovery)");
   app.add_option("--log-level", options.log_level, "trace | debug | info | warn | error");
+  app.add_option("--dds-profile", options.dds_profile,
+                 "network profile (deploy/dds/*.xml; default: $CRANE_DDS_PROFILE): replaces loopback/--lan")
+      ->check(CLI::ExistingFile);
 }
 
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name) {
@@ -44,6 +49,10 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
   p.domain_id = options.domain_id;
   p.loopback_only = options.loopback_only;
   p.shared_memory = options.shared_memory;
+  p.profile_file = options.dds_profile;
+  if (p.profile_file.empty()) {
+    if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;
+  }
   p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
   return std::make_unique<transport::Participant>(p);
 }

@@ -22,6 +22,7 @@ struct StackOptions {
   std::map<std::string, std::string> dds_per_process;  // stage name -> vendor
   unsigned domain_id{0};
   bool lan{false};                    // every process with --lan (all interfaces) instead of loopback only
+  std::string dds_profile;            // every process with --dds-profile (deploy/dds/*.xml); empty: none
   bool lockstep{true};                // plant clock: lockstep (default) or realtime
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]

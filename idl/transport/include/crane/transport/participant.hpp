@@ -40,6 +40,8 @@ struct ParticipantOptions {
   bool loopback_only{true};       // bind to 127.0.0.1 only, unicast discovery on loopback
   bool shared_memory{true};       // with loopback_only false: also the shared-memory transport (false: UDP
                                   // only, as a participant on another machine talks to the stack)
+  std::string profile_file;       // a network profile (deploy/dds/*.xml): its participant profile
+                                  // "crane_participant" replaces loopback_only/shared_memory; empty: none
   Vendor vendor{Vendor::fast_dds};
 };
 

@@ -43,6 +43,7 @@ struct NodeOptions {
   std::uint32_t domain_id{0};
   bool loopback_only{true};
   bool shared_memory{true};  // false: UDP only when not loopback_only (crane_topic --lan)
+  std::string dds_profile;   // network profile XML (deploy/dds/); empty: $CRANE_DDS_PROFILE, else none
   std::string log_level{"info"};
 };
 
