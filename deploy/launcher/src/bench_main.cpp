@@ -123,6 +123,11 @@ int main(int argc, char** argv) {
   latency_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(1.0, 3600.0));
   latency_cmd->add_option("--domain", domain, "DDS domain (the floor uses domain + 1)")->check(CLI::Range(0, 231));
   latency_cmd->add_flag("--json", as_json, "one JSON object");
+  bool lan = false;
+  std::string dds_profile;
+  latency_cmd->add_flag("--lan", lan, "every process on all interfaces (monitors on other machines may join)");
+  latency_cmd->add_option("--dds-profile", dds_profile, "network profile of every process (deploy/dds/*.xml)")
+      ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging("warn", "bench");
@@ -150,11 +155,15 @@ int main(int argc, char** argv) {
     stack.domain_id = domain;
     stack.lockstep = false;
     stack.plant_stats_path = (dir / "plant_stats.json").string();
+    stack.lan = lan;
+    if (!dds_profile.empty()) stack.dds_profile = fs::absolute(dds_profile).string();
     launch::ProcessGroup group;
     for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
 
     runtime::NodeOptions node;
     node.domain_id = domain;
+    node.loopback_only = !lan;
+    node.dds_profile = stack.dds_profile;
     auto participant = runtime::make_participant(node, "bench");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Ten monitors on another host do not disturb the loop (issue 6): the stack's latency benchmark
+# (crane_bench latency, realtime, --lan) in namespace A, once alone and once while ten crane_topic
+# monitors in namespace B (joined by a veth pair) each follow the sensor stream and echo the status.
+# Prints both runs' end-to-end p50/p99 and overruns and the p99 ratio. A benchmark, not a ctest:
+# two runs on a shared machine differ by their own noise (run it on an idle machine).
+# Usage: ten_monitors.sh BIN_DIR CONFIG OUT_DIR [DURATION_S]
+set -euo pipefail
+BIN=$1 CONFIG=$2 OUT=$3 DURATION=${4:-10}
+mkdir -p "$OUT"
+if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
+  if unshare --net true 2>/dev/null; then exec unshare --net env CRANE_IN_NAMESPACE=1 "$0" "$@"; fi
+  exec unshare --net --map-root-user env CRANE_IN_NAMESPACE=1 "$0" "$@"
+fi
+ip link set lo up && ip link set lo multicast on
+unshare --net sleep 3600 &
+HOLDER=$!
+MONITORS=()
+cleanup() { for p in "${MONITORS[@]}"; do kill "$p" 2>/dev/null || true; done; kill "$HOLDER" 2>/dev/null || true; }
+trap cleanup EXIT
+sleep 0.2
+ip link add crane_a type veth peer name crane_b
+ip link set crane_b netns "$HOLDER"
+ip addr add 10.77.0.1/24 dev crane_a && ip link set crane_a up && ip link set crane_a multicast on
+ip route add 224.0.0.0/4 dev crane_a
+inb() { nsenter -t "$HOLDER" -n "$@"; }
+inb ip link set lo up
+inb ip addr add 10.77.0.2/24 dev crane_b && inb ip link set crane_b up && inb ip link set crane_b multicast on
+inb ip route add 224.0.0.0/4 dev crane_b
+
+"$BIN/crane_bench" latency --config "$CONFIG" --lan --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
+for i in $(seq 1 10); do
+  inb "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --domain 22 --duration $((DURATION + 15)) --json \
+    > "$OUT/monitor_$i.json" 2>&1 &
+  MONITORS+=($!)
+done
+"$BIN/crane_bench" latency --config "$CONFIG" --lan --domain 22 --duration "$DURATION" --json > "$OUT/monitored.json"
+for p in "${MONITORS[@]}"; do wait "$p" || true; done
+MONITORS=()
+/usr/bin/python3 - "$OUT" <<'PY'
+import json, sys, glob
+out = sys.argv[1]
+a, m = json.load(open(out + "/alone.json")), json.load(open(out + "/monitored.json"))
+rates = [json.load(open(f))["receive"].get("rate_hz", 0) for f in sorted(glob.glob(out + "/monitor_*.json"))]
+for name, r in (("alone", a), ("10 monitors", m)):
+    e = r["end_to_end"]
+    print("%-12s end to end p50 %7.1f us  p99 %7.1f us  max %8.1f us  overruns %d" % (name, e["p50_us"], e["p99_us"], e["max_us"], r["overruns"]))
+print("monitors received the sensor stream at %s Hz" % ", ".join("%.1f" % x for x in rates))
+print("p99 ratio monitored / alone = %.2f" % (m["end_to_end"]["p99_us"] / a["end_to_end"]["p99_us"]))
+PY
