@@ -85,13 +85,12 @@ TEST(Stack, TrolleyManeuverThroughEveryProcess) {
   EXPECT_EQ(pids.size(), loop["processes"].size()) << "two entries share a pid";
 }
 
-// Runs crane_demo with `extra` arguments (all three maneuvers, compensation on) and returns its summary.
-nlohmann::json run_demo(const std::string& name, unsigned domain, const std::vector<std::string>& extra) {
+// Runs crane_demo (lab config, its own output directory and DDS domain) with `options` and returns
+// its summary.json; an empty json (and a test failure) if it fails or takes longer than 240 s.
+nlohmann::json run_demo(const std::string& name, unsigned domain, const std::vector<std::string>& options) {
   const fs::path out = fresh_directory(name);
-  std::vector<std::string> arguments{"--config", kConfig, "--out", out.string(), "--friction-compensation", "on",
-                                     "--domain", std::to_string(domain), "--maneuver", "trolley", "--maneuver", "slew",
-                                     "--maneuver", "combined"};
-  arguments.insert(arguments.end(), extra.begin(), extra.end());
+  std::vector<std::string> arguments{"--config", kConfig, "--out", out.string(), "--domain", std::to_string(domain)};
+  arguments.insert(arguments.end(), options.begin(), options.end());
   ProcessGroup group;
   group.start({"crane_demo", kBin + "/crane_demo", arguments, (out / "demo.log").string()});
   std::optional<crane::launch::ChildExit> exit;
@@ -109,8 +108,12 @@ nlohmann::json run_demo(const std::string& name, unsigned domain, const std::vec
 // emulated board, with the plant behind the board, give the results of the plant on DDS: within
 // 5 mm and 0.5 deg (issue 5). Both runs are lockstep (the bridge on the board's sample clock).
 TEST(Stack, ThreeManeuversThroughTheHardwareBridgeMatchThePlantOnDds) {
-  const auto dds = run_demo("maneuvers_dds", 13, {});
-  const auto bridge = run_demo("maneuvers_bridge", 14, {"--hardware", "shm"});
+  const std::vector<std::string> maneuvers{"--friction-compensation", "on", "--maneuver", "trolley",
+                                           "--maneuver", "slew", "--maneuver", "combined"};
+  auto with_bridge = maneuvers;
+  with_bridge.insert(with_bridge.end(), {"--hardware", "shm"});
+  const auto dds = run_demo("maneuvers_dds", 13, maneuvers);
+  const auto bridge = run_demo("maneuvers_bridge", 14, with_bridge);
   ASSERT_FALSE(dds.is_null());
   ASSERT_FALSE(bridge.is_null());
   ASSERT_EQ(dds["maneuvers"].size(), 3U);
@@ -150,18 +153,9 @@ TEST(Stack, ThreeManeuversThroughTheHardwareBridgeMatchThePlantOnDds) {
 // `--profile time_optimal` alone picks the controller (auto: PD tracking with acceleration
 // feedforward, no anti-swing law, for a trolley move).
 TEST(Stack, TimeOptimalTrolleyMoveSettlesWithinTenPercentOfItsDuration) {
-  const fs::path out = fresh_directory("time_optimal");
-  ProcessGroup group;
-  group.start({"crane_demo", kBin + "/crane_demo",
-               {"--config", kConfig, "--out", out.string(), "--maneuver", "trolley", "--friction-compensation", "on",
-                "--profile", "time_optimal", "--domain", "15"},
-               (out / "demo.log").string()});
-  std::optional<crane::launch::ChildExit> exit;
-  const auto deadline = Clock::now() + std::chrono::seconds(240);
-  while (!(exit = group.poll()) && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  ASSERT_TRUE(exit.has_value() && WIFEXITED(exit->status) && WEXITSTATUS(exit->status) == 0) << "see " << out;
-  std::ifstream file(out / "summary.json");
-  const auto summary = nlohmann::json::parse(file);
+  const auto summary = run_demo("time_optimal", 15, {"--maneuver", "trolley", "--friction-compensation", "on",
+                                                      "--profile", "time_optimal"});
+  ASSERT_FALSE(summary.is_null());
   const auto& m = summary["maneuvers"][0];
   EXPECT_EQ(summary["controller"], "auto");
   EXPECT_EQ(m["controller"], "none+feedforward");
@@ -240,19 +234,9 @@ class StackController : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(StackController, TrolleyManeuverMeetsTheCriteria) {
   const std::string controller = GetParam();
-  const fs::path out = fresh_directory("controller_" + controller);
-  ProcessGroup group;
-  group.start({"crane_demo", kBin + "/crane_demo",
-               {"--config", kConfig, "--out", out.string(), "--maneuver", "trolley", "--friction-compensation",
-                "on", "--controller", controller, "--domain", "13"},
-               (out / "demo.log").string()});
-  std::optional<crane::launch::ChildExit> exit;
-  const auto deadline = Clock::now() + std::chrono::seconds(240);
-  while (!(exit = group.poll()) && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  ASSERT_TRUE(exit.has_value()) << "crane_demo did not finish within 240 s; see " << out;
-  ASSERT_TRUE(WIFEXITED(exit->status) && WEXITSTATUS(exit->status) == 0) << exit->describe() << "; see " << out;
-  std::ifstream file(out / "summary.json");
-  const auto summary = nlohmann::json::parse(file);
+  const auto summary = run_demo("controller_" + controller, 13,
+                                {"--maneuver", "trolley", "--friction-compensation", "on", "--controller", controller});
+  ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary["controller"], controller);
   const auto& m = summary["maneuvers"][0];
   EXPECT_LT(m["final_position_error_m"].get<double>(), 0.005) << controller;
