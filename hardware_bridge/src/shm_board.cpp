@@ -312,7 +312,8 @@ ShmBoardEmulator::ShmBoardEmulator(ShmSegment segment, bool owns_segment) noexce
       ranges_(ranges_of(segment_.layout())) {}
 
 ShmBoardEmulator ShmBoardEmulator::create(const std::string& name, const common::CraneParameters& crane,
-                                          int counter_bits) {
+                                          int counter_bits,
+                                          const std::array<std::int64_t, kCounterCount>& initial_counts) {
   (void)shm_segment_path(name);
   common::validate(crane, "crane");
   common::require_in_range("counter_bits", static_cast<double>(counter_bits), 2.0, 32.0);
@@ -327,6 +328,9 @@ ShmBoardEmulator ShmBoardEmulator::create(const std::string& name, const common:
     layout.analog_max_volts[i] = range.max_volts;
     layout.analog_maxdata[i] = range.maxdata;
     layout.dac_codes[i].store(volts_to_code(0.0, range), std::memory_order_relaxed);
+  }
+  for (std::size_t i = 0; i < kCounterCount; ++i) {
+    layout.counters[i].store(counter_register_value(initial_counts[i], counter_bits), std::memory_order_relaxed);
   }
   layout.magic.store(kShmBoardMagic, std::memory_order_release);  // last: the segment is ready
   return ShmBoardEmulator(std::move(segment), true);

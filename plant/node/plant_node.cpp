@@ -61,8 +61,19 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
                      plant::CraneSimulator& simulator, bool realtime, const runtime::NodeOptions& options,
                      const std::string& stats_path) {
   namespace hb = hardware_bridge;
-  auto board = hb::ShmBoardEmulator::create(board_name, cfg.crane, cfg.hardware_bridge.board.counter_bits);
   const plant::DrivesAndSensors sensors_model(truth.crane);
+  const auto encoder_counts = [&] {
+    const auto& m = simulator.output().measurement;
+    return std::array<std::int64_t, hb::kCounterCount>{
+        plant::position_to_encoder_counts(m.trolley_position, sensors_model.trolley_resolution()),
+        plant::position_to_encoder_counts(m.slew_angle, sensors_model.slew_resolution()),
+        plant::position_to_encoder_counts(m.swing_in_plane, sensors_model.swing_resolution()),
+        plant::position_to_encoder_counts(m.swing_out_of_plane, sensors_model.swing_resolution())};
+  };
+  // The initial state is on the counters before the board exists for the bridge (a bridge that
+  // read zeros here saw the trolley at 0 m, outside its travel, then jumping to 0.25 m).
+  auto board = hb::ShmBoardEmulator::create(board_name, cfg.crane, cfg.hardware_bridge.board.counter_bits,
+                                            encoder_counts());
   auto participant = runtime::make_participant(options, "plant");
   transport::Wakeup wakeup;
   runtime::install_stop_handlers(&wakeup);
@@ -71,13 +82,7 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
   const auto lockstep_timeout =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_timeout));
-  auto publish = [&] {
-    const auto& m = simulator.output().measurement;
-    return board.publish_sample({plant::position_to_encoder_counts(m.trolley_position, sensors_model.trolley_resolution()),
-                                 plant::position_to_encoder_counts(m.slew_angle, sensors_model.slew_resolution()),
-                                 plant::position_to_encoder_counts(m.swing_in_plane, sensors_model.swing_resolution()),
-                                 plant::position_to_encoder_counts(m.swing_out_of_plane, sensors_model.swing_resolution())});
-  };
+  auto publish = [&] { return board.publish_sample(encoder_counts()); };
   const auto bit = [](hb::DigitalOutput line) { return 1U << static_cast<unsigned>(line); };
   spdlog::info("behind the emulated board {} ({} clock): counters {} bits, DAC [{}, {}] V", board.segment_path(),
                realtime ? "realtime" : "board-paced lockstep", board.counter_bits(),

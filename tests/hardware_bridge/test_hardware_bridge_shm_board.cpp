@@ -85,6 +85,20 @@ TEST(ShmBoard, CountersWrapLikeTheHardware) {
   EXPECT_EQ(unwrapper.update(raw[3]), 8388607);
 }
 
+// A driver that opens the board the moment it exists reads the plant's initial state, before
+// any sample is published (a bridge that read zeros there saw the trolley jump from 0 m to its
+// initial 0.25 m: travel and overspeed faults at start-up).
+TEST(ShmBoard, HoldsTheInitialCountsFromTheStart) {
+  const std::string name = unique_name();
+  const std::array<std::int64_t, kCounterCount> initial{70000, -5, 123456789, 0};
+  const ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{}, 24, initial);
+  EXPECT_EQ(emulator.sample_tick(), 0U);
+  ShmBoard board(name);
+  std::array<std::uint32_t, kCounterCount> raw{};
+  board.read_counters(raw);
+  for (std::size_t i = 0; i < kCounterCount; ++i) EXPECT_EQ(raw[i], modulo(initial[i], 24)) << i;
+}
+
 TEST(ShmBoard, OutputsReachTheEmulatorWithTickCountAndTime) {
   const std::string name = unique_name();
   ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});

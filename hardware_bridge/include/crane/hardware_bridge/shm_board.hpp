@@ -117,12 +117,15 @@ struct ShmOutputs {
 /// The board side: what the simulated plant (or a test) sees.
 class ShmBoardEmulator {
  public:
-  /// (Re-)creates /crane_board_NAME: counter_bits wide counters at 0, the three analog outputs with
-  /// plant_dac_range(crane) and code 0 V, inputs and outputs 0, then publishes the magic. Unlinks
-  /// the segment when destroyed. Throws common::ConfigError for a bad NAME, invalid `crane`
-  /// parameters or counter_bits outside [2, 32]; BoardError if the segment cannot be created.
+  /// (Re-)creates /crane_board_NAME: counter_bits wide counters holding `initial_counts` (sample
+  /// tick 0), the three analog outputs with plant_dac_range(crane) and code 0 V, inputs and outputs
+  /// 0, then publishes the magic: a driver that opens the board as soon as it exists reads the
+  /// plant's initial state, never a zero the plant has not reached. Unlinks the segment when
+  /// destroyed. Throws common::ConfigError for a bad NAME, invalid `crane` parameters or
+  /// counter_bits outside [2, 32]; BoardError if the segment cannot be created.
   [[nodiscard]] static ShmBoardEmulator create(const std::string& name, const common::CraneParameters& crane,
-                                               int counter_bits = 24);
+                                               int counter_bits = 24,
+                                               const std::array<std::int64_t, kCounterCount>& initial_counts = {});
   /// Maps an existing, initialized segment (same checks as ShmBoard); never unlinks it.
   [[nodiscard]] static ShmBoardEmulator attach(const std::string& name);
 
