@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -21,6 +22,7 @@
 
 #include "crane/launch/maneuver_metrics.hpp"
 #include "crane/launch/process_group.hpp"
+#include "crane/launch/stack.hpp"
 
 namespace la = crane::launch;
 using namespace std::chrono_literals;
@@ -316,3 +318,39 @@ TEST_F(ProcessGroupTest, DestructorStopsRunningChildren) {
 }
 
 }  // namespace
+
+// --dds-mix: vendor per process; every process not named keeps --dds.
+TEST(DdsMix, ParsesAndOverridesPerProcess) {
+  crane::launch::StackOptions o;
+  o.config_path = "c.yaml";
+  o.binary_directory = "/bin";
+  o.dds = "fast";
+  const auto known = crane::launch::stack_process_names(o);
+  o.dds_per_process = crane::launch::parse_dds_mix("plant=cyclone,state_estimator=cyclone", known);
+  ASSERT_EQ(o.dds_per_process.size(), 2U);
+  for (const auto& spec : crane::launch::stack_processes(o)) {
+    const auto at = std::find(spec.arguments.begin(), spec.arguments.end(), "--dds");
+    ASSERT_NE(at, spec.arguments.end()) << spec.name;
+    const bool cyclone = spec.name == "plant" || spec.name == "state_estimator";
+    EXPECT_EQ(*(at + 1), cyclone ? "cyclone" : "fast") << spec.name;
+  }
+  EXPECT_TRUE(crane::launch::parse_dds_mix("", known).empty());
+}
+
+TEST(DdsMix, RefusesBadEntriesNamingThem) {
+  const std::vector<std::string> known{"plant", "tracking"};
+  const auto message = [&](const std::string& text) {
+    try {
+      (void)crane::launch::parse_dds_mix(text, known);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("plant").find("'plant' is not NAME=VENDOR"), std::string::npos) << message("plant");
+  EXPECT_NE(message("crane=fast").find("process 'crane' is not one of plant, tracking"), std::string::npos)
+      << message("crane=fast");
+  EXPECT_NE(message("plant=opensplice").find("vendor 'opensplice' must be fast or cyclone"), std::string::npos)
+      << message("plant=opensplice");
+  EXPECT_NE(message("plant=fast,plant=cyclone").find("twice"), std::string::npos) << message("plant=fast,plant=cyclone");
+}

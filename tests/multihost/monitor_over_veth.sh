@@ -6,11 +6,15 @@
 # nothing is sent anywhere else. Needs: unshare --net (root or user namespaces), ip, nsenter.
 # Usage: monitor_over_veth.sh BIN_DIR CONFIG OUT_DIR [multicast|unicast PROFILE.xml]
 #   multicast (default): --lan, multicast discovery over the pair;
-#   unicast PROFILE: multicast switched off on the pair, every process with a copy of the Fast DDS
-#   profile (deploy/dds/fastdds_lan_unicast.xml) whose peer addresses become the pair's.
+#   unicast PROFILE: multicast switched off on the pair, every process with a copy of the profile
+#   pair (deploy/dds/fastdds_lan_unicast.xml and its cyclone_ counterpart) whose peer addresses
+#   become the pair's.
+# Vendors: CRANE_STACK_DDS (every process of the stack) and CRANE_MONITOR_DDS (crane_topic), fast
+# or cyclone, default fast.
 # Exit 0 = every check passed.
 set -euo pipefail
 BIN=$1 CONFIG=$2 OUT=$3 MODE=${4:-multicast} PROFILE=${5:-}
+STACK_DDS=${CRANE_STACK_DDS:-fast} MONITOR_DDS=${CRANE_MONITOR_DDS:-fast}
 mkdir -p "$OUT"
 if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
   # Re-run inside a fresh namespace "A" (the stack's host).
@@ -44,24 +48,27 @@ if [ "$MODE" = multicast ]; then
 else
   ip link set crane_a multicast off
   inb ip link set crane_b multicast off
-  sed -e 's/192\.168\.10\.1/10.77.0.1/' -e 's/192\.168\.10\.2/10.77.0.2/' "$PROFILE" > "$OUT/profile.xml"
-  NET=(--dds-profile "$OUT/profile.xml")
+  for vendor in fastdds cyclone; do
+    sed -e 's/192\.168\.10\.1/10.77.0.1/' -e 's/192\.168\.10\.2/10.77.0.2/' \
+      "$(dirname "$PROFILE")/${vendor}_$(basename "$PROFILE" | sed 's/^[a-z]*_//')" > "$OUT/${vendor}_lan_unicast.xml"
+  done
+  NET=(--dds-profile "$OUT/fastdds_lan_unicast.xml")  # each process takes its vendor's file of the pair
 fi
 inb ip addr show crane_b > "$OUT/address_b.txt"
 grep -q 10.77.0.2 "$OUT/address_b.txt"
 
-"$BIN/crane_launch" --config "$CONFIG" "${NET[@]}" --domain 21 --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
+"$BIN/crane_launch" --config "$CONFIG" "${NET[@]}" --dds "$STACK_DDS" --domain 21 --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
 STACK=$!
 sleep 5
 status=0
-inb "$BIN/crane_topic" list "${NET[@]}" --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
-inb "$BIN/crane_topic" hz rt/crane/hw/sensors "${NET[@]}" --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
-inb "$BIN/crane_topic" record "${NET[@]}" --domain 21 --duration 2 --out "$OUT/run.csv" 2> "$OUT/record.log" || status=1
+inb "$BIN/crane_topic" list "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
+inb "$BIN/crane_topic" hz rt/crane/hw/sensors "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
+inb "$BIN/crane_topic" record "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --duration 2 --out "$OUT/run.csv" 2> "$OUT/record.log" || status=1
 # The monitor's participant has no shared memory: everything it got came over the veth pair.
 rx=$(inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])')
 echo "{\"veth_rx_bytes\": $rx}" > "$OUT/veth.json"
 [ "$rx" -gt 100000 ] || { echo "only $rx bytes crossed the veth pair"; status=1; }
-/usr/bin/python3 - "$OUT" "$MODE" <<'PY' || status=1
+/usr/bin/python3 - "$OUT" "$MODE, stack $STACK_DDS, monitor $MONITOR_DDS" <<'PY' || status=1
 import json, sys
 out = sys.argv[1]
 topics = json.load(open(out + "/list.json"))

@@ -13,36 +13,30 @@ import pathlib
 import re
 import sys
 
-PRIMITIVES = {"double": "float64", "float": "float32", "boolean": "bool", "octet": "byte", "char": "char",
-              "int8": "int8", "uint8": "uint8", "int16": "int16", "uint16": "uint16", "int32": "int32",
-              "uint32": "uint32", "int64": "int64", "uint64": "uint64"}
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "idl" / "tools"))
+import idl_structs  # noqa: E402  (the one IDL parser of the project)
+
+ROS_TYPES = {"double": "float64", "float": "float32", "boolean": "bool", "octet": "byte", "char": "char",
+             "int8": "int8", "uint8": "uint8", "int16": "int16", "uint16": "uint16", "int32": "int32",
+             "uint32": "uint32", "int64": "int64", "uint64": "uint64"}
 
 
-def idl_structs(text):
-    """{name: [(ros_type, field)]} for the structs of crane_msgs::msg::dds_."""
-    text = re.sub(r"//[^\n]*", "", text)
-    module = text[text.index("module crane_msgs"):]
+def idl_structs_of(text):
+    """{name: [(ros_type, field)]} for the structs of crane_msgs::msg::dds_ (name without the _)."""
     structs = {}
-    for match in re.finditer(r"struct\s+(\w+)_\s*\{(.*?)\};", module, re.S):
+    for s in idl_structs.parse(text):
+        if s.modules != ["crane_msgs", "msg", "dds_"]:
+            continue
         fields = []
-        for decl in match.group(2).split(";"):
-            decl = decl.strip()
-            if not decl:
-                continue
-            m = re.fullmatch(r"([\w:]+)\s+(\w+)(\[(\d+)\])?", decl)
-            if not m:
-                raise SystemExit(f"unparsed IDL declaration in {match.group(1)}_: {decl!r}")
-            idl_type, name, _, size = m.groups()
-            if idl_type in PRIMITIVES:
-                ros = PRIMITIVES[idl_type]
-            elif idl_type == "builtin_interfaces::msg::dds_::Time_":
+        for f in s.fields:
+            if f.primitive:
+                ros = ROS_TYPES[f.idl_type]
+            elif f.idl_type == "Time_":
                 ros = "builtin_interfaces/Time"
-            elif re.fullmatch(r"\w+_", idl_type):
-                ros = idl_type[:-1]
             else:
-                raise SystemExit(f"unmapped IDL type {idl_type} in {match.group(1)}_")
-            fields.append((ros + (f"[{size}]" if size else ""), name))
-        structs[match.group(1)] = fields
+                ros = f.idl_type[:-1]
+            fields.append((ros + (f"[{f.size}]" if f.size else ""), f.name))
+        structs[s.name[:-1]] = fields
     return structs
 
 
@@ -78,7 +72,7 @@ def check_fields_header(structs, header):
 
 def main():
     idl = pathlib.Path(sys.argv[1])
-    structs = idl_structs(idl.read_text())
+    structs = idl_structs_of(idl.read_text())
     if sys.argv[2] == "--fields-header":
         return check_fields_header(structs, pathlib.Path(sys.argv[3]))
     msg_dir = pathlib.Path(sys.argv[2])

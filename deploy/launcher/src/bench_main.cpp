@@ -9,9 +9,10 @@
 // header minus the stamp of its input, for the same cycle (all on this machine, one clock).
 // End-to-end: the plant's own measurement, sensor sample time to command arrival. Floor: two
 // participants of this process bounce an ActuatorCommand_ (the chain's message size) over the same
-// transport and QoS; one-way = round trip / 2.
-// Fast DDS only for now (the Cyclone adapter is issue 6). Run it inside a private network
-// namespace (deploy/crane bench does).
+// transport and QoS; one-way = round trip / 2. Vendors: --dds for every process, --dds-mix per
+// process; the floor's ping side uses the plant's vendor and its echo side the state estimator's
+// (the first hop of the chain), so a mixed stack is measured against a mixed floor. Run it inside
+// a private network namespace (deploy/crane bench does).
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -54,7 +55,8 @@ json summary(std::vector<double> us) {
 
 /// One-way latency [us] of a raw DDS ping-pong on the actuator topic's QoS: two participants, the
 /// echo side answers each sample; `count` round trips.
-std::vector<double> ping_pong(std::uint32_t domain, int count) {
+std::vector<double> ping_pong(std::uint32_t domain, int count, transport::Vendor ping_vendor,
+                              transport::Vendor echo_vendor) {
   // Ping on the actuator topic, pong on the linear-command topic (same stream QoS, 8 bytes less),
   // in a domain of their own.
   transport::ParticipantOptions a_options, b_options;
@@ -62,6 +64,8 @@ std::vector<double> ping_pong(std::uint32_t domain, int count) {
   a_options.domain_id = domain;
   b_options.name = "bench_pong";
   b_options.domain_id = domain;
+  a_options.vendor = ping_vendor;
+  b_options.vendor = echo_vendor;
   transport::Participant a(a_options), b(b_options);
   transport::Wakeup a_wake, b_wake;
   auto a_writer = a.make_writer<tp::Actuators>();
@@ -123,6 +127,12 @@ int main(int argc, char** argv) {
   latency_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(1.0, 3600.0));
   latency_cmd->add_option("--domain", domain, "DDS domain (the floor uses domain + 1)")->check(CLI::Range(0, 231));
   latency_cmd->add_flag("--json", as_json, "one JSON object");
+  std::string dds = "fast";
+  std::string dds_mix;
+  latency_cmd->add_option("--dds", dds, "DDS vendor of every process: fast | cyclone")
+      ->check(CLI::IsMember({"fast", "cyclone"}));
+  latency_cmd->add_option("--dds-mix", dds_mix, "vendor per process, overriding --dds, e.g. "
+                                                "plant=cyclone,state_estimator=cyclone (names: the stages, bench)");
   bool lan = false;
   std::string dds_profile;
   latency_cmd->add_flag("--lan", lan, "every process on all interfaces (monitors on other machines may join)");
@@ -156,11 +166,18 @@ int main(int argc, char** argv) {
     stack.lockstep = false;
     stack.plant_stats_path = (dir / "plant_stats.json").string();
     stack.lan = lan;
+    stack.dds = dds;
+    {
+      auto known = launch::stack_process_names(stack);
+      known.push_back("bench");
+      stack.dds_per_process = launch::parse_dds_mix(dds_mix, known);
+    }
     if (!dds_profile.empty()) stack.dds_profile = fs::absolute(dds_profile).string();
     launch::ProcessGroup group;
     for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
 
     runtime::NodeOptions node;
+    node.dds = launch::vendor_of(stack, "bench");
     node.domain_id = domain;
     node.loopback_only = !lan;
     node.dds_profile = stack.dds_profile;
@@ -240,12 +257,17 @@ int main(int argc, char** argv) {
       if (stats) plant = json::parse(stats, nullptr, false);
       if (plant.is_object()) end_to_end = plant.value("latency_us", std::vector<double>{});
     }
-    const auto floor = ping_pong(domain + 1, 1000);
+    const auto ping_vendor = launch::vendor_of(stack, "plant");
+    const auto echo_vendor = launch::vendor_of(stack, "state_estimator");
+    const auto floor = ping_pong(domain + 1, 1000, transport::parse_vendor(ping_vendor),
+                                 transport::parse_vendor(echo_vendor));
 
     json j;
     j["rate_hz"] = rate;
     j["duration_s"] = duration;
-    j["dds"] = "fast";
+    j["dds"] = dds;
+    j["dds_mix"] = stack.dds_per_process;
+    j["floor_vendors"] = ping_vendor + "->" + echo_vendor;
     j["end_to_end"] = summary(end_to_end);  // plant: sensor sample -> command arrival (all cycles of the run)
     j["chain_sensors_to_actuators"] = summary(chain);
     for (int h = 0; h < 5; ++h) j["hops"][hop_names[h]] = summary(hops[h]);
@@ -266,7 +288,9 @@ int main(int argc, char** argv) {
         std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us  (%d)\n", name, s["p50_us"].get<double>(),
                     s["p99_us"].get<double>(), s["max_us"].get<double>(), s["samples"].get<int>());
       };
-      std::printf("Fast DDS, %.0f Hz, %.0f s, %d overruns\n", rate, duration, j["overruns"].get<int>());
+      std::string vendors = dds;
+      for (const auto& [name, vendor] : stack.dds_per_process) vendors += ", " + name + "=" + vendor;
+      std::printf("dds %s, %.0f Hz, %.0f s, %d overruns\n", vendors.c_str(), rate, duration, j["overruns"].get<int>());
       line("end to end (sample -> command at plant)", j["end_to_end"]);
       line("chain (sensor stamp -> actuator stamp)", j["chain_sensors_to_actuators"]);
       for (int h = 0; h < 5; ++h) line(hop_names[h], j["hops"][hop_names[h]]);

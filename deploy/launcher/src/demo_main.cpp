@@ -35,6 +35,8 @@ struct DemoOptions {
   std::string config_path;
   std::string out_dir{"demo-out"};
   std::string dds{"fast"};
+  std::string dds_mix;                                 // --dds-mix text
+  std::map<std::string, std::string> dds_per_process;  // parsed from dds_mix (stages and "operator")
   std::vector<std::string> maneuvers;
   std::string compensation{"both"};
   bool realtime{false};
@@ -184,6 +186,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.binary_directory = launch::executable_directory();
   stack.log_directory = log_dir.string();
   stack.dds = options.dds;
+  stack.dds_per_process = options.dds_per_process;
   stack.domain_id = options.domain_id;
   stack.lockstep = !options.realtime;
   stack.initial_trolley_position = m.initial_trolley_position;
@@ -221,7 +224,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   op.forget_status();
   for (const auto& spec : launch::stack_processes(stack)) {
     const pid_t pid = group.start(spec);
-    result.processes.push_back(ProcessRecord{spec.name, pid, options.dds, run_name});
+    result.processes.push_back(ProcessRecord{spec.name, pid, launch::vendor_of(stack, spec.name), run_name});
   }
 
   // 1. Wait until every stage is matched and alive, the supervisor is ready, and this operator
@@ -416,7 +419,11 @@ int main(int argc, char** argv) {
   DemoOptions options;
   app.add_option("--config", options.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--out", options.out_dir, "output directory (summary.json, CSV, plots, logs)");
-  app.add_option("--dds", options.dds, "DDS vendor of every process: fast | cyclone");
+  app.add_option("--dds", options.dds, "DDS vendor of every process: fast | cyclone")
+      ->check(CLI::IsMember({"fast", "cyclone"}));
+  app.add_option("--dds-mix", options.dds_mix,
+                 "vendor per process, overriding --dds, e.g. plant=cyclone,state_estimator=cyclone "
+                 "(names: the stages, plant, hardware_bridge, operator)");
   app.add_option("--maneuver", options.maneuvers, "maneuver names to run (default: all in the config)");
   app.add_option("--friction-compensation", options.compensation, "on | off | both")
       ->check(CLI::IsMember({"on", "off", "both"}));
@@ -488,8 +495,15 @@ int main(int argc, char** argv) {
     if (options.compensation != "on") settings.push_back(false);
     fs::create_directories(options.out_dir);
 
+    {
+      launch::StackOptions all;
+      all.hardware = options.hardware == "shm" ? "shm:x" : "";
+      auto known = launch::stack_process_names(all);
+      known.push_back("operator");
+      options.dds_per_process = launch::parse_dds_mix(options.dds_mix, known);
+    }
     runtime::NodeOptions node;
-    node.dds = options.dds;
+    node.dds = options.dds_per_process.count("operator") != 0 ? options.dds_per_process.at("operator") : options.dds;
     node.domain_id = options.domain_id;
     auto participant = runtime::make_participant(node, "operator");
     Operator op(*participant);
@@ -513,6 +527,7 @@ int main(int argc, char** argv) {
     summary["clock"] = options.realtime ? "realtime" : "lockstep";
     summary["sensor_writer"] = options.hardware.empty() ? "plant" : "hardware_bridge (emulated board, plant behind it)";
     summary["dds"] = options.dds;
+    summary["dds_mix"] = options.dds_per_process;
     summary["profile"] = options.profile;
     summary["plant_cable_length_factor"] = options.plant_cable_length_factor;
     summary["plant_load_mass_factor"] = options.plant_load_mass_factor;
@@ -554,7 +569,7 @@ int main(int argc, char** argv) {
         processes.push_back({{"name", p.name}, {"pid", p.pid}, {"dds", p.dds}, {"run", p.run}});
       }
     }
-    processes.push_back({{"name", "operator"}, {"pid", getpid()}, {"dds", options.dds}, {"run", "all"}});
+    processes.push_back({{"name", "operator"}, {"pid", getpid()}, {"dds", node.dds}, {"run", "all"}});
     summary["maneuvers"] = maneuvers;
     summary["loop"] = {{"cycles", cycles},
                        {"overruns", overruns},

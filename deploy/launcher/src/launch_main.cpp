@@ -35,7 +35,12 @@ int main(int argc, char** argv) {
   std::string fault_log;
   app.add_option("--fault-log", fault_log, "the supervisor's fault log (JSON lines; default <log-dir>/faults.jsonl)");
   app.add_option("--config", stack.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
-  app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone");
+  app.add_option("--dds", stack.dds, "DDS vendor of every process: fast | cyclone")
+      ->check(CLI::IsMember({"fast", "cyclone"}));
+  std::string dds_mix;
+  app.add_option("--dds-mix", dds_mix,
+                 "vendor per process, overriding --dds, e.g. plant=cyclone,state_estimator=cyclone "
+                 "(names: the stack's processes and launcher)");
   app.add_option("--domain", stack.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--dds-profile", stack.dds_profile, "network profile of every process (deploy/dds/*.xml)")
       ->check(CLI::ExistingFile);
@@ -60,9 +65,12 @@ int main(int argc, char** argv) {
         std::filesystem::absolute(fault_log.empty() ? std::filesystem::path(log_dir) / "faults.jsonl"
                                                      : std::filesystem::path(fault_log)).string();
     stack.binary_directory = launch::executable_directory();
+    auto known = launch::stack_process_names(stack);
+    known.push_back("launcher");
+    stack.dds_per_process = launch::parse_dds_mix(dds_mix, known);
 
     runtime::NodeOptions node;
-    node.dds = stack.dds;
+    node.dds = launch::vendor_of(stack, "launcher");
     node.domain_id = stack.domain_id;
     node.loopback_only = !stack.lan;
     if (!stack.dds_profile.empty()) stack.dds_profile = std::filesystem::absolute(stack.dds_profile).string();

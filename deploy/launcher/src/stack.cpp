@@ -1,6 +1,8 @@
 #include "crane/launch/stack.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 namespace crane::launch {
@@ -34,6 +36,38 @@ std::vector<std::string> stack_process_names(const StackOptions& o) {
   return names;
 }
 
+std::map<std::string, std::string> parse_dds_mix(const std::string& text, const std::vector<std::string>& known) {
+  std::map<std::string, std::string> mix;
+  std::stringstream entries(text);
+  std::string entry;
+  while (std::getline(entries, entry, ',')) {
+    if (entry.empty()) continue;
+    const auto eq = entry.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == entry.size()) {
+      throw std::invalid_argument("--dds-mix entry '" + entry + "' is not NAME=VENDOR (e.g. plant=cyclone)");
+    }
+    const std::string name = entry.substr(0, eq);
+    const std::string vendor = entry.substr(eq + 1);
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw std::invalid_argument("--dds-mix entry '" + entry + "': process '" + name + "' is not one of " + list);
+    }
+    if (vendor != "fast" && vendor != "cyclone") {  // the --dds values of every process
+      throw std::invalid_argument("--dds-mix entry '" + entry + "': vendor '" + vendor + "' must be fast or cyclone");
+    }
+    if (!mix.emplace(name, vendor).second) {
+      throw std::invalid_argument("--dds-mix names process '" + name + "' twice");
+    }
+  }
+  return mix;
+}
+
+std::string vendor_of(const StackOptions& o, const std::string& name) {
+  const auto found = o.dds_per_process.find(name);
+  return found != o.dds_per_process.end() ? found->second : o.dds;
+}
+
 std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
   std::vector<ProcessSpec> specs;
   const bool bridge = !o.hardware.empty();
@@ -41,7 +75,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     ProcessSpec spec;
     spec.name = name;
     spec.executable = o.binary_directory + "/" + name;
-    const auto vendor = o.dds_per_process.count(name) != 0 ? o.dds_per_process.at(name) : o.dds;
+    const auto vendor = vendor_of(o, name);
     spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
                       "--log-level", o.log_level};
     if (o.lan) spec.arguments.push_back("--lan");

@@ -5,7 +5,7 @@
 //   crane_topic echo TOPIC [--count N] [--timeout S]   samples as JSON lines
 //   crane_topic hz TOPIC [--duration S] [--json]       rate and period jitter (receive time and the
 //                                                     writer's stamps)
-//   crane_topic record --out run.csv [--duration S]    the audit's CSV (t,u_x,u_gamma,x,gamma,phi,
+//   crane_topic record --out run.csv [--duration S] [--timeout S]   the audit's CSV (t,u_x,u_gamma,x,gamma,phi,
 //                                                     theta,L, one row per sensor cycle) and every
 //                                                     sample of every topic in run.csv.samples.jsonl
 //
@@ -176,7 +176,10 @@ int main(int argc, char** argv) {
   auto* record_cmd = app.add_subcommand("record", "the audit's CSV and every sample (JSON lines)");
   std::string out_path;
   record_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L)")->required();
-  record_cmd->add_option("--duration", duration, "[s] recording time")->check(CLI::Range(0.1, 86400.0));
+  record_cmd->add_option("--duration", duration, "[s] recording time, from the first sensor sample")
+      ->check(CLI::Range(0.1, 86400.0));
+  record_cmd->add_option("--timeout", timeout, "[s] give up when no sensor sample arrives this long")
+      ->check(CLI::Range(0.1, 3600.0));
   double sample_period = 0.01;
   record_cmd->add_option("--sample-period", sample_period, "[s] of the sensor stream (t = cycle number * this)")
       ->check(CLI::Range(1e-4, 1.0));
@@ -262,11 +265,19 @@ int main(int argc, char** argv) {
         });
       });
     }
-    const auto end = after(duration);
+    // The recording time counts from the first sensor sample (discovery across vendors or by
+    // unicast can take a second or two); give up after --timeout without one.
+    auto end = after(timeout);
+    bool started = false;
     while (!runtime::stop_requested() && Clock::now() < end) {
       for (auto& d : drains) d();
+      if (!started && !sensors.empty()) {
+        started = true;
+        end = after(duration);
+      }
       wakeup.wait_until(std::min(end, Clock::now() + std::chrono::milliseconds(20)));
     }
+    if (!started) throw std::runtime_error("no sensor sample arrived within --timeout " + std::to_string(timeout) + " s");
     for (auto& d : drains) d();
     // Row k: the sensors of cycle k and the voltage applied during cycle k, which sample k+1 reports.
     std::ofstream csv(out_path);

@@ -1,6 +1,7 @@
 #include "crane/transport/participant.hpp"
 
 #include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,21 @@ const char* vendor_name(Vendor vendor) noexcept {
   return "unknown";
 }
 
+std::string profile_for_vendor(const std::string& path, Vendor vendor) {
+  if (path.empty()) return path;
+  const std::filesystem::path file(path);
+  const std::string name = file.filename().string();
+  const std::string want = vendor == Vendor::fast_dds ? "fastdds_" : "cyclone_";
+  const std::string other = vendor == Vendor::fast_dds ? "cyclone_" : "fastdds_";
+  if (name.rfind(want, 0) == 0 || name.rfind(other, 0) != 0) return path;
+  const std::filesystem::path counterpart = file.parent_path() / (want + name.substr(other.size()));
+  if (!std::filesystem::exists(counterpart)) {
+    throw std::invalid_argument("network profile " + path + " is for the other vendor and " + counterpart.string() +
+                                " (its " + vendor_name(vendor) + " counterpart) does not exist");
+  }
+  return counterpart.string();
+}
+
 void Wakeup::notify() noexcept {
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -42,12 +58,14 @@ bool Wakeup::wait_until(std::chrono::steady_clock::time_point deadline) {
 }
 
 Participant::Participant(const ParticipantOptions& options) : options_(options) {
+  options_.profile_file = profile_for_vendor(options.profile_file, options.vendor);
   switch (options.vendor) {
     case Vendor::fast_dds:
-      backend_ = detail::make_fast_dds_backend(options);
+      backend_ = detail::make_fast_dds_backend(options_);
       break;
     case Vendor::cyclone_dds:
-      throw std::runtime_error("dds vendor 'cyclone' is not built into this version: use --dds fast");
+      backend_ = detail::make_cyclone_dds_backend(options_);
+      break;
   }
 }
 

@@ -49,4 +49,13 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& options);
 /// Names of the processes, in the order stack_processes() returns them.
 std::vector<std::string> stack_process_names(const StackOptions& options);
 
+/// Parses a vendor mix "plant=cyclone,state_estimator=cyclone" (--dds-mix) into process name ->
+/// vendor ("fast" or "cyclone"). `known` lists the names a mix may use. Empty text: empty map.
+/// Throws std::invalid_argument naming the entry: not NAME=VENDOR, a name not in `known` (lists
+/// them), a vendor not known, a name given twice.
+std::map<std::string, std::string> parse_dds_mix(const std::string& text, const std::vector<std::string>& known);
+
+/// The vendor of process `name`: its entry in options.dds_per_process, else options.dds.
+std::string vendor_of(const StackOptions& options, const std::string& name);
+
 }  // namespace crane::launch
