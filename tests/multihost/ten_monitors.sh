@@ -5,11 +5,18 @@
 # Prints both runs' end-to-end p50/p99 and overruns and the p99 ratio. A benchmark, not a ctest:
 # two runs on a shared machine differ by their own noise (run it on an idle machine).
 # Usage: ten_monitors.sh BIN_DIR CONFIG OUT_DIR [DURATION_S]
+# The monitors run under SCHED_IDLE (chrt --idle): in this emulation they share the machine's two
+# cores with the stack, where on a real second host they would have CPUs of their own; idle
+# scheduling leaves the stack's processes the CPU, so what remains measured is what monitors cost
+# the stack itself (discovery, one more destination per writer, the bytes on the pair).
+# CRANE_MONITOR_SCHED=normal runs them at normal priority (the whole machine shared).
 # Vendors: CRANE_STACK_DDS (every process of the stack and the bench) and CRANE_MONITOR_DDS (the
 # monitors), fast or cyclone, default fast.
 set -euo pipefail
 BIN=$1 CONFIG=$2 OUT=$3 DURATION=${4:-10}
 STACK_DDS=${CRANE_STACK_DDS:-fast} MONITOR_DDS=${CRANE_MONITOR_DDS:-fast}
+SCHED=(chrt --idle 0)
+[ "${CRANE_MONITOR_SCHED:-idle}" = normal ] && SCHED=()
 mkdir -p "$OUT"
 if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
   if unshare --net true 2>/dev/null; then exec unshare --net env CRANE_IN_NAMESPACE=1 "$0" "$@"; fi
@@ -33,17 +40,17 @@ inb ip route add 224.0.0.0/4 dev crane_b
 
 "$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
 for i in $(seq 1 10); do
-  inb "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
+  inb "${SCHED[@]}" "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
     > "$OUT/monitor_$i.json" 2>&1 &
   MONITORS+=($!)
 done
 "$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/monitored.json"
 for p in "${MONITORS[@]}"; do wait "$p" || true; done
 MONITORS=()
-/usr/bin/python3 - "$OUT" "$STACK_DDS" "$MONITOR_DDS" <<'PY'
+/usr/bin/python3 - "$OUT" "$STACK_DDS" "$MONITOR_DDS" "${CRANE_MONITOR_SCHED:-idle}" <<'PY'
 import json, sys, glob
 out = sys.argv[1]
-print("stack on %s, monitors on %s" % (sys.argv[2], sys.argv[3]))
+print("stack on %s, monitors on %s (%s scheduling)" % (sys.argv[2], sys.argv[3], sys.argv[4]))
 a, m = json.load(open(out + "/alone.json")), json.load(open(out + "/monitored.json"))
 rates = [json.load(open(f))["receive"].get("rate_hz", 0) for f in sorted(glob.glob(out + "/monitor_*.json"))]
 for name, r in (("alone", a), ("10 monitors", m)):

@@ -7,12 +7,13 @@
 // The stack (plant on DDS, realtime) is started at `--rate` (the config's sample period replaced by
 // 1/rate), every stage its own process. Per hop: the `stamp` each stage writes into its output
 // header minus the stamp of its input, for the same cycle (all on this machine, one clock).
-// End-to-end: the plant's own measurement, sensor sample time to command arrival. Floor: two
-// participants of this process bounce an ActuatorCommand_ (the chain's message size) over the same
-// transport and QoS; one-way = round trip / 2. Vendors: --dds for every process, --dds-mix per
-// process; the floor's ping side uses the plant's vendor and its echo side the state estimator's
-// (the first hop of the chain), so a mixed stack is measured against a mixed floor. Run it inside
-// a private network namespace (deploy/crane bench does).
+// End-to-end: the plant's own measurement, sensor sample time to command arrival. Floor: this
+// process and a child (crane_bench pong) bounce an ActuatorCommand_ (the chain's message size) over
+// the same transport and QoS; one-way = round trip / 2. Between two processes, as between two
+// stages: within one process Cyclone DDS delivers locally, without the network. Vendors: --dds
+// for every process, --dds-mix per process; the floor's ping side uses the plant's vendor and its
+// echo side the other vendor when the stack mixes them, so a mixed stack is measured against a
+// cross-vendor floor. Run it inside a private network namespace (deploy/crane bench does).
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,7 +21,6 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,62 +53,68 @@ json summary(std::vector<double> us) {
   return json{{"samples", us.size()}, {"p50_us", at(50)}, {"p99_us", at(99)}, {"max_us", us.back()}};
 }
 
-/// One-way latency [us] of a raw DDS ping-pong on the actuator topic's QoS: two participants, the
-/// echo side answers each sample; `count` round trips.
-std::vector<double> ping_pong(std::uint32_t domain, int count, transport::Vendor ping_vendor,
-                              transport::Vendor echo_vendor) {
-  // Ping on the actuator topic, pong on the linear-command topic (same stream QoS, 8 bytes less),
-  // in a domain of their own.
-  transport::ParticipantOptions a_options, b_options;
-  a_options.name = "bench_ping";
-  a_options.domain_id = domain;
-  b_options.name = "bench_pong";
-  b_options.domain_id = domain;
-  a_options.vendor = ping_vendor;
-  b_options.vendor = echo_vendor;
-  transport::Participant a(a_options), b(b_options);
-  transport::Wakeup a_wake, b_wake;
-  auto a_writer = a.make_writer<tp::Actuators>();
-  auto b_reader = b.make_reader<tp::Actuators>(&b_wake);
-  auto b_writer = b.make_writer<tp::LinearCommand>();
-  auto a_reader = a.make_reader<tp::LinearCommand>(&a_wake);
-  std::atomic<bool> stop{false};
-  std::thread echo([&] {
-    tp::msgs::ActuatorCommand_ in;
-    tp::msgs::LinearCommand_ out;
-    while (!stop) {
-      while (b_reader->take_next(in)) {
-        out.header(in.header());
-        b_writer->write(out);
-      }
-      b_wake.wait_until(Clock::now() + std::chrono::milliseconds(5));
+/// The echo side of the floor (crane_bench pong, a process of its own like every stage): answers
+/// each ActuatorCommand_ with a LinearCommand_ carrying its header, until SIGINT/SIGTERM.
+int pong(std::uint32_t domain, transport::Vendor vendor) {
+  transport::ParticipantOptions options;
+  options.name = "bench_pong";
+  options.domain_id = domain;
+  options.vendor = vendor;
+  transport::Participant participant(options);
+  transport::Wakeup wake;
+  runtime::install_stop_handlers(&wake);
+  auto reader = participant.make_reader<tp::Actuators>(&wake);
+  auto writer = participant.make_writer<tp::LinearCommand>();
+  tp::msgs::ActuatorCommand_ in;
+  tp::msgs::LinearCommand_ out;
+  while (!runtime::stop_requested()) {
+    while (reader->take_next(in)) {
+      out.header(in.header());
+      writer->write(out);
     }
-  });
-  const auto matched = Clock::now() + std::chrono::seconds(5);
-  while ((a_writer->health().matched_readers == 0 || b_writer->health().matched_readers == 0) && Clock::now() < matched) {
+    wake.wait_until(Clock::now() + std::chrono::milliseconds(50));
+  }
+  return 0;
+}
+
+/// One-way latency [us] of a raw DDS ping-pong on the actuator topic's QoS between this process
+/// (ping, `ping_vendor`) and a child process (crane_bench pong, `echo_vendor`), as between two
+/// stages; `count` round trips, in a domain of their own. Ping on the actuator topic, pong on the
+/// linear-command topic (same stream QoS, 8 bytes less).
+std::vector<double> ping_pong(std::uint32_t domain, int count, const std::string& ping_vendor,
+                              const std::string& echo_vendor, const std::string& log_path) {
+  launch::ProcessGroup echo_process;
+  echo_process.start({"bench_pong", launch::executable_directory() + "/crane_bench",
+                      {"pong", "--domain", std::to_string(domain), "--dds", echo_vendor}, log_path});
+  transport::ParticipantOptions options;
+  options.name = "bench_ping";
+  options.domain_id = domain;
+  options.vendor = transport::parse_vendor(ping_vendor);
+  transport::Participant participant(options);
+  transport::Wakeup wake;
+  auto writer = participant.make_writer<tp::Actuators>();
+  auto reader = participant.make_reader<tp::LinearCommand>(&wake);
+  const auto matched = Clock::now() + std::chrono::seconds(10);
+  while ((writer->health().matched_readers == 0 || reader->health().matched_writers == 0) && Clock::now() < matched) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   std::vector<double> one_way;
   tp::msgs::ActuatorCommand_ ping;
-  tp::msgs::LinearCommand_ pong;
-  for (int i = 0; i < count; ++i) {
+  tp::msgs::LinearCommand_ answer;
+  for (int i = 0; i < count && !runtime::stop_requested(); ++i) {
     runtime::stamp_header(ping.header(), static_cast<std::uint64_t>(i), runtime::now_stamp());
     const auto sent = Clock::now();
-    a_writer->write(ping);
+    writer->write(ping);
     const auto deadline = sent + std::chrono::milliseconds(100);
     bool got = false;
     while (!got && Clock::now() < deadline) {
-      while (a_reader->take_next(pong)) got = got || pong.header().seq() == static_cast<std::uint64_t>(i);
-      if (!got) a_wake.wait_until(deadline);
+      while (reader->take_next(answer)) got = got || answer.header().seq() == static_cast<std::uint64_t>(i);
+      if (!got) wake.wait_until(deadline);
     }
     if (got) one_way.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent).count() / 2.0);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  stop = true;
-  echo.join();
-  a_reader.reset();
-  b_reader.reset();
-  return one_way;
+  return one_way;  // echo_process stops its child (SIGTERM, then SIGKILL) when it goes
 }
 
 }  // namespace
@@ -138,7 +144,21 @@ int main(int argc, char** argv) {
   latency_cmd->add_flag("--lan", lan, "every process on all interfaces (monitors on other machines may join)");
   latency_cmd->add_option("--dds-profile", dds_profile, "network profile of every process (deploy/dds/*.xml)")
       ->check(CLI::ExistingFile);
+  auto* pong_cmd = app.add_subcommand("pong", "(internal) the echo process of the DDS floor");
+  pong_cmd->group("");  // not listed in --help
+  std::string pong_dds = "fast";
+  unsigned pong_domain = 31;
+  pong_cmd->add_option("--dds", pong_dds, "DDS vendor")->check(CLI::IsMember({"fast", "cyclone"}));
+  pong_cmd->add_option("--domain", pong_domain, "DDS domain")->check(CLI::Range(0, 232));
   CLI11_PARSE(app, argc, argv);
+  if (pong_cmd->parsed()) {
+    try {
+      return pong(pong_domain, transport::parse_vendor(pong_dds));
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_bench pong: %s\n", error.what());
+      return 1;
+    }
+  }
   try {
     runtime::configure_logging("warn", "bench");
     // The configuration at the requested rate.
@@ -257,10 +277,14 @@ int main(int argc, char** argv) {
       if (stats) plant = json::parse(stats, nullptr, false);
       if (plant.is_object()) end_to_end = plant.value("latency_us", std::vector<double>{});
     }
+    // Floor between two processes: the plant's vendor pings; the echo takes the other vendor when
+    // the stack mixes them (the cross-vendor hop is the floor of a mixed stack), else the same.
     const auto ping_vendor = launch::vendor_of(stack, "plant");
-    const auto echo_vendor = launch::vendor_of(stack, "state_estimator");
-    const auto floor = ping_pong(domain + 1, 1000, transport::parse_vendor(ping_vendor),
-                                 transport::parse_vendor(echo_vendor));
+    auto echo_vendor = ping_vendor;
+    for (const auto& name : launch::stack_process_names(stack)) {
+      if (launch::vendor_of(stack, name) != ping_vendor) echo_vendor = launch::vendor_of(stack, name);
+    }
+    const auto floor = ping_pong(domain + 1, 1000, ping_vendor, echo_vendor, (dir / "bench_pong.log").string());
 
     json j;
     j["rate_hz"] = rate;
