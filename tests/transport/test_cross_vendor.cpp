@@ -279,4 +279,21 @@ TEST_F(ProfileFiles, CycloneRefusesAFileThatIsNotACycloneProfile) {
   }
 }
 
+// Cyclone configures a domain once per process: a second participant of the same domain that asks
+// for another network configuration is refused (naming the domain), not silently given the first.
+TEST(CycloneDomain, SecondParticipantWithAnotherNetworkConfigurationIsRefused) {
+  auto loopback = options_for(Vendor::cyclone_dds, "loopback_one");
+  loopback.domain_id = 62;
+  Participant first(loopback);
+  Participant same(loopback);  // same configuration: shares the domain
+  auto lan = loopback;
+  lan.loopback_only = false;
+  try {
+    Participant other(lan);
+    FAIL() << "a second configuration of domain 62 was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("domain 62"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace

@@ -76,17 +76,31 @@ class DomainRegistry {
     static DomainRegistry registry;
     return registry;
   }
+  /// Throws std::runtime_error when the domain is already in use in this process with another
+  /// configuration (Cyclone cannot give one domain two), or when Cyclone refuses the configuration.
   void acquire(dds_domainid_t id, const std::string& config) {
     std::lock_guard lock(mutex_);
     auto& d = domains_[id];
-    if (d.users++ > 0 || config.empty()) return;
-    const dds_entity_t domain = dds_create_domain(id, config.c_str());
-    if (domain < 0 && domain != DDS_RETCODE_PRECONDITION_NOT_MET) {
-      d.users--;
-      throw std::runtime_error("cyclone dds: cannot create domain " + std::to_string(id) +
-                               " with the network configuration: " + error_text(domain));
+    if (d.users > 0) {
+      if (config != d.config) {
+        throw std::runtime_error("cyclone dds: domain " + std::to_string(id) +
+                                 " is already in use in this process with another network configuration "
+                                 "(loopback-only, --lan or a profile): one per domain and process");
+      }
+      d.users++;
+      return;
     }
-    d.entity = domain > 0 ? domain : 0;  // PRECONDITION_NOT_MET: made elsewhere, keeps its config
+    if (!config.empty()) {
+      const dds_entity_t domain = dds_create_domain(id, config.c_str());
+      if (domain < 0 && domain != DDS_RETCODE_PRECONDITION_NOT_MET) {
+        domains_.erase(id);
+        throw std::runtime_error("cyclone dds: cannot create domain " + std::to_string(id) +
+                                 " with the network configuration: " + error_text(domain));
+      }
+      d.entity = domain > 0 ? domain : 0;  // PRECONDITION_NOT_MET: made outside the transport
+    }
+    d.config = config;
+    d.users = 1;
   }
   void release(dds_domainid_t id) noexcept {
     std::lock_guard lock(mutex_);
@@ -100,6 +114,7 @@ class DomainRegistry {
   struct Domain {
     int users{0};
     dds_entity_t entity{0};
+    std::string config;  // what it was created with ("" = Cyclone's defaults)
   };
   std::mutex mutex_;
   std::map<dds_domainid_t, Domain> domains_;
