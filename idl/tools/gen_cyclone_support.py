@@ -29,7 +29,7 @@ def support(structs, idl_name):
     out = [HEADER.format(idl=idl_name)]
     out.append('#include <algorithm>\n#include <cstring>\n#include <iterator>\n#include <string_view>\n\n'
                '#include "crane_msgs.h"            // fastddsgen: the C++ classes\n'
-               '#include "cyclone_c/crane_msgs.h"  // idlc: the C structs\n'
+               '#include "cyclone/crane_msgs.h"    // idlc: the C structs\n'
                '#include "cyclone_type_support.hpp"\n\n'
                'namespace crane::transport::detail {\nnamespace {\n\n')
     for s in structs:  # declarations first: nested structs convert through each other
