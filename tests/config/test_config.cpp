@@ -1,5 +1,6 @@
 // Tests of crane::config: the real lab configuration against the dissertation (H. M. Omar,
 // "Control of Gantry and Tower Cranes", Virginia Tech 2003), and the messages of bad files.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -272,4 +273,19 @@ TEST(LabConfig, MissingFileNamesThePath) {
 TEST(LabConfig, EmptyDocumentIsRefused) {
   const auto message = error_of("");
   EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+}
+
+// A key given twice is refused with both lines (yaml-cpp itself keeps the first silently).
+TEST_F(LabConfigText, DuplicateField) {
+  const auto at = text_.find("\n  cable_length:");
+  ASSERT_NE(at, std::string::npos);
+  const auto line_end = text_.find('\n', at + 1);
+  std::string text = text_;
+  text.insert(line_end, "\n  cable_length: 1.5");
+  const int first_line = static_cast<int>(std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 2;
+  const auto message = error_of(text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "field crane.cable_length appears twice (lines " + std::to_string(first_line) + " and " +
+                                    std::to_string(first_line + 1) + ")"))
+      << message;
 }

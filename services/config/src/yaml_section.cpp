@@ -1,6 +1,7 @@
 #include "crane/config/yaml_section.hpp"
 
 #include <cmath>
+#include <map>
 
 #include "crane/common/validation.hpp"
 
@@ -11,6 +12,16 @@ using common::ConfigError;
 YamlSection::YamlSection(YAML::Node node, std::string path) : node_(std::move(node)), path_(std::move(path)) {
   if (!node_.IsMap()) {
     throw ConfigError((path_.empty() ? std::string("the document") : path_) + " must be a mapping of fields");
+  }
+  std::map<std::string, int> lines;  // key -> line of its first appearance
+  for (const auto& entry : node_) {
+    const std::string key = entry.first.as<std::string>();
+    const int line = entry.first.Mark().line + 1;
+    const auto [first, inserted] = lines.emplace(key, line);
+    if (!inserted) {
+      throw ConfigError("field " + field(key) + " appears twice (lines " + std::to_string(first->second) + " and " +
+                        std::to_string(line) + ")");
+    }
   }
 }
 

@@ -12,7 +12,9 @@ namespace crane::config {
 
 class YamlSection {
  public:
-  /// `path` is the dotted name of this mapping ("" for the document root).
+  /// `path` is the dotted name of this mapping ("" for the document root). Throws
+  /// common::ConfigError when `node` is not a mapping, or when a key appears twice in it (naming the
+  /// field and both lines: YAML parsers keep one of the two silently).
   YamlSection(YAML::Node node, std::string path);
 
   /// Required number in [lower, upper]. Throws ConfigError if missing, not a number, or out of range.
