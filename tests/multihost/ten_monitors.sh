@@ -39,6 +39,8 @@ inb ip addr add 10.77.0.2/24 dev crane_b && inb ip link set crane_b up && inb ip
 inb ip route add 224.0.0.0/4 dev crane_b
 
 "$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
+rx_bytes() { inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])'; }
+RX0=$(rx_bytes)
 for i in $(seq 1 10); do
   inb "${SCHED[@]}" "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
     > "$OUT/monitor_$i.json" 2>&1 &
@@ -47,6 +49,7 @@ done
 "$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/monitored.json"
 for p in "${MONITORS[@]}"; do wait "$p" || true; done
 MONITORS=()
+echo "{\"rx_bytes\": $(( $(rx_bytes) - RX0 ))}" > "$OUT/veth.json"
 /usr/bin/python3 - "$OUT" "$STACK_DDS" "$MONITOR_DDS" "${CRANE_MONITOR_SCHED:-idle}" <<'PY'
 import json, sys, glob
 out = sys.argv[1]
@@ -57,5 +60,6 @@ for name, r in (("alone", a), ("10 monitors", m)):
     e = r["end_to_end"]
     print("%-12s end to end p50 %7.1f us  p99 %7.1f us  max %8.1f us  overruns %d" % (name, e["p50_us"], e["p99_us"], e["max_us"], r["overruns"]))
 print("monitors received the sensor stream at %s Hz" % ", ".join("%.1f" % x for x in rates))
+print("bytes into the monitors' host while monitored: %.1f MB" % (json.load(open(out + "/veth.json"))["rx_bytes"] / 1e6))
 print("p99 ratio monitored / alone = %.2f" % (m["end_to_end"]["p99_us"] / a["end_to_end"]["p99_us"]))
 PY

@@ -295,8 +295,17 @@ class FastParticipant final : public ParticipantBackend {
       qos.wire_protocol().builtin.metatrafficUnicastLocatorList.push_back(meta);
       qos.wire_protocol().default_unicast_locator_list.push_back(meta);
     } else if (!options.shared_memory) {
+      // A participant on another machine (crane_topic --lan): UDP only, and its readers ask for
+      // user data on the RTPS default user multicast group and port of the domain, so that a
+      // writer sends each sample once for all such monitors (Fast DDS picks a multicast locator
+      // that several readers share) instead of once per monitor.
       qos.transport().use_builtin_transports = false;
       qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+      eprosima::fastrtps::rtps::Locator_t group;
+      eprosima::fastrtps::rtps::IPLocator::setIPv4(group, 239, 255, 0, 1);
+      group.kind = LOCATOR_KIND_UDPv4;
+      group.port = 7400U + 250U * options.domain_id + 1U;  // PB + DG * domain + d2 (RTPS 2.2, 9.6.1.1)
+      qos.wire_protocol().default_multicast_locator_list.push_back(group);
     }
     // Only the discovery callbacks go to the listener; data and status stay with each endpoint.
     participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
