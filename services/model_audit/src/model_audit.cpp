@@ -26,8 +26,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kTrolleyPrefix = "trolley_";  // crane catalog names of the trolley axis entries
 constexpr const char* kSlewPrefix = "slew_";
-constexpr double kSwingWindow = 5.0;
-constexpr double kSwingCutoff = 5.0;  // [Hz] low-pass of the swing angles in the drives' coupling (swing ~0.5 Hz)  // [s] shortest replay window of the crane swing channel
+constexpr double kRestartQuanta = 2.0;  // every_grid_start: restart above this training RMS [quanta]
+constexpr double kSwingWindow = 5.0;  // [s] shortest replay window of the crane swing channel
+constexpr double kSwingCutoff = 5.0;  // [Hz] low-pass of the swing angles in the drives' coupling (swing ~0.5 Hz)
 
 // ---------------------------------------------------------------------------------------------
 // Catalog definitions.
@@ -1122,8 +1123,8 @@ AuditReport run_audit_channel(const AuditData& data, const AuditOptions& options
   const bool effort = axis && options.channel == AuditChannel::effort;
 
   AuditReport report;
-  report.plant = axis ? "axis" : (swing ? "crane swing" : "pendulum");
-  report.channel = axis ? (effort ? "effort" : "position") : (swing ? "swing" : "angle");
+  report.plant = axis ? "axis" : (swing ? "swing" : "pendulum");
+  report.channel = axis ? (effort ? "effort" : "position") : "angle";
   report.unit = axis ? (effort ? "V" : "m") : "rad";
   report.sample_time = sample_time;
   report.samples = n;
@@ -1368,26 +1369,41 @@ AuditReport run_audit_channel(const AuditData& data, const AuditOptions& options
         }
       }
     }
-    fits[c] = fit_problem(problem, full, free, start_nuisance, residual_count);
+    const auto fit_from = [&](const std::vector<double>& start) {
+      return fit_problem(problem, start, free, start_nuisance, residual_count);
+    };
+    fits[c] = fit_from(full);
     if (candidate.parameters.size() > 1) {
       // Several parameters (stribeck: level and v_s trade off along a valley): the grid scores use
       // unfitted initial states, so also fit from other starts and keep the lowest training RSS.
       // Extra starts: the best grid points at the second parameter's grid neighbours (below and
-      // above) of the grid optimum.
+      // above) of the grid optimum; with every_grid_start, when the fit still leaves more than
+      // kRestartQuanta quanta of training RMS, at each of its other grid values too.
       std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       const auto& second = candidate.parameters[1].grid;
       const auto at = std::find(second.begin(), second.end(), best_point[1]);
       std::vector<double> neighbours;
       if (at != second.end() && at != second.begin()) neighbours.push_back(*(at - 1));
       if (at != second.end() && at + 1 != second.end()) neighbours.push_back(*(at + 1));
-      for (const auto& [rss, point] : scored) {
-        const auto it = std::find(neighbours.begin(), neighbours.end(), point[1]);
-        if (it == neighbours.end()) continue;
-        neighbours.erase(it);
-        std::vector<double> start = full;
-        std::copy(point.begin(), point.end(), start.begin() + static_cast<std::ptrdiff_t>(base_count));
-        Fit other = fit_problem(problem, start, free, start_nuisance, residual_count);
-        if (other.train_rss < fits[c].train_rss) fits[c] = std::move(other);
+      const auto fit_from_best_at = [&](std::vector<double> values) {
+        for (const auto& [rss, point] : scored) {
+          const auto it = std::find(values.begin(), values.end(), point[1]);
+          if (it == values.end()) continue;
+          values.erase(it);
+          std::vector<double> start = full;
+          std::copy(point.begin(), point.end(), start.begin() + static_cast<std::ptrdiff_t>(base_count));
+          Fit other = fit_from(start);
+          if (other.train_rss < fits[c].train_rss) fits[c] = std::move(other);
+        }
+      };
+      fit_from_best_at(neighbours);
+      const double train_rms = std::sqrt(fits[c].train_rss / static_cast<double>(std::max<std::size_t>(fits[c].train_n, 1)));
+      if (options.every_grid_start && train_rms > kRestartQuanta * quantum) {
+        std::vector<double> others;
+        for (const double v : second) {
+          if (v != best_point[1] && std::find(neighbours.begin(), neighbours.end(), v) == neighbours.end()) others.push_back(v);
+        }
+        fit_from_best_at(others);
       }
     }
     if (axis && candidate.name == "stiction") {
@@ -1649,6 +1665,20 @@ std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
   return out;
 }
 
+// The slew's units: the axis model's metres are radians there ("m/s^2/m" -> "rad/s^2/rad").
+std::string slew_unit(const std::string& unit) {
+  std::string out;
+  std::size_t start = 0;
+  while (start <= unit.size()) {
+    const std::size_t end = std::min(unit.find('/', start), unit.size());
+    const std::string token = unit.substr(start, end - start);
+    out += (token == "m" ? "rad" : token.rfind("m^", 0) == 0 ? "rad" + token.substr(1) : token);
+    if (end < unit.size()) out += '/';
+    start = end + 1;
+  }
+  return out;
+}
+
 AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) {
   if (options.calibrate) {
     throw common::ConfigError("calibrate: not available for the crane model (give the nominal parameters with "
@@ -1695,6 +1725,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     if (!requested) return std::nullopt;
     axis_options.parameters = drive_axis_audit_parameters(friction, gain);
     axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    axis_options.every_grid_start = true;
     AuditData axis_data;
     axis_data.source = data.source;
     axis_data.time = data.time;
@@ -1709,9 +1740,13 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     validate(axis_options);
     AuditReport channel = run_audit_channel(axis_data, axis_options, nullptr);
     channel.plant = prefix.substr(0, prefix.size() - 1);
+    const bool slew = prefix == kSlewPrefix;
+    if (slew) channel.unit = slew_unit(channel.unit);
     for (auto& candidate : channel.candidates) {
       if (candidate.name != "payload_mass_error") candidate.name = prefix + candidate.name;
+      for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
     }
+    for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
     if (channel.cause != "none" && channel.cause != "payload_mass_error") channel.cause = prefix + channel.cause;
     return channel;
   };

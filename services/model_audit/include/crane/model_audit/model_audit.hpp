@@ -157,6 +157,12 @@ struct AuditOptions {
   // the measured channel (its smallest nonzero step; position and angle channels). The crane audit
   // uses kCraneResolutionQuanta for its channels, whatever is given here.
   double min_holdout_gain_quanta{0.0};   // [-] >= 0
+  // Two-parameter candidates (stribeck: level and v_s trade off along a valley) are fitted from the
+  // grid optimum and the best grid points at its v_s grid neighbours; with every_grid_start also
+  // at every other v_s grid value when the fit still leaves more than two quanta of training RMS
+  // (set for the crane drives: with the coupling, the grid scores of the unfitted initial states
+  // often put the optimum at the wrong end of the valley).
+  bool every_grid_start{false};
   int substeps{4};                  // >= 1, for the non-closed-form entries
   std::size_t max_lag{20};          // [samples] Ljung-Box lags
 };
