@@ -4,8 +4,6 @@
 // encoder quantization) audited against the right and against a wrong payload mass.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -20,6 +18,7 @@
 #include "crane/model_audit/hidden_effect_generator.hpp"
 #include "crane/model_audit/model_audit.hpp"
 #include "crane/plant/crane_simulator.hpp"
+#include "audit_test_files.hpp"
 
 #if !defined(CRANE_AUDIT_EXECUTABLE) || !defined(CRANE_LAB_CONFIG)
 #error "CRANE_AUDIT_EXECUTABLE and CRANE_LAB_CONFIG must name crane_audit and the lab configuration"
@@ -30,37 +29,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("crane_audit_crane_test_" + name);
-  std::ofstream(path) << text;
-  return path;
-}
-
-// n rows of a plausible crane record; row `bad_at` (0-based data row) replaced by `bad_row`.
+// n rows of a plausible crane record; data row `bad_at` replaced by `bad_row`.
 std::string crane_rows(std::size_t n, const std::string& header = "t,u_x,u_gamma,x,gamma,phi,theta,L",
                        const std::string& bad_row = "", std::size_t bad_at = 0) {
-  std::ostringstream out;
-  out << "# crane test\n" << header << "\n";
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!bad_row.empty() && k == bad_at) {
-      out << bad_row << "\n";
-      continue;
-    }
+  return ma::test::rows(n, header, [](std::size_t k) {
     const double t = 0.01 * static_cast<double>(k);
-    out << t << ",0.5,0.2," << 0.5 + 1e-3 * static_cast<double>(k) << "," << 1e-3 * static_cast<double>(k) << ","
-        << 0.01 * std::sin(t) << "," << 0.01 * std::cos(t) << ",1.0\n";
-  }
-  return out.str();
+    std::ostringstream row;
+    row << t << ",0.5,0.2," << 0.5 + 1e-3 * static_cast<double>(k) << "," << 1e-3 * static_cast<double>(k) << ","
+        << 0.01 * std::sin(t) << "," << 0.01 * std::cos(t) << ",1.0";
+    return row.str();
+  }, bad_row, bad_at);
 }
 
 void expect_refused(const fs::path& path, const std::string& needle) {
-  try {
-    (void)ma::read_audit_data(path, ma::AuditPlant::crane, "", 0.0);
-    FAIL() << "accepted " << path;
-  } catch (const ma::DataError& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  ma::test::expect_refused(path, ma::AuditPlant::crane, needle);
 }
+
+using ma::test::run_tool;
+using ma::test::write_file;
 
 TEST(CraneAuditData, BadInputIsRefusedNamingRowColumnOrCause) {
   // Data rows start at file line 3 (comment, header): data row 50 is "row 53".
@@ -245,11 +231,6 @@ TEST(CraneAuditCli, ConfigAndParamGiveTheNominalAndBadDataIsRefused) {
   const fs::path dir = fs::temp_directory_path() / "crane_audit_crane_cli_test";
   fs::remove_all(dir);
   const fs::path data = dir.string() + "_case.csv";
-  const auto run_tool = [](const std::string& arguments) {
-    const std::string command = std::string(CRANE_AUDIT_EXECUTABLE) + " " + arguments + " > /dev/null 2>&1";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  };
   ASSERT_EQ(run_tool("generate --model crane --effect none --seed 31 --out " + data.string()), 0);
   const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, "none", 31);
   const std::string mass = " --param load_mass=" + crane::common::format_value(c.nominal.at("load_mass"));
