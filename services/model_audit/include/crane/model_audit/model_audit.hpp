@@ -137,10 +137,11 @@ struct AuditData {
                                         std::size_t minimum_samples = 50);
 
 /// Resolution floor of the crane channels (AuditOptions::min_holdout_gain_quanta): the coupled model
-/// replayed from 100 Hz samples leaves a systematic residual of about one encoder count on clean
-/// data (the coupling is held per sample), which the BIC alone would attribute to tiny causes (e.g.
-/// a payload off by 0.02 %); half a count of held-out gain is required of a cause.
-inline constexpr double kCraneResolutionQuanta = 0.5;
+/// replayed from 100 Hz samples leaves a systematic residual of one to three encoder counts on clean
+/// data (the coupling is held per sample; it grows with the load mass), which the BIC alone
+/// attributes to tiny causes: a payload off by 0.02-0.05 %, gaining up to 1.4 counts of held-out
+/// trolley RMS on 13 clean recordings. Two counts of held-out gain are required of a cause.
+inline constexpr double kCraneResolutionQuanta = 2.0;
 
 struct AuditOptions {
   AuditPlant plant{AuditPlant::axis};
