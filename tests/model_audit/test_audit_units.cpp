@@ -19,6 +19,7 @@
 #include "crane/model_audit/hidden_effect_generator.hpp"
 #include "crane/model_audit/model_audit.hpp"
 #include "crane/model_audit/residual_analysis.hpp"
+#include "audit_test_files.hpp"
 
 #ifndef CRANE_AUDIT_EXECUTABLE
 #error "CRANE_AUDIT_EXECUTABLE must name the crane_audit binary"
@@ -134,33 +135,20 @@ TEST(AuditOptions, UnknownParameterAndCauseAreRefusedByName) {
   EXPECT_THROW(ma::validate(options), crane::common::ConfigError);
 }
 
-fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("crane_audit_test_" + name);
-  std::ofstream(path) << text;
-  return path;
-}
-
 std::string rows(std::size_t n, const std::string& bad_row = "", std::size_t bad_at = 0) {
-  std::ostringstream out;
-  out << "# test\nt,u,x\n";
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!bad_row.empty() && k == bad_at) {
-      out << bad_row << "\n";
-      continue;
-    }
-    out << 0.01 * static_cast<double>(k) << ",0.5," << 1e-3 * static_cast<double>(k) << "\n";
-  }
-  return out.str();
+  return ma::test::rows(n, "t,u,x", [](std::size_t k) {
+    std::ostringstream row;
+    row << 0.01 * static_cast<double>(k) << ",0.5," << 1e-3 * static_cast<double>(k);
+    return row.str();
+  }, bad_row, bad_at);
 }
 
 void expect_refused(const fs::path& path, const std::string& needle) {
-  try {
-    (void)ma::read_audit_data(path, ma::AuditPlant::axis, "", 0.0);
-    FAIL() << "accepted " << path;
-  } catch (const ma::DataError& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  ma::test::expect_refused(path, ma::AuditPlant::axis, needle);
 }
+
+using ma::test::run_tool;
+using ma::test::write_file;
 
 TEST(AuditData, BadInputIsRefusedNamingRowOrColumn) {
   expect_refused(write_file("nan.csv", rows(100, "0.5,nan,0.0", 50)), "row 53");
@@ -171,12 +159,6 @@ TEST(AuditData, BadInputIsRefusedNamingRowOrColumn) {
   uneven.replace(uneven.find("\n0.5,"), 5, "\n0.505,");
   expect_refused(write_file("uneven.csv", uneven), "not uniform");
   EXPECT_NO_THROW((void)ma::read_audit_data(write_file("good.csv", rows(100)), ma::AuditPlant::axis, "", 0.0));
-}
-
-int run_tool(const std::string& arguments) {
-  const std::string command = std::string(CRANE_AUDIT_EXECUTABLE) + " " + arguments + " > /dev/null 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 TEST(CraneAuditCli, WritesTheReportAndRefusesBadOptions) {

@@ -62,12 +62,15 @@ void print(const std::string& title, const Tally& tally, const std::vector<std::
   for (std::size_t i = 0; i < columns.size(); ++i) std::printf("  %zu = %s\n", i, columns[i].c_str());
 }
 
-Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_cases, std::uint64_t seed_base) {
+// Case i has the catalog entry (i * stride) % size (stride coprime to the size: every entry covered
+// once in `size` cases, and a short run spreads over the catalog).
+Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_cases, std::uint64_t seed_base,
+          std::size_t stride = 1, std::size_t first = 0) {
   const auto& catalog = ma::audit_catalog(plant);
   Tally tally;
-  for (std::size_t i = 0; i < effect_cases + clean_cases; ++i) {
+  for (std::size_t i = first; i < effect_cases + clean_cases; ++i) {
     const bool clean = i >= effect_cases;
-    const std::string effect = clean ? "none" : catalog[i % catalog.size()];  // every entry covered
+    const std::string effect = clean ? "none" : catalog[(i * stride) % catalog.size()];
     const auto c = ma::generate_hidden_effect_case(plant, effect, seed_base + i);
     ma::AuditOptions options;
     options.plant = plant;
@@ -128,4 +131,18 @@ TEST(HiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
   EXPECT_EQ(within, checked);
   EXPECT_EQ(axis.clean_none, axis.clean_cases);
   EXPECT_EQ(pendulum.clean_none, pendulum.clean_cases);
+}
+
+// The crane (full plant, three channels): env CRANE_AUDIT_CRANE_CASES effect cases (default 6: the
+// whole suite stays short; about 8 s per case on one core) and CRANE_AUDIT_CRANE_CLEAN_CASES clean
+// cases (default 1). Entries in steps of 7 through the 26-entry catalog (all in 26 cases). A long
+// run can be split: CRANE_AUDIT_CRANE_FIRST = the first case index to run (cases keep their seeds).
+TEST(CraneHiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
+  const std::size_t cases = env_count("CRANE_AUDIT_CRANE_CASES", 6);
+  const std::size_t clean = env_count("CRANE_AUDIT_CRANE_CLEAN_CASES", 1);
+  const Tally crane = run(ma::AuditPlant::crane, cases, clean, 9000, 7, env_count("CRANE_AUDIT_CRANE_FIRST", 0));
+  print("crane", crane, ma::audit_catalog(ma::AuditPlant::crane));
+  EXPECT_GE(crane.correct, static_cast<int>(std::ceil(0.95 * crane.cases)));
+  EXPECT_EQ(crane.parameter_within, crane.parameter_checked);
+  EXPECT_EQ(crane.clean_none, crane.clean_cases);
 }

@@ -16,6 +16,7 @@ void validate(const AxisModel& model) {
   common::require_finite("coulomb_asymmetry", model.coulomb_asymmetry);
   common::require_finite("viscous_asymmetry", model.viscous_asymmetry);
   require_at_least("stiction", model.stiction, 0.0);
+  common::require_in_range("stiction_asymmetry", model.stiction_asymmetry, -model.stiction, model.stiction);
   require_at_least("stribeck_level", model.stribeck_level, 0.0);
   common::require_greater("stribeck_velocity", model.stribeck_velocity, 0.0);
   require_at_least("deadzone", model.deadzone, 0.0);
@@ -30,6 +31,14 @@ double axis_drive_acceleration(const AxisModel& model, double input) noexcept {
   double u = input - std::clamp(input, -model.deadzone, model.deadzone);  // D(u)
   if (model.saturation > 0.0) u = std::clamp(u, -model.saturation, model.saturation);  // S(.)
   return model.motor_constant * (1.0 + model.gain_error) * u;
+}
+
+AxisModel scale_axis_inertia(AxisModel m, double ratio) noexcept {
+  for (double* v : {&m.motor_constant, &m.viscous, &m.coulomb, &m.coulomb_asymmetry, &m.viscous_asymmetry, &m.stiction,
+                    &m.stiction_asymmetry, &m.stribeck_level, &m.position_friction}) {
+    *v *= ratio;
+  }
+  return m;
 }
 
 namespace {
@@ -83,8 +92,9 @@ void advance_piece(double drive, double duration, double b_plus, double b_minus,
 
 }  // namespace
 
-void advance_axis(const AxisModel& model, double input, double duration, int substeps, AxisState& state) noexcept {
-  const double drive = axis_drive_acceleration(model, input);
+void advance_axis(const AxisModel& model, double input, double duration, int substeps, AxisState& state,
+                  double external_acceleration) noexcept {
+  const double drive = axis_drive_acceleration(model, input) + external_acceleration;
   const int pieces = std::max(substeps, 1);
   const double h = duration / pieces;
   const double half_gap = 0.5 * model.backlash;
@@ -107,9 +117,11 @@ void advance_axis(const AxisModel& model, double input, double duration, int sub
     kinetic(state.position, state.velocity, c_plus, c_minus);
     // Breakaway levels use the static (x' = 0) friction at the piece's start.
     const double break_plus = std::max(0.0, model.coulomb + model.coulomb_asymmetry +
-                                                model.position_friction * state.position) + static_extra;
+                                                model.position_friction * state.position) + static_extra +
+                              model.stiction_asymmetry;
     const double break_minus = std::max(0.0, model.coulomb - model.coulomb_asymmetry +
-                                                 model.position_friction * state.position) + static_extra;
+                                                 model.position_friction * state.position) + static_extra -
+                               model.stiction_asymmetry;
     if (state_dependent) {
       // Midpoint rule: freeze the friction at the state of a half piece (closed form with the start
       // values): second order in the piece length instead of first. A half piece that stops keeps
@@ -133,8 +145,11 @@ void advance_axis(const AxisModel& model, double input, double duration, int sub
 }
 
 void replay_axis(const AxisModel& model, std::span<const double> input, double sample_time, std::size_t first,
-                 AxisState initial, int substeps, std::span<double> out) noexcept {
+                 AxisState initial, int substeps, std::span<double> out,
+                 std::span<const double> external_acceleration, std::span<const double> inertia_ratio) noexcept {
   assert(first + out.size() <= input.size());
+  assert(external_acceleration.empty() || external_acceleration.size() == input.size());
+  assert(inertia_ratio.empty() || inertia_ratio.size() == input.size());
   assert(sample_time > 0.0);
   const double delay_samples = model.input_delay / sample_time;
   const auto whole = static_cast<std::ptrdiff_t>(std::floor(delay_samples));
@@ -148,11 +163,13 @@ void replay_axis(const AxisModel& model, std::span<const double> input, double s
     out[i] = state.load_position;
     if (i + 1 == out.size()) break;
     const auto k = static_cast<std::ptrdiff_t>(first + i);
+    const double external = external_acceleration.empty() ? 0.0 : external_acceleration[first + i];
+    const AxisModel& m = inertia_ratio.empty() ? model : scale_axis_inertia(model, inertia_ratio[first + i]);
     if (fraction > 1e-12) {
-      advance_axis(model, held(k - whole - 1), fraction * sample_time, substeps, state);
-      advance_axis(model, held(k - whole), (1.0 - fraction) * sample_time, substeps, state);
+      advance_axis(m, held(k - whole - 1), fraction * sample_time, substeps, state, external);
+      advance_axis(m, held(k - whole), (1.0 - fraction) * sample_time, substeps, state, external);
     } else {
-      advance_axis(model, held(k - whole), sample_time, substeps, state);
+      advance_axis(m, held(k - whole), sample_time, substeps, state, external);
     }
   }
 }

@@ -2,11 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <random>
 
 #include "crane/common/validation.hpp"
+#include <Eigen/LU>
+
 #include "crane/model_audit/audit_models.hpp"
+#include "crane/model_audit/crane_swing.hpp"
+#include "crane/plant/drives_and_sensors.hpp"
+#include "crane/plant/tower_crane_model.hpp"
 
 namespace crane::model_audit {
 
@@ -82,6 +88,284 @@ double run_axis(const AxisModel& model, double duration, const Sensor& sensor, s
   return max_input;
 }
 
+using Uniform = std::function<double(double, double)>;
+
+struct AxisScales {
+  double coulomb{0.0};        // c [m/s^2] (slew: [rad/s^2])
+  double viscous{0.0};        // b [1/s]
+  double span{0.6};           // [m] (slew: [rad]) travel over which position-dependent friction changes by gamma span
+  double unit{1.0};           // 1 m (trolley, axis) or 1 rad (slew): scales v_s and the backlash
+  double viscous_fraction{0.4};  // largest |db| / b drawn
+};
+
+struct Drawn {
+  std::string parameter;  // main parameter as the audit reports it
+  double value{0.0};      // saturation: the fraction of the nominal run's largest |u| (the caller scales)
+};
+
+// Draws the magnitude of one axis catalog entry (ranges in hidden_effect_generator.hpp) into `model`.
+Drawn draw_axis_effect(const std::string& e, AxisModel& model, const AxisScales& s, const Uniform& uniform,
+                       const Uniform& signed_uniform) {
+  const double c = s.coulomb;
+  if (e == "coulomb_friction_asymmetry") {
+    const double dc = signed_uniform(0.2, 0.5) * c;
+    model.coulomb_asymmetry += dc;
+    return {"coulomb_asymmetry", dc};
+  }
+  if (e == "viscous_friction_asymmetry") {
+    const double db = signed_uniform(0.15, s.viscous_fraction) * s.viscous;
+    model.viscous_asymmetry += db;
+    return {"viscous_asymmetry", db};
+  }
+  if (e == "stiction") {
+    const double extra = uniform(0.4, 1.0) * c;
+    model.stiction += extra;
+    return {"stiction", extra};
+  }
+  if (e == "stribeck") {
+    model.stribeck_level = uniform(0.4, 1.0) * c;
+    model.stribeck_velocity = uniform(0.02, 0.06) * s.unit;
+    return {"stribeck_level", model.stribeck_level};
+  }
+  if (e == "deadzone") {
+    model.deadzone = uniform(0.3, 0.8) * c / model.motor_constant;
+    return {"deadzone", model.deadzone};
+  }
+  if (e == "saturation") return {"saturation", uniform(0.45, 0.75)};
+  if (e == "backlash") {
+    model.backlash = uniform(0.001, 0.004) * s.unit;
+    return {"backlash", model.backlash};
+  }
+  if (e == "input_delay") {
+    model.input_delay = uniform(0.005, 0.025);
+    return {"input_delay", model.input_delay};
+  }
+  if (e == "gain_error") {
+    model.gain_error = signed_uniform(0.1, 0.3);
+    return {"gain_error", model.gain_error};
+  }
+  if (e == "position_dependent_friction") {
+    model.position_friction = signed_uniform(0.3, 0.7) * c / s.span;
+    return {"position_friction_slope", model.position_friction};
+  }
+  return {"", 0.0};
+}
+
+// Draws the magnitude of one pendulum catalog entry into `model` (PendulumModel or SwingEffects:
+// the same field names); `omega2` = g / L [1/s^2].
+template <typename Model>
+Drawn draw_pendulum_effect(const std::string& e, Model& model, double omega2, const Uniform& uniform,
+                           const Uniform& signed_uniform) {
+  if (e == "pendulum_viscous_damping") {
+    model.extra_viscous = uniform(0.05, 0.3);
+    return {"extra_viscous_damping", model.extra_viscous};
+  }
+  if (e == "pendulum_coulomb_damping") {
+    model.coulomb = uniform(0.002, 0.006) * omega2;
+    return {"coulomb_damping", model.coulomb};
+  }
+  if (e == "pendulum_quadratic_damping") {
+    model.quadratic = uniform(0.1, 0.5);
+    return {"quadratic_damping", model.quadratic};
+  }
+  if (e == "cable_length_error") {
+    model.length_error = signed_uniform(0.05, 0.15);
+    return {"length_error", model.length_error};
+  }
+  if (e == "encoder_offset") {
+    model.encoder_offset = signed_uniform(0.01, 0.05);
+    return {"encoder_offset", model.encoder_offset};
+  }
+  return {"", 0.0};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Crane.
+
+constexpr double kCraneSampleTime = 0.01;  // [s] the plant's cycle
+constexpr int kCraneSubsteps = 320;
+constexpr double kTrolleyGain = 100.0;     // [V/m] trolley PD (3.17)
+constexpr double kSlewGain = 40.0;         // [V/rad] slew PD
+constexpr double kDerivativeTime = 0.2;    // [s] K_d of both PDs
+constexpr double kTrolleyCentre = 0.65;    // [m]
+
+// Creep triangle (as the axis run) then two sines per drive; the slew's differ in period from the
+// trolley's so that the two drives are not in phase.
+double crane_trolley_reference(double t) {
+  if (t < kCreepDuration) return kTrolleyCentre + axis_reference(t);
+  const double s = t - kCreepDuration;
+  return kTrolleyCentre + kCreepSpeed + 0.2 * std::sin(2.0 * std::numbers::pi * 0.25 * s) -
+         0.2 * std::sin(2.0 * std::numbers::pi * s / 3.0);
+}
+
+double crane_slew_reference(double t) {
+  if (t < kCreepDuration) return axis_reference(t);
+  const double s = t - kCreepDuration;
+  return kCreepSpeed + 0.25 * std::sin(2.0 * std::numbers::pi * 0.15 * s) - 0.25 * std::sin(2.0 * std::numbers::pi * 0.3 * s);
+}
+
+struct CraneTruth {
+  common::CraneParameters crane;  // true plant (load mass and cable length as simulated)
+  AxisModel trolley;              // nominal friction plus the drawn entry, [m/s^2] on M_drive
+  AxisModel slew;                 // [rad/s^2] on J_o
+  SwingEffects swing;
+};
+
+// Closed-loop run of the crane (see the header). Returns max |u| of each drive (x, gamma) when
+// `record` is null.
+std::pair<double, double> run_crane(const CraneTruth& truth, double duration, std::uint64_t seed, AuditData* record) {
+  const plant::TowerCraneModel model([&] {
+    common::CraneParameters p = truth.crane;
+    p.cable_length = truth.crane.cable_length * (1.0 + truth.swing.length_error);
+    return p;
+  }());
+  const plant::DrivesAndSensors sensors(truth.crane);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 0.5);  // encoder edge jitter [counts]
+  const auto read = [&](double value, double resolution) {  // the middle of the count
+    return (std::floor(value / resolution + normal(rng)) + 0.5) * resolution;
+  };
+  const double length = truth.crane.cable_length * (1.0 + truth.swing.length_error);
+  const plant::HoistMotion hoist{length, 0.0, 0.0};
+  const auto samples = static_cast<std::size_t>(std::llround(duration / kCraneSampleTime)) + 1;
+  const double h = kCraneSampleTime / kCraneSubsteps;
+  AxisState trolley;
+  trolley.position = trolley.load_position = kTrolleyCentre;
+  AxisState slew;
+  SwingState swing;
+  double trolley_acceleration = 0.0;
+  double slew_acceleration = 0.0;
+  std::vector<double> u_x;
+  std::vector<double> u_gamma;
+  double previous_x = kTrolleyCentre;
+  double previous_gamma = 0.0;
+  std::pair<double, double> max_input{0.0, 0.0};
+  using plant::kInPlaneSwingIndex;
+  using plant::kOutOfPlaneSwingIndex;
+  using plant::kSlewIndex;
+  using plant::kTrolleyIndex;
+  for (std::size_t k = 0; k < samples; ++k) {
+    const double t = static_cast<double>(k) * kCraneSampleTime;
+    const double x = read(trolley.load_position, sensors.trolley_resolution());
+    const double gamma = read(slew.load_position, sensors.slew_resolution());
+    const double phi = read(swing.in_plane, sensors.swing_resolution()) + truth.swing.encoder_offset;
+    const double theta = read(swing.out_of_plane, sensors.swing_resolution());
+    const double v_x = k == 0 ? 0.0 : (x - previous_x) / kCraneSampleTime;
+    const double v_gamma = k == 0 ? 0.0 : (gamma - previous_gamma) / kCraneSampleTime;
+    previous_x = x;
+    previous_gamma = gamma;
+    u_x.push_back(sensors.applied_voltage(kTrolleyGain * (crane_trolley_reference(t) - x - kDerivativeTime * v_x)));
+    u_gamma.push_back(sensors.applied_voltage(kSlewGain * (crane_slew_reference(t) - gamma - kDerivativeTime * v_gamma)));
+    max_input.first = std::max(max_input.first, std::abs(u_x.back()));
+    max_input.second = std::max(max_input.second, std::abs(u_gamma.back()));
+    if (record != nullptr) {
+      record->time.push_back(t);
+      record->input.push_back(u_x.back());
+      record->output.push_back(x);
+      record->slew_input.push_back(u_gamma.back());
+      record->slew_angle.push_back(gamma);
+      record->swing_in_plane.push_back(phi);
+      record->swing_out_of_plane.push_back(theta);
+      record->cable_length.push_back(truth.crane.cable_length);
+    }
+    // Delayed commands: u(t - tau) is u[j] on [t_j, t_j+1); a delay splits the sample at fraction * T.
+    const auto held = [&](const std::vector<double>& u, double delay, double at) {
+      const auto j = static_cast<std::ptrdiff_t>(std::floor((t + at - delay) / kCraneSampleTime + 1e-9));
+      return u[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(j, 0, static_cast<std::ptrdiff_t>(k)))];
+    };
+    for (int i = 0; i < kCraneSubsteps; ++i) {
+      const double at = (i + 0.5) * h;  // delays are whole substeps: a substep never straddles a sample edge
+      plant::ModelState q;
+      q.position << trolley.position, swing.in_plane, slew.position, swing.out_of_plane;
+      q.velocity << trolley.velocity, swing.in_plane_rate, slew.velocity, swing.out_of_plane_rate;
+      plant::CoordinateMatrix mass;
+      plant::CoordinateVector bias;
+      model.compute_dynamics(q, hoist, mass, bias);
+      // Swing rows eliminated (with the swing entries' damping): s'' = S a'' + s0, M_eff a'' + b_eff = Q.
+      const SwingElimination e =
+          eliminate_swing(mass, bias, swing_damping(truth.swing, swing.in_plane_rate, swing.out_of_plane_rate));
+      const Eigen::Matrix2d& m_eff = e.drive_inertia;
+      const Eigen::Vector2d& b_eff = e.drive_bias;
+      // Each drive with its own effective inertia; the small cross term from the other drive's
+      // acceleration of the previous substep.
+      const double ratio_x = truth.crane.trolley_drive_mass / m_eff(0, 0);
+      const double ratio_g = truth.crane.jib_inertia / m_eff(1, 1);
+      const double ext_x = -(b_eff(0) + m_eff(0, 1) * slew_acceleration) / m_eff(0, 0);
+      const double ext_g = -(b_eff(1) + m_eff(1, 0) * trolley_acceleration) / m_eff(1, 1);
+      const double v_x0 = trolley.velocity;
+      const double v_g0 = slew.velocity;
+      advance_axis(scale_axis_inertia(truth.trolley, ratio_x), held(u_x, truth.trolley.input_delay, at), h, 1, trolley, ext_x);
+      advance_axis(scale_axis_inertia(truth.slew, ratio_g), held(u_gamma, truth.slew.input_delay, at), h, 1, slew, ext_g);
+      trolley_acceleration = (trolley.velocity - v_x0) / h;
+      slew_acceleration = (slew.velocity - v_g0) / h;
+      const Eigen::Vector2d s_dd = e.swing_gain * Eigen::Vector2d(trolley_acceleration, slew_acceleration) + e.swing_free;
+      swing.in_plane_rate += h * s_dd(0);
+      swing.out_of_plane_rate += h * s_dd(1);
+      swing.in_plane += h * swing.in_plane_rate;
+      swing.out_of_plane += h * swing.out_of_plane_rate;
+    }
+  }
+  return max_input;
+}
+
+HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, double duration,
+                                     const Uniform& uniform, const Uniform& signed_uniform) {
+  HiddenEffectCase out;
+  out.effect = e;
+  CraneTruth truth;
+  truth.crane.load_mass = uniform(1.0, 3.0);
+  truth.crane.cable_length = uniform(0.6, 1.6);
+  common::CraneParameters nominal = truth.crane;
+  const auto axis_truth = [](const common::AxisFriction& f, double gain) {
+    const auto p = drive_axis_audit_parameters(f, gain);
+    AxisModel m;
+    m.motor_constant = p.at("K_m");
+    m.viscous = p.at("b");
+    m.viscous_asymmetry = p.at("viscous_asymmetry");
+    m.coulomb = p.at("c");
+    m.coulomb_asymmetry = p.at("coulomb_asymmetry");
+    m.stiction = p.at("stiction");
+    m.stiction_asymmetry = p.at("stiction_asymmetry");
+    return m;
+  };
+  truth.trolley = axis_truth(truth.crane.trolley_friction, truth.crane.trolley_drive_gain);
+  truth.slew = axis_truth(truth.crane.slew_friction, truth.crane.slew_drive_gain);
+  const double length = duration > 0.0 ? duration : kCreepDuration + 14.0;
+  const std::string trolley_prefix = "trolley_";
+  const std::string slew_prefix = "slew_";
+  Drawn drawn;
+  if (e.rfind(trolley_prefix, 0) == 0 || e.rfind(slew_prefix, 0) == 0) {
+    const bool on_trolley = e.rfind(trolley_prefix, 0) == 0;
+    const std::string entry = e.substr(on_trolley ? trolley_prefix.size() : slew_prefix.size());
+    AxisModel& axis = on_trolley ? truth.trolley : truth.slew;
+    // Trolley: the lab crane's b- is four times b+, so |db| <= 0.3 b keeps b+ = b + db > 0.
+    drawn = draw_axis_effect(entry, axis, {axis.coulomb, axis.viscous, on_trolley ? 0.6 : 0.5, 1.0, 0.3}, uniform,
+                             signed_uniform);
+    if (entry == "input_delay") {  // whole substeps, so that no substep straddles a delayed sample edge
+      const double h = kCraneSampleTime / kCraneSubsteps;
+      axis.input_delay = std::round(axis.input_delay / h) * h;
+      drawn.value = axis.input_delay;
+    }
+    if (entry == "saturation") {
+      const auto [max_x, max_gamma] = run_crane(truth, length, seed, nullptr);
+      axis.saturation = drawn.value * (on_trolley ? max_x : max_gamma);
+      drawn.value = axis.saturation;
+    }
+  } else if (e == "payload_mass_error") {
+    const double dm = -signed_uniform(0.15, 0.4) * truth.crane.load_mass;  // the nominal is off by -dm
+    nominal.load_mass = truth.crane.load_mass - dm;
+    drawn = {"load_mass_error", dm};
+  } else if (e != "none") {
+    drawn = draw_pendulum_effect(e, truth.swing, truth.crane.gravity / truth.crane.cable_length, uniform, signed_uniform);
+  }
+  out.main_parameter = drawn.parameter;
+  out.main_value = drawn.value;
+  out.nominal = crane_audit_parameters(nominal);
+  out.data.source = "generated crane case (seed " + std::to_string(seed) + ", effect " + e + ")";
+  run_crane(truth, length, seed, &out.data);
+  return out;
+}
+
 }  // namespace
 
 HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string& effect, std::uint64_t seed,
@@ -98,6 +382,7 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
     throw common::ConfigError("effect: '" + effect + "' is not in the catalog");
   }
   const std::string& e = out.effect;
+  if (plant == AuditPlant::crane) return generate_crane_case(e, seed, duration, uniform, signed_uniform);
 
   if (plant == AuditPlant::axis) {
     AxisModel model;
@@ -109,48 +394,12 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
     const double b = model.viscous;
     const Sensor sensor{5e-6, 1e-5};
     const double length = duration > 0.0 ? duration : kCreepDuration + 12.0;
-    if (e == "coulomb_friction_asymmetry") {
-      model.coulomb_asymmetry = signed_uniform(0.2, 0.5) * c;
-      out.main_parameter = "coulomb_asymmetry";
-      out.main_value = model.coulomb_asymmetry;
-    } else if (e == "viscous_friction_asymmetry") {
-      model.viscous_asymmetry = signed_uniform(0.15, 0.4) * b;
-      out.main_parameter = "viscous_asymmetry";
-      out.main_value = model.viscous_asymmetry;
-    } else if (e == "stiction") {
-      model.stiction = uniform(0.4, 1.0) * c;
-      out.main_parameter = "stiction";
-      out.main_value = model.stiction;
-    } else if (e == "stribeck") {
-      model.stribeck_level = uniform(0.4, 1.0) * c;
-      model.stribeck_velocity = uniform(0.02, 0.06);
-      out.main_parameter = "stribeck_level";
-      out.main_value = model.stribeck_level;
-    } else if (e == "deadzone") {
-      model.deadzone = uniform(0.3, 0.8) * c / model.motor_constant;
-      out.main_parameter = "deadzone";
-      out.main_value = model.deadzone;
-    } else if (e == "saturation") {
-      const double max_input = run_axis(model, length, sensor, seed, nullptr);
-      model.saturation = uniform(0.45, 0.75) * max_input;
-      out.main_parameter = "saturation";
+    const Drawn drawn = draw_axis_effect(e, model, {c, b, 0.6, 1.0, 0.4}, uniform, signed_uniform);
+    out.main_parameter = drawn.parameter;
+    out.main_value = drawn.value;
+    if (e == "saturation") {  // a fraction of the largest command of the nominal run
+      model.saturation = drawn.value * run_axis(model, length, sensor, seed, nullptr);
       out.main_value = model.saturation;
-    } else if (e == "backlash") {
-      model.backlash = uniform(0.001, 0.004);
-      out.main_parameter = "backlash";
-      out.main_value = model.backlash;
-    } else if (e == "input_delay") {
-      model.input_delay = uniform(0.005, 0.025);
-      out.main_parameter = "input_delay";
-      out.main_value = model.input_delay;
-    } else if (e == "gain_error") {
-      model.gain_error = signed_uniform(0.1, 0.3);
-      out.main_parameter = "gain_error";
-      out.main_value = model.gain_error;
-    } else if (e == "position_dependent_friction") {
-      model.position_friction = signed_uniform(0.3, 0.7) * c / 0.6;
-      out.main_parameter = "position_friction_slope";
-      out.main_value = model.position_friction;
     }
     out.data.source = "generated axis case (seed " + std::to_string(seed) + ", effect " + e + ")";
     run_axis(model, length, sensor, seed, &out.data);
@@ -163,27 +412,9 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
   const double zero = std::numbers::pi;
   model.theta_zero = zero;
   out.nominal = {{"L", model.length}, {"damping", model.damping}, {"theta_zero", zero}};
-  if (e == "pendulum_viscous_damping") {
-    model.extra_viscous = uniform(0.05, 0.3);
-    out.main_parameter = "extra_viscous_damping";
-    out.main_value = model.extra_viscous;
-  } else if (e == "pendulum_coulomb_damping") {
-    model.coulomb = uniform(0.002, 0.006) * model.gravity / model.length;
-    out.main_parameter = "coulomb_damping";
-    out.main_value = model.coulomb;
-  } else if (e == "pendulum_quadratic_damping") {
-    model.quadratic = uniform(0.1, 0.5);
-    out.main_parameter = "quadratic_damping";
-    out.main_value = model.quadratic;
-  } else if (e == "cable_length_error") {
-    model.length_error = signed_uniform(0.05, 0.15);
-    out.main_parameter = "length_error";
-    out.main_value = model.length_error;
-  } else if (e == "encoder_offset") {
-    model.encoder_offset = signed_uniform(0.01, 0.05);
-    out.main_parameter = "encoder_offset";
-    out.main_value = model.encoder_offset;
-  }
+  const Drawn drawn = draw_pendulum_effect(e, model, model.gravity / model.length, uniform, signed_uniform);
+  out.main_parameter = drawn.parameter;
+  out.main_value = drawn.value;
   constexpr double kSampleTime = 0.01;
   const Sensor sensor{1e-4, 2.0 * std::numbers::pi / 40000.0};
   const double swing = duration > 0.0 ? duration : 6.0;

@@ -16,12 +16,19 @@
 
 #include "crane/common/validation.hpp"
 #include "crane/model_audit/audit_models.hpp"
+#include "crane/model_audit/crane_swing.hpp"
+#include "crane/model_audit/zero_phase_filter.hpp"
 
 namespace crane::model_audit {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kTrolleyPrefix = "trolley_";  // crane catalog names of the trolley axis entries
+constexpr const char* kSlewPrefix = "slew_";
+constexpr double kRestartQuanta = 2.0;  // every_grid_start: restart above this training RMS [quanta]
+constexpr double kSwingWindow = 5.0;  // [s] shortest replay window of the crane swing channel
+constexpr double kSwingCutoff = 5.0;  // [Hz] low-pass of the swing angles in the drives' coupling (swing ~0.5 Hz)
 
 // ---------------------------------------------------------------------------------------------
 // Catalog definitions.
@@ -319,15 +326,34 @@ std::string join(const std::vector<std::string>& names) {
 
 constexpr std::size_t kAxisBase = 3;  // K_m, b, c
 
-AxisModel axis_model(const std::vector<double>& full, const std::string& cause) {
-  AxisModel m;
+struct AxisSeries {
+  std::vector<double> x;
+  std::vector<double> u;
+  double sample_time{0.0};
+  int substeps{1};
+  std::string cause;
+  double dead_band{0.0};
+  AxisModel nominal;  // nominal asymmetries and stiction (catalog entries add to them)
+  // Crane drive axis (empty for a lone axis): the axis row I a + C = I_drive (drive - friction) with
+  // I = inertia + dm inertia_per_mass and C = force + dm force_per_mass at t_k (dm = the
+  // payload_mass_error parameter [kg]); see AuditData.
+  std::vector<double> inertia;
+  std::vector<double> inertia_per_mass;
+  std::vector<double> force;
+  std::vector<double> force_per_mass;
+  double drive_inertia{0.0};
+};
+
+AxisModel axis_model(const AxisSeries& s, const std::vector<double>& full) {
+  const std::string& cause = s.cause;
+  AxisModel m = s.nominal;
   m.motor_constant = std::max(full[0], 1e-9);
   m.viscous = std::max(full[1], 0.0);
   m.coulomb = std::max(full[2], 0.0);
   const double* p = full.data() + kAxisBase;
-  if (cause == "coulomb_friction_asymmetry") m.coulomb_asymmetry = p[0];
-  if (cause == "viscous_friction_asymmetry") m.viscous_asymmetry = p[0];
-  if (cause == "stiction") m.stiction = std::max(p[0], 0.0);
+  if (cause == "coulomb_friction_asymmetry") m.coulomb_asymmetry += p[0];
+  if (cause == "viscous_friction_asymmetry") m.viscous_asymmetry += p[0];
+  if (cause == "stiction") m.stiction += std::max(p[0], 0.0);
   if (cause == "stribeck") {
     m.stribeck_level = std::max(p[0], 0.0);
     m.stribeck_velocity = std::max(p[1], 1e-6);
@@ -381,17 +407,46 @@ std::vector<Candidate> axis_candidates(const AuditData& data, double k_m, double
                   {{"position_friction_slope", "m/s^2/m", c_scale / half_range, -10 * c_scale / half_range,
                     10 * c_scale / half_range, linspace(-c_scale / half_range, c_scale / half_range, 41)}},
                   ""});
+  if (!data.coupling_inertia.empty()) {  // a crane drive axis
+    const double m = std::max(data.load_mass, 0.1);
+    list.push_back({"payload_mass_error",
+                    {{"load_mass_error", "kg", 0.2 * m, -0.95 * data.load_mass, 5.0 * m, linspace(-0.6 * m, 0.6 * m, 49)}},
+                    ""});
+  }
   return list;
 }
 
-struct AxisSeries {
-  std::vector<double> x;
-  std::vector<double> u;
-  double sample_time{0.0};
-  int substeps{1};
-  std::string cause;
-  double dead_band{0.0};
+// Coupling of a crane drive axis for `full` (payload_mass_error shifts the load mass): the row
+// inertia I and force C at t_k, and, held over [t_k, t_k+1) (means of t_k and t_k+1), the inertia
+// ratio I_drive / I and the external acceleration -C / I of the replay. Empty for a lone axis.
+struct AxisCoupling {
+  std::vector<double> inertia;  // [kg] or [kg m^2]
+  std::vector<double> force;    // [N] or [N m]
+  std::vector<double> ratio;    // [-]
+  std::vector<double> external; // [m/s^2] or [rad/s^2]
 };
+
+AxisCoupling axis_coupling(const AxisSeries& s, const std::vector<double>& full) {
+  AxisCoupling c;
+  if (s.inertia.empty()) return c;
+  const double dm = s.cause == "payload_mass_error" ? full[kAxisBase] : 0.0;
+  const std::size_t n = s.inertia.size();
+  c.inertia.resize(n);
+  c.force.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    c.inertia[k] = std::max(s.inertia[k] + dm * s.inertia_per_mass[k], 1e-9);
+    c.force[k] = s.force[k] + dm * s.force_per_mass[k];
+  }
+  c.ratio.resize(n);
+  c.external.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t next = std::min(k + 1, n - 1);
+    const double inertia = 0.5 * (c.inertia[k] + c.inertia[next]);
+    c.ratio[k] = s.drive_inertia / inertia;
+    c.external[k] = -0.5 * (c.force[k] + c.force[next]) / inertia;
+  }
+  return c;
+}
 
 Problem axis_position_problem(const std::shared_ptr<AxisSeries>& s, double window_duration, double holdout_fraction) {
   Problem problem;
@@ -417,21 +472,23 @@ Problem axis_position_problem(const std::shared_ptr<AxisSeries>& s, double windo
   };
   problem.residual = [s](const std::vector<double>& full, const double* nuisance, const Window& w, std::size_t count,
                          double* out) {
-    const AxisModel model = axis_model(full, s->cause);
+    const AxisModel model = axis_model(*s, full);
+    const AxisCoupling coupling = axis_coupling(*s, full);
     AxisState initial;
     initial.load_position = nuisance[0];
     initial.velocity = nuisance[1];
     const double sign = s->cause == "backlash" ? std::clamp(nuisance[2], -1.0, 1.0) : 0.0;
     initial.position = nuisance[0] + 0.5 * model.backlash * sign;
     std::span<double> prediction(out, count);
-    replay_axis(model, s->u, s->sample_time, w.first, initial, s->substeps, prediction);
+    replay_axis(model, s->u, s->sample_time, w.first, initial, s->substeps, prediction, coupling.external,
+                coupling.ratio);
     for (std::size_t i = 0; i < count; ++i) out[i] = s->x[w.first + i] - out[i];
   };
   return problem;
 }
 
 // Effort residual [V] of sample k (1 <= k <= n - 2), NaN when the stencil mixes regimes.
-double axis_effort_residual(const AxisSeries& s, const AxisModel& m, std::size_t k) {
+double axis_effort_residual(const AxisSeries& s, const AxisModel& m, const AxisCoupling& coupling, std::size_t k) {
   const double t = s.sample_time;
   const double vm = (s.x[k] - s.x[k - 1]) / t;
   const double vp = (s.x[k + 1] - s.x[k]) / t;
@@ -449,6 +506,8 @@ double axis_effort_residual(const AxisSeries& s, const AxisModel& m, std::size_t
   };
   const auto kk = static_cast<std::ptrdiff_t>(k);
   const double drive = 0.5 * (drive_over(kk - 1) + drive_over(kk));
+  // What the motion needs from the drive besides friction: a, or (I a + C) / I_drive on a crane.
+  const double needed = coupling.inertia.empty() ? a : (coupling.inertia[k] * a + coupling.force[k]) / s.drive_inertia;
   const double position_term = m.position_friction * s.x[k];
   const double c_plus = std::max(0.0, m.coulomb + m.coulomb_asymmetry + position_term);
   const double c_minus = std::max(0.0, m.coulomb - m.coulomb_asymmetry + position_term);
@@ -456,17 +515,18 @@ double axis_effort_residual(const AxisSeries& s, const AxisModel& m, std::size_t
   if (vm > s.dead_band && vp > s.dead_band) {
     const double friction = std::max(0.0, m.viscous + m.viscous_asymmetry) * v + c_plus +
                             m.stribeck_level * std::exp(-std::pow(v / m.stribeck_velocity, 2));
-    return (drive - a - friction) / k_eff;
+    return (drive - needed - friction) / k_eff;
   }
   if (vm < -s.dead_band && vp < -s.dead_band) {
     const double friction = std::max(0.0, m.viscous - m.viscous_asymmetry) * v - c_minus -
                             m.stribeck_level * std::exp(-std::pow(v / m.stribeck_velocity, 2));
-    return (drive - a - friction) / k_eff;
+    return (drive - needed - friction) / k_eff;
   }
   if (std::abs(vm) <= s.dead_band && std::abs(vp) <= s.dead_band) {
-    const double net = drive - a - m.viscous * v;
+    const double net = drive - needed - m.viscous * v;
     const double extra = m.stribeck_level + m.stiction;
-    return (net - std::clamp(net, -(c_minus + extra), c_plus + extra)) / k_eff;
+    return (net - std::clamp(net, -(c_minus + extra - m.stiction_asymmetry), c_plus + extra + m.stiction_asymmetry)) /
+           k_eff;
   }
   return kNaN;
 }
@@ -479,17 +539,19 @@ Problem axis_effort_problem(const std::shared_ptr<AxisSeries>& s, double holdout
   problem.windows.push_back({split, n - split, 0});
   problem.residual = [s](const std::vector<double>& full, const double*, const Window& w, std::size_t count,
                          double* out) {
-    const AxisModel model = axis_model(full, s->cause);
+    const AxisModel model = axis_model(*s, full);
+    const AxisCoupling coupling = axis_coupling(*s, full);
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t k = w.first + i;
-      out[i] = (k >= 1 && k + 2 <= s->x.size()) ? axis_effort_residual(*s, model, k) : kNaN;
+      out[i] = (k >= 1 && k + 2 <= s->x.size()) ? axis_effort_residual(*s, model, coupling, k) : kNaN;
     }
   };
   return problem;
 }
 
 // Linear least squares in the effort domain for the candidates linear in their parameter:
-// K_m u - a - b v - c s = phi * theta on moving samples (Eigen column-pivoted QR).
+// K_m u - a - b v - db |v| - c s - dc = phi * theta on moving samples (db, dc nominal; on a crane
+// axis (I a + C) / I_drive instead of a; Eigen column-pivoted QR).
 std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vector<double>& base, const std::string& cause) {
   std::vector<double> y;
   std::vector<double> phi;
@@ -502,8 +564,11 @@ std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vecto
     const double a = (vp - vm) / t;
     const double sign = v > 0.0 ? 1.0 : -1.0;
     const double u = 0.5 * (s.u[k - 1] + s.u[k]);
-    y.push_back(base[0] * u - a - base[1] * v - base[2] * sign);
+    const double needed = s.inertia.empty() ? a : (s.inertia[k] * a + s.force[k]) / s.drive_inertia;
+    y.push_back(base[0] * u - needed - base[1] * v - s.nominal.viscous_asymmetry * std::abs(v) - base[2] * sign -
+                s.nominal.coulomb_asymmetry);
     if (cause == "coulomb_friction_asymmetry") phi.push_back(1.0);
+    else if (cause == "payload_mass_error") phi.push_back((s.inertia_per_mass[k] * a + s.force_per_mass[k]) / s.drive_inertia);
     else if (cause == "viscous_friction_asymmetry") phi.push_back(std::abs(v));
     else if (cause == "gain_error") phi.push_back(-base[0] * u);
     else if (cause == "position_dependent_friction") phi.push_back(sign * s.x[k]);
@@ -526,7 +591,11 @@ std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vecto
 // the one (of the last four of the episode) whose nominal-model motion from rest (kinetic friction
 // only, which does not depend on Delta_s) best matches the next kMotionSamples samples. The
 // estimate is the middle of the stretch covered by the most brackets; nullopt below two brackets.
-// Returns the threshold bracket [lower, upper] of c + Delta_s [m/s^2].
+// Each bracket is taken relative to the nominal breakaway level of its direction (c + s dc +
+// Delta_s,nominal + s dDelta_s,nominal), so it brackets the added Delta_s also for an asymmetric
+// nominal; on a crane axis the drive includes the coupling -C / I_drive and the motion from rest is
+// simulated with the coupling of the replay.
+// Returns the bracket [lower, upper] of the added Delta_s [m/s^2].
 constexpr double kRestQuanta = 2.5;
 constexpr std::size_t kMotionSamples = 5;
 
@@ -539,10 +608,15 @@ std::optional<std::pair<double, double>> axis_breakaway_bracket(const AxisSeries
   }
   if (!std::isfinite(quantum)) return std::nullopt;
   const double tolerance = kRestQuanta * quantum;
-  AxisModel nominal;
-  nominal.motor_constant = std::max(full[0], 1e-9);
-  nominal.viscous = std::max(full[1], 0.0);
-  nominal.coulomb = std::max(full[2], 0.0);
+  AxisSeries base = s;
+  base.cause.clear();
+  const AxisModel nominal = axis_model(base, full);
+  const AxisCoupling coupling = axis_coupling(base, full);
+  const auto external = [&](std::size_t k) { return coupling.force.empty() ? 0.0 : -coupling.force[k] / s.drive_inertia; };
+  const auto nominal_level = [&](double direction) {
+    return std::max(0.0, nominal.coulomb + direction * nominal.coulomb_asymmetry) + nominal.stiction +
+           direction * nominal.stiction_asymmetry;
+  };
   std::vector<std::pair<double, double>> brackets;
   std::size_t first = 0;
   while (first + 5 + kMotionSamples + 4 < n) {
@@ -569,7 +643,12 @@ std::optional<std::pair<double, double>> axis_breakaway_bracket(const AxisSeries
       state.load_position = rest;
       double error = 0.0;
       for (std::size_t k = b; k < last + kMotionSamples; ++k) {
-        advance_axis(nominal, s.u[k], s.sample_time, 1, state);
+        if (coupling.ratio.empty()) {
+          advance_axis(nominal, s.u[k], s.sample_time, 1, state);
+        } else {
+          advance_axis(scale_axis_inertia(nominal, coupling.ratio[k]), s.u[k], s.sample_time, 1, state,
+                       coupling.external[k]);
+        }
         const double e = s.x[k + 1] - state.position;
         error += e * e;
       }
@@ -579,11 +658,12 @@ std::optional<std::pair<double, double>> axis_breakaway_bracket(const AxisSeries
         breakaway = b;
       }
     }
-    double lower = 0.0;  // the samples held at rest: direction * drive <= threshold
+    const double level = nominal_level(direction);
+    double lower = -level;  // the samples held at rest: direction * drive <= threshold
     for (std::size_t k = first + 1; k < breakaway; ++k) {
-      lower = std::max(lower, direction * axis_drive_acceleration(nominal, s.u[k]));
+      lower = std::max(lower, direction * (axis_drive_acceleration(nominal, s.u[k]) + external(k)) - level);
     }
-    const double upper = direction * axis_drive_acceleration(nominal, s.u[breakaway]);
+    const double upper = direction * (axis_drive_acceleration(nominal, s.u[breakaway]) + external(breakaway)) - level;
     if (upper > lower) brackets.emplace_back(lower, upper);
     first = last + 1;
   }
@@ -690,6 +770,68 @@ std::vector<Candidate> pendulum_candidates(double length, double gravity) {
   return list;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Crane swing channel (crane_swing.hpp): the swing replayed with the measured drive motion.
+
+struct CraneSwingSeries {
+  std::shared_ptr<const plant::TowerCraneModel> model;
+  std::vector<DriveMotion> motion;
+  std::vector<double> measured;  // interleaved phi, theta [rad] (2 per sample)
+  double sample_time{0.0};
+  int substeps{1};
+  std::string cause;
+};
+
+SwingEffects swing_effects(const std::vector<double>& full, const std::string& cause) {
+  SwingEffects e;
+  if (full.empty()) return e;
+  const double p = full[0];  // no base parameters: the candidate's parameter comes first
+  if (cause == "pendulum_viscous_damping") e.extra_viscous = p;
+  if (cause == "pendulum_coulomb_damping") e.coulomb = std::max(p, 0.0);
+  if (cause == "pendulum_quadratic_damping") e.quadratic = std::max(p, 0.0);
+  if (cause == "cable_length_error") e.length_error = std::max(p, -0.9);
+  if (cause == "encoder_offset") e.encoder_offset = p;
+  return e;
+}
+
+// Windows of window_duration [s] (in the interleaved index space: 2 residuals per sample, phi then
+// theta); the windows in the last holdout_fraction are held out; nuisance: the initial swing state.
+Problem crane_swing_problem(const std::shared_ptr<CraneSwingSeries>& s, double window_duration,
+                            double holdout_fraction) {
+  Problem problem;
+  const std::size_t n = s->motion.size();
+  const auto length = std::max<std::size_t>(static_cast<std::size_t>(std::llround(window_duration / s->sample_time)), 10);
+  const auto holdout_start = static_cast<std::size_t>(std::floor((1.0 - holdout_fraction) * static_cast<double>(n)));
+  for (std::size_t first = 0; first + 10 <= n; first += length) {
+    const std::size_t count = std::min(length, n - first);
+    problem.windows.push_back({2 * first, 2 * count, first >= holdout_start ? 0 : 2 * count});
+  }
+  problem.nuisance_size = 4;
+  problem.initial_nuisance = [s](const Window& w, double* out) {
+    std::vector<double> phi(w.count / 2);
+    std::vector<double> theta(w.count / 2);
+    for (std::size_t i = 0; i < phi.size(); ++i) {
+      phi[i] = s->measured[w.first + 2 * i];
+      theta[i] = s->measured[w.first + 2 * i + 1];
+    }
+    const auto [phi0, phi_rate] = local_state(phi, 0, phi.size(), s->sample_time);
+    const auto [theta0, theta_rate] = local_state(theta, 0, theta.size(), s->sample_time);
+    out[0] = phi0;
+    out[1] = phi_rate;
+    out[2] = theta0;
+    out[3] = theta_rate;
+  };
+  problem.residual = [s](const std::vector<double>& full, const double* nuisance, const Window& w, std::size_t count,
+                         double* out) {
+    const SwingEffects effects = swing_effects(full, s->cause);
+    const SwingState initial{nuisance[0] - effects.encoder_offset, nuisance[1], nuisance[2], nuisance[3]};
+    replay_crane_swing(*s->model, effects, s->motion, s->sample_time, w.first / 2, count / 2, initial, s->substeps,
+                       std::span<double>(out, count));
+    for (std::size_t i = 0; i < count; ++i) out[i] = s->measured[w.first + i] - out[i];
+  };
+  return problem;
+}
+
 // Grid product of the candidate's grids.
 std::vector<std::vector<double>> grid_points(const Candidate& candidate) {
   std::vector<std::vector<double>> points{{}};
@@ -738,18 +880,104 @@ const std::vector<std::string>& audit_catalog(AuditPlant plant) {
                                              "gain_error", "position_dependent_friction"};
   static const std::vector<std::string> pendulum{"pendulum_viscous_damping", "pendulum_coulomb_damping",
                                                  "pendulum_quadratic_damping", "cable_length_error", "encoder_offset"};
-  return plant == AuditPlant::axis ? axis : pendulum;
+  static const std::vector<std::string> crane = [] {
+    std::vector<std::string> list;
+    for (const char* prefix : {kTrolleyPrefix, kSlewPrefix}) {
+      for (const auto& name : axis) list.push_back(prefix + name);
+    }
+    list.insert(list.end(), pendulum.begin(), pendulum.end());
+    list.push_back("payload_mass_error");
+    return list;
+  }();
+  return plant == AuditPlant::axis ? axis : plant == AuditPlant::pendulum ? pendulum : crane;
 }
 
 const std::vector<std::string>& audit_parameter_names(AuditPlant plant) {
-  static const std::vector<std::string> axis{"K_m", "b", "c"};
+  static const std::vector<std::string> axis{"K_m", "b", "c", "coulomb_asymmetry", "viscous_asymmetry", "stiction",
+                                             "stiction_asymmetry"};
   static const std::vector<std::string> pendulum{"L", "damping", "theta_zero", "gravity"};
-  return plant == AuditPlant::axis ? axis : pendulum;
+  static const std::vector<std::string> crane = [] {
+    std::vector<std::string> list;
+    for (const auto& [name, value] : crane_audit_parameters(common::CraneParameters{})) list.push_back(name);
+    return list;
+  }();
+  return plant == AuditPlant::axis ? axis : plant == AuditPlant::pendulum ? pendulum : crane;
+}
+
+namespace {
+
+// One table for both directions of the crane parameter mapping.
+struct CraneField {
+  std::string name;
+  double common::CraneParameters::*scalar;
+  common::AxisFriction common::CraneParameters::*axis;
+  double common::AxisFriction::*friction;
+};
+
+const std::vector<CraneField>& crane_fields() {
+  using P = common::CraneParameters;
+  using F = common::AxisFriction;
+  static const std::vector<CraneField> fields = [] {
+    std::vector<CraneField> list{{"gravity", &P::gravity, nullptr, nullptr},
+                                 {"load_mass", &P::load_mass, nullptr, nullptr},
+                                 {"trolley_drive_mass", &P::trolley_drive_mass, nullptr, nullptr},
+                                 {"trolley_mass", &P::trolley_mass, nullptr, nullptr},
+                                 {"jib_inertia", &P::jib_inertia, nullptr, nullptr},
+                                 {"trolley_drive_gain", &P::trolley_drive_gain, nullptr, nullptr},
+                                 {"slew_drive_gain", &P::slew_drive_gain, nullptr, nullptr}};
+    const std::pair<const char*, double F::*> friction[] = {
+        {"viscous_positive", &F::viscous_positive}, {"viscous_negative", &F::viscous_negative},
+        {"coulomb_positive", &F::coulomb_positive}, {"coulomb_negative", &F::coulomb_negative},
+        {"static_positive", &F::static_positive},   {"static_negative", &F::static_negative}};
+    for (const auto& [axis, member] : {std::pair{"trolley_", &P::trolley_friction}, std::pair{"slew_", &P::slew_friction}}) {
+      for (const auto& [name, field] : friction) {
+        list.push_back({std::string(axis) + name, nullptr, member, field});
+      }
+    }
+    return list;
+  }();
+  return fields;
+}
+
+}  // namespace
+
+std::map<std::string, double> drive_axis_audit_parameters(const common::AxisFriction& f, double gain) {
+  const double excess_plus = std::max(f.static_positive, f.coulomb_positive) - f.coulomb_positive;
+  const double excess_minus = std::max(f.static_negative, f.coulomb_negative) - f.coulomb_negative;
+  return {{"K_m", gain},
+          {"b", gain * 0.5 * (f.viscous_positive + f.viscous_negative)},
+          {"viscous_asymmetry", gain * 0.5 * (f.viscous_positive - f.viscous_negative)},
+          {"c", gain * 0.5 * (f.coulomb_positive + f.coulomb_negative)},
+          {"coulomb_asymmetry", gain * 0.5 * (f.coulomb_positive - f.coulomb_negative)},
+          {"stiction", gain * 0.5 * (excess_plus + excess_minus)},
+          {"stiction_asymmetry", gain * 0.5 * (excess_plus - excess_minus)}};
+}
+
+std::map<std::string, double> crane_audit_parameters(const common::CraneParameters& crane) {
+  std::map<std::string, double> out;
+  for (const auto& f : crane_fields()) out[f.name] = f.scalar != nullptr ? crane.*f.scalar : (crane.*f.axis).*f.friction;
+  return out;
+}
+
+common::CraneParameters crane_parameters_from_audit(const std::map<std::string, double>& parameters,
+                                                    const common::CraneParameters& base) {
+  common::CraneParameters crane = base;
+  for (const auto& [name, value] : parameters) {
+    const auto& fields = crane_fields();
+    const auto it = std::find_if(fields.begin(), fields.end(), [&](const CraneField& f) { return name == f.name; });
+    if (it == fields.end()) throw common::ConfigError("param: unknown crane parameter '" + name + "'");
+    if (it->scalar != nullptr) crane.*it->scalar = value;
+    else (crane.*it->axis).*it->friction = value;
+  }
+  common::validate(crane, "param");
+  return crane;
 }
 
 void validate(const AuditOptions& options) {
   const auto& names = audit_parameter_names(options.plant);
-  const std::string plant = options.plant == AuditPlant::axis ? "axis" : "pendulum";
+  const std::string plant = options.plant == AuditPlant::axis       ? "axis"
+                            : options.plant == AuditPlant::pendulum ? "pendulum"
+                                                                    : "crane";
   for (const auto& [name, value] : options.parameters) {
     if (std::find(names.begin(), names.end(), name) == names.end()) {
       throw common::ConfigError("param: unknown parameter '" + name + "' for model " + plant + " (valid: " +
@@ -757,8 +985,9 @@ void validate(const AuditOptions& options) {
     }
     common::require_finite("param " + name, value);
   }
-  const std::vector<std::string> required =
-      options.plant == AuditPlant::axis ? std::vector<std::string>{"K_m", "b", "c"} : std::vector<std::string>{"L"};
+  const std::vector<std::string> required = options.plant == AuditPlant::axis       ? std::vector<std::string>{"K_m", "b", "c"}
+                                            : options.plant == AuditPlant::pendulum ? std::vector<std::string>{"L"}
+                                                                                    : names;
   for (const auto& name : required) {
     if (!options.parameters.contains(name)) {
       throw common::ConfigError("param: nominal parameter '" + name + "' of model " + plant +
@@ -769,6 +998,12 @@ void validate(const AuditOptions& options) {
     common::require_greater("param K_m", options.parameters.at("K_m"), 0.0);
     common::require_at_least("param b", options.parameters.at("b"), 0.0);
     common::require_at_least("param c", options.parameters.at("c"), 0.0);
+    const double stiction = parameter(options.parameters, "stiction", 0.0);
+    common::require_at_least("param stiction", stiction, 0.0);
+    common::require_in_range("param stiction_asymmetry", parameter(options.parameters, "stiction_asymmetry", 0.0),
+                             -stiction, stiction);
+  } else if (options.plant == AuditPlant::crane) {
+    static_cast<void>(crane_parameters_from_audit(options.parameters));  // validates every field
   } else {
     common::require_greater("param L", options.parameters.at("L"), 0.0);
     common::require_at_least("param damping", parameter(options.parameters, "damping", 0.0), 0.0);
@@ -776,6 +1011,8 @@ void validate(const AuditOptions& options) {
   }
   const auto& catalog = audit_catalog(options.plant);
   for (const auto& cause : options.causes) {
+    // payload_mass_error is fitted on an axis only as a drive of the crane (coupling data given).
+    if (options.plant == AuditPlant::axis && cause == "payload_mass_error") continue;
     if (std::find(catalog.begin(), catalog.end(), cause) == catalog.end()) {
       throw common::ConfigError("cause: '" + cause + "' is not in the " + plant + " catalog (valid: " +
                                 join(catalog) + ")");
@@ -789,6 +1026,7 @@ void validate(const AuditOptions& options) {
   common::require_at_least("dead_band", options.dead_band, 0.0);
   common::require_at_least("bic_threshold", options.bic_threshold, 0.0);
   common::require_at_least("min_holdout_gain_percent", options.min_holdout_gain_percent, 0.0);
+  common::require_at_least("min_holdout_gain_quanta", options.min_holdout_gain_quanta, 0.0);
   if (options.substeps < 1) throw common::ConfigError("substeps = " + std::to_string(options.substeps) + " must be >= 1");
 }
 
@@ -796,16 +1034,18 @@ AuditData read_audit_data(const std::filesystem::path& file, AuditPlant plant, c
                           double max_rate, std::size_t minimum_samples) {
   CsvReadOptions read;
   read.mapping = parse_column_mapping(columns);
-  const std::vector<std::string> allowed = plant == AuditPlant::axis
-                                               ? std::vector<std::string>{"t", "u", "x"}
-                                               : std::vector<std::string>{"t", "theta", "x", "segment"};
+  const std::vector<std::string> crane_columns{"t", "u_x", "u_gamma", "x", "gamma", "phi", "theta", "L"};
+  const std::vector<std::string> allowed = plant == AuditPlant::axis       ? std::vector<std::string>{"t", "u", "x"}
+                                           : plant == AuditPlant::pendulum ? std::vector<std::string>{"t", "theta", "x", "segment"}
+                                                                           : crane_columns;
   for (const auto& [canonical, file_column] : read.mapping.entries) {
     if (std::find(allowed.begin(), allowed.end(), canonical) == allowed.end()) {
       throw common::ConfigError("columns: unknown canonical name '" + canonical + "' (expected " + join(allowed) + ")");
     }
   }
-  read.required_columns = plant == AuditPlant::axis ? std::vector<std::string>{"t", "u", "x"}
-                                                    : std::vector<std::string>{"t", "theta"};
+  read.required_columns = plant == AuditPlant::axis       ? std::vector<std::string>{"t", "u", "x"}
+                          : plant == AuditPlant::pendulum ? std::vector<std::string>{"t", "theta"}
+                                                          : crane_columns;
   read.time_column = "t";
   read.minimum_samples = minimum_samples;
   const TimeSeries series = read_time_series_csv(file, read);
@@ -835,6 +1075,21 @@ AuditData read_audit_data(const std::filesystem::path& file, AuditPlant plant, c
   if (plant == AuditPlant::axis) {
     data.input = take(series.column("u"));
     data.output = take(series.column("x"));
+  } else if (plant == AuditPlant::crane) {
+    data.input = take(series.column("u_x"));
+    data.output = take(series.column("x"));
+    data.slew_input = take(series.column("u_gamma"));
+    data.slew_angle = take(series.column("gamma"));
+    data.swing_in_plane = take(series.column("phi"));
+    data.swing_out_of_plane = take(series.column("theta"));
+    data.cable_length = take(series.column("L"));
+    for (std::size_t k = 0; k < data.cable_length.size(); ++k) {
+      if (data.cable_length[k] <= 0.0) {
+        throw DataError(file.string() + ": column '" + read.mapping.file_column("L") + "': cable length " +
+                        common::format_value(data.cable_length[k]) + " m at data row " + std::to_string(k * factor + 1) +
+                        " must be > 0");
+      }
+    }
   } else {
     data.output = take(series.column("theta"));
     if (series.has_column("x") && (read.mapping.file_column("x") != "x" || series.has_column("x"))) {
@@ -851,9 +1106,14 @@ AuditData read_audit_data(const std::filesystem::path& file, AuditPlant plant, c
   return data;
 }
 
-AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
-  validate(options);
+namespace {
+
+// The audit of one channel: axis (position or effort), pendulum, or, with `swing` given, the crane
+// swing channel (then `options` is a pendulum's, with L the mean cable length).
+AuditReport run_audit_channel(const AuditData& data, const AuditOptions& options,
+                              const std::shared_ptr<CraneSwingSeries>& swing) {
   const std::size_t n = data.time.size();
+  const std::size_t residual_count = swing ? 2 * n : n;
   if (n < 50) throw DataError(data.source + ": too few samples: " + std::to_string(n) + " (minimum 50)");
   if (data.output.size() != n || (options.plant == AuditPlant::axis && data.input.size() != n)) {
     throw DataError(data.source + ": columns of different lengths");
@@ -863,7 +1123,7 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
   const bool effort = axis && options.channel == AuditChannel::effort;
 
   AuditReport report;
-  report.plant = axis ? "axis" : "pendulum";
+  report.plant = axis ? "axis" : (swing ? "swing" : "pendulum");
   report.channel = axis ? (effort ? "effort" : "position") : "angle";
   report.unit = axis ? (effort ? "V" : "m") : "rad";
   report.sample_time = sample_time;
@@ -889,8 +1149,19 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
     axis_series = std::make_shared<AxisSeries>();
     axis_series->x = data.output;
     axis_series->u = data.input;
+    axis_series->nominal.coulomb_asymmetry = parameter(options.parameters, "coulomb_asymmetry", 0.0);
+    axis_series->nominal.viscous_asymmetry = parameter(options.parameters, "viscous_asymmetry", 0.0);
+    axis_series->nominal.stiction = parameter(options.parameters, "stiction", 0.0);
+    axis_series->nominal.stiction_asymmetry = parameter(options.parameters, "stiction_asymmetry", 0.0);
+    axis_series->inertia = data.coupling_inertia;
+    axis_series->inertia_per_mass = data.coupling_inertia_per_mass;
+    axis_series->force = data.coupling_force;
+    axis_series->force_per_mass = data.coupling_force_per_mass;
+    axis_series->drive_inertia = data.drive_inertia;
     axis_series->sample_time = sample_time;
     axis_series->dead_band = options.dead_band;
+  } else if (swing) {
+    candidates = pendulum_candidates(options.parameters.at("L"), parameter(options.parameters, "gravity", 9.80665));
   } else {
     gravity = parameter(options.parameters, "gravity", 9.80665);
     const double length = options.parameters.at("L");
@@ -961,6 +1232,11 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
       return effort ? axis_effort_problem(s, options.holdout_fraction)
                     : axis_position_problem(s, options.window_duration, options.holdout_fraction);
     }
+    if (swing) {
+      auto s = std::make_shared<CraneSwingSeries>(*swing);
+      s->cause = cause;
+      return crane_swing_problem(s, options.window_duration, options.holdout_fraction);
+    }
     auto s = std::make_shared<PendulumSeries>(*pendulum_series);
     s->cause = cause;
     return pendulum_problem(s, data.segment, options.holdout_fraction, base);
@@ -978,7 +1254,7 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
   std::size_t train_windows = 0;
   for (const auto& w : nominal_problem.windows) train_windows += w.train_count >= 3 ? 1 : 0;
   if (train_windows == 0) throw DataError(data.source + ": too few samples for a training window");
-  const Fit nominal = fit_problem(nominal_problem, base, nominal_free, initial_nuisance(nominal_problem), n);
+  const Fit nominal = fit_problem(nominal_problem, base, nominal_free, initial_nuisance(nominal_problem), residual_count);
   for (std::size_t i = 0; i < base_count; ++i) {
     report.nominal.push_back({base_specs[i].name, base_specs[i].unit, nominal.full[i], 0.0});
   }
@@ -989,6 +1265,19 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
   report.before = summarize(nominal, summary_input, options.max_lag);
   const double bic_nominal = bic(nominal.train_rss, nominal.train_n, 0);
   const double holdout_nominal = report.before.holdout_rms;
+  // Resolution of the channel: the smallest nonzero step of the measured signal (position/angle
+  // channels; 0 for effort, which sets no resolution floor).
+  double quantum = 0.0;
+  if (!effort) {
+    const std::vector<double>& measured = swing ? swing->measured : data.output;
+    const std::size_t stride = swing ? 2 : 1;
+    quantum = std::numeric_limits<double>::infinity();
+    for (std::size_t k = stride; k < measured.size(); ++k) {
+      const double step = std::abs(measured[k] - measured[k - stride]);
+      if (step > 1e-15) quantum = std::min(quantum, step);
+    }
+    if (!std::isfinite(quantum)) quantum = 0.0;
+  }
 
   // Candidates.
   std::vector<Fit> fits(candidates.size());
@@ -1080,26 +1369,41 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
         }
       }
     }
-    fits[c] = fit_problem(problem, full, free, start_nuisance, n);
+    const auto fit_from = [&](const std::vector<double>& start) {
+      return fit_problem(problem, start, free, start_nuisance, residual_count);
+    };
+    fits[c] = fit_from(full);
     if (candidate.parameters.size() > 1) {
       // Several parameters (stribeck: level and v_s trade off along a valley): the grid scores use
       // unfitted initial states, so also fit from other starts and keep the lowest training RSS.
       // Extra starts: the best grid points at the second parameter's grid neighbours (below and
-      // above) of the grid optimum.
+      // above) of the grid optimum; with every_grid_start, when the fit still leaves more than
+      // kRestartQuanta quanta of training RMS, at each of its other grid values too.
       std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       const auto& second = candidate.parameters[1].grid;
       const auto at = std::find(second.begin(), second.end(), best_point[1]);
       std::vector<double> neighbours;
       if (at != second.end() && at != second.begin()) neighbours.push_back(*(at - 1));
       if (at != second.end() && at + 1 != second.end()) neighbours.push_back(*(at + 1));
-      for (const auto& [rss, point] : scored) {
-        const auto it = std::find(neighbours.begin(), neighbours.end(), point[1]);
-        if (it == neighbours.end()) continue;
-        neighbours.erase(it);
-        std::vector<double> start = full;
-        std::copy(point.begin(), point.end(), start.begin() + static_cast<std::ptrdiff_t>(base_count));
-        Fit other = fit_problem(problem, start, free, start_nuisance, n);
-        if (other.train_rss < fits[c].train_rss) fits[c] = std::move(other);
+      const auto fit_from_best_at = [&](std::vector<double> values) {
+        for (const auto& [rss, point] : scored) {
+          const auto it = std::find(values.begin(), values.end(), point[1]);
+          if (it == values.end()) continue;
+          values.erase(it);
+          std::vector<double> start = full;
+          std::copy(point.begin(), point.end(), start.begin() + static_cast<std::ptrdiff_t>(base_count));
+          Fit other = fit_from(start);
+          if (other.train_rss < fits[c].train_rss) fits[c] = std::move(other);
+        }
+      };
+      fit_from_best_at(neighbours);
+      const double train_rms = std::sqrt(fits[c].train_rss / static_cast<double>(std::max<std::size_t>(fits[c].train_n, 1)));
+      if (options.every_grid_start && train_rms > kRestartQuanta * quantum) {
+        std::vector<double> others;
+        for (const double v : second) {
+          if (v != best_point[1] && std::find(neighbours.begin(), neighbours.end(), v) == neighbours.end()) others.push_back(v);
+        }
+        fit_from_best_at(others);
       }
     }
     if (axis && candidate.name == "stiction") {
@@ -1107,7 +1411,7 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
       // model and the initial states refitted with it held.
       if (const auto bracket = axis_breakaway_bracket(*axis_series, fits[c].full)) {
         std::vector<double> held = fits[c].full;
-        held[base_count] = std::max(0.5 * (bracket->first + bracket->second) - held[2], 0.0);
+        held[base_count] = std::max(0.5 * (bracket->first + bracket->second), 0.0);
         const double half_width = 0.5 * (bracket->second - bracket->first);
         Fit refit = fit_problem(problem, held, nominal_free, fits[c].nuisance, n);
         refit.standard_errors.push_back(half_width / std::sqrt(3.0));  // uniform within the bracket
@@ -1126,7 +1430,8 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
     entry.holdout_rms = fit.holdout_n ? std::sqrt(fit.holdout_rss / static_cast<double>(fit.holdout_n)) : 0.0;
     entry.holdout_gain_percent = holdout_nominal > 0.0 ? 100.0 * (holdout_nominal - entry.holdout_rms) / holdout_nominal : 0.0;
     entry.qualifies = entry.delta_bic < -options.bic_threshold &&
-                      entry.holdout_gain_percent >= options.min_holdout_gain_percent;
+                      entry.holdout_gain_percent >= options.min_holdout_gain_percent &&
+                      holdout_nominal - entry.holdout_rms >= options.min_holdout_gain_quanta * quantum;
     report.candidates.push_back(entry);
   }
 
@@ -1146,7 +1451,12 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
     chosen = -1;
   } else if (chosen < 0) {
     report.stop_reason = "no candidate earns its parameters (delta-BIC < -" + common::format_value(options.bic_threshold) +
-                         " and held-out gain >= " + common::format_value(options.min_holdout_gain_percent) + " %)";
+                         " and held-out gain >= " + common::format_value(options.min_holdout_gain_percent) + " %" +
+                         (options.min_holdout_gain_quanta > 0.0
+                              ? " and >= " + common::format_value(options.min_holdout_gain_quanta) + " quanta of " +
+                                    common::format_value(quantum) + " " + report.unit
+                              : std::string()) +
+                         ")";
   }
   const Fit* selected = &nominal;
   if (chosen >= 0) {
@@ -1200,15 +1510,20 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
 
   // Series.
   report.time = data.time;
-  report.measured = effort ? std::vector<double>(n, kNaN) : data.output;
+  report.measured.assign(n, kNaN);
   report.nominal_prediction.assign(n, kNaN);
   report.extended_prediction.assign(n, kNaN);
-  report.holdout = nominal.holdout_flag;
+  report.holdout.assign(n, 0.0);
+  const std::size_t stride = swing ? 2 : 1;  // swing: the in-plane angle phi
   for (std::size_t k = 0; k < n; ++k) {
-    const double measured = effort ? (k >= 1 ? 0.5 * (data.input[k - 1] + data.input[k]) : data.input[0]) : data.output[k];
+    const double measured = swing    ? swing->measured[stride * k]
+                            : effort ? (k >= 1 ? 0.5 * (data.input[k - 1] + data.input[k]) : data.input[0])
+                                     : data.output[k];
+    const std::size_t i = stride * k;
     report.measured[k] = measured;
-    if (std::isfinite(nominal.residual_per_sample[k])) report.nominal_prediction[k] = measured - nominal.residual_per_sample[k];
-    if (std::isfinite(selected->residual_per_sample[k])) report.extended_prediction[k] = measured - selected->residual_per_sample[k];
+    report.holdout[k] = nominal.holdout_flag[i];
+    if (std::isfinite(nominal.residual_per_sample[i])) report.nominal_prediction[k] = measured - nominal.residual_per_sample[i];
+    if (std::isfinite(selected->residual_per_sample[i])) report.extended_prediction[k] = measured - selected->residual_per_sample[i];
   }
 
   // Rank: fitted candidates by delta-BIC, then the skipped ones.
@@ -1217,6 +1532,335 @@ AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
     return a.fitted && a.delta_bic < b.delta_bic;
   });
   return report;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Crane: three channels (trolley, slew, swing), each an audit of its own, combined.
+
+// Causes of one channel requested by the crane options: names with `prefix` stripped, pendulum
+// names, or payload_mass_error. `requested` = false when the options name causes but none here.
+std::vector<std::string> channel_causes(const std::vector<std::string>& causes, const std::string& prefix,
+                                        const std::vector<std::string>& catalog, bool with_payload, bool& requested) {
+  requested = causes.empty();
+  std::vector<std::string> out;
+  for (const auto& cause : causes) {
+    std::string name = cause;
+    if (!prefix.empty()) {
+      if (cause == "payload_mass_error" && with_payload) {
+        out.push_back(cause);
+        continue;
+      }
+      if (cause.rfind(prefix, 0) != 0) continue;
+      name = cause.substr(prefix.size());
+    }
+    if (std::find(catalog.begin(), catalog.end(), name) != catalog.end()) out.push_back(name);
+  }
+  requested = requested || !out.empty();
+  return out;
+}
+
+// Measured motion of the crane per sample: central differences (one-sided copies at the ends).
+struct CraneMotion {
+  std::vector<plant::ModelState> state;
+  std::vector<plant::CoordinateVector> acceleration;
+  std::vector<plant::HoistMotion> hoist;
+};
+
+CraneMotion crane_motion(const AuditData& data, double sample_time) {
+  const std::size_t n = data.time.size();
+  const std::vector<double>* q[plant::kNumCoordinates] = {&data.output, &data.swing_in_plane, &data.slew_angle,
+                                                           &data.swing_out_of_plane};
+  CraneMotion m;
+  m.state.resize(n);
+  m.acceleration.resize(n);
+  m.hoist.resize(n);
+  const double t = sample_time;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t c = std::clamp<std::size_t>(k, 1, n - 2);  // stencil centre
+    for (int j = 0; j < plant::kNumCoordinates; ++j) {
+      const auto& v = *q[j];
+      m.state[k].position[j] = v[k];
+      m.state[k].velocity[j] = (v[c + 1] - v[c - 1]) / (2.0 * t);
+      m.acceleration[k][j] = (v[c + 1] - 2.0 * v[c] + v[c - 1]) / (t * t);
+    }
+    const auto& L = data.cable_length;
+    m.hoist[k] = {L[k], (L[c + 1] - L[c - 1]) / (2.0 * t), (L[c + 1] - 2.0 * L[c] + L[c - 1]) / (t * t)};
+  }
+  return m;
+}
+
+// Coupling of the drive axes (inverse dynamics of the full model with the measured motion). The
+// swing accelerations are not differentiated twice (the swing encoders' quanta would give several
+// rad/s^2 of noise): the swing rows of TowerCraneModel give them from the drive accelerations,
+// s'' = -M_ss^-1 (M_sa a'' + bias_s), so the drive rows become M_eff a'' + b_eff = (F_x, T_gamma) with
+//   M_eff = M_aa - M_as M_ss^-1 M_sa,  b_eff = bias_a - M_as M_ss^-1 bias_s
+// at the measured positions and (central-difference) rates. Drive i: I_i a_i + C_i with the inertia
+// I_i = M_eff,ii and C_i = b_eff,i + M_eff,ij a_j (the other drive's measured acceleration). The swing
+// rows do not depend on the load mass and the drive rows are affine in it, so I and C are affine in
+// m: I = I(0) + m dI, C = C(0) + m dC.
+struct DriveCoupling {
+  std::vector<double> inertia;           // at the nominal load mass
+  std::vector<double> inertia_per_mass;
+  std::vector<double> force;
+  std::vector<double> force_per_mass;
+};
+
+std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion) {
+  common::CraneParameters massless = crane;
+  massless.load_mass = 0.0;
+  common::CraneParameters unit = crane;
+  unit.load_mass = 1.0;
+  const plant::TowerCraneModel model0(massless);
+  const plant::TowerCraneModel model1(unit);
+  const std::size_t n = motion.state.size();
+  std::pair<DriveCoupling, DriveCoupling> out;
+  for (auto* c : {&out.first, &out.second}) {
+    c->inertia.resize(n);
+    c->inertia_per_mass.resize(n);
+    c->force.resize(n);
+    c->force_per_mass.resize(n);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    plant::CoordinateMatrix mass0;
+    plant::CoordinateMatrix mass1;
+    plant::CoordinateVector bias0;
+    plant::CoordinateVector bias1;
+    model0.compute_dynamics(motion.state[k], motion.hoist[k], mass0, bias0);
+    model1.compute_dynamics(motion.state[k], motion.hoist[k], mass1, bias1);
+    const Eigen::Vector2d a(motion.acceleration[k][plant::kTrolleyIndex], motion.acceleration[k][plant::kSlewIndex]);
+    const SwingElimination e0 = eliminate_swing(mass0, bias0);
+    const SwingElimination e1 = eliminate_swing(mass1, bias1);
+    const Eigen::Matrix2d inertia[2] = {e0.drive_inertia, e1.drive_inertia};
+    const Eigen::Vector2d bias[2] = {e0.drive_bias, e1.drive_bias};
+    for (int i = 0; i < 2; ++i) {
+      DriveCoupling& c = i == 0 ? out.first : out.second;
+      const double force0 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i);
+      const double force1 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i);
+      c.inertia_per_mass[k] = inertia[1](i, i) - inertia[0](i, i);
+      c.force_per_mass[k] = force1 - force0;
+      c.inertia[k] = inertia[0](i, i) + crane.load_mass * c.inertia_per_mass[k];
+      c.force[k] = force0 + crane.load_mass * c.force_per_mass[k];
+    }
+  }
+  return out;
+}
+
+// Drive motion held over [t_k, t_k+1) for the swing replay: position and rates at t_k, the
+// acceleration of the interval (mean of the second differences at k and k+1).
+std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
+  const std::size_t n = m.state.size();
+  std::vector<DriveMotion> out(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t next = std::min(k + 1, n - 1);
+    DriveMotion& d = out[k];
+    d.trolley_position = m.state[k].position[plant::kTrolleyIndex];
+    d.trolley_velocity = m.state[k].velocity[plant::kTrolleyIndex];
+    d.trolley_acceleration = 0.5 * (m.acceleration[k][plant::kTrolleyIndex] + m.acceleration[next][plant::kTrolleyIndex]);
+    d.slew_rate = m.state[k].velocity[plant::kSlewIndex];
+    d.slew_acceleration = 0.5 * (m.acceleration[k][plant::kSlewIndex] + m.acceleration[next][plant::kSlewIndex]);
+    d.cable_length = m.hoist[k].cable_length;
+    d.cable_length_rate = m.hoist[k].cable_length_rate;
+    d.cable_length_acceleration = m.hoist[k].cable_length_acceleration;
+  }
+  return out;
+}
+
+// The slew's units: the axis model's metres are radians there ("m/s^2/m" -> "rad/s^2/rad").
+std::string slew_unit(const std::string& unit) {
+  std::string out;
+  std::size_t start = 0;
+  while (start <= unit.size()) {
+    const std::size_t end = std::min(unit.find('/', start), unit.size());
+    const std::string token = unit.substr(start, end - start);
+    out += (token == "m" ? "rad" : token.rfind("m^", 0) == 0 ? "rad" + token.substr(1) : token);
+    if (end < unit.size()) out += '/';
+    start = end + 1;
+  }
+  return out;
+}
+
+AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) {
+  if (options.calibrate) {
+    throw common::ConfigError("calibrate: not available for the crane model (give the nominal parameters with "
+                              "--config and --param)");
+  }
+  if (options.channel == AuditChannel::effort) {
+    throw common::ConfigError("channel: the crane audit fits the position and swing channels and reports the "
+                              "effort channel of each drive as a second opinion; do not give --channel effort");
+  }
+  const std::size_t n = data.time.size();
+  if (n < 50) throw DataError(data.source + ": too few samples: " + std::to_string(n) + " (minimum 50)");
+  for (const auto* column : {&data.input, &data.output, &data.slew_input, &data.slew_angle, &data.swing_in_plane,
+                             &data.swing_out_of_plane, &data.cable_length}) {
+    if (column->size() != n) throw DataError(data.source + ": crane columns of different lengths");
+  }
+  const common::CraneParameters crane = crane_parameters_from_audit(options.parameters);
+  const double sample_time = (data.time.back() - data.time.front()) / static_cast<double>(n - 1);
+  const CraneMotion motion = crane_motion(data, sample_time);
+  // The coupling uses the swing angles low-passed (zero phase, kSwingCutoff): their encoder quanta
+  // would otherwise reach the drives through the rates in the centripetal and Coriolis terms.
+  AuditData smoothed = data;
+  if (sample_time < 0.25 / kSwingCutoff) {
+    smoothed.swing_in_plane = zero_phase_low_pass(data.swing_in_plane, kSwingCutoff, 1.0 / sample_time);
+    smoothed.swing_out_of_plane = zero_phase_low_pass(data.swing_out_of_plane, kSwingCutoff, 1.0 / sample_time);
+  }
+  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, crane_motion(smoothed, sample_time));
+
+  AuditReport report;
+  report.plant = "crane";
+  report.sample_time = sample_time;
+  report.samples = n;
+  for (const auto& [name, value] : crane_audit_parameters(crane)) report.nominal.push_back({name, "", value, 0.0});
+
+  // Drive axes.
+  const auto& axis_catalog = audit_catalog(AuditPlant::axis);
+  const auto drive_channel = [&](const std::string& prefix, const std::vector<double>& input,
+                                 const std::vector<double>& position, const DriveCoupling& coupling,
+                                 double drive_inertia, const common::AxisFriction& friction,
+                                 double gain) -> std::optional<AuditReport> {
+    bool requested = false;
+    AuditOptions axis_options = options;
+    axis_options.plant = AuditPlant::axis;
+    axis_options.causes = channel_causes(options.causes, prefix, axis_catalog, true, requested);
+    if (!requested) return std::nullopt;
+    axis_options.parameters = drive_axis_audit_parameters(friction, gain);
+    axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    axis_options.every_grid_start = true;
+    AuditData axis_data;
+    axis_data.source = data.source;
+    axis_data.time = data.time;
+    axis_data.input = input;
+    axis_data.output = position;
+    axis_data.coupling_inertia = coupling.inertia;
+    axis_data.coupling_inertia_per_mass = coupling.inertia_per_mass;
+    axis_data.coupling_force = coupling.force;
+    axis_data.coupling_force_per_mass = coupling.force_per_mass;
+    axis_data.drive_inertia = drive_inertia;
+    axis_data.load_mass = crane.load_mass;
+    validate(axis_options);
+    AuditReport channel = run_audit_channel(axis_data, axis_options, nullptr);
+    channel.plant = prefix.substr(0, prefix.size() - 1);
+    const bool slew = prefix == kSlewPrefix;
+    if (slew) channel.unit = slew_unit(channel.unit);
+    for (auto& candidate : channel.candidates) {
+      if (candidate.name != "payload_mass_error") candidate.name = prefix + candidate.name;
+      for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
+    }
+    for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
+    if (channel.cause != "none" && channel.cause != "payload_mass_error") channel.cause = prefix + channel.cause;
+    return channel;
+  };
+  if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
+                             crane.trolley_friction, crane.trolley_drive_gain)) {
+    report.channels.push_back(std::move(*c));
+  }
+  if (auto c = drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, slew_coupling, crane.jib_inertia,
+                             crane.slew_friction, crane.slew_drive_gain)) {
+    report.channels.push_back(std::move(*c));
+  }
+
+  // Swing.
+  {
+    bool requested = false;
+    AuditOptions swing_options = options;
+    swing_options.plant = AuditPlant::pendulum;
+    swing_options.causes = channel_causes(options.causes, "", audit_catalog(AuditPlant::pendulum), false, requested);
+    double mean_length = 0.0;
+    for (const double L : data.cable_length) mean_length += L / static_cast<double>(n);
+    swing_options.parameters = {{"L", mean_length}, {"gravity", crane.gravity}};
+    swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
+    swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    if (requested) {
+      auto series = std::make_shared<CraneSwingSeries>();
+      series->model = std::make_shared<const plant::TowerCraneModel>(crane);
+      series->motion = swing_drive_motion(motion);
+      series->sample_time = sample_time;
+      series->substeps = 1;
+      series->measured.resize(2 * n);
+      for (std::size_t k = 0; k < n; ++k) {
+        series->measured[2 * k] = data.swing_in_plane[k];
+        series->measured[2 * k + 1] = data.swing_out_of_plane[k];
+      }
+      AuditData swing_data;
+      swing_data.source = data.source;
+      swing_data.time = data.time;
+      swing_data.output = data.swing_in_plane;
+      validate(swing_options);
+      report.channels.push_back(run_audit_channel(swing_data, swing_options, series));
+    }
+  }
+
+  // Combine: the qualifying candidate with the lowest delta-BIC over the channels whose nominal
+  // residual is not white; payload_mass_error (fitted on both drives) keeps its better fit.
+  const AuditReport* chosen_channel = nullptr;
+  const CandidateReport* chosen = nullptr;
+  const CandidateReport* payload = nullptr;
+  for (const auto& channel : report.channels) {
+    const bool white = channel.before.whiteness.lags > 0 && channel.before.whiteness.p_value >= 0.05;
+    for (const auto& candidate : channel.candidates) {
+      if (candidate.name == "payload_mass_error" && candidate.fitted &&
+          (payload == nullptr || candidate.delta_bic < payload->delta_bic)) {
+        payload = &candidate;
+      }
+      if (white || !candidate.qualifies) continue;
+      if (chosen == nullptr || candidate.delta_bic < chosen->delta_bic) {
+        chosen = &candidate;
+        chosen_channel = &channel;
+      }
+    }
+  }
+  for (const auto& channel : report.channels) {
+    for (const auto& candidate : channel.candidates) {
+      if (candidate.name == "payload_mass_error" && candidate.fitted && &candidate != payload) continue;
+      report.candidates.push_back(candidate);
+    }
+  }
+  std::stable_sort(report.candidates.begin(), report.candidates.end(), [](const auto& a, const auto& b) {
+    if (a.fitted != b.fitted) return a.fitted;
+    return a.fitted && a.delta_bic < b.delta_bic;
+  });
+  const AuditReport& shown = chosen_channel != nullptr ? *chosen_channel : report.channels.front();
+  report.channel = shown.plant + " " + shown.channel;
+  report.unit = shown.unit;
+  report.before = shown.before;
+  report.after = shown.after;
+  report.holdout_before = shown.holdout_before;
+  report.holdout_after = shown.holdout_after;
+  report.holdout_percent = shown.holdout_percent;
+  report.effort_holdout_before = shown.effort_holdout_before;
+  report.effort_holdout_after = shown.effort_holdout_after;
+  report.time = shown.time;
+  report.measured = shown.measured;
+  report.nominal_prediction = shown.nominal_prediction;
+  report.extended_prediction = shown.extended_prediction;
+  report.holdout = shown.holdout;
+  if (chosen != nullptr) {
+    report.cause = chosen->name;
+    report.parameters = chosen->parameters;
+    report.extended_nominal = shown.extended_nominal;
+    if (chosen->name == "payload_mass_error") {
+      const double dm = chosen->parameters.front().value;
+      report.parameters.push_back({"load_mass", "kg", crane.load_mass + dm, chosen->parameters.front().standard_error});
+    }
+    report.stop_reason = "selected " + chosen->name + " on the " + report.channel +
+                         " channel (lowest delta-BIC among qualifying candidates of all channels)";
+  } else {
+    report.stop_reason = "no channel has a candidate that earns its parameters (";
+    for (const auto& channel : report.channels) {
+      report.stop_reason += channel.plant + " " + channel.channel + ": " + channel.stop_reason + "; ";
+    }
+    report.stop_reason.resize(report.stop_reason.size() - 2);
+    report.stop_reason += ")";
+  }
+  return report;
+}
+
+}  // namespace
+
+AuditReport run_audit(const AuditData& data, const AuditOptions& options) {
+  validate(options);
+  if (options.plant == AuditPlant::crane) return run_crane_audit(data, options);
+  return run_audit_channel(data, options, nullptr);
 }
 
 void write_audit_report(const AuditReport& report, const std::filesystem::path& directory,
@@ -1258,9 +1902,25 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
   if (!report.extended_nominal.empty()) json["nominal_refitted_with_cause"] = parameters_json(report.extended_nominal);
   json["residual_before"] = summary_json(report.before);
   json["residual_after"] = summary_json(report.after);
-  if (report.plant == "axis") {
-    json["effort_holdout_rms_V"] = {{"before", number(report.effort_holdout_before)},
-                                    {"after", number(report.effort_holdout_after)}};
+  const auto effort_json = [&](const AuditReport& r) {
+    return nlohmann::json{{"before", number(r.effort_holdout_before)}, {"after", number(r.effort_holdout_after)}};
+  };
+  if (report.plant == "axis") json["effort_holdout_rms_V"] = effort_json(report);
+  if (!report.channels.empty()) {
+    nlohmann::json channels = nlohmann::json::array();
+    for (const auto& c : report.channels) {
+      nlohmann::json entry{{"name", c.plant},
+                           {"channel", c.channel},
+                           {"unit", c.unit},
+                           {"cause", c.cause},
+                           {"stop_reason", c.stop_reason},
+                           {"holdout_rms", {{"before", number(c.holdout_before)}, {"after", number(c.holdout_after)}}},
+                           {"residual_before", summary_json(c.before)},
+                           {"residual_after", summary_json(c.after)}};
+      if (c.channel == "position") entry["effort_holdout_rms_V"] = effort_json(c);
+      channels.push_back(entry);
+    }
+    json["channels"] = channels;
   }
   nlohmann::json list = nlohmann::json::array();
   int rank = 0;
@@ -1307,6 +1967,16 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
        << " %)\n\n";
     md << "Nominal:";
     for (const auto& p : report.nominal) md << " " << p.name << " = " << common::format_value(p.value) << " " << p.unit << ";";
+    if (!report.channels.empty()) {
+      md << "\n\n| channel | cause | held-out RMS before | after | effort RMS before [V] | after [V] | Ljung-Box p |\n"
+            "|---|---|---|---|---|---|---|\n";
+      for (const auto& c : report.channels) {
+        md << "| " << c.plant << " " << c.channel << " [" << c.unit << "] | " << c.cause << " | "
+           << common::format_value(c.holdout_before) << " | " << common::format_value(c.holdout_after) << " | "
+           << common::format_value(c.effort_holdout_before) << " | " << common::format_value(c.effort_holdout_after)
+           << " | " << common::format_value(c.before.whiteness.p_value) << " |\n";
+      }
+    }
     md << "\n\nResidual before: Ljung-Box p = " << common::format_value(report.before.whiteness.p_value)
        << ", after: p = " << common::format_value(report.after.whiteness.p_value) << "\n\n";
     md << "| rank | candidate | delta-BIC | held-out RMS | gain % | signature corr. | parameters |\n|---|---|---|---|---|---|---|\n";

@@ -1,17 +1,22 @@
 // crane_audit: model audit of measured data against a nominal model (model_audit.hpp).
 //
-//   crane_audit --model axis|pendulum --data measured.csv [--param NAME=VALUE ...] [--calibrate]
-//               [--columns t=COL,u=COL,x=COL] [--cause NAME ...] [--channel position|effort]
-//               [--holdout F] [--window S] [--dead-band V] [--max-rate HZ] [--t-min S] [--t-max S]
-//               [--plot] --out DIR
-//   crane_audit generate --model axis|pendulum --effect NAME|none|random --seed N --out FILE.csv
+//   crane_audit --model crane|axis|pendulum --data measured.csv [--config nominal.yaml]
+//               [--param NAME=VALUE ...] [--calibrate] [--columns t=COL,u=COL,x=COL ...] [--cause NAME ...]
+//               [--channel position|effort] [--holdout F] [--window S] [--dead-band V] [--max-rate HZ]
+//               [--t-min S] [--t-max S] [--plot] --out DIR
+//   crane_audit generate --model crane|axis|pendulum --effect NAME|none|random --seed N --out FILE.csv
 //     Writes a hidden-effect test case (hidden_effect_generator.hpp); the nominal parameters and
 //     the truth go into the comment line.
 //
 // Axis: x'' = K_m u - b x' - c sign(x') (3.6), params K_m [m/s^2/V], b [1/s], c [m/s^2]; columns
 // t [s], u [V], x [m]. Pendulum: params L [m], damping [1/s], theta_zero [rad] (the measured angle
 // of hanging straight down, e.g. --param theta_zero=3.14159; omitted = estimated), gravity;
-// columns t, theta [rad], optional x [m] (trolley) and segment (maneuver id).
+// columns t, theta [rad], optional x [m] (trolley) and segment (maneuver id). Crane: columns t, u_x,
+// u_gamma [V], x [m], gamma, phi, theta [rad], L [m]; nominal parameters from --config (the stack's
+// YAML, crane section, loaded by crane::config) and --param (names: audit_parameter_names(crane),
+// e.g. --param load_mass=2.4); every parameter is required, so give --config or all of them.
+// --config for axis: the trolley drive (K_m, b, c and the nominal asymmetries). --calibrate is
+// refused for the crane.
 // Exit codes: 0 success; 2 input refused (message names the file, row, column, option or cause);
 // 1 anything else.
 #include <CLI/CLI.hpp>
@@ -22,6 +27,7 @@
 #include <vector>
 
 #include "crane/common/validation.hpp"
+#include "crane/config/stack_config.hpp"
 #include "crane/model_audit/hidden_effect_generator.hpp"
 #include "crane/model_audit/measured_data.hpp"
 #include "crane/model_audit/model_audit.hpp"
@@ -35,7 +41,8 @@ constexpr int kExitInputRefused = 2;
 ma::AuditPlant parse_plant(const std::string& name) {
   if (name == "axis") return ma::AuditPlant::axis;
   if (name == "pendulum") return ma::AuditPlant::pendulum;
-  throw crane::common::ConfigError("model: '" + name + "' is not a model (valid: axis, pendulum)");
+  if (name == "crane") return ma::AuditPlant::crane;
+  throw crane::common::ConfigError("model: '" + name + "' is not a model (valid: crane, axis, pendulum)");
 }
 
 std::map<std::string, double> parse_parameters(const std::vector<std::string>& entries) {
@@ -58,6 +65,16 @@ std::map<std::string, double> parse_parameters(const std::vector<std::string>& e
   return out;
 }
 
+// Nominal parameters of `plant` from the stack configuration `path` (empty: none).
+std::map<std::string, double> config_parameters(const std::string& path, ma::AuditPlant plant) {
+  if (path.empty()) return {};
+  const crane::common::CraneParameters crane = crane::config::load_stack_config(path).crane;
+  if (plant == ma::AuditPlant::crane) return ma::crane_audit_parameters(crane);
+  if (plant == ma::AuditPlant::axis) return ma::drive_axis_audit_parameters(crane.trolley_friction, crane.trolley_drive_gain);
+  throw crane::common::ConfigError("config: --config gives crane or trolley-axis parameters, not the pendulum's "
+                                   "(give --param L=VALUE)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,6 +82,7 @@ int main(int argc, char** argv) {
   std::string model_name;
   std::string data_path;
   std::vector<std::string> params;
+  std::string config_path;
   bool calibrate = false;
   std::string columns;
   std::vector<std::string> causes;
@@ -75,8 +93,9 @@ int main(int argc, char** argv) {
   double t_min = -1e300;
   double t_max = 1e300;
   ma::AuditOptions options;
-  app.add_option("--model", model_name, "axis | pendulum");
+  app.add_option("--model", model_name, "crane | axis | pendulum");
   app.add_option("--data", data_path, "measured CSV");
+  app.add_option("--config", config_path, "nominal parameters from the stack YAML (crane; axis: the trolley drive)");
   app.add_option("--param", params, "nominal parameter NAME=VALUE (repeatable)");
   app.add_flag("--calibrate", calibrate, "fit the nominal parameters first");
   app.add_option("--columns", columns, "canonical=file column mapping, e.g. t=t_s,u=vir_V,x=qm_m");
@@ -97,7 +116,7 @@ int main(int argc, char** argv) {
   std::string effect = "random";
   std::uint64_t seed = 1;
   std::string generate_out;
-  generate->add_option("--model", model_name, "axis | pendulum");
+  generate->add_option("--model", model_name, "crane | axis | pendulum");
   generate->add_option("--effect", effect, "catalog name, none or random");
   generate->add_option("--seed", seed, "seed");
   generate->add_option("--out", generate_out, "CSV file")->required();
@@ -110,7 +129,7 @@ int main(int argc, char** argv) {
   std::string command_line;
   for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
   try {
-    if (model_name.empty()) throw crane::common::ConfigError("model: --model is required (axis or pendulum)");
+    if (model_name.empty()) throw crane::common::ConfigError("model: --model is required (crane, axis or pendulum)");
     const ma::AuditPlant plant = parse_plant(model_name);
     if (generate->parsed()) {
       const auto c = ma::generate_hidden_effect_case(plant, effect, seed);
@@ -118,8 +137,13 @@ int main(int argc, char** argv) {
                             crane::common::format_value(c.main_value) + "; nominal";
       for (const auto& [k, v] : c.nominal) comment += " " + k + "=" + crane::common::format_value(v);
       std::ofstream out(generate_out);
+      const auto& d = c.data;
       if (plant == ma::AuditPlant::axis) {
-        ma::write_time_series_csv(out, {comment}, {"t", "u", "x"}, {c.data.time, c.data.input, c.data.output});
+        ma::write_time_series_csv(out, {comment}, {"t", "u", "x"}, {d.time, d.input, d.output});
+      } else if (plant == ma::AuditPlant::crane) {
+        ma::write_time_series_csv(out, {comment}, {"t", "u_x", "u_gamma", "x", "gamma", "phi", "theta", "L"},
+                                  {d.time, d.input, d.slew_input, d.output, d.slew_angle, d.swing_in_plane,
+                                   d.swing_out_of_plane, d.cable_length});
       } else {
         ma::write_time_series_csv(out, {comment}, {"t", "theta", "segment"}, {c.data.time, c.data.output, c.data.segment});
       }
@@ -129,7 +153,8 @@ int main(int argc, char** argv) {
     if (data_path.empty()) throw crane::common::ConfigError("data: --data is required");
     if (out_dir.empty()) throw crane::common::ConfigError("out: --out is required");
     options.plant = plant;
-    options.parameters = parse_parameters(params);
+    options.parameters = config_parameters(config_path, plant);
+    for (const auto& [name, value] : parse_parameters(params)) options.parameters[name] = value;
     options.calibrate = calibrate;
     options.causes = causes;
     if (channel == "effort") options.channel = ma::AuditChannel::effort;
@@ -140,13 +165,22 @@ int main(int argc, char** argv) {
     if (t_min > -1e300 || t_max < 1e300) {  // crop to [t_min, t_max]
       ma::AuditData cropped;
       cropped.source = data.source;
+      const std::pair<const std::vector<double>*, std::vector<double>*> columns_of[] = {
+          {&data.time, &cropped.time},
+          {&data.output, &cropped.output},
+          {&data.input, &cropped.input},
+          {&data.trolley_position, &cropped.trolley_position},
+          {&data.segment, &cropped.segment},
+          {&data.slew_input, &cropped.slew_input},
+          {&data.slew_angle, &cropped.slew_angle},
+          {&data.swing_in_plane, &cropped.swing_in_plane},
+          {&data.swing_out_of_plane, &cropped.swing_out_of_plane},
+          {&data.cable_length, &cropped.cable_length}};
       for (std::size_t k = 0; k < data.time.size(); ++k) {
         if (data.time[k] < t_min || data.time[k] > t_max) continue;
-        cropped.time.push_back(data.time[k]);
-        cropped.output.push_back(data.output[k]);
-        if (!data.input.empty()) cropped.input.push_back(data.input[k]);
-        if (!data.trolley_position.empty()) cropped.trolley_position.push_back(data.trolley_position[k]);
-        if (!data.segment.empty()) cropped.segment.push_back(data.segment[k]);
+        for (const auto& [from, to] : columns_of) {
+          if (!from->empty()) to->push_back((*from)[k]);
+        }
       }
       data = std::move(cropped);
     }

@@ -3,12 +3,16 @@
 //
 // Axis (one drive axis, (3.6) of H. M. Omar, "Control of Gantry and Tower Cranes", Virginia Tech
 // 2003), extended by every axis catalog entry at once (an entry at its neutral value is absent):
-//   x'' = K_m (1 + g) S(D(u(t - tau))) - b_s x' - F_s(x, x') ,      s = sign(x')
+//   x'' = K_m (1 + g) S(D(u(t - tau))) + a_ext - b_s x' - F_s(x, x') ,      s = sign(x')
 //   b_s = b + s db                                   (viscous_friction_asymmetry: db)
 //   F_s = s [max(0, c + s dc + gamma x) + Delta exp(-(x'/v_s)^2)]
 //        (coulomb_friction_asymmetry: dc; position_dependent_friction: gamma; stribeck: Delta, v_s)
-//   at rest (x' = 0) the axis breaks away toward s only if s K_m(1+g)S(D(u)) exceeds
-//   max(0, c + s dc + gamma x) + Delta + Delta_s      (stiction: Delta_s; Filippov rest rule)
+//   at rest (x' = 0) the axis breaks away toward s only if s (K_m(1+g)S(D(u)) + a_ext) exceeds
+//   max(0, c + s dc + gamma x) + Delta + Delta_s + s dDelta_s
+//        (stiction: Delta_s; dDelta_s: a nominal asymmetry of the breakaway level, as in the
+//         crane configuration's static_positive/static_negative; Filippov rest rule)
+//   a_ext: an external acceleration [m/s^2] that does not pass through the drive (the crane's
+//        swing and slew coupling on a drive axis, model_audit.hpp), zero for a lone axis
 //   D(u) = u - clamp(u, -d, d)                       (deadzone: d [V])
 //   S(u) = clamp(u, -u_max, u_max)                   (saturation: u_max [V], 0 = none)
 //   tau                                              (input_delay [s])
@@ -47,6 +51,8 @@ struct AxisModel {
   double coulomb_asymmetry{0.0};  // dc [m/s^2]: c+ = c + dc, c- = c - dc
   double viscous_asymmetry{0.0};  // db [1/s]: b+ = b + db, b- = b - db (both kept >= 0)
   double stiction{0.0};           // Delta_s [m/s^2] >= 0: breakaway level above Coulomb
+  double stiction_asymmetry{0.0}; // dDelta_s [m/s^2]: level Delta_s + dDelta_s toward +, Delta_s - dDelta_s
+                                  // toward - (|dDelta_s| <= Delta_s)
   double stribeck_level{0.0};     // Delta [m/s^2] >= 0
   double stribeck_velocity{0.05}; // v_s [m/s] > 0
   double deadzone{0.0};           // d [V] >= 0
@@ -66,19 +72,30 @@ struct AxisState {
   double load_position{0.0};  // y [m] measured side of the backlash (= position when w = 0)
 };
 
+/// `model` with its acceleration-level terms (K_m, b, db, c, dc, Delta_s, dDelta_s, Stribeck level,
+/// gamma) multiplied by `ratio` [-] > 0: the axis of a crane whose row inertia is I_drive / ratio
+/// (the drive's own model is written for the inertia I_drive).
+[[nodiscard]] AxisModel scale_axis_inertia(AxisModel model, double ratio) noexcept;
+
 /// Effective drive acceleration K_m (1 + g) S(D(u)) [m/s^2] for a command `input` u [V].
 [[nodiscard]] double axis_drive_acceleration(const AxisModel& model, double input) noexcept;
 
 /// Advances `state` by `duration` [s] >= 0 under the constant command `input` [V] (already delayed)
-/// with `substeps` >= 1 frozen-coefficient closed-form pieces (see the header comment).
-void advance_axis(const AxisModel& model, double input, double duration, int substeps, AxisState& state) noexcept;
+/// and the constant external acceleration `external_acceleration` a_ext [m/s^2], with `substeps` >= 1
+/// frozen-coefficient closed-form pieces (see the header comment).
+void advance_axis(const AxisModel& model, double input, double duration, int substeps, AxisState& state,
+                  double external_acceleration = 0.0) noexcept;
 
 /// Replays the recorded commands: input[k] [V] is held over [t_k, t_k + sample_time); the state at
 /// sample `first` is `initial`; writes the measured position y(t_k) [m] for k = first ..
 /// first + out.size() - 1 into `out`. Delayed inputs before sample 0 are taken as input[0].
-/// Preconditions (asserted): first + out.size() <= input.size(), sample_time > 0.
+/// `external_acceleration` a_ext [m/s^2] and `inertia_ratio` (scale_axis_inertia) per sample, held
+/// over [t_k, t_k + sample_time) (not delayed), or empty for none. Preconditions (asserted):
+/// first + out.size() <= input.size(), the spans empty or of input's size, sample_time > 0.
 void replay_axis(const AxisModel& model, std::span<const double> input, double sample_time, std::size_t first,
-                 AxisState initial, int substeps, std::span<double> out) noexcept;
+                 AxisState initial, int substeps, std::span<double> out,
+                 std::span<const double> external_acceleration = {},
+                 std::span<const double> inertia_ratio = {}) noexcept;
 
 struct PendulumModel {
   double length{1.0};          // L [m] > 0

@@ -23,6 +23,25 @@
 //  pendulum_quadratic_damping q = [0.1, 0.5] 1/rad     cable_length_error e = +-[0.05, 0.15]
 //  encoder_offset = +-[0.01, 0.05] rad
 // Sensors: axis noise sigma = 5 um, quantum 10 um; pendulum noise 1e-4 rad, quantum 2 pi / 40000 rad.
+//
+// Crane: the lab tower crane of the configuration (common::CraneParameters defaults = deploy/config/
+// lab_tower_crane.yaml) with the load mass drawn in [1, 3] kg and the cable length in [0.6, 1.6] m
+// (constant), 18 s at the plant's 100 Hz: a digital PD per drive (trolley 100 V/m, slew 40 V/rad,
+// K_d = 0.2 s, as (3.17)) tracks a 4 s breakaway triangle at 0.03 m/s (0.03 rad/s) and then two
+// sines per drive (trolley 0.65 m + 0.2 sin(2 pi 0.25 t) - 0.2 sin(2 pi t / 3), slew 0.25 sin(2 pi
+// 0.15 t) - 0.25 sin(2 pi 0.3 t): swings up to about 0.3-0.5 rad); commands through the plant's
+// DAC (13 bit, +-10 V). Plant: TowerCraneModel's rows with the swing eliminated (crane_swing.hpp)
+// and each drive advanced as the extended axis model of audit_models.hpp scaled to its effective
+// inertia (the other drive's acceleration from the previous substep), 320 substeps per sample; the
+// swing by semi-implicit Euler with the swing entries' damping. Sensors: the plant's encoders
+// (drives_and_sensors.hpp: trolley 1.6 um, slew 17 urad, swing 0.26 mrad per count) with a
+// Gaussian edge jitter of 0.5 count, recorded as the middle of the count.
+// Crane magnitudes: the axis ranges above per drive with c, b the drive's mean Coulomb and viscous
+// levels in its own units (slew: [rad]), except viscous_friction_asymmetry db = +-[0.15, 0.3] b (the
+// trolley's nominal b- is four times b+; 0.3 b keeps b+ positive), position_dependent_friction over
+// 0.6 m (trolley) or 0.5 rad (slew), input_delay rounded to whole substeps (31 us); the pendulum
+// ranges with g/L; payload_mass_error: the nominal load mass is off by dm = +-[0.15, 0.4] m_true
+// (main parameter load_mass_error = m_true - m_nominal [kg]); encoder_offset on phi.
 // Offline, allocates; throws common::ConfigError for an unknown effect name.
 
 #include <cstdint>
@@ -43,7 +62,7 @@ struct HiddenEffectCase {
 };
 
 /// Draws and simulates one case. `effect` = catalog name, "none" (clean), or "random" (uniform over
-/// the plant's catalog). `duration` [s] per axis run or per pendulum swing.
+/// the plant's catalog). `duration` [s] per axis or crane run or per pendulum swing (0 = default).
 [[nodiscard]] HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string& effect,
                                                            std::uint64_t seed, double duration = 0.0);
 
