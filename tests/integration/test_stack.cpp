@@ -207,6 +207,45 @@ TEST(Stack, MixedVendorStacksGiveTheSingleVendorResults) {
   }
 }
 
+// Issue 4 on the running stack: a recording of the combined maneuver over DDS (mixed vendors) is
+// audited with the crane model against the configuration. The plant as configured gives "none";
+// the plant with a load 25 % heavier than the configuration says (2.5 kg against 2.0 kg) gives
+// payload_mass_error with the 0.5 kg within 10 %. The record is cut at 7 s, inside the move: the
+// audit holds out the last 30 % of a record, and after the move the crane is at rest, where every
+// model predicts the same (on the whole record the payload ranks first but cannot earn its
+// parameters on the held-out part: docs/model_audit.md).
+TEST(Stack, CraneAuditOfAStackRecordingNamesAHeavierPayload) {
+  const std::vector<std::string> run{"--maneuver", "combined", "--friction-compensation", "on",
+                                     "--dds-mix", "plant=cyclone,state_estimator=cyclone"};
+  auto heavy_run = run;
+  heavy_run.insert(heavy_run.end(), {"--plant-load-mass-factor", "1.25"});
+  const auto as_configured = run_demo("audit_configured", 23, run);
+  const auto heavy = run_demo("audit_heavy", 24, heavy_run);
+  ASSERT_FALSE(as_configured.is_null());
+  ASSERT_FALSE(heavy.is_null());
+  auto audit = [](const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("crane_test_" + name + "_" + std::to_string(getpid()));
+    const std::string command = kBin + "/crane_audit --model crane --data " + (dir / "combined_fc_on.csv").string() +
+                                " --config " + kConfig + " --t-max 7 --out " + (dir / "audit").string() + " > " +
+                                (dir / "audit.log").string() + " 2>&1";
+    EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 0) << "see " << dir / "audit.log";
+    std::ifstream file(dir / "audit" / "report.json");
+    return file ? nlohmann::json::parse(file, nullptr, false) : nlohmann::json();
+  };
+  const auto configured_report = audit("audit_configured");
+  const auto heavy_report = audit("audit_heavy");
+  ASSERT_TRUE(configured_report.is_object());
+  ASSERT_TRUE(heavy_report.is_object());
+  const double error = heavy_report["parameters"].value("load_mass_error", nlohmann::json::object()).value("value", 0.0);
+  std::printf("[ figure   ] crane audit of stack recordings: as configured -> %s; load 2.5 kg against 2.0 kg "
+              "configured -> %s, load mass error %+.4f kg, held-out gain %.1f %%\n",
+              configured_report["cause"].get<std::string>().c_str(), heavy_report["cause"].get<std::string>().c_str(),
+              error, heavy_report["gain"].value("percent", 0.0));
+  EXPECT_EQ(configured_report["cause"], "none");
+  EXPECT_EQ(heavy_report["cause"], "payload_mass_error");
+  EXPECT_NEAR(error, 0.5, 0.05);
+}
+
 // The time-optimal swing-free profile for the 0.75 m trolley move of (3.54), closed loop on the
 // plant with friction: settled within 1.1 times the profile's duration (2.2543 s, checked against a
 // linear program in tests/trajectory_profiles) with residual swing below 0.2 deg (issue 3).

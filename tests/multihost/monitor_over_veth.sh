@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Monitoring from another machine, emulated: two network namespaces joined by a veth pair
 # (10.77.0.1 <-> 10.77.0.2, multicast on). The stack runs in the first with --lan; crane_topic runs
-# in the second and must discover every topic, measure the 100 Hz sensor stream and record it.
+# in the second and must discover every topic, measure the 100 Hz sensor stream and record it, and
+# the recording must be accepted by crane_audit --model crane.
 # Both namespaces (and the veth pair with them) are private to this script and vanish with it;
 # nothing is sent anywhere else. Needs: unshare --net (root or user namespaces), ip, nsenter.
 # Usage: monitor_over_veth.sh BIN_DIR CONFIG OUT_DIR [multicast|unicast PROFILE.xml]
@@ -64,6 +65,9 @@ status=0
 inb "$BIN/crane_topic" list "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
 inb "$BIN/crane_topic" hz rt/crane/hw/sensors "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
 inb "$BIN/crane_topic" record "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --duration 2 --out "$OUT/run.csv" 2> "$OUT/record.log" || status=1
+# The recording is accepted by the model audit (crane model, nominal parameters from the config).
+inb "$BIN/crane_audit" --model crane --data "$OUT/run.csv" --config "$CONFIG" --out "$OUT/audit" > "$OUT/audit.log" 2>&1 \
+  || { echo "crane_audit refused the recording: $(tail -3 "$OUT/audit.log")"; status=1; }
 # The monitor's participant has no shared memory: everything it got came over the veth pair.
 rx=$(inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])')
 echo "{\"veth_rx_bytes\": $rx}" > "$OUT/veth.json"
@@ -75,8 +79,12 @@ topics = json.load(open(out + "/list.json"))
 hz = json.load(open(out + "/hz.json"))
 rows = sum(1 for _ in open(out + "/run.csv")) - 1
 rx = json.load(open(out + "/veth.json"))["veth_rx_bytes"]
+try:
+    audit = json.load(open(out + "/audit/report.json"))["cause"]
+except (OSError, ValueError, KeyError):
+    audit = "no report"
 print("[ figure   ] monitor in a second namespace over veth (" + sys.argv[2] + "): %d topics discovered, sensors %.2f Hz (jitter p99 %.2f ms), "
-      "%d rows recorded, %d bytes received" % (len(topics), hz["receive"]["rate_hz"], hz["receive"]["jitter_p99_ms"], rows, rx))
+      "%d rows recorded (crane audit: %s), %d bytes received" % (len(topics), hz["receive"]["rate_hz"], hz["receive"]["jitter_p99_ms"], rows, audit, rx))
 problems = []
 if "rt/crane/hw/sensors" not in topics or [w["participant"] for w in topics["rt/crane/hw/sensors"]["writers"]] != ["plant"]:
     problems.append("the sensor topic and its single writer 'plant' were not discovered")
