@@ -17,38 +17,18 @@ set -euo pipefail
 BIN=$1 CONFIG=$2 OUT=$3 MODE=${4:-multicast} PROFILE=${5:-}
 STACK_DDS=${CRANE_STACK_DDS:-fast} MONITOR_DDS=${CRANE_MONITOR_DDS:-fast}
 mkdir -p "$OUT"
-if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
-  # Re-run inside a fresh namespace "A" (the stack's host).
-  if unshare --net true 2>/dev/null; then exec unshare --net env CRANE_IN_NAMESPACE=1 "$0" "$@"; fi
-  exec unshare --net --map-root-user env CRANE_IN_NAMESPACE=1 "$0" "$@"
-fi
-ip link set lo up && ip link set lo multicast on
-# Namespace "B" (the monitoring host): a placeholder process holds it.
-unshare --net sleep 600 &
-HOLDER=$!
+. "$(dirname "$0")/veth_pair.sh"
+enter_namespace_a "$0" "$@"
+HOLDER=
 cleanup() {
   [ -n "${STACK:-}" ] && kill -INT "$STACK" 2>/dev/null && wait "$STACK" 2>/dev/null
-  kill "$HOLDER" 2>/dev/null || true
+  [ -n "$HOLDER" ] && kill "$HOLDER" 2>/dev/null || true
 }
 trap cleanup EXIT
-sleep 0.2
-ip link add crane_a type veth peer name crane_b
-ip link set crane_b netns "$HOLDER"
-ip addr add 10.77.0.1/24 dev crane_a
-ip link set crane_a up
-inb() { nsenter -t "$HOLDER" -n "$@"; }
-inb ip link set lo up
-inb ip addr add 10.77.0.2/24 dev crane_b
-inb ip link set crane_b up
+make_veth_pair "$MODE"
 if [ "$MODE" = multicast ]; then
-  ip link set crane_a multicast on
-  ip route add 224.0.0.0/4 dev crane_a
-  inb ip link set crane_b multicast on
-  inb ip route add 224.0.0.0/4 dev crane_b
   NET=(--lan)
 else
-  ip link set crane_a multicast off
-  inb ip link set crane_b multicast off
   for vendor in fastdds cyclone; do
     sed -e 's/192\.168\.10\.1/10.77.0.1/' -e 's/192\.168\.10\.2/10.77.0.2/' \
       "$(dirname "$PROFILE")/${vendor}_$(basename "$PROFILE" | sed 's/^[a-z]*_//')" > "$OUT/${vendor}_lan_unicast.xml"
@@ -69,7 +49,7 @@ inb "$BIN/crane_topic" record "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --dur
 inb "$BIN/crane_audit" --model crane --data "$OUT/run.csv" --config "$CONFIG" --out "$OUT/audit" > "$OUT/audit.log" 2>&1 \
   || { echo "crane_audit refused the recording: $(tail -3 "$OUT/audit.log")"; status=1; }
 # The monitor's participant has no shared memory: everything it got came over the veth pair.
-rx=$(inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])')
+rx=$(rx_bytes)
 echo "{\"veth_rx_bytes\": $rx}" > "$OUT/veth.json"
 [ "$rx" -gt 100000 ] || { echo "only $rx bytes crossed the veth pair"; status=1; }
 /usr/bin/python3 - "$OUT" "$MODE, stack $STACK_DDS, monitor $MONITOR_DDS" <<'PY' || status=1

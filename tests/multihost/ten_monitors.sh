@@ -18,28 +18,18 @@ STACK_DDS=${CRANE_STACK_DDS:-fast} MONITOR_DDS=${CRANE_MONITOR_DDS:-fast}
 SCHED=(chrt --idle 0)
 [ "${CRANE_MONITOR_SCHED:-idle}" = normal ] && SCHED=()
 mkdir -p "$OUT"
-if [ "${CRANE_IN_NAMESPACE:-}" != 1 ]; then
-  if unshare --net true 2>/dev/null; then exec unshare --net env CRANE_IN_NAMESPACE=1 "$0" "$@"; fi
-  exec unshare --net --map-root-user env CRANE_IN_NAMESPACE=1 "$0" "$@"
-fi
-ip link set lo up && ip link set lo multicast on
-unshare --net sleep 3600 &
-HOLDER=$!
+. "$(dirname "$0")/veth_pair.sh"
+enter_namespace_a "$0" "$@"
+HOLDER=
 MONITORS=()
-cleanup() { for p in "${MONITORS[@]}"; do kill "$p" 2>/dev/null || true; done; kill "$HOLDER" 2>/dev/null || true; }
+cleanup() {
+  for p in "${MONITORS[@]}"; do kill "$p" 2>/dev/null || true; done
+  [ -n "$HOLDER" ] && kill "$HOLDER" 2>/dev/null || true
+}
 trap cleanup EXIT
-sleep 0.2
-ip link add crane_a type veth peer name crane_b
-ip link set crane_b netns "$HOLDER"
-ip addr add 10.77.0.1/24 dev crane_a && ip link set crane_a up && ip link set crane_a multicast on
-ip route add 224.0.0.0/4 dev crane_a
-inb() { nsenter -t "$HOLDER" -n "$@"; }
-inb ip link set lo up
-inb ip addr add 10.77.0.2/24 dev crane_b && inb ip link set crane_b up && inb ip link set crane_b multicast on
-inb ip route add 224.0.0.0/4 dev crane_b
+make_veth_pair multicast
 
 "$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
-rx_bytes() { inb ip -j -s link show dev crane_b | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["stats64"]["rx"]["bytes"])'; }
 RX0=$(rx_bytes)
 for i in $(seq 1 10); do
   inb "${SCHED[@]}" "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
