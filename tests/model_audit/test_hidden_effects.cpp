@@ -3,8 +3,10 @@
 // and quantization); the audit sees only the data and the nominal parameters and must name the
 // effect (>= 95 % of the cases), recover its main parameter within 10 %, and report "none" for
 // every clean case. Cases: env CRANE_AUDIT_CASES (effect cases, split over both models in
-// proportion to their catalogs, default 200) and CRANE_AUDIT_CLEAN_CASES (per model, default 10).
-// The confusion matrix is printed.
+// proportion to their catalogs; default 120, 8 per catalog entry, so that deploy/crane test stays
+// in its budget: docs/build.md; the acceptance figures of docs/model_audit.md are 200) and
+// CRANE_AUDIT_CLEAN_CASES (per model, default 10). The axis and the pendulum are two tests, so that
+// ctest runs them side by side. The confusion matrix is printed.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -111,26 +113,29 @@ Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_case
 
 }  // namespace
 
-TEST(HiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
-  const std::size_t total = env_count("CRANE_AUDIT_CASES", 200);
+namespace {
+
+// One model's share of CRANE_AUDIT_CASES: the axis 10/15, the pendulum 5/15 (their catalog sizes).
+void expect_hidden_effects_found(ma::AuditPlant plant, std::uint64_t seed_base) {
+  const std::size_t total = env_count("CRANE_AUDIT_CASES", 120);
   const std::size_t clean = env_count("CRANE_AUDIT_CLEAN_CASES", 10);
   const std::size_t axis_cases = total * 10 / 15;
-  const std::size_t pendulum_cases = total - axis_cases;
-  const Tally axis = run(ma::AuditPlant::axis, axis_cases, clean, 1000);
-  print("axis", axis, ma::audit_catalog(ma::AuditPlant::axis));
-  const Tally pendulum = run(ma::AuditPlant::pendulum, pendulum_cases, clean, 5000);
-  print("pendulum", pendulum, ma::audit_catalog(ma::AuditPlant::pendulum));
-  const int cases = axis.cases + pendulum.cases;
-  const int correct = axis.correct + pendulum.correct;
-  const int checked = axis.parameter_checked + pendulum.parameter_checked;
-  const int within = axis.parameter_within + pendulum.parameter_within;
-  std::printf("\ntotal: %d/%d correct (%.1f %%), parameter within 10 %%: %d/%d, clean none: %d/%d\n", correct, cases,
-              cases ? 100.0 * correct / cases : 0.0, within, checked, axis.clean_none + pendulum.clean_none,
-              axis.clean_cases + pendulum.clean_cases);
-  EXPECT_GE(correct, static_cast<int>(std::ceil(0.95 * cases)));
-  EXPECT_EQ(within, checked);
-  EXPECT_EQ(axis.clean_none, axis.clean_cases);
-  EXPECT_EQ(pendulum.clean_none, pendulum.clean_cases);
+  const std::size_t cases = plant == ma::AuditPlant::axis ? axis_cases : total - axis_cases;
+  const Tally tally = run(plant, cases, clean, seed_base);
+  print(plant == ma::AuditPlant::axis ? "axis" : "pendulum", tally, ma::audit_catalog(plant));
+  EXPECT_GE(tally.correct, static_cast<int>(std::ceil(0.95 * tally.cases)));
+  EXPECT_EQ(tally.parameter_within, tally.parameter_checked);
+  EXPECT_EQ(tally.clean_none, tally.clean_cases);
+}
+
+}  // namespace
+
+TEST(HiddenEffects, AxisAuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
+  expect_hidden_effects_found(ma::AuditPlant::axis, 1000);
+}
+
+TEST(HiddenEffects, PendulumAuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
+  expect_hidden_effects_found(ma::AuditPlant::pendulum, 5000);
 }
 
 // The crane (full plant, three channels): env CRANE_AUDIT_CRANE_CASES effect cases (default 6: the

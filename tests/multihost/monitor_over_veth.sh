@@ -40,7 +40,12 @@ grep -q 10.77.0.2 "$OUT/address_b.txt"
 
 "$BIN/crane_launch" --config "$CONFIG" "${NET[@]}" --dds "$STACK_DDS" --domain 21 --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
 STACK=$!
-sleep 5
+# Until the launcher reports every stage matched and alive (at most 30 s).
+for _ in $(seq 300); do
+  grep -q "all stages matched and alive" "$OUT/launch.log" 2>/dev/null && break
+  kill -0 "$STACK" 2>/dev/null || break
+  sleep 0.1
+done
 status=0
 inb "$BIN/crane_topic" list "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --wait 3 --json > "$OUT/list.json" || status=1
 inb "$BIN/crane_topic" hz rt/crane/hw/sensors "${NET[@]}" --dds "$MONITOR_DDS" --domain 21 --duration 3 --json > "$OUT/hz.json" || status=1
