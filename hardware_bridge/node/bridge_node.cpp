@@ -7,8 +7,10 @@
 //   --clock timer  absolute sample_period deadlines on the monotonic clock (a real board);
 //   --clock board  the emulated board's sample clock (shm only): each sample the simulated plant
 //                  publishes is answered once, so the plant can run in lockstep behind the board.
-//                  Times given to BridgeCore are then simulated (k * sample_period); the supervisor
-//                  status counts as fresh while younger than lockstep_timeout on the wall clock.
+//                  Times given to BridgeCore are then simulated (k * sample_period), and sample k is
+//                  answered only with the command of cycle k gated by the supervisor's status of
+//                  cycle k-1 (or without a command when that status inhibits motion); a wait longer
+//                  than plant.lockstep_hang_timeout is reported as a hung chain.
 //
 // Fail-safe: safe outputs (0 V, brakes engaged, drives disabled) are written right after the board
 // opens, whenever BridgeCore says so (no valid command for watchdog_timeout, no fresh supervisor
@@ -18,9 +20,11 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -28,6 +32,7 @@
 #include "crane/hardware_bridge/board.hpp"
 #include "crane/hardware_bridge/bridge_core.hpp"
 #include "crane/hardware_bridge/shm_board.hpp"
+#include "crane/supervisor/supervisor.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
 namespace {
@@ -112,7 +117,9 @@ int main(int argc, char** argv) {
     auto participant = runtime::make_participant(options, "hardware_bridge");
     auto sensors = participant->make_writer<tp::Sensors>();
     auto actuators = participant->make_reader<tp::Actuators>(&wakeup);
-    auto safety = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    // A few statuses deep: on the board clock the status of cycle k can follow that of k-1 before
+    // this process has taken it, and sample k needs k-1's.
+    auto safety = participant->make_recording_reader<tp::SafetyStatus>(&wakeup, 8);
     runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::hardware_bridge);
     runtime::LatencyStatistics latency;
     runtime::LoopCounters counters;
@@ -125,19 +132,22 @@ int main(int argc, char** argv) {
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits())};
     const double period_s = cfg.plant.sample_period;
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
-    const auto lockstep_timeout =
-        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_timeout));
+    const auto hang_timeout =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
     const auto republish = std::chrono::milliseconds(10);
     const bool board_clock = clock == "board";
     const auto epoch = Clock::now();
 
     tp::msgs::SensorSample_ sample;
+    tp::msgs::SensorSample_ previous_sample;  // board clock: cycle k-1, offered again with cycle k
     tp::msgs::ActuatorCommand_ incoming;
     tp::msgs::SupervisorStatus_ incoming_status;
     hb::BridgeInput in;
     hb::BridgeOutput out;
     out.board = core.safe_outputs();
-    Clock::time_point status_wall{};
+    std::uint64_t status_seq = 0;  // cycle of the supervisor status applied last
+    std::array<std::optional<tp::msgs::SupervisorStatus_>, 8> recent_statuses;  // board clock: by cycle
+    bool board_command = false;    // board clock: a valid command of the current cycle is held in `in`
     std::uint64_t seq = 0;
     std::uint64_t tick = 0;
     std::uint64_t stale_commands = 0;  // valid commands for another cycle than the current one
@@ -178,13 +188,17 @@ int main(int argc, char** argv) {
           ++counters.nonfinite_rejected;
           continue;
         }
+        if (board_clock) {  // kept by cycle: the status of cycle k-1 gates sample k (board_step)
+          recent_statuses[incoming_status.header().seq() % recent_statuses.size()] = incoming_status;
+          continue;
+        }
         in.status_received = true;
         in.status.motion_enabled = incoming_status.motion_enabled();
         in.status.brakes_released = incoming_status.brakes_released();
         in.status.trolley_voltage_limit = incoming_status.trolley_voltage_limit();
         in.status.slew_voltage_limit = incoming_status.slew_voltage_limit();
         in.status_arrival_time = now_s;
-        status_wall = Clock::now();
+        status_seq = incoming_status.header().seq();
       }
       bool applied = false;
       while (actuators->take_next(incoming)) {
@@ -211,8 +225,12 @@ int main(int argc, char** argv) {
         in.command_received = true;
         in.command = {incoming.trolley_voltage(), incoming.slew_voltage(), incoming.hoist_speed()};
         in.command_arrival_time = now_s;
-        if (board_clock) {  // simulated time: the status is fresh while young on the wall clock
-          in.status_arrival_time = Clock::now() - status_wall <= lockstep_timeout ? now_s : -1e9;
+        if (board_clock) {  // applied once the status of this cycle is there (board_step below)
+          board_command = true;
+          const double us = static_cast<double>(arrival_ns - runtime::to_nanoseconds(sample.header().origin())) / 1000.0;
+          latency.record(us);
+          if (latency_log.size() < latency_log.capacity()) latency_log.push_back(us);
+          continue;
         }
         const auto status = core.step(in, out);
         in.command_received = false;
@@ -232,9 +250,40 @@ int main(int argc, char** argv) {
     auto step_without_command = [&](double now_s) {
       in.time = now_s;
       in.command_received = false;
-      if (board_clock) in.status_arrival_time = Clock::now() - status_wall <= lockstep_timeout ? now_s : -1e9;
       (void)core.step(in, out);
       board->write_outputs(out.board);
+    };
+    // Board clock (lockstep, as the plant on DDS): sample k is answered with the command of cycle k
+    // gated by the supervisor's status of cycle k-1 (sample 0: of cycle 0), or without a command
+    // when that status reports a dead stage. That status is fresh in simulated time.
+    auto board_step = [&](std::uint64_t k, double now_s) {
+      const std::uint64_t gate_seq = k == 0 ? 0 : k - 1;
+      const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
+      const bool status_ready = gate.has_value() && gate->header().seq() == gate_seq;
+      if (status_ready) {
+        in.status_received = true;
+        in.status.motion_enabled = gate->motion_enabled();
+        in.status.brakes_released = gate->brakes_released();
+        in.status.trolley_voltage_limit = gate->trolley_voltage_limit();
+        in.status.slew_voltage_limit = gate->slew_voltage_limit();
+        status_seq = gate_seq;
+      }
+      if (!status_ready) return false;
+      // Only a dead stage (stage_silent latched) lets a sample pass without the chain's command.
+      const bool chain_dead = status_ready && (gate->latched_faults() & supervisor::kFaultStageSilent) != 0;
+      if (!board_command && !chain_dead) return false;
+      in.time = now_s;
+      in.status_arrival_time = status_ready ? now_s : -1e9;
+      in.command_received = board_command;
+      const auto status = core.step(in, out);
+      in.command_received = false;
+      board_command = false;
+      if (status != hb::CommandStatus::accepted && status != hb::CommandStatus::none_received) {
+        ++counters.nonfinite_rejected;  // counted by reason in core.counters()
+      }
+      board->write_outputs(out.board);
+      started = started || status == hb::CommandStatus::accepted;
+      return true;
     };
 
     while (!runtime::stop_requested()) {
@@ -249,7 +298,7 @@ int main(int argc, char** argv) {
           continue;
         }
         now_s = static_cast<double>(seq) * period_s;
-        cycle_deadline = Clock::now() + lockstep_timeout;
+        cycle_deadline = Clock::time_point::max();
       } else {
         next_deadline += period;
         now_s = seconds_since(epoch, Clock::now());
@@ -259,17 +308,30 @@ int main(int argc, char** argv) {
       sensors->write(sample);
       bool applied = false;
       auto next_republish = Clock::now() + republish;
+      const auto wait_start = Clock::now();
+      bool hang_reported = false;
       while (!runtime::stop_requested()) {
         applied = drain(seq, board_clock ? now_s : seconds_since(epoch, Clock::now()));
+        if (board_clock) applied = board_step(seq, now_s);
         if (applied) break;
         const auto now = Clock::now();
         if (board_clock && now >= next_republish) {
           // As the plant in lockstep: offer the cycle again until the chain answers (start-up, or a
-          // best-effort sample lost); before the first answer wait as long as it takes.
+          // best-effort sample lost); every stage answers a repeated cycle from its stored output.
+          if (seq > 0) {  // the previous cycle first: the supervisor may still lack it (it gates this one)
+            previous_sample.header().stamp(runtime::now_stamp());
+            sensors->write(previous_sample);
+          }
           runtime::stamp_header(sample.header(), seq, runtime::now_stamp());
           sensors->write(sample);
           next_republish = now + republish;
-          if (!started) cycle_deadline = now + lockstep_timeout;
+          if (started && !hang_reported && now - wait_start >= hang_timeout) {
+            hang_reported = true;
+            ++counters.overruns;
+            spdlog::error("lockstep: cycle {} has waited {} s for {}: the chain is hung (the cycle keeps waiting)", seq,
+                          cfg.plant.lockstep_hang_timeout,
+                          status_seq + 1 < seq || !recent_statuses[0] ? "the supervisor status" : "the actuator command");
+          }
         }
         if (now >= cycle_deadline) break;
         wakeup.wait_until(std::min(cycle_deadline, next_republish));
@@ -289,6 +351,7 @@ int main(int argc, char** argv) {
       }
       ++counters.cycles;
       counters.last_seq = seq;
+      previous_sample = sample;
       ++seq;
       diagnostics.maybe_publish(counters, &latency);
       if (!board_clock) std::this_thread::sleep_until(next_deadline);

@@ -2,12 +2,16 @@
 // publishes rt/crane/hw/sensors{seq = k}, applies the actuator command of cycle k (zero-order hold
 // over one sample period) and integrates the nonlinear model to k+1.
 //
-//   --lockstep  advance as soon as the command of cycle k arrives (or after lockstep_timeout, then
-//               the cycle counts as an overrun and is integrated with 0 V and brakes on);
+//   --lockstep  integrate cycle k as soon as the command of cycle k and the supervisor's status of
+//               cycle k have arrived, never before and never with another cycle's command; the
+//               cycle is offered again while it waits (a lost best-effort sample), and a wait longer
+//               than plant.lockstep_hang_timeout is reported as a hung chain;
 //   --realtime  absolute deadlines every sample_period on the monotonic clock; a command that has
-//               not arrived by the deadline is an overrun, treated the same way.
-// Brakes are released and the command applied only while the supervisor's latest status, no older
-// than safety_status_timeout, says so. Non-finite commands are rejected and counted.
+//               not arrived by the deadline is an overrun: the last one is held for at most
+//               plant.command_timeout, then 0 V and brakes.
+// Brakes are released and the command applied only while the supervisor's status (of cycle k in
+// lockstep; the latest, no older than safety_status_timeout, in realtime) says so. Non-finite
+// commands are rejected and counted.
 //
 //   --board shm:NAME  the plant sits behind the emulated interface board instead of the DDS bus
 //               (hardware-in-the-loop): it creates the shared-memory board, writes the encoder
@@ -21,7 +25,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <array>
 #include <fstream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -30,6 +36,7 @@
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/plant/drives_and_sensors.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/supervisor/supervisor.hpp"
 
 namespace {
 using namespace crane;
@@ -80,8 +87,8 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
   runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::plant);
   runtime::LoopCounters counters;
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
-  const auto lockstep_timeout =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_timeout));
+  const auto hang_timeout =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
   auto publish = [&] { return board.publish_sample(encoder_counts()); };
   const auto bit = [](hb::DigitalOutput line) { return 1U << static_cast<unsigned>(line); };
   spdlog::info("behind the emulated board {} ({} clock): counters {} bits, DAC [{}, {}] V", board.segment_path(),
@@ -97,17 +104,23 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
       next_deadline += period;
       if (Clock::now() > next_deadline) ++counters.overruns;  // the plant itself fell behind
     } else {
-      // Board-paced lockstep: wait for the bridge's outputs of this sample. Before the first answer
-      // the bridge (or the chain behind it) is still starting: wait without stepping.
-      const auto deadline = Clock::now() + (answered_once ? lockstep_timeout : std::chrono::milliseconds(100));
-      if (!board.wait_for_outputs(tick, deadline)) {
-        if (!answered_once) continue;
-        ++counters.overruns;
-        spdlog::warn("no board outputs for sample {} within {} s: the outputs as they are are applied",
-                     tick, cfg.plant.lockstep_timeout);
-      } else {
-        answered_once = true;
+      // Board-paced lockstep: sample `tick` is integrated only with the bridge's outputs of that
+      // sample, however long they take (nothing is guessed); a wait beyond lockstep_hang_timeout is
+      // reported as a hung chain, once per sample.
+      const auto wait_start = Clock::now();
+      bool hang_reported = false;
+      bool answered = false;
+      while (!runtime::stop_requested() && !answered) {
+        answered = board.wait_for_outputs(tick, Clock::now() + std::chrono::milliseconds(100));
+        if (!answered && answered_once && !hang_reported && Clock::now() - wait_start >= hang_timeout) {
+          hang_reported = true;
+          ++counters.overruns;
+          spdlog::error("lockstep: no board outputs for sample {} in {} s: the chain behind the bridge is hung "
+                        "(the sample keeps waiting)", tick, cfg.plant.lockstep_hang_timeout);
+        }
       }
+      if (!answered) break;
+      answered_once = true;
     }
     const auto outputs = board.read_outputs();
     const std::uint32_t digital = outputs.outputs.digital_outputs;
@@ -202,7 +215,9 @@ int main(int argc, char** argv) {
     runtime::install_stop_handlers(&wakeup);
     auto sensors = participant->make_writer<tp::Sensors>();
     auto actuators = participant->make_reader<tp::Actuators>(&wakeup);
-    auto safety = participant->make_reader<tp::SafetyStatus>(&wakeup);
+    // A few statuses deep: in lockstep the status of cycle k can follow that of k-1 before this
+    // process has taken it, and cycle k needs k-1's.
+    auto safety = participant->make_recording_reader<tp::SafetyStatus>(&wakeup, 8);
     runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::plant);
     runtime::LatencyStatistics latency;
     runtime::LoopCounters counters;
@@ -210,12 +225,10 @@ int main(int argc, char** argv) {
     latency_log.reserve(1 << 16);
 
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
-    const auto lockstep_timeout = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(cfg.plant.lockstep_timeout));
-    // In lockstep the supervisor's status may lag simulated time by up to lockstep_timeout.
-    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-        realtime ? cfg.plant.safety_status_timeout : std::max(cfg.plant.safety_status_timeout, cfg.plant.lockstep_timeout)));
-    const auto republish = std::chrono::milliseconds(10);
+    const auto hang_timeout = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
+    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(cfg.plant.safety_status_timeout));
 
     tp::msgs::SensorSample_ sample;
     tp::msgs::ActuatorCommand_ command;
@@ -225,7 +238,8 @@ int main(int argc, char** argv) {
     Clock::time_point status_received{};
     bool have_status = false;
     bool have_command = false;
-    std::uint64_t reoffered = 0;  // lockstep cycles offered again after a lost sample
+    std::uint64_t reoffered = 0;  // lockstep: cycles offered again (a best-effort sample lost, or start-up)
+    std::uint64_t hangs = 0;      // lockstep: cycles that waited longer than lockstep_hang_timeout
     auto next_brake_report = Clock::now() + std::chrono::seconds(2);
     std::uint64_t last_command_seq = 0;
     bool started = false;      // the chain has answered once
@@ -233,140 +247,225 @@ int main(int argc, char** argv) {
     std::uint64_t seq = 0;
     builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
     std::int64_t origin_ns = runtime::to_nanoseconds(origin);
-    fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
-    sensors->write(sample);
-    auto cycle_start = Clock::now();
-    auto next_deadline = cycle_start + period;
-    spdlog::info("simulating at {} Hz, {} clock, x0 = {} m, gamma0 = {} rad", 1.0 / cfg.plant.sample_period,
-                 realtime ? "realtime" : "lockstep", initial_trolley, initial_slew);
-
-    while (!runtime::stop_requested()) {
-      // Wait for the command of cycle `seq`.
-      bool got = false;
-      std::int64_t arrival_ns = 0;
-      const auto deadline = realtime ? next_deadline : cycle_start + lockstep_timeout;
-      auto next_republish = Clock::now() + republish;
-      while (!runtime::stop_requested()) {
-        while (actuators->take_next(incoming)) {
-          if (!runtime::all_finite(incoming)) {
-            ++counters.nonfinite_rejected;
-            continue;
-          }
-          if (incoming.header().seq() == seq) {
-            command = incoming;
-            got = true;
-            arrival_ns = runtime::now_nanoseconds();
-          }
-        }
-        while (safety->take_next(incoming_status)) {
-          if (!runtime::all_finite(incoming_status)) {
-            ++counters.nonfinite_rejected;
-            continue;
-          }
-          status = incoming_status;
-          status_received = Clock::now();
-          have_status = true;
-          chain_ready = chain_ready || status.stages_alive() == 0x3FU;
-        }
-        if (got && !realtime) break;
-        const auto now = Clock::now();
-        if (now >= deadline) break;
-        if (!realtime && now >= next_republish) {
-          // Lockstep: offer this cycle again until the chain answers. At start-up the stages are
-          // still discovering each other; later a best-effort sample was lost on the way. Stages
-          // answer a repeated cycle without stepping their cores twice, so the run stays
-          // deterministic. Not an overrun unless lockstep_timeout passes.
-          if (started) {
-            ++reoffered;
-          } else {  // start-up: a fresh sample time, so latency counts from when the chain is up
-            origin = runtime::now_stamp();
-            origin_ns = runtime::to_nanoseconds(origin);
-          }
-          fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
-          sensors->write(sample);
-          next_republish = now + republish;
-        }
-        wakeup.wait_until(std::min(deadline, next_republish));
-      }
-      if (runtime::stop_requested()) break;
-      if (!got && !started && !realtime) {  // lockstep start-up: offer the same cycle again
-        cycle_start = Clock::now();
-        continue;
-      }
-      // Until the whole chain is matched and alive, a missing command is start-up (the stages still
-      // discover each other), not an overrun; brakes are on then anyway.
-      const bool count_overrun = !got && started && chain_ready;
-      if (got) started = true;
-
-      // A late command is replaced by the last valid one while that is younger than
-      // plant.command_timeout (the drive amplifier holds its input); after that: 0 V and brakes.
-      if (got) {
-        last_command_seq = seq;
-        have_command = true;
-        latency.record(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
-        if (latency_log.size() < latency_log.capacity()) {
-          latency_log.push_back(static_cast<double>(arrival_ns - origin_ns) / 1000.0);
-        }
-      }
-      const bool command_valid =
-          have_command && static_cast<double>(seq - last_command_seq) * cfg.plant.sample_period <=
-                              cfg.plant.command_timeout + 1e-9;
-      const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
+    const auto publish = [&] {
+      fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
+      sensors->write(sample);
+    };
+    const auto new_origin = [&] {
+      origin = runtime::now_stamp();
+      origin_ns = runtime::to_nanoseconds(origin);
+    };
+    // The actuation rule: the command applies only while the supervisor's status says motion
+    // enabled and brakes released, clamped to its current voltage limits (lowered near a travel
+    // limit); otherwise 0 V and brakes engaged.
+    const auto gated_input = [&](bool command_valid, bool status_valid) {
       plant::DriveInput input;  // default: 0 V, brakes engaged
-      if (command_valid && status_fresh && status.brakes_released() && status.motion_enabled()) {
-        // The supervisor's current limits (lowered near a travel limit: approach margins).
+      if (command_valid && status_valid && status.brakes_released() && status.motion_enabled()) {
         input.trolley_voltage = std::clamp(command.trolley_voltage(), -status.trolley_voltage_limit(),
                                            status.trolley_voltage_limit());
         input.slew_voltage = std::clamp(command.slew_voltage(), -status.slew_voltage_limit(), status.slew_voltage_limit());
         input.hoist_speed = command.hoist_speed();
         input.brakes_engaged = false;
       }
-      if (input.brakes_engaged && Clock::now() >= next_brake_report) {
-        // Off the hot path: at most once every 2 s while the brakes stay on.
-        next_brake_report = Clock::now() + std::chrono::seconds(2);
-        const auto health = safety->health();
-        spdlog::info("brakes on at cycle {}: supervisor status {} (matched writers {}, alive {}, samples {}), "
-                     "motion {}, command {}",
-                     seq, have_status ? (status_fresh ? "fresh" : "stale") : "never received", health.matched_writers,
-                     health.alive_writers, health.samples,
-                     have_status && status.motion_enabled() ? "enabled" : "disabled",
-                     command_valid ? "valid" : "missing");
-      }
-      if (count_overrun) {
-        ++counters.overruns;
-        spdlog::warn("overrun: no command for cycle {} within {} ms; {}", seq,
-                     realtime ? cfg.plant.sample_period * 1e3 : cfg.plant.lockstep_timeout * 1e3,
-                     command_valid ? "the last command is held" : "0 V and brakes for this cycle");
-      }
+      return input;
+    };
+    const auto record_arrival = [&](std::int64_t arrival_ns) {
+      const double us = static_cast<double>(arrival_ns - origin_ns) / 1000.0;
+      latency.record(us);
+      if (latency_log.size() < latency_log.capacity()) latency_log.push_back(us);
+    };
+    runtime::LatencyStatistics step_cost(1 << 16);  // [us] of simulator.step(): where a lockstep cycle goes
+    const auto step = [&](const plant::DriveInput& input) {
+      const auto step_start = Clock::now();
       const auto step_status = simulator.step(input);
+      step_cost.record(std::chrono::duration<double, std::micro>(Clock::now() - step_start).count());
       if (step_status != common::StepStatus::ok) {
         spdlog::error("plant step at cycle {} returned status {}", seq, static_cast<int>(step_status));
       }
       ++counters.cycles;
       ++seq;
       counters.last_seq = seq;
+    };
+    publish();
+    spdlog::info("simulating at {} Hz, {} clock, x0 = {} m, gamma0 = {} rad", 1.0 / cfg.plant.sample_period,
+                 realtime ? "realtime" : "lockstep", initial_trolley, initial_slew);
 
-      if (realtime) {
+    if (!realtime) {
+      std::array<std::optional<tp::msgs::SupervisorStatus_>, 8> recent_statuses;
+      tp::msgs::SensorSample_ previous_sample;  // of cycle k-1, offered again with cycle k
+      // Lockstep (docs/architecture.md, "The 100 Hz cycle"): cycle k is integrated only with the
+      // command of cycle k, gated by the supervisor's status of cycle k-1 (computed from every
+      // stage's output of cycle k-1, while the chain computes cycle k: the supervisor is off the
+      // chain's path, and its decision lags the command by one cycle as in realtime). Cycle 0 waits
+      // for the status of cycle 0, so the supervisor always has a cycle done before the next one
+      // exists. Nothing is guessed and nothing depends on wall time: a slow machine slows the
+      // simulation, never changes it. While it waits, the plant offers cycle k again (after 10 ms,
+      // then doubling to 80 ms): a lost best-effort sample is recovered, and every stage and the
+      // supervisor answer a repeated cycle from their stored output. Only a status that reports a
+      // dead stage (stage_silent latched: its writer is gone) lets a cycle run, braked, without a
+      // command: every other cycle waits for the chain's answer.
+      while (!runtime::stop_requested()) {
+        bool got_command = false;
+        bool got_status = false;
+        std::int64_t arrival_ns = 0;
+        const auto wait_start = Clock::now();
+        auto backoff = std::chrono::milliseconds(10);
+        auto next_reoffer = wait_start + backoff;
+        bool hang_reported = false;
+        while (!runtime::stop_requested()) {
+          while (actuators->take_next(incoming)) {
+            if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
+            if (!runtime::all_finite(incoming)) {
+              ++counters.nonfinite_rejected;
+              continue;
+            }
+            if (incoming.header().seq() == seq && !got_command) {
+              command = incoming;
+              got_command = true;
+              arrival_ns = runtime::now_nanoseconds();
+            }
+          }
+          while (safety->take_next(incoming_status)) {
+            if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
+            if (!runtime::all_finite(incoming_status)) {
+              ++counters.nonfinite_rejected;
+              continue;
+            }
+            // Kept by cycle: one for a later cycle may arrive before this cycle is done.
+            recent_statuses[incoming_status.header().seq() % recent_statuses.size()] = incoming_status;
+          }
+          if (!got_status) {
+            const std::uint64_t gate_seq = seq == 0 ? 0 : seq - 1;
+            const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
+            if (gate.has_value() && gate->header().seq() == gate_seq) {
+              status = *gate;
+              got_status = true;
+            }
+          }
+          // A dead stage (the supervisor latched stage_silent) will never answer: the cycle runs braked.
+          const bool chain_dead = got_status && (status.latched_faults() & supervisor::kFaultStageSilent) != 0;
+          if (got_status && (got_command || chain_dead)) break;
+          const auto now = Clock::now();
+          if (now >= next_reoffer) {
+            if (started) {
+              ++reoffered;
+              // The previous cycle first: the supervisor may still lack it (it gates this cycle).
+              previous_sample.header().stamp(runtime::now_stamp());
+              sensors->write(previous_sample);
+            } else {
+              new_origin();  // start-up: latency counts from when the chain is up
+            }
+            publish();
+            backoff = std::min(backoff * 2, std::chrono::milliseconds(80));
+            next_reoffer = now + backoff;
+          }
+          if (started && !hang_reported && now - wait_start >= hang_timeout) {
+            hang_reported = true;
+            ++hangs;
+            const auto a = actuators->health();
+            const auto h = safety->health();
+            spdlog::error("lockstep: cycle {} has waited {:.1f} s for {}{}{}: the chain is hung (not a crane fault; "
+                          "the cycle keeps waiting). Actuator writers matched {}, supervisor status writers matched {}",
+                          seq, std::chrono::duration<double>(now - wait_start).count(),
+                          got_command ? "" : "the actuator command", !got_command && !got_status ? " and " : "",
+                          got_status ? "" : "the supervisor status", a.matched_writers, h.matched_writers);
+          }
+          wakeup.wait_until(next_reoffer);
+        }
+        if (runtime::stop_requested()) break;
+        started = true;
+        if (got_command) record_arrival(arrival_ns);
+        previous_sample = sample;
+        step(gated_input(got_command, got_status));
+        new_origin();
+        publish();
+        diagnostics.maybe_publish(counters, &latency);
+      }
+    } else {
+      // Realtime: absolute deadlines every sample period on the monotonic clock. A command missing at
+      // the deadline is an overrun; the last valid one is held while it is at most
+      // plant.command_timeout old (a drive amplifier holds its input), then 0 V and brakes.
+      auto next_deadline = Clock::now() + period;
+      while (!runtime::stop_requested()) {
+        bool got = false;
+        std::int64_t arrival_ns = 0;
+        while (!runtime::stop_requested()) {
+          while (actuators->take_next(incoming)) {
+            if (!runtime::all_finite(incoming)) {
+              ++counters.nonfinite_rejected;
+              continue;
+            }
+            if (incoming.header().seq() == seq) {
+              command = incoming;
+              got = true;
+              arrival_ns = runtime::now_nanoseconds();
+            }
+          }
+          while (safety->take_next(incoming_status)) {
+            if (!runtime::all_finite(incoming_status)) {
+              ++counters.nonfinite_rejected;
+              continue;
+            }
+            status = incoming_status;
+            status_received = Clock::now();
+            have_status = true;
+            chain_ready = chain_ready || status.stages_alive() == 0x3FU;
+          }
+          if (Clock::now() >= next_deadline) break;
+          wakeup.wait_until(next_deadline);
+        }
+        if (runtime::stop_requested()) break;
+        // Until the whole chain is matched and alive, a missing command is start-up, not an overrun.
+        const bool count_overrun = !got && started && chain_ready;
+        if (got) {
+          started = true;
+          last_command_seq = seq;
+          have_command = true;
+          record_arrival(arrival_ns);
+        }
+        const bool command_valid =
+            have_command && static_cast<double>(seq - last_command_seq) * cfg.plant.sample_period <=
+                                cfg.plant.command_timeout + 1e-9;
+        const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
+        const auto input = gated_input(command_valid, status_fresh);
+        if (input.brakes_engaged && Clock::now() >= next_brake_report) {
+          // Off the hot path: at most once every 2 s while the brakes stay on.
+          next_brake_report = Clock::now() + std::chrono::seconds(2);
+          const auto health = safety->health();
+          spdlog::info("brakes on at cycle {}: supervisor status {} (matched writers {}, alive {}, samples {}), "
+                       "motion {}, command {}",
+                       seq, have_status ? (status_fresh ? "fresh" : "stale") : "never received", health.matched_writers,
+                       health.alive_writers, health.samples,
+                       have_status && status.motion_enabled() ? "enabled" : "disabled",
+                       command_valid ? "valid" : "missing");
+        }
+        if (count_overrun) {
+          ++counters.overruns;
+          spdlog::warn("overrun: no command for cycle {} within {} ms; {}", seq, cfg.plant.sample_period * 1e3,
+                       command_valid ? "the last command is held" : "0 V and brakes for this cycle");
+        }
+        step(input);
         std::this_thread::sleep_until(next_deadline);
         next_deadline += period;
+        new_origin();
+        publish();
+        diagnostics.maybe_publish(counters, &latency);
       }
-      cycle_start = Clock::now();
-      origin = runtime::now_stamp();
-      origin_ns = runtime::to_nanoseconds(origin);
-      fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
-      sensors->write(sample);
-      diagnostics.maybe_publish(counters, &latency);
     }
 
     diagnostics.publish_final(counters, &latency);
-    spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} cycles offered again, {} non-finite commands "
-                 "rejected, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us, {} friction events",
-                 simulator.time(), counters.cycles, counters.overruns, reoffered, counters.nonfinite_rejected,
-                 latency.percentile(50), latency.percentile(99), latency.maximum(), simulator.friction_event_count());
+    spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} cycles offered again, {} hung, {} non-finite "
+                 "commands rejected, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us, {} friction events, "
+                 "plant step p50 {:.0f} us p99 {:.0f} us",
+                 simulator.time(), counters.cycles, counters.overruns, reoffered, hangs, counters.nonfinite_rejected,
+                 latency.percentile(50), latency.percentile(99), latency.maximum(), simulator.friction_event_count(),
+                 step_cost.percentile(50), step_cost.percentile(99));
     if (!stats_path.empty()) {
       std::ofstream out(stats_path);
       out << "{\"cycles\": " << counters.cycles << ", \"overruns\": " << counters.overruns
-          << ", \"reoffered\": " << reoffered
+          << ", \"reoffered\": " << reoffered << ", \"hung\": " << hangs
+          << ", \"simulated_time_s\": " << simulator.time() << ", \"step_us\": {\"p50\": " << step_cost.percentile(50)
+          << ", \"p99\": " << step_cost.percentile(99) << ", \"max\": " << step_cost.maximum() << "}"
           << ", \"nonfinite_rejected\": " << counters.nonfinite_rejected << ", \"latency_us\": [";
       for (std::size_t i = 0; i < latency_log.size(); ++i) out << (i ? "," : "") << latency_log[i];
       out << "]}\n";

@@ -1,5 +1,15 @@
 // supervisor process: watches every stage of the chain and owns brakes and motion enable.
-// Runs on its own 100 Hz wall-clock timer (absolute deadlines), independent of the data it watches.
+//
+// Realtime: runs on its own 100 Hz wall-clock timer (absolute deadlines), independent of the data
+// it watches; a stage's silence is measured in wall time since its last sample.
+// Lockstep (--lockstep): runs once per cycle of the sensor clock, when every stage's output of
+// cycle k has arrived (or a stage's writer is gone), and publishes the status of cycle k stamped
+// seq = k, which gates cycle k+1 at the plant (computed while the chain computes cycle k+1). A
+// stage's silence is counted in cycles, so a slow machine slows the simulation and never faults it;
+// a cycle that waits longer than plant.lockstep_hang_timeout is reported as a hung chain, naming the
+// stages it waits for. A sensor sample offered again means the plant still waits: the last status
+// is sent again.
+//
 // Every fault raised or cleared, and every operator command, goes to the log and (with --fault-log)
 // to a JSON-lines fault log, flushed line by line; the status topic carries the fault bits, the
 // count, the last fault and the answer to the last command.
@@ -9,6 +19,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -25,12 +36,22 @@ using Clock = std::chrono::steady_clock;
 struct Watched {
   Clock::time_point last_sample{};
   bool seen{false};
+  std::uint64_t last_seq{0};  // cycle of the newest valid sample
   std::uint64_t deadline_missed{0};
   // DDS liveliness and deadline events combined with our own receive time (header of supervisor.hpp).
-  supervisor::StageObservation observe(Clock::time_point now, const transport::ReaderHealth& health, bool lockstep) {
+  // Lockstep: silence in cycles of the sensor clock (`sensor_seq`), liveliness by matching alone.
+  supervisor::StageObservation observe(Clock::time_point now, const transport::ReaderHealth& health, bool lockstep,
+                                       std::uint64_t sensor_seq, double sample_period) {
     supervisor::StageObservation o;
-    o.alive = lockstep ? health.matched_writers > 0 : health.alive_writers > 0;
-    o.seconds_since_sample = seen ? std::chrono::duration<double>(now - last_sample).count() : 1e9;
+    o.present = health.matched_writers > 0;
+    o.alive = lockstep ? o.present : health.alive_writers > 0;
+    if (!seen) {
+      o.seconds_since_sample = 1e9;
+    } else if (lockstep) {
+      o.seconds_since_sample = sensor_seq > last_seq ? static_cast<double>(sensor_seq - last_seq) * sample_period : 0.0;
+    } else {
+      o.seconds_since_sample = std::chrono::duration<double>(now - last_sample).count();
+    }
     // Deadlines run on the wall clock: meaningless while the plant runs faster than real time.
     o.deadline_missed = !lockstep && seen && health.deadline_missed > deadline_missed;
     deadline_missed = health.deadline_missed;
@@ -65,23 +86,43 @@ std::string fault_record(const char* event, std::uint32_t bit, std::uint64_t seq
   return buffer;
 }
 
+// Lockstep keeps the last few samples of a topic by cycle: the supervisor steps every cycle in
+// order, and the plant may already be a cycle ahead.
+template <class Message>
+using ByCycle = std::array<std::optional<Message>, 8>;
+
+struct Drained {
+  bool any{false};     // a valid sample was taken
+  bool repeat{false};  // one of them repeated a cycle already held (a lockstep re-offer)
+};
+
 template <class ReaderT, class Message>
-bool drain(ReaderT& reader, Message& latest, Watched& watched, Clock::time_point now, runtime::LoopCounters& counters,
-           bool& nonfinite) {
+Drained drain(ReaderT& reader, Message& latest, Watched& watched, Clock::time_point now, runtime::LoopCounters& counters,
+              bool& nonfinite, ByCycle<Message>* by_cycle = nullptr) {
   Message sample;
-  bool any = false;
+  Drained d;
   while (reader.take_next(sample)) {
+    if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
     if (!runtime::all_finite(sample)) {
       ++counters.nonfinite_rejected;
       nonfinite = true;
       continue;
     }
+    const auto seq = sample.header().seq();
+    if (by_cycle != nullptr) {
+      auto& slot = (*by_cycle)[seq % by_cycle->size()];
+      d.repeat = d.repeat || (slot.has_value() && slot->header().seq() == seq);
+      slot = sample;
+    }
+    d.any = true;
+    // Lockstep re-offers repeat a cycle: the newest cycle stays the latest.
+    if (watched.seen && seq < watched.last_seq) continue;
     latest = sample;
     watched.last_sample = now;
+    watched.last_seq = seq;
     watched.seen = true;
-    any = true;
   }
-  return any;
+  return d;
 }
 
 }  // namespace
@@ -92,8 +133,8 @@ int main(int argc, char** argv) {
   runtime::add_node_options(app, options);
   bool lockstep = false;
   app.add_flag("--lockstep", lockstep,
-               "the plant runs in lockstep: a stage is dead after lockstep_stage_timeout of silence, and DDS "
-               "liveliness (a wall-clock lease) is not required");
+               "the plant runs in lockstep: step once per sensor cycle when every stage's output of it has "
+               "arrived, count silence in cycles, and require matching instead of DDS liveliness (a wall-clock lease)");
   std::string fault_log_path;
   app.add_option("--fault-log", fault_log_path, "append every fault raised or cleared and every command here "
                                                 "(JSON lines, flushed at once)");
@@ -106,7 +147,6 @@ int main(int argc, char** argv) {
     runtime::configure_logging(options.log_level, "supervisor");
     const config::StackConfig cfg = config::load_stack_config(options.config_path);
     supervisor::SupervisorParams params = cfg.supervisor;
-    if (lockstep) params.stage_timeout = params.lockstep_stage_timeout;
     params.expected_sensor_source = sensor_source == "plant" ? 1 : sensor_source == "bridge" ? 2 : 0;
     std::ofstream fault_log;
     if (!fault_log_path.empty()) {
@@ -119,13 +159,22 @@ int main(int argc, char** argv) {
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
     namespace tp = transport::topics;
-    auto sensors = participant->make_reader<tp::Sensors>(nullptr);
-    auto estimate = participant->make_reader<tp::StateEstimate>(nullptr);
-    auto reference = participant->make_reader<tp::Reference>(nullptr);
-    auto anti_swing = participant->make_reader<tp::AntiSwing>(nullptr);
-    auto linear = participant->make_reader<tp::LinearCommand>(nullptr);
-    auto actuators = participant->make_reader<tp::Actuators>(nullptr);
-    auto commands = participant->make_reader<tp::SafetyCommand>(nullptr);
+    // Lockstep waits on data; realtime polls on its own timer.
+    transport::Wakeup* data_wakeup = lockstep ? &wakeup : nullptr;
+    // Lockstep: a few cycles deep, so that no cycle is overwritten before it is supervised (the plant
+    // may publish cycle k+1 before every output of cycle k has arrived here).
+    const auto reader = [&](auto tag) {
+      using Topic = decltype(tag);
+      return lockstep ? participant->make_recording_reader<Topic>(data_wakeup, 16)
+                      : participant->make_reader<Topic>(data_wakeup);
+    };
+    auto sensors = reader(tp::Sensors{});
+    auto estimate = reader(tp::StateEstimate{});
+    auto reference = reader(tp::Reference{});
+    auto anti_swing = reader(tp::AntiSwing{});
+    auto linear = reader(tp::LinearCommand{});
+    auto actuators = reader(tp::Actuators{});
+    auto commands = participant->make_reader<tp::SafetyCommand>(data_wakeup);
     auto status_writer = participant->make_writer<tp::SafetyStatus>();
     runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::supervisor);
 
@@ -143,38 +192,40 @@ int main(int argc, char** argv) {
     bool pending_command = false;
     std::uint32_t last_request_id = 0;
     std::uint8_t last_request_result = 0;
+    tp::msgs::SupervisorStatus_ status;
+    const double dt = cfg.plant.sample_period;
+    using supervisor::Stage;
 
-    const auto period = std::chrono::microseconds(static_cast<long>(cfg.plant.sample_period * 1e6));
-    auto next = Clock::now();
-    auto next_health_log = next;
-    spdlog::info("supervising 6 stages at {} Hz", 1.0 / cfg.plant.sample_period);
-    while (!runtime::stop_requested()) {
-      next += period;
-      std::this_thread::sleep_until(next);
-      const auto now = Clock::now();
-      if (now - next > period) {
-        ++counters.overruns;
-        next = now;
-      }
-      bool nonfinite = false;
-      using supervisor::Stage;
-      drain(*sensors, last_sensors, watched[static_cast<int>(Stage::sensors)], now, counters, nonfinite);
+    // Takes every sample that arrived (lockstep: kept by cycle too); says whether a sensor sample
+    // did, and whether it repeated a cycle.
+    bool nonfinite = false;
+    ByCycle<tp::msgs::SensorSample_> sensors_by_cycle;
+    ByCycle<tp::msgs::Reference_> references_by_cycle;
+    ByCycle<tp::msgs::ActuatorCommand_> actuators_by_cycle;
+    const auto drain_all = [&](Clock::time_point now) {
+      const auto sensed = drain(*sensors, last_sensors, watched[static_cast<int>(Stage::sensors)], now, counters,
+                                nonfinite, lockstep ? &sensors_by_cycle : nullptr);
       drain(*estimate, last_estimate, watched[static_cast<int>(Stage::state_estimator)], now, counters, nonfinite);
-      drain(*reference, last_reference, watched[static_cast<int>(Stage::trajectory_planner)], now, counters, nonfinite);
+      drain(*reference, last_reference, watched[static_cast<int>(Stage::trajectory_planner)], now, counters, nonfinite,
+            lockstep ? &references_by_cycle : nullptr);
       drain(*anti_swing, last_anti_swing, watched[static_cast<int>(Stage::anti_swing)], now, counters, nonfinite);
       drain(*linear, last_linear, watched[static_cast<int>(Stage::tracking)], now, counters, nonfinite);
       drain(*actuators, last_actuators, watched[static_cast<int>(Stage::friction_compensation)], now, counters,
-            nonfinite);
+            nonfinite, lockstep ? &actuators_by_cycle : nullptr);
+      return sensed;
+    };
+    const auto healths = [&] {
+      return std::array<transport::ReaderHealth, supervisor::kStageCount>{
+          sensors->health(), estimate->health(), reference->health(), anti_swing->health(), linear->health(),
+          actuators->health()};
+    };
 
+    // One supervision step on what was observed, then the status (stamped with the sensor cycle).
+    const auto supervise = [&](Clock::time_point now, const std::array<transport::ReaderHealth, supervisor::kStageCount>& h) {
       supervisor::SupervisorInput in;
-      const auto sensor_health = sensors->health();
-      const auto actuator_health = actuators->health();
-      in.stages[0] = watched[0].observe(now, sensor_health, lockstep);
-      in.stages[1] = watched[1].observe(now, estimate->health(), lockstep);
-      in.stages[2] = watched[2].observe(now, reference->health(), lockstep);
-      in.stages[3] = watched[3].observe(now, anti_swing->health(), lockstep);
-      in.stages[4] = watched[4].observe(now, linear->health(), lockstep);
-      in.stages[5] = watched[5].observe(now, actuator_health, lockstep);
+      for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
+        in.stages[i] = watched[i].observe(now, h[i], lockstep, last_sensors.header().seq(), dt);
+      }
       in.sensors_valid = watched[0].seen;
       in.sensor_seq = last_sensors.header().seq();
       in.sensor_source = last_sensors.source();
@@ -188,9 +239,10 @@ int main(int argc, char** argv) {
       in.actuator_seq = last_actuators.header().seq();
       in.trolley_voltage = last_actuators.trolley_voltage();
       in.slew_voltage = last_actuators.slew_voltage();
-      in.sensor_writers = sensor_health.matched_writers;
-      in.actuator_writers = actuator_health.matched_writers;
+      in.sensor_writers = h[0].matched_writers;
+      in.actuator_writers = h[5].matched_writers;
       in.nonfinite_seen = nonfinite;
+      nonfinite = false;
       in.move_in_progress = last_reference.phase() == 1;
       // One operator command per cycle; a second one waits for the next cycle (nothing is dropped).
       if (!pending_command && commands->take_next(command)) pending_command = true;
@@ -219,16 +271,7 @@ int main(int argc, char** argv) {
                     << supervisor::mode_name(out.mode) << "\"}" << std::endl;
         }
       }
-      if (out.stages_alive != 0x3FU && now >= next_health_log) {
-        next_health_log = now + std::chrono::seconds(2);
-        for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
-          spdlog::info("  stage {}: liveliness {}, last sample {:.3f} s ago",
-                       supervisor::stage_name(static_cast<supervisor::Stage>(i)), in.stages[i].alive ? "alive" : "lost",
-                       in.stages[i].seconds_since_sample);
-        }
-      }
 
-      tp::msgs::SupervisorStatus_ status;
       runtime::stamp_header(status.header(), last_sensors.header().seq(), last_sensors.header().origin());
       status.mode(static_cast<uint8_t>(out.mode));
       status.motion_enabled(out.motion_enabled);
@@ -268,7 +311,120 @@ int main(int argc, char** argv) {
         spdlog::info("mode {} -> {}", supervisor::mode_name(logged_mode), supervisor::mode_name(out.mode));
         logged_mode = out.mode;
       }
-      diagnostics.maybe_publish(counters, nullptr);
+      return in;
+    };
+    const auto log_stages = [&](const supervisor::SupervisorInput& in, const char* why) {
+      for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
+        spdlog::info("  stage {}: {}, last sample {} {:.3f} s ago{}", supervisor::stage_name(static_cast<Stage>(i)),
+                     in.stages[i].alive ? "alive" : "lost", watched[i].seen ? "of cycle" : "never",
+                     in.stages[i].seconds_since_sample, why);
+      }
+    };
+
+    spdlog::info("supervising 6 stages at {} Hz, {} clock", 1.0 / dt, lockstep ? "lockstep (cycle-driven)" : "realtime");
+    auto next_health_log = Clock::now();
+    if (lockstep) {
+      // Every cycle in order, exactly once: cycle k is supervised when the sensor sample of k and
+      // every stage's output of k have arrived (or a stage's writer is gone).
+      const auto hang_timeout = std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout);
+      std::array<bool, supervisor::kStageCount> was_matched{};
+      bool stepped_any = false;
+      std::uint64_t stepped_seq = 0;
+      tp::msgs::SupervisorStatus_ previous_status;  // of the cycle before the last stepped (the plant may need it)
+      bool have_previous_status = false;
+      auto waiting_since = Clock::now();
+      bool hang_reported = false;
+      while (!runtime::stop_requested()) {
+        wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+        const auto now = Clock::now();
+        const auto sensed = drain_all(now);
+        if (sensed.repeat && stepped_any) {
+          // A re-offered cycle: the plant still waits; answer again with the stored statuses (each of
+          // its own cycle, stamped anew).
+          if (have_previous_status) {
+            runtime::stamp_header(previous_status.header(), previous_status.header().seq(),
+                                  previous_status.header().origin());
+            status_writer->write(previous_status);
+          }
+          runtime::stamp_header(status.header(), stepped_seq, status.header().origin());
+          status_writer->write(status);
+        }
+        while (!runtime::stop_requested()) {
+          // The next cycle: after the last one supervised, or the oldest one held at start.
+          std::optional<std::uint64_t> next;
+          if (stepped_any) {
+            next = stepped_seq + 1;
+          } else {
+            for (const auto& s : sensors_by_cycle) {
+              if (s && (!next || s->header().seq() < *next)) next = s->header().seq();
+            }
+          }
+          if (!next) break;
+          const auto& sensor_slot = sensors_by_cycle[*next % sensors_by_cycle.size()];
+          if (!sensor_slot || sensor_slot->header().seq() != *next) break;
+          const std::uint64_t k = *next;
+          const auto h = healths();
+          bool complete = true;
+          bool gone = false;
+          for (std::size_t i = 1; i < supervisor::kStageCount; ++i) {
+            const bool answered = watched[i].seen && watched[i].last_seq >= k;
+            complete = complete && answered;
+            was_matched[i] = was_matched[i] || h[i].matched_writers > 0;
+            gone = gone || (was_matched[i] && h[i].matched_writers == 0 && !answered);
+          }
+          if (!complete && !gone) {
+            if (!hang_reported && now - waiting_since >= hang_timeout) {
+              hang_reported = true;
+              std::string missing;
+              for (std::size_t i = 1; i < supervisor::kStageCount; ++i) {
+                if (watched[i].seen && watched[i].last_seq >= k) continue;
+                missing += std::string(missing.empty() ? "" : ", ") + supervisor::stage_name(static_cast<Stage>(i));
+              }
+              spdlog::error("lockstep: cycle {} has waited {:.1f} s for the output of {}: the chain is hung (not a "
+                            "crane fault; the cycle keeps waiting)",
+                            k, std::chrono::duration<double>(now - waiting_since).count(), missing);
+            }
+            break;
+          }
+          // The values of cycle k itself (the plant may already have published k+1).
+          last_sensors = *sensor_slot;
+          const auto& a = actuators_by_cycle[k % actuators_by_cycle.size()];
+          if (a && a->header().seq() == k) last_actuators = *a;
+          const auto& r = references_by_cycle[k % references_by_cycle.size()];
+          if (r && r->header().seq() == k) last_reference = *r;
+          previous_status = status;
+          have_previous_status = stepped_any;
+          const auto in = supervise(now, h);
+          if (gone && now >= next_health_log) {
+            next_health_log = now + std::chrono::seconds(2);
+            log_stages(in, " (a writer is gone)");
+          }
+          stepped_any = true;
+          stepped_seq = k;
+          waiting_since = now;
+          hang_reported = false;
+        }
+        diagnostics.maybe_publish(counters, nullptr);
+      }
+    } else {
+      const auto period = std::chrono::microseconds(static_cast<long>(dt * 1e6));
+      auto next = Clock::now();
+      while (!runtime::stop_requested()) {
+        next += period;
+        std::this_thread::sleep_until(next);
+        const auto now = Clock::now();
+        if (now - next > period) {
+          ++counters.overruns;
+          next = now;
+        }
+        drain_all(now);
+        const auto in = supervise(now, healths());
+        if (out.stages_alive != 0x3FU && now >= next_health_log) {
+          next_health_log = now + std::chrono::seconds(2);
+          log_stages(in, "");
+        }
+        diagnostics.maybe_publish(counters, nullptr);
+      }
     }
     diagnostics.publish_final(counters, nullptr);
     spdlog::info("stopping: {} cycles, {} overruns, {} non-finite samples rejected", counters.cycles,

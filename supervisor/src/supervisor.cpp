@@ -110,7 +110,7 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.max_voltage_rate", p.max_voltage_rate, 1.0, 1e6);
   require_in_range("supervisor.max_swing", p.max_swing, 0.01, 1.5);
   require_in_range("supervisor.stage_timeout", p.stage_timeout, 0.005, 5.0);
-  require_in_range("supervisor.lockstep_stage_timeout", p.lockstep_stage_timeout, p.stage_timeout, 60.0);
+  require_in_range("supervisor.stage_dead_timeout", p.stage_dead_timeout, p.stage_timeout, 60.0);
   require_in_range("supervisor.sample_period", p.sample_period, 1e-4, 1.0);
   require_in_range("supervisor.expected_sensor_source", p.expected_sensor_source, 0.0, 2.0);
 }
@@ -119,11 +119,15 @@ Supervisor::Supervisor(const SupervisorParams& params) : params_(params) { valid
 
 void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept {
   std::uint32_t alive_mask = 0;
+  std::uint32_t dead_mask = 0;
   std::uint32_t warnings = 0;
   for (std::size_t i = 0; i < kStageCount; ++i) {
     const auto& s = in.stages[i];
-    if (s.alive && s.seconds_since_sample <= params_.stage_timeout) alive_mask |= 1U << i;
-    if (s.deadline_missed) warnings |= kWarningStageLate;
+    const bool fresh = s.alive && s.present && s.seconds_since_sample <= params_.stage_timeout;
+    const bool dead = !s.present || !(s.seconds_since_sample <= params_.stage_dead_timeout);
+    if (fresh) alive_mask |= 1U << i;
+    if (dead) dead_mask |= 1U << i;
+    if (s.deadline_missed || (!fresh && !dead)) warnings |= kWarningStageLate;
   }
   const std::uint32_t all_alive = (1U << kStageCount) - 1U;
   const bool chain_healthy = alive_mask == all_alive;
@@ -147,7 +151,9 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
 
   std::uint32_t active = 0;
   // A stage that dies after the chain was up is a fault; during start-up it only keeps us waiting.
-  if (!chain_healthy && mode_ != Mode::starting) active |= kFaultStageSilent;
+  // A late stage only inhibits motion while it is late (below).
+  if (dead_mask != 0 && chain_was_up_) active |= kFaultStageSilent;
+  chain_was_up_ = chain_was_up_ || chain_healthy;
   double trolley_limit = params_.voltage_limit;
   double slew_limit = params_.voltage_limit;
   if (in.sensors_valid && finite_sensors) {
@@ -225,7 +231,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   } else if (latched_ != 0) {
     mode_ = Mode::fault;
   } else if (!chain_healthy) {
-    mode_ = Mode::starting;
+    // Start-up, or a late stage: the mode stays, motion is inhibited below until it is fresh again.
+    if (!chain_was_up_ || mode_ == Mode::fault || mode_ == Mode::emergency_stop) mode_ = Mode::starting;
   } else if (armed_ || params_.arm_on_start) {
     if (mode_ == Mode::starting && params_.arm_on_start) armed_ = true;
     mode_ = armed_ ? (in.move_in_progress ? Mode::operating : Mode::ready) : Mode::standby;
@@ -233,7 +240,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     mode_ = Mode::standby;
   }
 
-  const bool enabled = mode_ == Mode::ready || mode_ == Mode::operating;
+  const bool enabled = chain_healthy && (mode_ == Mode::ready || mode_ == Mode::operating);
   out.mode = mode_;
   out.motion_enabled = enabled;
   // The brakes open one cycle after the drives were enabled, with the chain still alive.
@@ -243,6 +250,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   out.latched_faults = latched_;
   out.fault_count = fault_count_;
   out.stages_alive = alive_mask;
+  out.stages_dead = dead_mask;
   out.warnings = warnings;
   out.last_fault = last_fault_;
   out.last_fault_seq = last_fault_seq_;

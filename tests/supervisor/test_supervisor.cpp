@@ -2,9 +2,10 @@
 //
 // Rules under test (header comment of supervisor.hpp):
 //  - brakes released and motion enabled only in ready/operating, and only while every stage is
-//    alive: alive && seconds_since_sample <= stage_timeout;
-//  - a stage going silent after start-up, a limit exceeded or a non-finite value: fault, brakes
-//    engaged, fault latched until a reset with a healthy chain;
+//    fresh: alive && present && seconds_since_sample <= stage_timeout;
+//  - a stage that is not fresh is late: motion inhibited while it lasts, no fault;
+//  - a stage dead after start-up (gone, or silent beyond stage_dead_timeout), a limit exceeded or a
+//    non-finite value: fault, brakes engaged, fault latched until a reset with a healthy chain;
 //  - an emergency stop engages the brakes at once and needs a reset.
 #include <gtest/gtest.h>
 
@@ -167,9 +168,9 @@ TEST(Supervisor, ArmCommandBeforeChainHealthyDoesNotReleaseBrakes) {
 TEST(Supervisor, SilentStageAfterReadyFaultsAndLatches) {
   auto supervisor = ready_supervisor();
 
-  // Tracking's last sample is 60 ms old > 50 ms: silent.
+  // Tracking's last sample is 260 ms old > stage_dead_timeout = 250 ms: dead.
   auto silent = healthy_input();
-  silent.stages[static_cast<std::size_t>(sv::Stage::tracking)].seconds_since_sample = 0.06;
+  silent.stages[static_cast<std::size_t>(sv::Stage::tracking)].seconds_since_sample = 0.26;
   auto out = step(supervisor, silent);
   EXPECT_EQ(out.mode, sv::Mode::fault);
   expect_stopped(out);
@@ -208,17 +209,62 @@ TEST(Supervisor, SilentStageAfterReadyFaultsAndLatches) {
   EXPECT_EQ(out.fault_count, 1U);  // the history is kept
 }
 
-TEST(Supervisor, StageLosingLivelinessAfterReadyFaults) {
+// Liveliness lost (a process starved for a lease, or dead): late at once, motion inhibited; a fault
+// only once its silence exceeds stage_dead_timeout.
+TEST(Supervisor, StageLosingLivelinessIsLateThenDead) {
   for (std::size_t dead = 0; dead < sv::kStageCount; ++dead) {
     SCOPED_TRACE(sv::stage_name(static_cast<sv::Stage>(dead)));
     auto supervisor = ready_supervisor();
     auto in = healthy_input();
     in.stages[dead].alive = false;
-    const auto out = step(supervisor, in);
+    auto out = step(supervisor, in);
+    EXPECT_EQ(out.mode, sv::Mode::ready);
+    expect_stopped(out);
+    EXPECT_EQ(out.latched_faults, 0U);
+    EXPECT_TRUE(out.warnings & sv::kWarningStageLate);
+    EXPECT_EQ(out.stages_alive, kAllStages & ~(1U << dead));
+    in.stages[dead].seconds_since_sample = 0.2501;
+    out = step(supervisor, in);
     EXPECT_EQ(out.mode, sv::Mode::fault);
     expect_stopped(out);
     EXPECT_TRUE(out.latched_faults & sv::kFaultStageSilent);
+    EXPECT_EQ(out.stages_dead, 1U << dead);
   }
+}
+
+// A writer that is no longer matched (its process exited, or its participant's lease expired) is
+// dead at once, however recent its last sample.
+TEST(Supervisor, StageWhoseWriterIsGoneIsDeadAtOnce) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.stages[static_cast<std::size_t>(sv::Stage::anti_swing)].present = false;
+  const auto out = step(supervisor, in);
+  EXPECT_EQ(out.mode, sv::Mode::fault);
+  expect_stopped(out);
+  EXPECT_EQ(out.latched_faults, static_cast<std::uint32_t>(sv::kFaultStageSilent));
+}
+
+// A few late cycles that recover (a stage starved for 60-240 ms) latch nothing: motion is inhibited
+// while the stage is late and comes back, brakes one cycle after the drives, as at start-up.
+TEST(Supervisor, LateStageThatRecoversLatchesNothing) {
+  auto supervisor = ready_supervisor();
+  auto late = healthy_input();
+  for (const double silence : {0.06, 0.12, 0.24, 0.25}) {
+    late.stages[static_cast<std::size_t>(sv::Stage::tracking)].seconds_since_sample = silence;
+    const auto out = step(supervisor, late);
+    expect_stopped(out);
+    EXPECT_EQ(out.mode, sv::Mode::ready);
+    EXPECT_EQ(out.active_faults, 0U);
+    EXPECT_EQ(out.latched_faults, 0U);
+    EXPECT_TRUE(out.warnings & sv::kWarningStageLate);
+  }
+  auto out = step(supervisor, healthy_input());
+  EXPECT_TRUE(out.motion_enabled);
+  EXPECT_FALSE(out.brakes_released);
+  EXPECT_EQ(out.warnings & sv::kWarningStageLate, 0U);
+  out = step(supervisor, healthy_input());
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_EQ(out.fault_count, 0U);
 }
 
 TEST(Supervisor, TravelLimitCheckedOnlyOnceSensorsValid) {
@@ -494,6 +540,8 @@ TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
         s.seconds_since_sample = uniform(0.0, params.stage_timeout);
         if (chance(disturbance * 0.2)) s.alive = false;
         if (chance(disturbance * 0.2)) s.seconds_since_sample = uniform(0.0, 2.0 * params.stage_timeout);
+        if (chance(disturbance * 0.05)) s.seconds_since_sample = uniform(0.0, 2.0 * params.stage_dead_timeout);
+        if (chance(disturbance * 0.02)) s.present = false;
       }
       if (chance(disturbance * 0.1)) in.stages[0].seconds_since_sample = params.stage_timeout;  // boundary
       if (chance(disturbance * 0.1)) in.sensors_valid = false;
@@ -514,7 +562,9 @@ TEST(Supervisor, RandomizedBrakesOnlyWithHealthyChainAndNoLatchedFault) {
                               : sv::Command::none;
 
       bool all_alive = true;
-      for (const auto& s : in.stages) all_alive = all_alive && s.alive && s.seconds_since_sample <= params.stage_timeout;
+      for (const auto& s : in.stages) {
+        all_alive = all_alive && s.alive && s.present && s.seconds_since_sample <= params.stage_timeout;
+      }
 
       sv::SupervisorOutput out;
       supervisor.step(in, out);

@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -117,6 +118,115 @@ std::vector<double> ping_pong(std::uint32_t domain, int count, const std::string
   return one_way;  // echo_process stops its child (SIGTERM, then SIGKILL) when it goes
 }
 
+
+// crane_bench soak: the live stack (realtime clock, real-time priority where the system allows it,
+// as crane_launch) at rest for `rest_s`, then `moves` moves between two positions, optionally with
+// stress-ng loading both cores at normal priority. Prints faults, moments the stack was not ready,
+// late-stage warnings, overruns and the end-to-end latency. Exit 0 when no fault and no overrun.
+int soak(const std::string& config_path, unsigned domain, double rest_s, int moves, bool stress, int priority,
+         const std::string& dds) {
+  const fs::path dir = fs::temp_directory_path() / ("crane_soak_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  launch::StackOptions stack;
+  stack.config_path = fs::absolute(config_path).string();
+  stack.binary_directory = launch::executable_directory();
+  stack.log_directory = dir.string();
+  stack.domain_id = domain;
+  stack.lockstep = false;
+  stack.dds = dds;
+  stack.plant_stats_path = (dir / "plant_stats.json").string();
+  stack.fault_log_path = (dir / "faults.jsonl").string();
+  const std::string rt_failure = priority > 0 ? launch::probe_realtime(priority + 10) : "not asked";
+  if (rt_failure.empty()) stack.realtime_priority = priority;
+  std::printf("soak: realtime clock, %s, rest %.0f s, %d moves, %s\n",
+              rt_failure.empty() ? ("SCHED_FIFO " + std::to_string(priority) + "+").c_str()
+                                 : ("normal priority (" + rt_failure + ")").c_str(),
+              rest_s, moves, stress ? "stress-ng --cpu 2 at normal priority" : "no load");
+  launch::ProcessGroup group;
+  for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
+  launch::ProcessGroup load;
+  runtime::NodeOptions node;
+  node.dds = dds;
+  node.domain_id = domain;
+  auto participant = runtime::make_participant(node, "bench");
+  transport::Wakeup wakeup;
+  runtime::install_stop_handlers(&wakeup);
+  auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
+  auto references = participant->make_reader<tp::Reference>(&wakeup);
+  auto goal_writer = participant->make_writer<tp::Goal>();
+  tp::msgs::SupervisorStatus_ status;
+  tp::msgs::Reference_ reference;
+  const auto ready_deadline = Clock::now() + std::chrono::seconds(60);
+  while (!(status.stages_alive() == 0x3FU && status.mode() == 2 && goal_writer->health().matched_readers > 0)) {
+    if (Clock::now() > ready_deadline || runtime::stop_requested()) {
+      std::fprintf(stderr, "crane_bench soak: the stack did not become ready; see %s\n", dir.string().c_str());
+      return 1;
+    }
+    if (auto exit = group.poll()) {
+      std::fprintf(stderr, "crane_bench soak: %s; see %s\n", exit->describe().c_str(), dir.string().c_str());
+      return 1;
+    }
+    status_reader->take_latest(status);
+    wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+  }
+  if (stress) load.start({"stress-ng", "/usr/bin/stress-ng", {"--cpu", "2", "--quiet"}, (dir / "stress.log").string()});
+  std::uint64_t statuses = 0, not_ready = 0, late = 0;
+  std::uint32_t faults = 0;
+  std::string died;
+  auto watch = [&](double seconds, const std::function<bool()>& done) {
+    const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    while (Clock::now() < end && !runtime::stop_requested() && died.empty()) {
+      while (status_reader->take_next(status)) {
+        ++statuses;
+        if (status.mode() != 2 && status.mode() != 3) ++not_ready;
+        if (status.warnings() & 0x8U) ++late;
+        faults = status.fault_count();
+      }
+      while (references->take_next(reference)) {
+      }
+      if (auto exit = group.poll()) died = exit->describe();
+      if (done && done()) return true;
+      wakeup.wait_until(std::min(end, Clock::now() + std::chrono::milliseconds(20)));
+    }
+    return false;
+  };
+  watch(rest_s, nullptr);
+  int arrived = 0;
+  for (int i = 0; i < moves && died.empty() && !runtime::stop_requested(); ++i) {
+    tp::msgs::MoveRequest_ goal;
+    runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
+    const auto id = static_cast<std::uint32_t>(i + 1);
+    goal.request_id(id);
+    goal.profile(1);
+    goal.axes(0x3);
+    goal.trolley_target(i % 2 == 0 ? 0.9 : 0.4);
+    goal.slew_target(i % 2 == 0 ? 0.5 : 0.0);
+    goal.cable_length_target(1.0);
+    bool seen = false;
+    // Sent until the planner executes it (the goal topic is volatile), then until it reports arrival.
+    const bool ok = watch(30.0, [&] {
+      if (!seen) goal_writer->write(goal);
+      seen = seen || reference.request_id() == id;
+      return seen && reference.request_id() == id && reference.phase() == 2;
+    });
+    if (ok) ++arrived;
+    watch(5.0, nullptr);  // let the load settle before the next move
+  }
+  load.stop_all();
+  group.stop_all();
+  json plant = json::parse(std::ifstream(stack.plant_stats_path), nullptr, false);
+  const auto e2e = summary(plant.is_object() ? plant.value("latency_us", std::vector<double>{}) : std::vector<double>{});
+  const int overruns = plant.is_object() ? plant.value("overruns", -1) : -1;
+  std::printf("statuses %llu, not ready %llu, late-stage warnings %llu, faults raised %u, moves arrived %d of %d%s%s\n",
+              static_cast<unsigned long long>(statuses), static_cast<unsigned long long>(not_ready),
+              static_cast<unsigned long long>(late), faults, arrived, moves, died.empty() ? "" : ", died: ",
+              died.c_str());
+  std::printf("plant: %d overruns, end to end p50 %.0f us, p99 %.0f us, max %.0f us (%d cycles); logs in %s\n", overruns,
+              e2e.value("p50_us", 0.0), e2e.value("p99_us", 0.0), e2e.value("max_us", 0.0),
+              e2e["samples"].get<int>(), dir.string().c_str());
+  return faults == 0 && overruns == 0 && died.empty() && arrived == moves ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -133,6 +243,10 @@ int main(int argc, char** argv) {
   latency_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(1.0, 3600.0));
   latency_cmd->add_option("--domain", domain, "DDS domain (the floor uses domain + 1)")->check(CLI::Range(0, 231));
   latency_cmd->add_flag("--json", as_json, "one JSON object");
+  bool lockstep = false;
+  latency_cmd->add_flag("--lockstep", lockstep,
+                        "plant in lockstep (as the demo): where a cycle's time goes when nothing waits on a clock, "
+                        "and the speed in multiples of real time");
   std::string dds = "fast";
   std::string dds_mix;
   latency_cmd->add_option("--dds", dds, "DDS vendor of every process: fast | cyclone")
@@ -144,6 +258,20 @@ int main(int argc, char** argv) {
   latency_cmd->add_flag("--lan", lan, "every process on all interfaces (monitors on other machines may join)");
   latency_cmd->add_option("--dds-profile", dds_profile, "network profile of every process (deploy/dds/*.xml)")
       ->check(CLI::ExistingFile);
+  auto* soak_cmd = app.add_subcommand("soak", "the live stack (realtime) at rest, then moves, optionally under load: "
+                                              "faults, readiness, overruns, end-to-end latency");
+  double soak_rest = 600.0;
+  int soak_moves = 20;
+  bool soak_stress = false;
+  int soak_priority = 70;
+  soak_cmd->add_option("--config", config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+  soak_cmd->add_option("--rest", soak_rest, "[s] at rest first")->check(CLI::Range(0.0, 86400.0));
+  soak_cmd->add_option("--moves", soak_moves, "moves between two positions after the rest")->check(CLI::Range(0, 10000));
+  soak_cmd->add_flag("--stress", soak_stress, "stress-ng loads both cores at normal priority meanwhile");
+  soak_cmd->add_option("--realtime-priority", soak_priority, "as crane_launch (0: normal priority)")
+      ->check(CLI::Range(0, 89));
+  soak_cmd->add_option("--domain", domain, "DDS domain")->check(CLI::Range(0, 232));
+  soak_cmd->add_option("--dds", dds, "DDS vendor of every process")->check(CLI::IsMember({"fast", "cyclone"}));
   auto* pong_cmd = app.add_subcommand("pong", "(internal) the echo process of the DDS floor");
   pong_cmd->group("");  // not listed in --help
   std::string pong_dds = "fast";
@@ -156,6 +284,15 @@ int main(int argc, char** argv) {
       return pong(pong_domain, transport::parse_vendor(pong_dds));
     } catch (const std::exception& error) {
       std::fprintf(stderr, "crane_bench pong: %s\n", error.what());
+      return 1;
+    }
+  }
+  if (soak_cmd->parsed()) {
+    try {
+      runtime::configure_logging("warn", "bench");
+      return soak(config_path, domain, soak_rest, soak_moves, soak_stress, soak_priority, dds);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_bench soak: %s\n", error.what());
       return 1;
     }
   }
@@ -183,7 +320,7 @@ int main(int argc, char** argv) {
     stack.binary_directory = launch::executable_directory();
     stack.log_directory = dir.string();
     stack.domain_id = domain;
-    stack.lockstep = false;
+    stack.lockstep = lockstep;
     stack.plant_stats_path = (dir / "plant_stats.json").string();
     stack.lan = lan;
     stack.dds = dds;
@@ -298,6 +435,13 @@ int main(int argc, char** argv) {
     j["sensor_jitter"] = summary(jitter);
     j["floor_one_way"] = summary(floor);
     j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
+    j["clock"] = lockstep ? "lockstep" : "realtime";
+    if (plant.is_object() && plant.contains("step_us")) j["plant_step"] = plant["step_us"];
+    if (lockstep && sensor_stamps.size() > 1) {
+      // Cycles stepped per second of wall time while recording.
+      const double wall = (sensor_stamps.back() - sensor_stamps.front()) / 1e9;
+      j["real_time_factor"] = static_cast<double>(sensor_stamps.size() - 1) / rate / wall;
+    }
     if (!floor.empty() && !end_to_end.empty()) {
       j["p99_ratio_to_floor"] = j["end_to_end"]["p99_us"].get<double>() / j["floor_one_way"]["p99_us"].get<double>();
     }
@@ -321,6 +465,14 @@ int main(int argc, char** argv) {
       line("sensor period jitter", j["sensor_jitter"]);
       line("floor: DDS one-way (ping-pong / 2)", j["floor_one_way"]);
       if (j.contains("p99_ratio_to_floor")) std::printf("end-to-end p99 / floor p99 = %.2f\n", j["p99_ratio_to_floor"].get<double>());
+      if (j.contains("plant_step")) {
+        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us\n", "plant step (CVODE, one cycle)",
+                    j["plant_step"]["p50"].get<double>(), j["plant_step"]["p99"].get<double>(),
+                    j["plant_step"]["max"].get<double>());
+      }
+      if (j.contains("real_time_factor")) {
+        std::printf("lockstep speed: %.1f x real time\n", j["real_time_factor"].get<double>());
+      }
     }
     fs::remove_all(dir);
     return 0;

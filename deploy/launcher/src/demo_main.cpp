@@ -80,6 +80,11 @@ struct RunResult {
   std::vector<ProcessRecord> processes;
   bool diagnostics_complete{false};
   std::vector<std::string> diagnostics_missing;  // stages whose final loop diagnostics never arrived
+  unsigned domain_id{0};         // this run's DDS domain (a fresh one per run)
+  double startup_s{0.0};         // [s] wall time from the first process started to the stack ready
+  double wall_time_s{0.0};       // [s] wall time of the stepping loop: from ready to the last recorded cycle
+  double simulated_time_s{0.0};  // [s] simulated time over the same cycles
+  std::vector<std::string> failures;  // stages that died (or did not stop cleanly), and why: the run failed
 };
 
 // Everything the operator records in one run, keyed by cycle.
@@ -175,7 +180,7 @@ std::string format_number(double v, int precision) {
 
 
 RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cfg, const config::ManeuverConfig& m,
-                       bool compensation, Operator& op, std::uint32_t request_id) {
+                       bool compensation, Operator& op, std::uint32_t request_id, unsigned domain_id) {
   const std::string run_name = m.name + (compensation ? "_fc_on" : "_fc_off");
   const fs::path out(options.out_dir);
   const fs::path log_dir = out / "logs" / run_name;
@@ -187,7 +192,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.log_directory = log_dir.string();
   stack.dds = options.dds;
   stack.dds_per_process = options.dds_per_process;
-  stack.domain_id = options.domain_id;
+  stack.domain_id = domain_id;
   stack.lockstep = !options.realtime;
   stack.initial_trolley_position = m.initial_trolley_position;
   stack.initial_slew_angle = m.initial_slew_angle;
@@ -216,12 +221,14 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   result.controller = stack.tracking_controller == "tracking" ? stack.anti_swing_controller : stack.tracking_controller;
   if (stack.tracking_acceleration_feedforward) result.controller += "+feedforward";
   result.friction_compensation = compensation;
+  result.domain_id = domain_id;
   // Swing period at the cable length the move ends with (the one the load settles at).
   result.swing_period = 2.0 * kPi * std::sqrt(m.cable_length_target / cfg.crane.gravity);
 
   launch::ProcessGroup group;
   op.drain_all();
   op.forget_status();
+  const auto run_start = Clock::now();
   for (const auto& spec : launch::stack_processes(stack)) {
     const pid_t pid = group.start(spec);
     result.processes.push_back(ProcessRecord{spec.name, pid, launch::vendor_of(stack, spec.name), run_name});
@@ -244,6 +251,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
                            !rec.sensors.rbegin()->second.brakes_engaged() && !rec.references.empty() &&
                            !rec.linear.empty() && !rec.actuators.empty();
     if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0 && recording) break;
+
     if (Clock::now() > ready_deadline) {
       throw RunFailure(
           run_name + ": the stack did not become ready within " + format_number(options.ready_timeout, 0) +
@@ -258,6 +266,10 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     }
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
+
+  const auto ready_time = Clock::now();
+  const std::uint64_t ready_seq = rec.sensors.rbegin()->first;
+  result.startup_s = std::chrono::duration<double>(ready_time - run_start).count();
 
   // 2. Send the move. The recording so far is kept: the first cycle of the move may be in it.
   tp::msgs::MoveRequest_ goal;
@@ -306,10 +318,17 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
 
-  // 4. Stop the stack; every stage publishes its final loop diagnostics on the way out.
+  result.wall_time_s = std::chrono::duration<double>(Clock::now() - ready_time).count();
+  result.simulated_time_s = static_cast<double>(rec.sensors.rbegin()->first - ready_seq) * cfg.plant.sample_period;
+
+  // 4. Stop the stack; every stage publishes its final loop diagnostics on the way out. A stage that
+  //    does not stop cleanly (it aborted, or had to be killed) fails the run.
   for (const auto& exit : group.stop_all()) {
     const bool clean = WIFEXITED(exit.status) && WEXITSTATUS(exit.status) == 0;
-    if (!clean) spdlog::warn("{}: {}", run_name, exit.describe());
+    if (!clean) {
+      spdlog::error("{}: {}", run_name, exit.describe());
+      result.failures.push_back(exit.describe());
+    }
   }
   std::map<std::uint32_t, tp::msgs::LoopDiagnostics_> diagnostics;
   const auto diag_deadline = Clock::now() + std::chrono::milliseconds(500);
@@ -346,7 +365,9 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   std::vector<launch::RecordedCycle> cycles;
   const fs::path csv_path = out / (run_name + ".csv");
   std::ofstream csv(csv_path);
-  csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,seq,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,"
+  // Every column is a function of the simulation alone (t counts from the move's first cycle), so
+  // two runs of the same maneuver give the same file to the last bit (the lockstep's promise).
+  csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,"
          "u_x_cmd,u_gamma_cmd,brakes\n";
   csv.precision(9);
   for (std::uint64_t seq = *start_seq; seq <= *start_seq + cycles_needed; ++seq) {
@@ -372,7 +393,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     const double nan = std::nan("");
     csv << t << ',' << c.trolley_voltage << ',' << c.slew_voltage << ',' << c.trolley_position << ','
         << c.slew_angle << ',' << c.swing_in_plane << ',' << c.swing_out_of_plane << ','
-        << s->second.cable_length() << ',' << seq << ','
+        << s->second.cable_length() << ','
         << (r != rec.references.end() ? r->second.trolley_position() : nan) << ','
         << (r != rec.references.end() ? r->second.slew_angle() : nan) << ','
         << (l != rec.linear.end() ? l->second.trolley_voltage() : nan) << ','
@@ -504,16 +525,30 @@ int main(int argc, char** argv) {
     }
     runtime::NodeOptions node;
     node.dds = options.dds_per_process.count("operator") != 0 ? options.dds_per_process.at("operator") : options.dds;
-    node.domain_id = options.domain_id;
-    auto participant = runtime::make_participant(node, "operator");
-    Operator op(*participant);
-    runtime::install_stop_handlers(&op.wakeup());
 
+    // Each run gets a fresh DDS domain and a fresh operator participant: nothing of one run's
+    // discovery (participants still being removed while the next stack starts) reaches the next.
+    // Fast DDS 2.9 can abort in PDP::check_remote_participant_liveliness when a remote participant
+    // is removed while its lease timer fires (docs/architecture.md, "Transport").
     std::vector<RunResult> results;
     std::uint32_t request_id = 1;
+    unsigned run_index = 0;
+    const auto demo_start = Clock::now();
     for (const auto& m : selected) {
       for (const bool compensation : settings) {
-        results.push_back(run_maneuver(options, cfg, m, compensation, op, request_id++));
+        node.domain_id = (options.domain_id + run_index++) % 233U;
+        std::unique_ptr<transport::Participant> participant = runtime::make_participant(node, "operator");
+        auto op = std::make_unique<Operator>(*participant);
+        runtime::install_stop_handlers(&op->wakeup());
+        try {
+          results.push_back(run_maneuver(options, cfg, m, compensation, *op, request_id++, node.domain_id));
+        } catch (...) {
+          runtime::install_stop_handlers(nullptr);
+          throw;
+        }
+        runtime::install_stop_handlers(nullptr);
+        op.reset();
+        participant.reset();
         const auto& r = results.back();
         spdlog::info("{} (friction compensation {}): settle {} s, position error {} mm, residual swing {} deg",
                      r.maneuver, r.friction_compensation ? "on" : "off", format_number(r.metrics.settle_time, 2),
@@ -534,6 +569,8 @@ int main(int argc, char** argv) {
     summary["controller"] = options.controller;
     json maneuvers = json::array();
     std::vector<double> all_latencies;
+    double wall_time = 0.0, simulated_time = 0.0, startup_time = 0.0;
+    std::vector<std::string> failures;
     std::uint64_t cycles = 0, overruns = 0, supervisor_overruns = 0, nonfinite = 0;
     json processes = json::array();
     bool diagnostics_complete = true;
@@ -558,7 +595,17 @@ int main(int argc, char** argv) {
       j["overruns"] = r.overruns;
       j["supervisor_timer_overruns"] = r.supervisor_timer_overruns;
       j["diagnostics_missing"] = r.diagnostics_missing;
+      j["domain_id"] = r.domain_id;
+      j["startup_s"] = r.startup_s;
+      j["wall_time_s"] = r.wall_time_s;
+      j["simulated_time_s"] = r.simulated_time_s;
+      j["failures"] = r.failures;
+      j["failed"] = !r.failures.empty();
       maneuvers.push_back(j);
+      wall_time += r.wall_time_s;
+      simulated_time += r.simulated_time_s;
+      startup_time += r.startup_s;
+      for (const auto& f : r.failures) failures.push_back(r.maneuver + (r.friction_compensation ? "_fc_on: " : "_fc_off: ") + f);
       all_latencies.insert(all_latencies.end(), r.latencies_us.begin(), r.latencies_us.end());
       cycles += r.cycles;
       overruns += r.overruns;
@@ -576,6 +623,12 @@ int main(int argc, char** argv) {
                        {"supervisor_timer_overruns", supervisor_overruns},
                        {"nonfinite_rejected", nonfinite},
                        {"diagnostics_complete", diagnostics_complete},
+                       {"wall_time_s", wall_time},
+                       {"simulated_time_s", simulated_time},
+                       {"real_time_factor", wall_time > 0.0 ? simulated_time / wall_time : 0.0},
+                       {"startup_s", startup_time},
+                       {"demo_wall_time_s", std::chrono::duration<double>(Clock::now() - demo_start).count()},
+                       {"failures", failures},
                        {"latency_us",
                         {{"p50", percentile(all_latencies, 50)},
                          {"p99", percentile(all_latencies, 99)},
@@ -601,13 +654,18 @@ int main(int argc, char** argv) {
                 percentile(all_latencies, 50), percentile(all_latencies, 99),
                 all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end()),
                 options.realtime ? "realtime" : "lockstep");
+    std::printf("speed: %.1f s simulated in %.2f s of stepping (%.0fx real time); stack start-up %.1f s over %zu runs\n",
+                simulated_time, wall_time, wall_time > 0.0 ? simulated_time / wall_time : 0.0, startup_time,
+                results.size());
     std::printf("summary: %s\n", summary_path.string().c_str());
+    for (const auto& f : failures) std::printf("FAILED: %s\n", f.c_str());
 
     if (!options.plot_script.empty()) {
       const std::string command = "'" + options.python + "' '" + options.plot_script + "' --out '" + options.out_dir + "'";
       const int rc = std::system(command.c_str());
       if (rc != 0) throw std::runtime_error("plot script failed: " + command);
     }
+    if (!failures.empty()) return 1;
   } catch (const std::exception& error) {
     spdlog::critical("{}", error.what());
     return 1;

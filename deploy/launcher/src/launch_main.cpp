@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
   app.add_option("--log-dir", log_dir, "one <stage>.log per process");
   app.add_option("--ready-timeout", ready_timeout, "[s] longest wait for the stack to become ready");
+  int realtime_priority = 70;
+  app.add_option("--realtime-priority", realtime_priority,
+                 "realtime clock: SCHED_FIFO priority of the chain (the sensor writer +10, the supervisor +5) and "
+                 "locked memory, where the system allows it; 0: normal priority (lockstep always runs at normal "
+                 "priority)")
+      ->check(CLI::Range(0, 89));
   CLI11_PARSE(app, argc, argv);
   stack.lockstep = lockstep;
   stack.friction_compensation = !no_compensation;
@@ -75,6 +81,20 @@ int main(int argc, char** argv) {
     node.loopback_only = !stack.lan;
     if (!stack.dds_profile.empty()) stack.dds_profile = std::filesystem::absolute(stack.dds_profile).string();
     node.dds_profile = stack.dds_profile;
+    if (!lockstep && realtime_priority > 0) {
+      // Ask before starting anything: a forked probe tries what every stage will do.
+      const std::string failure = launch::probe_realtime(realtime_priority + 10);
+      if (failure.empty()) {
+        stack.realtime_priority = realtime_priority;
+        spdlog::info("stages run at real-time priority: SCHED_FIFO {} (plant/bridge {}, supervisor {}), memory locked",
+                     realtime_priority, realtime_priority + 10, realtime_priority + 5);
+      } else {
+        spdlog::warn("the stages cannot run at real-time priority here ({}; it needs CAP_SYS_NICE or an RLIMIT_RTPRIO, "
+                     "and CAP_IPC_LOCK or an RLIMIT_MEMLOCK, as the systemd units give): they run at normal priority, "
+                     "and another busy process can make them late",
+                     failure);
+      }
+    }
     auto participant = runtime::make_participant(node, "launcher");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -1,11 +1,14 @@
 #include "crane/launch/process_group.hpp"
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -115,6 +118,26 @@ std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
 
 std::string executable_directory() {
   return std::filesystem::canonical("/proc/self/exe").parent_path().string();
+}
+
+std::string probe_realtime(int priority) {
+  const pid_t pid = fork();
+  if (pid < 0) return std::string("fork: ") + std::strerror(errno);
+  if (pid == 0) {
+    sched_param param{};
+    param.sched_priority = priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) _exit(100 + std::min(errno, 100));
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) _exit(std::min(errno, 99));
+    _exit(0);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status)) return "the probe process did not exit";
+  const int code = WEXITSTATUS(status);
+  if (code == 0) return {};
+  if (code >= 100) return "SCHED_FIFO " + std::to_string(priority) + ": " + std::strerror(code - 100);
+  return std::string("mlockall: ") + std::strerror(code);
 }
 
 }  // namespace crane::launch

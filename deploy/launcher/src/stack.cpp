@@ -79,6 +79,11 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
                       "--log-level", o.log_level};
     if (o.lan) spec.arguments.push_back("--lan");
+    if (o.realtime_priority > 0) {
+      const int offset = name == "plant" || name == "hardware_bridge" ? 10 : name == "supervisor" ? 5 : 0;
+      spec.arguments.insert(spec.arguments.end(),
+                            {"--realtime-priority", std::to_string(std::min(o.realtime_priority + offset, 99))});
+    }
     if (!o.dds_profile.empty()) spec.arguments.insert(spec.arguments.end(), {"--dds-profile", o.dds_profile});
     if (name == "plant") {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");

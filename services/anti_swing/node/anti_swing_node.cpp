@@ -123,14 +123,20 @@ int main(int argc, char** argv) {
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
           while (runtime::take_finite(*states, state, ctx.counters)) {
-            if (watch->advance(state.header().seq(), ctx.counters)) {
-              if (law->step(runtime::to_estimate(state), *out) == common::StepStatus::rejected_nonfinite) {
-                ++ctx.counters.nonfinite_rejected;
-                continue;
-              }
-              ++ctx.counters.cycles;
+            const auto seq = state.header().seq();
+            switch (watch->classify(seq, ctx.counters)) {
+              case runtime::CycleKind::stale: continue;
+              case runtime::CycleKind::repeat: break;  // answered again from *out, the law untouched
+              case runtime::CycleKind::new_cycle:
+                if (law->step(runtime::to_estimate(state), *out) == common::StepStatus::rejected_nonfinite) {
+                  ++ctx.counters.nonfinite_rejected;
+                  continue;
+                }
+                ++ctx.counters.cycles;
+                watch->answered(seq);
+                break;
             }
-            runtime::stamp_header(out->header(), state.header().seq(), state.header().origin());
+            runtime::stamp_header(out->header(), seq, state.header().origin());
             writer->write(*out);
             runtime::record_latency(ctx.latency, out->header());
           }

@@ -60,7 +60,7 @@ PlantConfig read_plant(YamlSection s) {
   p.hoist_max_acceleration = s.number("hoist_max_acceleration", 1e-3, 100.0);
   p.min_cable_length = s.number("min_cable_length", 0.05, 200.0);
   p.max_cable_length = s.number("max_cable_length", p.min_cable_length, 200.0);
-  p.lockstep_timeout = s.number("lockstep_timeout", 0.01, 60.0);
+  p.lockstep_hang_timeout = s.number("lockstep_hang_timeout", 0.1, 3600.0);
   p.command_timeout = s.number("command_timeout", 0.0, 1.0);
   p.safety_status_timeout = s.number("safety_status_timeout", 0.01, 10.0);
   s.finish();
@@ -87,7 +87,7 @@ supervisor::SupervisorParams read_supervisor(YamlSection s, double sample_period
   p.max_voltage_rate = s.number("max_voltage_rate", 1.0, 1e6);
   p.max_swing = s.number("max_swing", 0.01, 1.5);
   p.stage_timeout = s.number("stage_timeout", 0.005, 5.0);
-  p.lockstep_stage_timeout = s.number("lockstep_stage_timeout", p.stage_timeout, 60.0);
+  p.stage_dead_timeout = s.number("stage_dead_timeout", p.stage_timeout, 60.0);
   p.arm_on_start = s.flag("arm_on_start");
   s.finish();
   supervisor::validate(p);

@@ -44,19 +44,27 @@ int main(int argc, char** argv) {
           if (matching.header().seq() != seq) return;  // its estimate is still on the way
           const tp::msgs::LinearCommand_ linear = **pending;
           pending->reset();
-          if (watch->advance(seq, ctx.counters)) ++ctx.counters.cycles;
-          friction_compensation::FrictionCompensationInput in;
-          in.estimate = runtime::to_estimate(matching);
-          in.command.trolley_voltage = linear.trolley_voltage();
-          in.command.slew_voltage = linear.slew_voltage();
-          in.command.hoist_speed = linear.hoist_speed();
-          friction_compensation::FrictionCompensationOutput result;
-          if (compensator->step(in, result) != common::StepStatus::ok) ++ctx.counters.nonfinite_rejected;
-          out->trolley_voltage(result.command.trolley_voltage);
-          out->slew_voltage(result.command.slew_voltage);
-          out->hoist_speed(result.command.hoist_speed);
-          out->trolley_friction_voltage(result.trolley_friction);
-          out->slew_friction_voltage(result.slew_friction);
+          switch (watch->classify(seq, ctx.counters)) {
+            case runtime::CycleKind::stale: return;
+            case runtime::CycleKind::repeat: break;  // answered again from *out, the compensator untouched
+            case runtime::CycleKind::new_cycle: {
+              ++ctx.counters.cycles;
+              friction_compensation::FrictionCompensationInput in;
+              in.estimate = runtime::to_estimate(matching);
+              in.command.trolley_voltage = linear.trolley_voltage();
+              in.command.slew_voltage = linear.slew_voltage();
+              in.command.hoist_speed = linear.hoist_speed();
+              friction_compensation::FrictionCompensationOutput result;
+              if (compensator->step(in, result) != common::StepStatus::ok) ++ctx.counters.nonfinite_rejected;
+              out->trolley_voltage(result.command.trolley_voltage);
+              out->slew_voltage(result.command.slew_voltage);
+              out->hoist_speed(result.command.hoist_speed);
+              out->trolley_friction_voltage(result.trolley_friction);
+              out->slew_friction_voltage(result.slew_friction);
+              watch->answered(seq);
+              break;
+            }
+          }
           runtime::stamp_header(out->header(), seq, linear.header().origin());
           writer->write(*out);
           runtime::record_latency(ctx.latency, out->header());

@@ -1,7 +1,12 @@
 #include "crane/runtime/node_runtime.hpp"
 
 #include <spdlog/spdlog.h>
+#include <sched.h>
+#include <sys/mman.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <cstdlib>
 
@@ -10,6 +15,8 @@
 #include <cmath>
 #include <csignal>
 #include <ctime>
+#include <random>
+#include <string>
 #include <stdexcept>
 #include <thread>
 
@@ -41,9 +48,34 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
   app.add_option("--dds-profile", options.dds_profile,
                  "network profile (deploy/dds/*.xml; default: $CRANE_DDS_PROFILE): replaces loopback/--lan")
       ->check(CLI::ExistingFile);
+  app.add_option("--realtime-priority", options.realtime_priority,
+                 "SCHED_FIFO priority (1-99) and locked memory, where the system allows it (0: normal priority)")
+      ->check(CLI::Range(0, 99));
+}
+
+std::string enter_realtime(int priority) {
+  if (priority <= 0) return {};
+  sched_param param{};
+  param.sched_priority = priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
+    return "SCHED_FIFO " + std::to_string(priority) + ": " + std::strerror(errno);
+  }
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    return "SCHED_FIFO " + std::to_string(priority) + " set, but mlockall: " + std::strerror(errno);
+  }
+  return {};
 }
 
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name) {
+  (void)injected_loss();  // a malformed CRANE_INJECT_LOSS is refused here, at start
+  if (options.realtime_priority > 0) {
+    const auto failure = enter_realtime(options.realtime_priority);
+    if (failure.empty()) {
+      spdlog::info("real time: SCHED_FIFO priority {}, memory locked", options.realtime_priority);
+    } else {
+      spdlog::warn("real time not available ({}): running at normal priority", failure);
+    }
+  }
   transport::ParticipantOptions p;
   p.name = name;
   p.domain_id = options.domain_id;
@@ -75,6 +107,31 @@ extern "C" void on_stop_signal(int) {
   // cleaner, but every loop also wakes at least every few milliseconds, so the flag is enough.
 }
 }  // namespace
+
+bool injected_loss() {
+  struct Loss {
+    double probability{0.0};
+    std::mt19937_64 generator;
+  };
+  static Loss loss = [] {
+    Loss l;
+    const char* text = std::getenv("CRANE_INJECT_LOSS");
+    if (text == nullptr || *text == '\0') return l;
+    const std::string value(text);
+    const auto colon = value.find(':');
+    char* end = nullptr;
+    const double p = std::strtod(value.c_str(), &end);
+    if (colon == std::string::npos || end != value.c_str() + colon || !(p >= 0.0 && p <= 0.5)) {
+      throw std::invalid_argument("CRANE_INJECT_LOSS = '" + value + "' must be P:SEED with P in [0, 0.5]");
+    }
+    const auto seed = std::strtoull(value.c_str() + colon + 1, nullptr, 10);
+    l.probability = p;
+    l.generator.seed(seed ^ (static_cast<std::uint64_t>(getpid()) << 20));
+    return l;
+  }();
+  if (loss.probability <= 0.0) return false;
+  return std::uniform_real_distribution<double>(0.0, 1.0)(loss.generator) < loss.probability;
+}
 
 void install_stop_handlers(transport::Wakeup* wakeup) {
   g_wakeup.store(wakeup);

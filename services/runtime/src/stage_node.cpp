@@ -6,18 +6,14 @@
 
 namespace crane::runtime {
 
-bool SequenceWatch::advance(std::uint64_t seq, LoopCounters& counters) noexcept {
-  if (!any_) {
-    any_ = true;
-    last_ = seq;
-    counters.last_seq = seq;
-    return true;
-  }
-  if (seq <= last_) return false;
-  counters.overruns += seq - last_ - 1;
+CycleKind SequenceWatch::classify(std::uint64_t seq, LoopCounters& counters) noexcept {
+  if (any_ && seq == last_) return has_answer_ && answered_ == seq ? CycleKind::repeat : CycleKind::stale;
+  if (any_ && seq < last_) return CycleKind::stale;
+  if (any_) counters.overruns += seq - last_ - 1;
+  any_ = true;
   last_ = seq;
   counters.last_seq = seq;
-  return true;
+  return CycleKind::new_cycle;
 }
 
 void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header) noexcept {

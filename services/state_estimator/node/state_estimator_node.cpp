@@ -19,17 +19,21 @@ int main(int argc, char** argv) {
         return [=, &ctx] {
           tp::msgs::SensorSample_ sample;
           while (runtime::take_finite(*sensors, sample, ctx.counters)) {
-            // A repeated cycle (the plant re-offering cycle 0 at start-up) is answered again
-            // without feeding the filters twice.
-            if (watch->advance(sample.header().seq(), ctx.counters)) {
-              if (estimator->step(runtime::to_measurement(sample), *estimate) != common::StepStatus::ok) {
-                ++ctx.counters.nonfinite_rejected;
-                continue;
-              }
-              ++ctx.counters.cycles;
+            const auto seq = sample.header().seq();
+            switch (watch->classify(seq, ctx.counters)) {
+              case runtime::CycleKind::stale: continue;
+              case runtime::CycleKind::repeat: break;  // answered again from *out, filters untouched
+              case runtime::CycleKind::new_cycle:
+                if (estimator->step(runtime::to_measurement(sample), *estimate) != common::StepStatus::ok) {
+                  ++ctx.counters.nonfinite_rejected;
+                  continue;
+                }
+                ++ctx.counters.cycles;
+                runtime::from_estimate(*estimate, *out);
+                watch->answered(seq);
+                break;
             }
-            runtime::from_estimate(*estimate, *out);
-            runtime::stamp_header(out->header(), sample.header().seq(), sample.header().origin());
+            runtime::stamp_header(out->header(), seq, sample.header().origin());
             writer->write(*out);
             runtime::record_latency(ctx.latency, out->header());
           }

@@ -69,31 +69,39 @@ int main(int argc, char** argv) {
                                 action->header().seq() == seq;
           if (!complete) return;
           *fresh = {false, false, false};
-          if (watch->advance(seq, ctx.counters)) ++ctx.counters.cycles;
-          tracking::TrackingInput in;
-          in.estimate = runtime::to_estimate(*state);
-          in.reference = runtime::to_reference(*reference);
-          tracking::TrackingOutput result;
-          if (scheduled) {
-            if (scheduled->step(in.estimate, in.reference, result.command) != common::StepStatus::ok) {
-              ++ctx.counters.nonfinite_rejected;
-            }
-          } else {
-            in.reference.trolley.position += action->trolley_reference_correction();
-            in.reference.trolley.velocity += action->trolley_reference_rate_correction();
-            in.reference.slew.position += action->slew_reference_correction();
-            in.reference.slew.velocity += action->slew_reference_rate_correction();
-            in.trolley_anti_swing_action = action->trolley_action();
-            in.slew_anti_swing_action = action->slew_action();
-            if (controller->step(in, result) != common::StepStatus::ok) {
-              ++ctx.counters.nonfinite_rejected;
+          switch (watch->classify(seq, ctx.counters)) {
+            case runtime::CycleKind::stale: return;
+            case runtime::CycleKind::repeat: break;  // answered again from *out, the controller untouched
+            case runtime::CycleKind::new_cycle: {
+              ++ctx.counters.cycles;
+              tracking::TrackingInput in;
+              in.estimate = runtime::to_estimate(*state);
+              in.reference = runtime::to_reference(*reference);
+              tracking::TrackingOutput result;
+              if (scheduled) {
+                if (scheduled->step(in.estimate, in.reference, result.command) != common::StepStatus::ok) {
+                  ++ctx.counters.nonfinite_rejected;
+                }
+              } else {
+                in.reference.trolley.position += action->trolley_reference_correction();
+                in.reference.trolley.velocity += action->trolley_reference_rate_correction();
+                in.reference.slew.position += action->slew_reference_correction();
+                in.reference.slew.velocity += action->slew_reference_rate_correction();
+                in.trolley_anti_swing_action = action->trolley_action();
+                in.slew_anti_swing_action = action->slew_action();
+                if (controller->step(in, result) != common::StepStatus::ok) {
+                  ++ctx.counters.nonfinite_rejected;
+                }
+              }
+              out->trolley_voltage(result.command.trolley_voltage);
+              out->slew_voltage(result.command.slew_voltage);
+              out->hoist_speed(result.command.hoist_speed);
+              out->trolley_tracking_action(result.trolley_tracking_action);
+              out->slew_tracking_action(result.slew_tracking_action);
+              watch->answered(seq);
+              break;
             }
           }
-          out->trolley_voltage(result.command.trolley_voltage);
-          out->slew_voltage(result.command.slew_voltage);
-          out->hoist_speed(result.command.hoist_speed);
-          out->trolley_tracking_action(result.trolley_tracking_action);
-          out->slew_tracking_action(result.slew_tracking_action);
           runtime::stamp_header(out->header(), seq, state->header().origin());
           writer->write(*out);
           runtime::record_latency(ctx.latency, out->header());

@@ -83,34 +83,43 @@ int main(int argc, char** argv) {
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
           while (runtime::take_finite(*states, state, ctx.counters)) {
-            const auto current = runtime::to_estimate(state);
-            if (!*holding) {
-              *holding = planner->hold(current) == trajectory_planner::GoalStatus::accepted;
-              if (!*holding) continue;
-            }
-            tp::msgs::MoveRequest_ request;
-            while (goals->take_next(request)) {
-              if (!runtime::all_finite(request)) {
-                ++ctx.counters.nonfinite_rejected;
-                spdlog::warn("move request {} rejected: non-finite field", request.request_id());
-                continue;
+            const auto seq = state.header().seq();
+            switch (watch->classify(seq, ctx.counters)) {
+              case runtime::CycleKind::stale: continue;
+              case runtime::CycleKind::repeat: break;  // answered again from *out; goals wait for a new cycle
+              case runtime::CycleKind::new_cycle: {
+                const auto current = runtime::to_estimate(state);
+                if (!*holding) {
+                  *holding = planner->hold(current) == trajectory_planner::GoalStatus::accepted;
+                  if (!*holding) continue;
+                }
+                // Goals are taken only at a new cycle, so a cycle's reference is computed once.
+                tp::msgs::MoveRequest_ request;
+                while (goals->take_next(request)) {
+                  if (!runtime::all_finite(request)) {
+                    ++ctx.counters.nonfinite_rejected;
+                    spdlog::warn("move request {} rejected: non-finite field", request.request_id());
+                    continue;
+                  }
+                  // Operators re-send a request until they see it executed: ids only increase.
+                  if (request.request_id() <= *last_request) continue;
+                  *last_request = request.request_id();
+                  const auto status = planner->start_move(to_goal(request, current), current);
+                  spdlog::info("move request {} to x = {} m, gamma = {} rad at cycle {}: {}", request.request_id(),
+                               request.trolley_target(), request.slew_target(), seq, goal_status_name(status));
+                }
+                if (planner->step(dt, *output) != common::StepStatus::ok) continue;
+                ++ctx.counters.cycles;
+                runtime::from_reference(output->reference, *out);
+                out->request_id(static_cast<std::uint32_t>(output->request_id));
+                out->phase(static_cast<std::uint8_t>(output->phase));
+                out->time_in_move(output->time_in_move);
+                out->move_duration(output->move_duration);
+                watch->answered(seq);
+                break;
               }
-              // Operators re-send a request until they see it executed: ids only increase.
-              if (request.request_id() <= *last_request) continue;
-              *last_request = request.request_id();
-              const auto status = planner->start_move(to_goal(request, current), current);
-              spdlog::info("move request {} to x = {} m, gamma = {} rad: {}", request.request_id(),
-                           request.trolley_target(), request.slew_target(), goal_status_name(status));
             }
-            const bool new_cycle = watch->advance(state.header().seq(), ctx.counters);
-            if (planner->step(new_cycle ? dt : 0.0, *output) != common::StepStatus::ok) continue;
-            if (new_cycle) ++ctx.counters.cycles;
-            runtime::from_reference(output->reference, *out);
-            out->request_id(static_cast<std::uint32_t>(output->request_id));
-            out->phase(static_cast<std::uint8_t>(output->phase));
-            out->time_in_move(output->time_in_move);
-            out->move_duration(output->move_duration);
-            runtime::stamp_header(out->header(), state.header().seq(), state.header().origin());
+            runtime::stamp_header(out->header(), seq, state.header().origin());
             writer->write(*out);
             runtime::record_latency(ctx.latency, out->header());
           }

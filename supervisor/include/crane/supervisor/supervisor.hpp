@@ -10,12 +10,15 @@
 //
 // Rules (docs/architecture.md, "Safety"):
 //  - motion (drives) is enabled only in ready/operating, and only while every stage of the chain is
-//    alive: DDS liveliness asserted and a sample received within stage_timeout. The brakes are
-//    released only in a cycle after the one that enabled the drives, with the chain still alive
+//    fresh: DDS liveliness asserted and a sample received within stage_timeout. The brakes are
+//    released only in a cycle after the one that enabled the drives, with the chain still fresh
 //    (the drives hold the load before the brakes let go);
-//  - the moment a stage goes silent, a limit is exceeded, a non-finite value arrives or a second
-//    writer appears: protective stop (fault), brakes engaged, drives at zero; the fault stays
-//    latched until an explicit reset command arrives with a healthy chain and nothing active;
+//  - a stage that is not fresh is late: motion is inhibited while it lasts (drives off, brakes on,
+//    warning kWarningStageLate), with no fault, so a few late cycles that recover latch nothing;
+//  - a stage silent for longer than stage_dead_timeout, or whose writer is gone (unmatched), is
+//    dead: protective stop (fault stage_silent). So is a limit exceeded, a non-finite value or a
+//    second writer: brakes engaged, drives at zero; the fault stays latched until an explicit
+//    reset command arrives with a healthy chain and nothing active;
 //  - an emergency stop (input or command) engages the brakes at once and needs a reset;
 //  - approach margins: within approach_margin of a travel/slew limit, moving toward it, the axis
 //    may not move faster than a speed that falls linearly from max to approach speed; when it does,
@@ -74,7 +77,8 @@ enum Warning : std::uint32_t {
   kWarningTrolleyApproach = 1U << 0,    // trolley inside its approach margin, moving toward the limit
   kWarningSlewApproach = 1U << 1,       // jib inside its approach margin, moving toward the limit
   kWarningSpeedLimited = 1U << 2,       // an approach speed was exceeded: drive voltage limited
-  kWarningStageLate = 1U << 3,          // a DDS deadline was missed on a stage (late, not yet dead)
+  kWarningStageLate = 1U << 3,          // a stage is late (not fresh, or a DDS deadline missed): motion
+                                        // inhibited while it lasts, not yet dead
 };
 
 /// One axis's range and approach behaviour. Units: [m] and [m/s] for the trolley, [rad] and [rad/s]
@@ -106,9 +110,9 @@ struct SupervisorParams {
   double approach_voltage_limit{0.5};  // [V] drive limit while an approach speed is exceeded
   double max_voltage_rate{1500.0};   // [V/s] largest change of a drive command between two samples
   double max_swing{0.35};            // [rad] swing angle beyond which the crane stops
-  double stage_timeout{0.05};        // [s] a stage silent for longer is dead (5 cycles at 100 Hz)
-  double lockstep_stage_timeout{1.0};  // [s] the same when the plant runs in lockstep: simulated time
-                                       // waits for a slow stage, so only a long silence is a death
+  double stage_timeout{0.05};        // [s] a stage silent for longer is late: motion inhibited (5 cycles)
+  double stage_dead_timeout{0.25};   // [s] a stage silent for longer is dead: fault stage_silent, latched
+                                     // (in lockstep both count cycles of the sensor clock, not wall time)
   double sample_period{0.01};        // [s] of the sensor stream (velocities from seq differences)
   bool arm_on_start{true};           // arm by itself once the chain is healthy (simulation); a
                                      // real crane sets false and waits for an explicit arm command
@@ -128,7 +132,9 @@ void validate(const SupervisorParams& params);
 /// What the node observed of one stage since the last step.
 struct StageObservation {
   bool alive{false};                  // DDS liveliness asserted and matched
-  double seconds_since_sample{1e9};   // [s] since the last valid sample was received
+  bool present{true};                 // its writer is matched (false: the process is gone: dead at once)
+  double seconds_since_sample{1e9};   // [s] since the last valid sample was received (in lockstep: cycles
+                                      // of the sensor clock since its last sample, times the sample period)
   bool deadline_missed{false};        // a DDS requested-deadline-missed event since the last step
 };
 
@@ -163,7 +169,8 @@ struct SupervisorOutput {
   std::uint32_t active_faults{0};
   std::uint32_t latched_faults{0};
   std::uint32_t fault_count{0};
-  std::uint32_t stages_alive{0};      // bit i set: Stage(i) alive
+  std::uint32_t stages_alive{0};      // bit i set: Stage(i) fresh (alive, sample within stage_timeout)
+  std::uint32_t stages_dead{0};       // bit i set: Stage(i) dead (gone, or silent beyond stage_dead_timeout)
   std::uint32_t warnings{0};          // Warning bits
   std::uint32_t last_fault{0};        // the most recently raised fault bit (0: none yet)
   std::uint64_t last_fault_seq{0};    // sensor cycle at which it was raised
@@ -197,6 +204,7 @@ class Supervisor {
   std::uint32_t newly_raised_{0};
   std::uint32_t newly_cleared_{0};
   std::uint32_t last_fault_{0};
+  bool chain_was_up_{false};  // every stage has been fresh once: a death from now on is a fault
   std::uint64_t last_fault_seq_{0};
   bool armed_{false};
   bool drives_enabled_previous_{false};

@@ -59,4 +59,9 @@ class ProcessGroup {
 /// Absolute path of the directory holding this executable (/proc/self/exe).
 std::string executable_directory();
 
+/// Whether a process started from here may run on SCHED_FIFO at `priority` and lock its memory, as
+/// every stage does with --realtime-priority: a forked child tries both and exits. Empty string if
+/// it may, else what failed and why ("SCHED_FIFO 80: Operation not permitted", "mlockall: ...").
+std::string probe_realtime(int priority);
+
 }  // namespace crane::launch

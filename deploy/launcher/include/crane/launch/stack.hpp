@@ -39,6 +39,9 @@ struct StackOptions {
   std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
                                       // hardware bridge on that board (see the file comment)
   std::string fault_log_path;         // supervisor --fault-log (optional)
+  int realtime_priority{0};           // > 0: every process --realtime-priority: the sensor writer (plant or
+                                      // bridge) this + 10, the supervisor + 5, the chain this (as the
+                                      // systemd units); 0: normal priority
 };
 
 /// The processes of the stack in start order: supervisor first, the sensor writer (plant or

@@ -32,7 +32,9 @@ struct PlantConfig {
   double hoist_max_acceleration{0.5};   // [m/s^2]
   double min_cable_length{0.2};         // [m]
   double max_cable_length{2.0};         // [m]
-  double lockstep_timeout{0.5};         // [s] lockstep: longest wait for a command and a fresh status
+  double lockstep_hang_timeout{5.0};    // [s] lockstep: wall time a cycle may wait for its command and its
+                                        // supervisor status before the chain is reported hung (nothing is
+                                        // guessed: the cycle keeps waiting)
   double command_timeout{0.03};         // [s] a missing command is replaced by the last one this long
   double safety_status_timeout{0.1};    // [s] brakes on when the supervisor status is older
 };

@@ -45,17 +45,33 @@ struct NodeOptions {
   bool shared_memory{true};  // false: UDP only when not loopback_only (crane_topic --lan)
   std::string dds_profile;   // network profile XML (deploy/dds/); empty: $CRANE_DDS_PROFILE, else none
   std::string log_level{"info"};
+  int realtime_priority{0};  // > 0: SCHED_FIFO at this priority and memory locked, where the system allows
 };
 
 /// Adds --config, --dds, --domain, --lan, --log-level to `app`, bound to `options`.
 void add_node_options(CLI::App& app, NodeOptions& options);
 
-/// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS).
+/// Puts the calling process (and the threads it creates afterwards, DDS's among them) on SCHED_FIFO
+/// at `priority` (1-99) and locks its memory (mlockall), as the systemd units ask. Returns an empty
+/// string on success, else what failed and why (e.g. "SCHED_FIFO 70: Operation not permitted"); the
+/// process then runs on at normal priority. `priority` <= 0: nothing, empty string.
+std::string enter_realtime(int priority);
+
+/// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS); first enters
+/// real time when options.realtime_priority > 0 (a warning in the log when it cannot).
 /// Throws std::invalid_argument on a bad vendor name, std::runtime_error if DDS fails.
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name);
 
 /// Applies --log-level to spdlog's default logger; throws std::invalid_argument on an unknown level.
 void configure_logging(const std::string& level, const std::string& process);
+
+/// Fault injection for tests: with CRANE_INJECT_LOSS="P:SEED" in the environment, true for a
+/// fraction P of the calls (a generator seeded with SEED and the process id), and every reader of
+/// the chain drops the sample it just took, as a lossy best-effort link would. Lockstep must give
+/// the same run with it (docs/architecture.md). Unset or empty: always false. Throws
+/// std::invalid_argument naming the variable on the first call when it is malformed or P is not
+/// in [0, 0.5].
+[[nodiscard]] bool injected_loss();
 
 /// SIGINT/SIGTERM set a flag (async-signal-safe) and wake the given Wakeup.
 void install_stop_handlers(transport::Wakeup* wakeup);

@@ -25,15 +25,33 @@ struct StageContext {
   LatencyStatistics& latency;  // this stage: origin of the sensor sample -> its own output written
 };
 
-/// Counts cycles skipped between consecutive sequence numbers.
+/// What the inputs of a cycle are to a stage (SequenceWatch::classify).
+enum class CycleKind : std::uint8_t {
+  new_cycle,  // a cycle after any seen: compute it once, then answered(seq)
+  repeat,     // the cycle last answered, offered again (lockstep re-offer, docs/architecture.md): send
+              // the stored output again, stamped anew, without stepping the core
+  stale,      // older than the last cycle, or a repeat of a cycle never answered: ignore
+};
+
+/// Lockstep's rule that every stage computes each cycle exactly once, in one place: the plant
+/// re-offers a cycle until the chain answers it, and every stage answers a re-offered cycle from
+/// its stored output. Also counts cycles skipped between consecutive new cycles as overruns.
 class SequenceWatch {
  public:
-  /// Returns true if `seq` is a new cycle (greater than any seen); adds skipped cycles to overruns.
-  bool advance(std::uint64_t seq, LoopCounters& counters) noexcept;
+  /// Classifies the cycle `seq` of a complete set of inputs; adds skipped cycles to overruns and
+  /// sets counters.last_seq for a new cycle.
+  [[nodiscard]] CycleKind classify(std::uint64_t seq, LoopCounters& counters) noexcept;
+  /// The stage computed cycle `seq` and stored its output: a repeat of `seq` is answered from it.
+  void answered(std::uint64_t seq) noexcept {
+    answered_ = seq;
+    has_answer_ = true;
+  }
 
  private:
   bool any_{false};
   std::uint64_t last_{0};
+  bool has_answer_{false};
+  std::uint64_t answered_{0};
 };
 
 /// The NaN/Inf gate at a topic's entry: takes the next sample whose every floating-point field is
@@ -41,6 +59,7 @@ class SequenceWatch {
 template <class ReaderT, class Message>
 bool take_finite(ReaderT& reader, Message& message, LoopCounters& counters) noexcept {
   while (reader.take_next(message)) {
+    if (injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS): a lost sample
     if (all_finite(message)) return true;
     ++counters.nonfinite_rejected;
   }
