@@ -159,21 +159,22 @@ int main(int argc, char** argv) {
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
     namespace tp = transport::topics;
-    // Lockstep waits on data; realtime polls on its own timer.
+    // Lockstep waits on data: woken by the sensor sample (a new cycle, or one offered again) and by
+    // the actuator command, the chain's last output of a cycle; the other outputs of the cycle are
+    // there by then, or taken at the next poll. Realtime polls on its own timer.
     transport::Wakeup* data_wakeup = lockstep ? &wakeup : nullptr;
     // Lockstep: a few cycles deep, so that no cycle is overwritten before it is supervised (the plant
     // may publish cycle k+1 before every output of cycle k has arrived here).
-    const auto reader = [&](auto tag) {
+    const auto reader = [&](auto tag, transport::Wakeup* wake) {
       using Topic = decltype(tag);
-      return lockstep ? participant->make_recording_reader<Topic>(data_wakeup, 16)
-                      : participant->make_reader<Topic>(data_wakeup);
+      return lockstep ? participant->make_recording_reader<Topic>(wake, 16) : participant->make_reader<Topic>(wake);
     };
-    auto sensors = reader(tp::Sensors{});
-    auto estimate = reader(tp::StateEstimate{});
-    auto reference = reader(tp::Reference{});
-    auto anti_swing = reader(tp::AntiSwing{});
-    auto linear = reader(tp::LinearCommand{});
-    auto actuators = reader(tp::Actuators{});
+    auto sensors = reader(tp::Sensors{}, data_wakeup);
+    auto estimate = reader(tp::StateEstimate{}, nullptr);
+    auto reference = reader(tp::Reference{}, nullptr);
+    auto anti_swing = reader(tp::AntiSwing{}, nullptr);
+    auto linear = reader(tp::LinearCommand{}, nullptr);
+    auto actuators = reader(tp::Actuators{}, data_wakeup);
     auto commands = participant->make_reader<tp::SafetyCommand>(data_wakeup);
     auto status_writer = participant->make_writer<tp::SafetyStatus>();
     runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::supervisor);
@@ -334,8 +335,10 @@ int main(int argc, char** argv) {
       bool have_previous_status = false;
       auto waiting_since = Clock::now();
       bool hang_reported = false;
+      bool incomplete = false;  // a cycle waits for an output that does not wake us: poll it soon
       while (!runtime::stop_requested()) {
-        wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+        wakeup.wait_until(Clock::now() + std::chrono::milliseconds(incomplete ? 1 : 20));
+        incomplete = false;
         const auto now = Clock::now();
         const auto sensed = drain_all(now);
         if (sensed.repeat && stepped_any) {
@@ -373,6 +376,10 @@ int main(int argc, char** argv) {
             gone = gone || (was_matched[i] && h[i].matched_writers == 0 && !answered);
           }
           if (!complete && !gone) {
+            // The actuator command of k is there but another output of k is not: it comes without
+            // waking us, so look again soon.
+            const auto& last = watched[static_cast<int>(Stage::friction_compensation)];
+            incomplete = last.seen && last.last_seq >= k;
             if (!hang_reported && now - waiting_since >= hang_timeout) {
               hang_reported = true;
               std::string missing;

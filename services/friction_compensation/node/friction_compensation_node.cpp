@@ -18,7 +18,9 @@ int main(int argc, char** argv) {
         auto params = ctx.config.friction_compensation;
         if (disable) params.enabled = false;
         auto compensator = std::make_shared<friction_compensation::FrictionCompensation>(params);
-        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
+        // The estimate of cycle k does not wake this stage: the linear command of k is computed from
+        // it two stages later, so it arrives after it (the loop's 5 ms poll covers the rest).
+        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(nullptr));
         auto commands = std::shared_ptr(ctx.participant.make_reader<tp::LinearCommand>(&ctx.wakeup));
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::Actuators>());
         auto watch = std::make_shared<runtime::SequenceWatch>();

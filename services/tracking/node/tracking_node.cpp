@@ -43,7 +43,9 @@ int main(int argc, char** argv) {
           p.slew_enabled = ctx.config.tracking.slew_enabled;
           scheduled = std::make_shared<gain_scheduling::GainSchedulingController>(p);
         }
-        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
+        // The estimate of cycle k does not wake this stage: the reference and the anti-swing action
+        // of k are computed from it, so they arrive after it (the loop's 5 ms poll covers the rest).
+        auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(nullptr));
         auto references = std::shared_ptr(ctx.participant.make_reader<tp::Reference>(&ctx.wakeup));
         auto actions = std::shared_ptr(ctx.participant.make_reader<tp::AntiSwing>(&ctx.wakeup));
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::LinearCommand>());
