@@ -81,6 +81,7 @@ struct RunResult {
   bool diagnostics_complete{false};
   std::vector<std::string> diagnostics_missing;  // stages whose final loop diagnostics never arrived
   unsigned domain_id{0};         // this run's DDS domain (a fresh one per run)
+  std::uint64_t move_start_cycle{0};  // lockstep: the cycle the move was asked to start at (0: realtime)
   double startup_s{0.0};         // [s] wall time from the first process started to the stack ready
   double wall_time_s{0.0};       // [s] wall time of the stepping loop: from ready to the last recorded cycle
   double simulated_time_s{0.0};  // [s] simulated time over the same cycles
@@ -270,12 +271,22 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   }
 
   const auto ready_time = Clock::now();
-  const std::uint64_t ready_seq = rec.sensors.rbegin()->first;
+  const std::uint64_t ready_seq = std::max(rec.sensors.rbegin()->first, op.latest_status()->header().seq());
   result.startup_s = std::chrono::duration<double>(ready_time - run_start).count();
 
-  // 2. Send the move. The recording so far is kept: the first cycle of the move may be in it.
+  // 2. Send the move. In lockstep it starts at a fixed cycle, not at the wall-clock moment the goal
+  //    arrives: the crane rests before it, but the estimator's filters and CVODE's step history at
+  //    rest differ in the last bits from one cycle to the next, so only the same start cycle gives
+  //    the same run to the last bit. The stack is ready after a few cycles; should it be later, the
+  //    start moves (and the run is repeatable only with runs that moved it alike). A goal that
+  //    arrives after its start cycle starts at once: the run is then failed. The recording so far
+  //    is kept: the first cycle of the move may be in it.
+  constexpr std::uint64_t kStartCycle = 400;  // 4 s of simulated rest: 0.1-1 s of wall time
+  constexpr std::uint64_t kStartAhead = 100;  // [cycles] at least, for the goal's delivery
+  const std::uint64_t start_at = options.realtime ? 0 : std::max(kStartCycle, ready_seq + kStartAhead);
+  result.move_start_cycle = start_at;
   tp::msgs::MoveRequest_ goal;
-  runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
+  runtime::stamp_header(goal.header(), start_at, runtime::now_stamp());
   goal.request_id(request_id);
   goal.profile(options.profile_code);  // MoveRequest_.profile code (idl/crane_msgs.idl)
   const bool hoists = m.cable_length_target != cfg.crane.cable_length;
@@ -320,6 +331,11 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
 
+  if (start_at != 0 && *start_seq != start_at) {
+    result.failures.push_back("the move started at cycle " + std::to_string(*start_seq) + " instead of " +
+                              std::to_string(start_at) + " (the goal arrived late): not repeatable to the bit");
+    spdlog::error("{}: {}", run_name, result.failures.back());
+  }
   result.wall_time_s = std::chrono::duration<double>(Clock::now() - ready_time).count();
   result.simulated_time_s = static_cast<double>(rec.sensors.rbegin()->first - ready_seq) * cfg.plant.sample_period;
 
@@ -598,6 +614,7 @@ int main(int argc, char** argv) {
       j["supervisor_timer_overruns"] = r.supervisor_timer_overruns;
       j["diagnostics_missing"] = r.diagnostics_missing;
       j["domain_id"] = r.domain_id;
+      j["move_start_cycle"] = r.move_start_cycle;
       j["startup_s"] = r.startup_s;
       j["wall_time_s"] = r.wall_time_s;
       j["simulated_time_s"] = r.simulated_time_s;

@@ -3,6 +3,7 @@
 // swing-free profile) -> rt/crane/planner/reference, once per
 // cycle, same seq and origin. Holds the first measured position until a goal arrives.
 #include <algorithm>
+#include <optional>
 #include <spdlog/spdlog.h>
 
 #include "crane/runtime/stage_node.hpp"
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
         auto output = std::make_shared<trajectory_planner::PlannerOutput>();
         auto holding = std::make_shared<bool>(false);
         auto last_request = std::make_shared<std::uint32_t>(0);
+        auto pending = std::make_shared<std::optional<tp::msgs::MoveRequest_>>();  // waits for its start cycle
         const double dt = ctx.config.plant.sample_period;
         return [=, &ctx] {
           tp::msgs::CraneState_ state;
@@ -93,7 +95,9 @@ int main(int argc, char** argv) {
                   *holding = planner->hold(current) == trajectory_planner::GoalStatus::accepted;
                   if (!*holding) continue;
                 }
-                // Goals are taken only at a new cycle, so a cycle's reference is computed once.
+                // Goals are taken only at a new cycle, so a cycle's reference is computed once. A goal
+                // whose header names a later cycle (header.seq) waits for it: a start at a cycle, not at
+                // a wall-clock moment (the lockstep demo's runs are then identical to the last bit).
                 tp::msgs::MoveRequest_ request;
                 while (goals->take_next(request)) {
                   if (!runtime::all_finite(request)) {
@@ -104,9 +108,25 @@ int main(int argc, char** argv) {
                   // Operators re-send a request until they see it executed: ids only increase.
                   if (request.request_id() <= *last_request) continue;
                   *last_request = request.request_id();
+                  if (request.header().seq() > seq) {
+                    *pending = request;
+                    continue;
+                  }
+                  if (request.header().seq() != 0 && request.header().seq() < seq) {
+                    spdlog::warn("move request {} asked to start at cycle {}, arrived at cycle {}: starts now",
+                                 request.request_id(), request.header().seq(), seq);
+                  }
+                  pending->reset();
                   const auto status = planner->start_move(to_goal(request, current), current);
                   spdlog::info("move request {} to x = {} m, gamma = {} rad at cycle {}: {}", request.request_id(),
                                request.trolley_target(), request.slew_target(), seq, goal_status_name(status));
+                }
+                if (pending->has_value() && (*pending)->header().seq() <= seq) {
+                  const auto status = planner->start_move(to_goal(**pending, current), current);
+                  spdlog::info("move request {} to x = {} m, gamma = {} rad at cycle {}, as asked: {}",
+                               (*pending)->request_id(), (*pending)->trolley_target(), (*pending)->slew_target(), seq,
+                               goal_status_name(status));
+                  pending->reset();
                 }
                 if (planner->step(dt, *output) != common::StepStatus::ok) continue;
                 ++ctx.counters.cycles;
