@@ -207,6 +207,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.tracking_controller = options.tracking_controller;
   stack.fault_log_path = (log_dir / "faults.jsonl").string();
   stack.tracking_acceleration_feedforward = options.acceleration_feedforward;
+  // Realtime runs as crane_launch does: the stages on SCHED_FIFO where the system allows it.
+  if (options.realtime && launch::probe_realtime(80).empty()) stack.realtime_priority = 70;
   if (options.controller == "auto") {
     // The best measured for the time-optimal profile (docs/architecture.md): a trolley move is
     // swing-free by itself and tracked by PD with acceleration feedforward, no anti-swing law to
@@ -306,6 +308,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   const double dt = cfg.plant.sample_period;
   const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
   std::optional<std::uint64_t> start_seq;
+  std::optional<Clock::time_point> tail_deadline;
   const double wall_budget = options.realtime ? m.duration * 1.5 + 20.0 : m.duration * 20.0 + 60.0;
   const auto record_deadline = Clock::now() + std::chrono::duration<double>(wall_budget);
   while (true) {
@@ -324,7 +327,16 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
         }
       }
     }
-    if (start_seq && !rec.sensors.empty() && rec.sensors.rbegin()->first >= *start_seq + cycles_needed + 1) break;
+    if (start_seq && !rec.sensors.empty() && rec.sensors.rbegin()->first >= *start_seq + cycles_needed + 1) {
+      // Every topic's last cycle too: they reach this process by other paths than the sensors (seen:
+      // the linear command of the last cycle arrived after its successor's sensor sample, 1 run in 46).
+      const std::uint64_t last = *start_seq + cycles_needed;
+      const bool complete =
+          rec.references.count(last) != 0 && rec.linear.count(last) != 0 && rec.actuators.count(last) != 0;
+      if (complete) break;
+      if (!tail_deadline) tail_deadline = Clock::now() + std::chrono::seconds(2);
+      if (Clock::now() > *tail_deadline) break;  // what is missing is counted below
+    }
     if (Clock::now() > record_deadline) {
       throw RunFailure(run_name + ": recording did not complete within " + format_number(wall_budget, 0) + " s");
     }
@@ -408,6 +420,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     const auto r = rec.references.find(seq);
     const auto l = rec.linear.find(seq);
     const auto a = rec.actuators.find(seq);
+    // A cycle whose reference, linear or actuator command was not recorded counts as missing too.
+    if (r == rec.references.end() || l == rec.linear.end() || a == rec.actuators.end()) ++result.missing;
     const double nan = std::nan("");
     csv << t << ',' << c.trolley_voltage << ',' << c.slew_voltage << ',' << c.trolley_position << ','
         << c.slew_angle << ',' << c.swing_in_plane << ',' << c.swing_out_of_plane << ','
