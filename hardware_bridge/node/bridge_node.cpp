@@ -359,6 +359,7 @@ int main(int argc, char** argv) {
 
     // Stopping (signal, or the emulated board closed): safe outputs first, then the bookkeeping.
     board->write_outputs(core.safe_outputs());
+    runtime::leave_realtime();
     spdlog::info("outputs safe: 0 V, brakes engaged, drives disabled");
     diagnostics.publish_final(counters, &latency);
     const auto& c = core.counters();

@@ -144,6 +144,7 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
     tick = publish();
     diagnostics.maybe_publish(counters, nullptr);
   }
+  runtime::leave_realtime();
   diagnostics.publish_final(counters, nullptr);
   spdlog::info("stopping at t = {:.2f} s: {} samples, {} overruns, {} friction events", simulator.time(),
                counters.cycles, counters.overruns, simulator.friction_event_count());
@@ -453,6 +454,7 @@ int main(int argc, char** argv) {
       }
     }
 
+    runtime::leave_realtime();
     diagnostics.publish_final(counters, &latency);
     spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} cycles offered again, {} hung, {} non-finite "
                  "commands rejected, latency p50 {:.0f} us p99 {:.0f} us max {:.0f} us, {} friction events, "

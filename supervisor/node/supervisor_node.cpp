@@ -433,6 +433,7 @@ int main(int argc, char** argv) {
         diagnostics.maybe_publish(counters, nullptr);
       }
     }
+    runtime::leave_realtime();
     diagnostics.publish_final(counters, nullptr);
     spdlog::info("stopping: {} cycles, {} overruns, {} non-finite samples rejected", counters.cycles,
                  counters.overruns, counters.nonfinite_rejected);

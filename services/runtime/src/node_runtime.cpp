@@ -7,6 +7,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 
 #include <cstdlib>
 
@@ -64,6 +66,17 @@ std::string enter_realtime(int priority) {
     return "SCHED_FIFO " + std::to_string(priority) + " set, but mlockall: " + std::strerror(errno);
   }
   return {};
+}
+
+void leave_realtime() noexcept {
+  if (sched_getscheduler(0) != SCHED_FIFO) return;
+  sched_param normal{};
+  normal.sched_priority = 0;
+  std::error_code error;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", error)) {
+    const auto tid = static_cast<pid_t>(std::strtol(task.path().filename().c_str(), nullptr, 10));
+    if (tid > 0) (void)sched_setscheduler(tid, SCHED_OTHER, &normal);
+  }
 }
 
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name) {

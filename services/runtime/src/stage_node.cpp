@@ -50,6 +50,7 @@ int run_stage(int argc, char** argv, ProcessId process, const std::string& descr
       poll();
       diagnostics.maybe_publish(counters, &latency);
     }
+    leave_realtime();
     diagnostics.publish_final(counters, &latency);
     spdlog::info("stopping: {} cycles, {} overruns, {} non-finite samples rejected, latency p50 {:.0f} us p99 {:.0f} us",
                  counters.cycles, counters.overruns, counters.nonfinite_rejected, latency.percentile(50),

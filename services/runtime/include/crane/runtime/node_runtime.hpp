@@ -57,6 +57,11 @@ void add_node_options(CLI::App& app, NodeOptions& options);
 /// process then runs on at normal priority. `priority` <= 0: nothing, empty string.
 std::string enter_realtime(int priority);
 
+/// Puts every thread of the process back on SCHED_OTHER (a stopping process: the middleware's shutdown
+/// is not written for real-time priority, and a thread of it spinning at SCHED_FIFO would starve
+/// everything else on the cores). Never throws; nothing happens when the process never entered.
+void leave_realtime() noexcept;
+
 /// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS); first enters
 /// real time when options.realtime_priority > 0 (a warning in the log when it cannot).
 /// Throws std::invalid_argument on a bad vendor name, std::runtime_error if DDS fails.
