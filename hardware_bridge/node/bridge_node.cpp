@@ -256,17 +256,22 @@ int main(int argc, char** argv) {
     // Board clock (lockstep, as the plant on DDS): sample k is answered with the command of cycle k
     // gated by the supervisor's status of cycle k-1 (sample 0: of cycle 0), or without a command
     // when that status reports a dead stage. That status is fresh in simulated time.
-    auto board_step = [&](std::uint64_t k, double now_s) {
+    // The status that gates sample k, when it has arrived (nullptr otherwise).
+    auto gating_status = [&](std::uint64_t k) -> const tp::msgs::SupervisorStatus_* {
       const std::uint64_t gate_seq = k == 0 ? 0 : k - 1;
-      const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
-      const bool status_ready = gate.has_value() && gate->header().seq() == gate_seq;
+      const auto& slot = recent_statuses[gate_seq % recent_statuses.size()];
+      return slot.has_value() && slot->header().seq() == gate_seq ? &*slot : nullptr;
+    };
+    auto board_step = [&](std::uint64_t k, double now_s) {
+      const auto* gate = gating_status(k);
+      const bool status_ready = gate != nullptr;
       if (status_ready) {
         in.status_received = true;
         in.status.motion_enabled = gate->motion_enabled();
         in.status.brakes_released = gate->brakes_released();
         in.status.trolley_voltage_limit = gate->trolley_voltage_limit();
         in.status.slew_voltage_limit = gate->slew_voltage_limit();
-        status_seq = gate_seq;
+        status_seq = gate->header().seq();
       }
       if (!status_ready) return false;
       // Only a dead stage (stage_silent latched) lets a sample pass without the chain's command.
@@ -330,7 +335,7 @@ int main(int argc, char** argv) {
             ++counters.overruns;
             spdlog::error("lockstep: cycle {} has waited {} s for {}: the chain is hung (the cycle keeps waiting)", seq,
                           cfg.plant.lockstep_hang_timeout,
-                          status_seq + 1 < seq || !recent_statuses[0] ? "the supervisor status" : "the actuator command");
+                          gating_status(seq) == nullptr ? "the supervisor status" : "the actuator command");
           }
         }
         if (now >= cycle_deadline) break;

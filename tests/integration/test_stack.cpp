@@ -154,6 +154,7 @@ TEST(Lockstep, RepeatedRunsAreBitIdenticalWithLostSamplesAndUnderLoad) {
       // No fault raised in any run: the supervisor's fault log holds commands only.
       const std::string run = csv.substr(0, csv.size() - 4);
       std::ifstream faults(out / "logs" / run / "faults.jsonl");
+      EXPECT_TRUE(faults.is_open()) << run << ": no fault log";  // the supervisor opens it at start
       std::string line;
       while (std::getline(faults, line)) EXPECT_EQ(line.find("\"raised\""), std::string::npos) << run << ": " << line;
       std::ifstream file(out / csv, std::ios::binary);
