@@ -4,7 +4,9 @@ One parser for every tool that reads the IDL: the build-time generator of the Cy
 support (gen_cyclone_support.py) and the checks of tests/ros2 (check_msgs.py).
 
 Supported: nested modules, `@final struct Name { TYPE name; TYPE name[N]; };` with primitive
-types and other structs of the file. Anything else is refused with the declaration quoted.
+types and other structs of the file, and integer constants `const TYPE NAME = VALUE;` in a module
+`<Struct>_Constants` beside the struct's module (rosidl's layout for a .msg's constants).
+Anything else is refused with the declaration quoted.
 """
 import re
 
@@ -17,10 +19,31 @@ class Field:
         self.idl_type = idl_type  # primitive name or the struct's name without modules ("Time_")
         self.name = name
         self.size = size          # array length, or None
+        self.comment = ""         # the IDL's trailing comment of the declaration (units, meaning)
 
     @property
     def primitive(self):
         return self.idl_type in PRIMITIVES
+
+
+class Constant:
+    def __init__(self, modules, idl_type, name, value):
+        self.modules = modules    # ["crane_msgs", "msg", "SupervisorStatus_Constants"]
+        self.idl_type = idl_type  # integer primitive
+        self.name = name          # "FAULT_STAGE_SILENT"
+        self.value = value        # int
+
+    @property
+    def owner(self):              # the struct the constant belongs to, without the trailing _: "SupervisorStatus"
+        return self.modules[-1][:-len("_Constants")]
+
+    @property
+    def group(self):              # "FAULT" of FAULT_STAGE_SILENT: constants of one group are one code
+        return self.name.split("_", 1)[0]
+
+    @property
+    def member(self):             # "stage_silent": the name of the value within its group
+        return self.name.split("_", 1)[1].lower() if "_" in self.name else self.name.lower()
 
 
 class Struct:
@@ -40,15 +63,39 @@ class Struct:
 
 def parse(text):
     """[Struct] in file order. Raises SystemExit naming an unparsed declaration."""
+    return parse_all(text)[0]
+
+
+def parse_all(text):
+    """([Struct], [Constant]) in file order. Raises SystemExit naming an unparsed declaration."""
+    comments = {}  # (struct, field) -> trailing comment, and its continuation lines
+    current = None
+    last = None
+    for line in text.splitlines():
+        s = re.match(r"\s*(?:@\w+\s*)*struct\s+(\w+)", line)
+        if s:
+            current, last = s.group(1), None
+            continue
+        d = re.match(r"\s*[\w:]+\s+(\w+)(?:\[\d+\])?\s*;\s*(?://\s*(.*))?$", line)
+        if d and current:
+            last = (current, d.group(1))
+            comments[last] = (d.group(2) or "").strip()
+        elif last and re.match(r"\s*//", line) and comments.get(last) and \
+                len(line) - len(line.lstrip()) > 20:  # a continuation aligned under the comment
+            comments[last] += " " + line.strip()[2:].strip()
+        else:
+            last = None
     text = re.sub(r"//[^\n]*", "", text)
     text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
     structs = []
+    constants = []
     known = set()
     modules = []
     depth_of_module = []
     depth = 0
     pos = 0
-    token = re.compile(r"module\s+(\w+)\s*\{|(?:@\w+\s*)*struct\s+(\w+)\s*\{(.*?)\}\s*;|\{|\}", re.S)
+    token = re.compile(r"module\s+(\w+)\s*\{|(?:@\w+\s*)*struct\s+(\w+)\s*\{(.*?)\}\s*;"
+                       r"|const\s+(\w+)\s+(\w+)\s*=\s*([^;]+);|\{|\}", re.S)
     while True:
         m = token.search(text, pos)
         if not m:
@@ -75,6 +122,15 @@ def parse(text):
                                     int(size) if size else None))
             structs.append(Struct(list(modules), m.group(2), fields))
             known.add(m.group(2))
+        elif m.group(4):
+            if not modules or not modules[-1].endswith("_Constants"):
+                raise SystemExit(f"constant {m.group(5)} outside a <Struct>_Constants module")
+            if m.group(4) not in PRIMITIVES or m.group(4) in ("double", "float", "boolean", "char"):
+                raise SystemExit(f"constant {m.group(5)}: only integer constants are supported, not {m.group(4)}")
+            value = m.group(6).strip()
+            if not re.fullmatch(r"-?(0x[0-9a-fA-F]+|\d+)", value):
+                raise SystemExit(f"constant {m.group(5)}: value {value!r} is not an integer literal")
+            constants.append(Constant(list(modules), m.group(4), m.group(5), int(value, 0)))
         elif m.group(0) == "{":
             depth += 1
         else:
@@ -82,4 +138,11 @@ def parse(text):
                 depth_of_module.pop()
                 modules.pop()
             depth -= 1
-    return structs
+    for s in structs:
+        for f in s.fields:
+            f.comment = comments.get((s.name, f.name), "")
+    owners = {s.name[:-1] for s in structs}
+    for c in constants:
+        if c.owner not in owners:
+            raise SystemExit(f"constant {c.name}: module {c.modules[-1]} names no struct {c.owner}_")
+    return structs, constants

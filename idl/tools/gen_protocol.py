@@ -1,0 +1,239 @@
+#!/usr/bin/env python3
+"""Generates the project's protocol headers from idl/crane_msgs.idl (build time, never committed).
+
+The IDL is the one place where a message's fields and the protocol's codes are written; this
+writes what repeats them:
+
+  gen_protocol.py IDL --messages OUT.hpp   crane::protocol: a plain struct per message (no DDS),
+                                           its codes (the IDL's <Name>_Constants) as static
+                                           constexpr members and a name table, all_finite() and
+                                           visit_fields() (names and values, for echo and records)
+  gen_protocol.py IDL --dds OUT.hpp        to_dds() / from_dds() between those structs and the
+                                           fastddsgen classes (the DDS transport's types)
+  gen_protocol.py IDL --msg-dir DIR        the ROS 2 interface files DIR/<Name>.msg (rosidl's .msg
+                                           syntax, constants included)
+
+Exit 1 with a message on an IDL construct the parser (idl_structs.py) does not know.
+"""
+import pathlib
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import idl_structs  # noqa: E402
+
+HEADER = "// Generated from {idl} by idl/tools/gen_protocol.py at build time. Do not edit.\n"
+
+CPP_TYPES = {"double": "double", "float": "float", "boolean": "bool", "octet": "std::uint8_t", "char": "char",
+             "int8": "std::int8_t", "uint8": "std::uint8_t", "int16": "std::int16_t", "uint16": "std::uint16_t",
+             "int32": "std::int32_t", "uint32": "std::uint32_t", "int64": "std::int64_t", "uint64": "std::uint64_t"}
+ROS_TYPES = {"double": "float64", "float": "float32", "boolean": "bool", "octet": "byte", "char": "char",
+             "int8": "int8", "uint8": "uint8", "int16": "int16", "uint16": "uint16", "int32": "int32",
+             "uint32": "uint32", "int64": "int64", "uint64": "uint64"}
+
+
+def plain(name):
+    """C++ name of a message's plain struct: the IDL name without its trailing underscore."""
+    return name[:-1] if name.endswith("_") else name
+
+
+def field_type(f):
+    base = CPP_TYPES[f.idl_type] if f.primitive else plain(f.idl_type)
+    return f"std::array<{base}, {f.size}>" if f.size else base
+
+
+def messages(structs, constants, idl_name):
+    out = [HEADER.format(idl=idl_name)]
+    out.append('''#pragma once
+// The crane protocol without DDS: one plain struct per message of idl/crane_msgs.idl (same names
+// without the trailing underscore, same fields, SI units as commented there), the protocol's codes
+// and bit masks (the IDL's <Name>_Constants modules) as static constexpr members of their message,
+// and the per-message code that would otherwise repeat each field list:
+//   all_finite(m)          every floating-point field (arrays included) is finite: the NaN gate
+//   visit_fields(m, v)     v(name, value) for every field in IDL order, nested structs as such
+//   code_name(...)         the name of a code ("stage_silent" for FAULT_STAGE_SILENT)
+// Stage objects (the cores of the processes) read and write these structs; the DDS translation is
+// crane/protocol/dds.hpp, the ROS 2 .msg files are generated from the same IDL.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace crane::protocol {
+
+/// One named code of the IDL: `group` is the constant's first word (FAULT), `name` the rest in
+/// lower case (stage_silent).
+struct NamedCode {
+  std::string_view group;
+  std::string_view name;
+  std::uint64_t value;
+};
+
+/// The name of `value` within `group` of `codes` (a message's kCodes), or "unknown".
+[[nodiscard]] constexpr std::string_view code_name(std::span<const NamedCode> codes, std::string_view group,
+                                                   std::uint64_t value) noexcept {
+  for (const auto& c : codes) {
+    if (c.group == group && c.value == value) return c.name;
+  }
+  return "unknown";
+}
+
+namespace detail {
+[[nodiscard]] inline bool finite(double v) noexcept { return std::isfinite(v); }
+[[nodiscard]] inline bool finite(float v) noexcept { return std::isfinite(v); }
+template <class T, std::size_t N>
+[[nodiscard]] bool finite(const std::array<T, N>& values) noexcept {
+  for (const auto& v : values) {
+    if (!finite(v)) return false;
+  }
+  return true;
+}
+}  // namespace detail
+
+''')
+    by_owner = {}
+    for c in constants:
+        by_owner.setdefault(c.owner, []).append(c)
+    for s in structs:
+        name = plain(s.name)
+        out.append(f"/// {s.scoped_name} (DDS type name).\n")
+        out.append(f"struct {name} {{\n")
+        out.append(f'  static constexpr std::string_view kTypeName = "{s.scoped_name}";\n')
+        codes = by_owner.get(name, [])
+        for c in codes:
+            out.append(f"  static constexpr {CPP_TYPES[c.idl_type]} {c.name} = {c.value};\n")
+        if codes:
+            out.append(f"  static constexpr std::array<NamedCode, {len(codes)}> kCodes{{{{\n")
+            for c in codes:
+                out.append(f'      {{"{c.group}", "{c.member}", {c.value}U}},\n')
+            out.append("  }};\n")
+        for f in s.fields:
+            comment = f"  // {f.comment}" if f.comment else ""
+            out.append(f"  {field_type(f)} {f.name}{{}};{comment}\n")
+        out.append("};\n\n")
+    # all_finite: declarations first (nested structs check through each other).
+    for s in structs:
+        out.append(f"[[nodiscard]] inline bool all_finite(const {plain(s.name)}& m) noexcept;\n")
+    out.append("\n")
+    for s in structs:
+        terms = []
+        for f in s.fields:
+            if f.primitive and f.idl_type in ("double", "float"):
+                terms.append(f"detail::finite(m.{f.name})")
+            elif not f.primitive:
+                if f.size:
+                    terms.append(f"std::all_of(m.{f.name}.begin(), m.{f.name}.end(), "
+                                 f"[](const auto& e) {{ return all_finite(e); }})")
+                else:
+                    terms.append(f"all_finite(m.{f.name})")
+        body = " &&\n         ".join(terms) if terms else "true"
+        unused = "" if terms else "  (void)m;\n"
+        out.append(f"inline bool all_finite(const {plain(s.name)}& m) noexcept {{\n{unused}  return {body};\n}}\n")
+    out.append("\n")
+    for const in ("const ", ""):
+        for s in structs:
+            out.append(f"template <class Visitor>\nvoid visit_fields({const}{plain(s.name)}& m, Visitor&& visit) {{\n")
+            for f in s.fields:
+                out.append(f'  visit("{f.name}", m.{f.name});\n')
+            out.append("}\n")
+    out.append("\n}  // namespace crane::protocol\n")
+    text = "".join(out)
+    if "std::all_of" in text:
+        text = text.replace("#include <array>\n", "#include <algorithm>\n#include <array>\n", 1)
+    return text
+
+
+def dds(structs, idl_name):
+    out = [HEADER.format(idl=idl_name)]
+    out.append('''#pragma once
+// Translation between the plain protocol structs (crane/protocol/messages.hpp) and the classes
+// fastddsgen generates for the DDS transport, field for field: the only place the two meet.
+#include <algorithm>
+
+#include "crane/protocol/messages.hpp"
+#include "crane_msgs.h"
+
+namespace crane::protocol {
+
+''')
+    for s in structs:
+        out.append(f"inline void to_dds(const {plain(s.name)}& in, {s.scoped_name}& out);\n")
+        out.append(f"inline void from_dds(const {s.scoped_name}& in, {plain(s.name)}& out);\n")
+    out.append("\n")
+    for s in structs:
+        to = [f"inline void to_dds(const {plain(s.name)}& in, {s.scoped_name}& out) {{"]
+        fr = [f"inline void from_dds(const {s.scoped_name}& in, {plain(s.name)}& out) {{"]
+        for f in s.fields:
+            n = f.name
+            if f.primitive and not f.size:
+                to.append(f"  out.{n}(in.{n});")
+                fr.append(f"  out.{n} = in.{n}();")
+            elif f.primitive:
+                to.append(f"  std::copy(in.{n}.begin(), in.{n}.end(), out.{n}().begin());")
+                fr.append(f"  std::copy(in.{n}().begin(), in.{n}().end(), out.{n}.begin());")
+            elif not f.size:
+                to.append(f"  to_dds(in.{n}, out.{n}());")
+                fr.append(f"  from_dds(in.{n}(), out.{n});")
+            else:
+                to.append(f"  for (std::size_t i = 0; i < {f.size}; ++i) to_dds(in.{n}[i], out.{n}()[i]);")
+                fr.append(f"  for (std::size_t i = 0; i < {f.size}; ++i) from_dds(in.{n}()[i], out.{n}[i]);")
+        out.append("\n".join(to) + "\n}\n")
+        out.append("\n".join(fr) + "\n}\n")
+    out.append("\n/// The plain struct of a fastddsgen class, and back.\n"
+               "template <class Dds>\nstruct PlainOf;\n")
+    for s in structs:
+        out.append(f"template <>\nstruct PlainOf<{s.scoped_name}> {{\n  using type = {plain(s.name)};\n}};\n")
+    out.append("\n}  // namespace crane::protocol\n")
+    return "".join(out)
+
+
+def msg_files(structs, constants, idl_name):
+    """{file name: text} of the ROS 2 .msg files of module crane_msgs::msg::dds_."""
+    files = {}
+    for s in structs:
+        if s.modules != ["crane_msgs", "msg", "dds_"]:
+            continue
+        name = plain(s.name)
+        lines = [f"# Generated from {idl_name} by idl/tools/gen_protocol.py. Do not edit.", ""]
+        for c in constants:
+            if c.owner == name:
+                lines.append(f"{ROS_TYPES[c.idl_type]} {c.name}={c.value}")
+        if any(c.owner == name for c in constants):
+            lines.append("")
+        for f in s.fields:
+            if f.primitive:
+                ros = ROS_TYPES[f.idl_type]
+            elif f.idl_type == "Time_":
+                ros = "builtin_interfaces/Time"
+            else:
+                ros = plain(f.idl_type)
+            comment = f"  # {f.comment}" if f.comment else ""
+            lines.append(f"{ros}{f'[{f.size}]' if f.size else ''} {f.name}{comment}")
+        files[f"{name}.msg"] = "\n".join(lines) + "\n"
+    return files
+
+
+def write_if_changed(target, text):
+    target = pathlib.Path(target)
+    if not target.exists() or target.read_text() != text:  # unchanged output: no rebuild
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text)
+
+
+def main():
+    if len(sys.argv) != 4 or sys.argv[2] not in ("--messages", "--dds", "--msg-dir"):
+        raise SystemExit("usage: gen_protocol.py IDL --messages OUT.hpp | --dds OUT.hpp | --msg-dir DIR")
+    idl = pathlib.Path(sys.argv[1])
+    structs, constants = idl_structs.parse_all(idl.read_text())
+    if sys.argv[2] == "--messages":
+        write_if_changed(sys.argv[3], messages(structs, constants, idl.name))
+    elif sys.argv[2] == "--dds":
+        write_if_changed(sys.argv[3], dds(structs, idl.name))
+    else:
+        for name, text in msg_files(structs, constants, idl.name).items():
+            write_if_changed(pathlib.Path(sys.argv[3]) / name, text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
