@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -113,15 +115,14 @@ TEST(ResidualAnalysis, ChiSquareAndLjungBox) {
 }
 
 TEST(AuditOptions, UnknownParameterAndCauseAreRefusedByName) {
-  ma::AuditOptions options;
-  options.parameters = {{"K_m", 1.7}, {"b", 4.0}, {"c", 1.7}, {"mass", 3.0}};
   try {
-    ma::validate(options);
+    (void)ma::nominal_from_values(ma::AuditPlant::axis, {{"K_m", 1.7}, {"b", 4.0}, {"c", 1.7}, {"mass", 3.0}});
     FAIL() << "unknown parameter accepted";
   } catch (const crane::common::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("'mass'"), std::string::npos) << e.what();
   }
-  options.parameters.erase("mass");
+  ma::AuditOptions options;
+  options.nominal = ma::nominal_from_values(ma::AuditPlant::axis, {{"K_m", 1.7}, {"b", 4.0}, {"c", 1.7}});
   options.causes = {"friction_of_the_gods"};
   try {
     ma::validate(options);
@@ -131,8 +132,87 @@ TEST(AuditOptions, UnknownParameterAndCauseAreRefusedByName) {
   }
   options.causes = {"stiction"};
   EXPECT_NO_THROW(ma::validate(options));
-  options.parameters.erase("c");
+  EXPECT_THROW((void)ma::nominal_from_values(ma::AuditPlant::axis, {{"K_m", 1.7}, {"b", 4.0}}),
+               crane::common::ConfigError);
+  // A nominal never given (the required fields are NaN until set) is refused too.
+  options.nominal = ma::AxisAuditParameters{};
   EXPECT_THROW(ma::validate(options), crane::common::ConfigError);
+}
+
+// Each model's catalog: non-empty, names unique; the crane's is the axis catalog once per drive, the
+// pendulum catalog, and payload_mass_error (26 entries).
+TEST(AuditCatalog, EveryModelHasAUniqueNonEmptyCatalog) {
+  for (const auto plant : {ma::AuditPlant::axis, ma::AuditPlant::pendulum, ma::AuditPlant::crane}) {
+    const auto& catalog = ma::audit_catalog(plant);
+    EXPECT_FALSE(catalog.empty()) << ma::plant_name(plant);
+    std::vector<std::string> sorted = catalog;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << ma::plant_name(plant);
+  }
+  const auto& axis = ma::audit_catalog(ma::AuditPlant::axis);
+  const auto& pendulum = ma::audit_catalog(ma::AuditPlant::pendulum);
+  const auto& crane = ma::audit_catalog(ma::AuditPlant::crane);
+  EXPECT_EQ(axis.size(), 10U);
+  EXPECT_EQ(pendulum.size(), 5U);
+  ASSERT_EQ(crane.size(), 2 * axis.size() + pendulum.size() + 1);
+  for (std::size_t i = 0; i < axis.size(); ++i) {
+    EXPECT_EQ(crane[i], "trolley_" + axis[i]);
+    EXPECT_EQ(crane[axis.size() + i], "slew_" + axis[i]);
+  }
+  EXPECT_EQ(crane.back(), "payload_mass_error");
+}
+
+// Typed parameters round-trip through their report names: every field of each model's table set to
+// a distinct value, written as names and read back, gives the same struct; the names are those of
+// audit_parameter_names() and of the JSON report.
+TEST(AuditParameters, TypedParametersRoundTripThroughTheReportNames) {
+  ma::AxisAuditParameters axis;
+  axis.motor_constant = 1.5;
+  axis.viscous = 4.25;
+  axis.coulomb = 1.75;
+  axis.coulomb_asymmetry = -0.125;
+  axis.viscous_asymmetry = 0.375;
+  axis.stiction = 0.5;
+  axis.stiction_asymmetry = -0.25;
+  const auto axis_values = ma::parameter_values(axis);
+  EXPECT_EQ(axis_values.at("K_m"), 1.5);
+  EXPECT_EQ(axis_values.at("b"), 4.25);
+  EXPECT_EQ(axis_values.at("c"), 1.75);
+  EXPECT_EQ(axis_values.at("stiction_asymmetry"), -0.25);
+  const auto axis_back = std::get<ma::AxisAuditParameters>(ma::nominal_from_values(ma::AuditPlant::axis, axis_values));
+  EXPECT_EQ(axis_back.motor_constant, axis.motor_constant);
+  EXPECT_EQ(axis_back.viscous, axis.viscous);
+  EXPECT_EQ(axis_back.coulomb, axis.coulomb);
+  EXPECT_EQ(axis_back.coulomb_asymmetry, axis.coulomb_asymmetry);
+  EXPECT_EQ(axis_back.viscous_asymmetry, axis.viscous_asymmetry);
+  EXPECT_EQ(axis_back.stiction, axis.stiction);
+  EXPECT_EQ(axis_back.stiction_asymmetry, axis.stiction_asymmetry);
+
+  ma::PendulumAuditParameters pendulum;
+  pendulum.length = 0.75;
+  pendulum.damping = 0.0625;
+  pendulum.gravity = 9.81;
+  EXPECT_FALSE(ma::parameter_values(pendulum).contains("theta_zero"));  // estimated: not a value
+  pendulum.theta_zero = 3.0;
+  const auto pendulum_values = ma::parameter_values(pendulum);
+  EXPECT_EQ(pendulum_values.size(), ma::audit_parameter_names(ma::AuditPlant::pendulum).size());
+  const auto pendulum_back =
+      std::get<ma::PendulumAuditParameters>(ma::nominal_from_values(ma::AuditPlant::pendulum, pendulum_values));
+  EXPECT_EQ(pendulum_back.length, 0.75);
+  EXPECT_EQ(pendulum_back.damping, 0.0625);
+  EXPECT_EQ(pendulum_back.gravity, 9.81);
+  EXPECT_EQ(pendulum_back.theta_zero, std::optional<double>(3.0));
+
+  for (const auto plant : {ma::AuditPlant::axis, ma::AuditPlant::pendulum, ma::AuditPlant::crane}) {
+    const auto& names = ma::audit_parameter_names(plant);
+    std::vector<std::string> sorted = names;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << ma::plant_name(plant);
+  }
+  const auto crane_values = ma::parameter_values(crane::common::CraneParameters{});
+  std::vector<std::string> crane_names;
+  for (const auto& [name, value] : crane_values) crane_names.push_back(name);
+  EXPECT_EQ(crane_names, ma::audit_parameter_names(ma::AuditPlant::crane));
 }
 
 std::string rows(std::size_t n, const std::string& bad_row = "", std::size_t bad_at = 0) {
@@ -168,7 +248,7 @@ TEST(CraneAuditCli, WritesTheReportAndRefusesBadOptions) {
   ASSERT_EQ(run_tool("generate --model axis --effect gain_error --seed 4 --out " + data.string()), 0);
   const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::axis, "gain_error", 4);
   std::string params;
-  for (const auto& [k, v] : c.nominal) params += " --param " + k + "=" + crane::common::format_value(v);
+  for (const auto& [k, v] : ma::parameter_values(c.nominal)) params += " --param " + k + "=" + crane::common::format_value(v);
   EXPECT_EQ(run_tool("--model axis --data " + data.string() + params + " --out " + dir.string()), 0);
   std::ifstream report(dir / "report.json");
   std::stringstream text;

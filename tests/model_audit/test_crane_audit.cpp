@@ -75,8 +75,7 @@ TEST(CraneAuditData, BadInputIsRefusedNamingRowColumnOrCause) {
   EXPECT_EQ(data.cable_length.size(), 100U);
 
   ma::AuditOptions options;
-  options.plant = ma::AuditPlant::crane;
-  options.parameters = ma::crane_audit_parameters(crane::common::CraneParameters{});
+  options.nominal = crane::common::CraneParameters{};
   options.causes = {"trolley_stiction", "slew_friction_of_the_gods"};
   try {
     ma::validate(options);
@@ -88,9 +87,10 @@ TEST(CraneAuditData, BadInputIsRefusedNamingRowColumnOrCause) {
   EXPECT_THROW(ma::validate(options), crane::common::ConfigError);
   options.causes = {"trolley_stiction", "payload_mass_error", "encoder_offset"};
   EXPECT_NO_THROW(ma::validate(options));
-  options.parameters.erase("jib_inertia");
+  auto values = ma::parameter_values(options.nominal);
+  values.erase("jib_inertia");
   try {
-    ma::validate(options);
+    (void)ma::nominal_from_values(ma::AuditPlant::crane, values);
     FAIL() << "missing parameter accepted";
   } catch (const crane::common::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("jib_inertia"), std::string::npos) << e.what();
@@ -100,20 +100,22 @@ TEST(CraneAuditData, BadInputIsRefusedNamingRowColumnOrCause) {
 TEST(CraneAuditData, ParameterMappingRoundTripsAndDriveAxisFollowsThePlantRule) {
   crane::common::CraneParameters crane;
   crane.load_mass = 2.4;
-  const auto back = ma::crane_parameters_from_audit(ma::crane_audit_parameters(crane));
+  const auto back = std::get<crane::common::CraneParameters>(
+      ma::nominal_from_values(ma::AuditPlant::crane, ma::parameter_values(crane)));
   EXPECT_EQ(back.load_mass, 2.4);
   EXPECT_EQ(back.slew_friction.static_negative, crane.slew_friction.static_negative);
-  EXPECT_THROW((void)ma::crane_parameters_from_audit({{"load_mass", -1.0}}), crane::common::ConfigError);
+  EXPECT_THROW((void)ma::override_values(crane::common::CraneParameters{}, {{"load_mass", -1.0}}),
+               crane::common::ConfigError);
   // Trolley of the lab crane (K = 2): b+ = 1.5, b- = 6 V s/m -> b = 2 * 3.75 = 7.5, db = 2 * (-2.25) = -4.5;
   // c+ = 0.9, c- = 1.2 V -> c = 2.1, dc = -0.3; static 1.0 / 1.2 V -> excess 0.1 / 0 V -> stiction
   // 2 * 0.05 = 0.1 and asymmetry 0.1 [m/s^2].
-  const auto axis = ma::drive_axis_audit_parameters(crane.trolley_friction, crane.trolley_drive_gain);
-  EXPECT_NEAR(axis.at("b"), 7.5, 1e-12);
-  EXPECT_NEAR(axis.at("viscous_asymmetry"), -4.5, 1e-12);
-  EXPECT_NEAR(axis.at("c"), 2.1, 1e-12);
-  EXPECT_NEAR(axis.at("coulomb_asymmetry"), -0.3, 1e-12);
-  EXPECT_NEAR(axis.at("stiction"), 0.1, 1e-12);
-  EXPECT_NEAR(axis.at("stiction_asymmetry"), 0.1, 1e-12);
+  const auto axis = ma::drive_axis_parameters(crane.trolley_friction, crane.trolley_drive_gain);
+  EXPECT_NEAR(axis.viscous, 7.5, 1e-12);
+  EXPECT_NEAR(axis.viscous_asymmetry, -4.5, 1e-12);
+  EXPECT_NEAR(axis.coulomb, 2.1, 1e-12);
+  EXPECT_NEAR(axis.coulomb_asymmetry, -0.3, 1e-12);
+  EXPECT_NEAR(axis.stiction, 0.1, 1e-12);
+  EXPECT_NEAR(axis.stiction_asymmetry, 0.1, 1e-12);
 }
 
 // Cross-check of the swing elimination against the plant model's own forward dynamics: with the
@@ -145,14 +147,13 @@ TEST(CraneSwing, EliminationMatchesTheForwardDynamics) {
 TEST(CraneAudit, StackRecordingGivesNoneAndAWrongPayloadIsFound) {
   const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, "none", 77);
   ma::AuditOptions options;
-  options.plant = ma::AuditPlant::crane;
-  options.parameters = c.nominal;
+  options.nominal = c.nominal;
   const auto clean = ma::run_audit(c.data, options);
   EXPECT_EQ(clean.cause, "none") << clean.stop_reason;
   ASSERT_EQ(clean.channels.size(), 3U);
 
-  const double true_mass = c.nominal.at("load_mass");
-  options.parameters["load_mass"] = 1.25 * true_mass;  // the configuration is 25 % off
+  const double true_mass = std::get<crane::common::CraneParameters>(c.nominal).load_mass;
+  std::get<crane::common::CraneParameters>(options.nominal).load_mass = 1.25 * true_mass;  // the configuration is 25 % off
   const auto wrong = ma::run_audit(c.data, options);
   ASSERT_EQ(wrong.cause, "payload_mass_error") << wrong.stop_reason;
   double fitted_mass = 0.0;
@@ -204,8 +205,7 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
     data.cable_length.push_back(m.cable_length);
   }
   ma::AuditOptions options;
-  options.plant = ma::AuditPlant::crane;
-  options.parameters = ma::crane_audit_parameters(parameters.crane);
+  options.nominal = parameters.crane;
   const auto right = ma::run_audit(data, options);
   EXPECT_EQ(right.cause, "none") << right.stop_reason;
   for (const auto& c : right.channels) {
@@ -213,7 +213,7 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
                 c.plant.c_str(), c.channel.c_str(), c.holdout_before, c.unit.c_str(), c.before.whiteness.p_value,
                 c.effort_holdout_before);
   }
-  options.parameters["load_mass"] = 0.8 * parameters.crane.load_mass;
+  std::get<crane::common::CraneParameters>(options.nominal).load_mass = 0.8 * parameters.crane.load_mass;
   const auto wrong = ma::run_audit(data, options);
   ASSERT_EQ(wrong.cause, "payload_mass_error") << wrong.stop_reason;
   for (const auto& p : wrong.parameters) {
@@ -233,7 +233,7 @@ TEST(CraneAuditCli, ConfigAndParamGiveTheNominalAndBadDataIsRefused) {
   const fs::path data = dir.string() + "_case.csv";
   ASSERT_EQ(run_tool("generate --model crane --effect none --seed 31 --out " + data.string()), 0);
   const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, "none", 31);
-  const std::string mass = " --param load_mass=" + crane::common::format_value(c.nominal.at("load_mass"));
+  const std::string mass = " --param load_mass=" + crane::common::format_value(std::get<crane::common::CraneParameters>(c.nominal).load_mass);
   ASSERT_EQ(run_tool("--model crane --data " + data.string() + " --config " + CRANE_LAB_CONFIG + mass + " --out " +
                      dir.string()),
             0);

@@ -75,8 +75,7 @@ Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_case
     const std::string effect = clean ? "none" : catalog[(i * stride) % catalog.size()];
     const auto c = ma::generate_hidden_effect_case(plant, effect, seed_base + i);
     ma::AuditOptions options;
-    options.plant = plant;
-    options.parameters = c.nominal;
+    options.nominal = c.nominal;
     const auto report = ma::run_audit(c.data, options);
     tally.confusion[c.effect][report.cause] += 1;
     if (clean) {

@@ -317,15 +317,15 @@ HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, d
   truth.crane.cable_length = uniform(0.6, 1.6);
   common::CraneParameters nominal = truth.crane;
   const auto axis_truth = [](const common::AxisFriction& f, double gain) {
-    const auto p = drive_axis_audit_parameters(f, gain);
+    const AxisAuditParameters p = drive_axis_parameters(f, gain);
     AxisModel m;
-    m.motor_constant = p.at("K_m");
-    m.viscous = p.at("b");
-    m.viscous_asymmetry = p.at("viscous_asymmetry");
-    m.coulomb = p.at("c");
-    m.coulomb_asymmetry = p.at("coulomb_asymmetry");
-    m.stiction = p.at("stiction");
-    m.stiction_asymmetry = p.at("stiction_asymmetry");
+    m.motor_constant = p.motor_constant;
+    m.viscous = p.viscous;
+    m.viscous_asymmetry = p.viscous_asymmetry;
+    m.coulomb = p.coulomb;
+    m.coulomb_asymmetry = p.coulomb_asymmetry;
+    m.stiction = p.stiction;
+    m.stiction_asymmetry = p.stiction_asymmetry;
     return m;
   };
   truth.trolley = axis_truth(truth.crane.trolley_friction, truth.crane.trolley_drive_gain);
@@ -360,7 +360,7 @@ HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, d
   }
   out.main_parameter = drawn.parameter;
   out.main_value = drawn.value;
-  out.nominal = crane_audit_parameters(nominal);
+  out.nominal = nominal;
   out.data.source = "generated crane case (seed " + std::to_string(seed) + ", effect " + e + ")";
   run_crane(truth, length, seed, &out.data);
   return out;
@@ -389,7 +389,11 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
     model.motor_constant = uniform(1.5, 2.0);
     model.viscous = uniform(2.5, 4.5) * model.motor_constant;
     model.coulomb = uniform(0.8, 1.2) * model.motor_constant;
-    out.nominal = {{"K_m", model.motor_constant}, {"b", model.viscous}, {"c", model.coulomb}};
+    AxisAuditParameters nominal;
+    nominal.motor_constant = model.motor_constant;
+    nominal.viscous = model.viscous;
+    nominal.coulomb = model.coulomb;
+    out.nominal = nominal;
     const double c = model.coulomb;
     const double b = model.viscous;
     const Sensor sensor{5e-6, 1e-5};
@@ -411,7 +415,11 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
   model.damping = uniform(0.005, 0.03);
   const double zero = std::numbers::pi;
   model.theta_zero = zero;
-  out.nominal = {{"L", model.length}, {"damping", model.damping}, {"theta_zero", zero}};
+  PendulumAuditParameters nominal;
+  nominal.length = model.length;
+  nominal.damping = model.damping;
+  nominal.theta_zero = zero;
+  out.nominal = nominal;
   const Drawn drawn = draw_pendulum_effect(e, model, model.gravity / model.length, uniform, signed_uniform);
   out.main_parameter = drawn.parameter;
   out.main_value = drawn.value;

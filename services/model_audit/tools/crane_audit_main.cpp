@@ -23,11 +23,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "crane/common/validation.hpp"
 #include "crane/config/stack_config.hpp"
+#include "crane/model_audit/audit_report.hpp"
 #include "crane/model_audit/hidden_effect_generator.hpp"
 #include "crane/model_audit/measured_data.hpp"
 #include "crane/model_audit/model_audit.hpp"
@@ -65,12 +68,14 @@ std::map<std::string, double> parse_parameters(const std::vector<std::string>& e
   return out;
 }
 
-// Nominal parameters of `plant` from the stack configuration `path` (empty: none).
-std::map<std::string, double> config_parameters(const std::string& path, ma::AuditPlant plant) {
-  if (path.empty()) return {};
+// Nominal model of `plant` from the stack configuration `path` (empty: none).
+std::optional<ma::AuditNominal> config_nominal(const std::string& path, ma::AuditPlant plant) {
+  if (path.empty()) return std::nullopt;
   const crane::common::CraneParameters crane = crane::config::load_stack_config(path).crane;
-  if (plant == ma::AuditPlant::crane) return ma::crane_audit_parameters(crane);
-  if (plant == ma::AuditPlant::axis) return ma::drive_axis_audit_parameters(crane.trolley_friction, crane.trolley_drive_gain);
+  if (plant == ma::AuditPlant::crane) return ma::AuditNominal{crane};
+  if (plant == ma::AuditPlant::axis) {
+    return ma::AuditNominal{ma::drive_axis_parameters(crane.trolley_friction, crane.trolley_drive_gain)};
+  }
   throw crane::common::ConfigError("config: --config gives crane or trolley-axis parameters, not the pendulum's "
                                    "(give --param L=VALUE)");
 }
@@ -135,7 +140,7 @@ int main(int argc, char** argv) {
       const auto c = ma::generate_hidden_effect_case(plant, effect, seed);
       std::string comment = "hidden-effect case: effect " + c.effect + " " + c.main_parameter + "=" +
                             crane::common::format_value(c.main_value) + "; nominal";
-      for (const auto& [k, v] : c.nominal) comment += " " + k + "=" + crane::common::format_value(v);
+      for (const auto& [k, v] : ma::parameter_values(c.nominal)) comment += " " + k + "=" + crane::common::format_value(v);
       std::ofstream out(generate_out);
       const auto& d = c.data;
       if (plant == ma::AuditPlant::axis) {
@@ -152,9 +157,9 @@ int main(int argc, char** argv) {
     }
     if (data_path.empty()) throw crane::common::ConfigError("data: --data is required");
     if (out_dir.empty()) throw crane::common::ConfigError("out: --out is required");
-    options.plant = plant;
-    options.parameters = config_parameters(config_path, plant);
-    for (const auto& [name, value] : parse_parameters(params)) options.parameters[name] = value;
+    const auto named = parse_parameters(params);
+    const auto from_config = config_nominal(config_path, plant);
+    options.nominal = from_config ? ma::override_values(*from_config, named) : ma::nominal_from_values(plant, named);
     options.calibrate = calibrate;
     options.causes = causes;
     if (channel == "effort") options.channel = ma::AuditChannel::effort;

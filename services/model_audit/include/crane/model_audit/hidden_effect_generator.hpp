@@ -45,7 +45,6 @@
 // Offline, allocates; throws common::ConfigError for an unknown effect name.
 
 #include <cstdint>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -57,7 +56,7 @@ struct HiddenEffectCase {
   std::string effect{"none"};                 // catalog name or "none"
   std::string main_parameter;                 // name as reported by the audit ("" for none)
   double main_value{0.0};                     // true value of the main parameter
-  std::map<std::string, double> nominal;      // nominal parameters to pass to the audit
+  AuditNominal nominal;                       // nominal model to pass to the audit
   AuditData data;
 };
 

@@ -22,11 +22,11 @@
 //    within dead_band are "at rest": their residual is the distance of the needed drive from the
 //    static friction interval. Backlash is not defined in this channel (skipped).
 // Crane (the full plant of plant::TowerCraneModel; data t, u_x, u_gamma, x, gamma, phi, theta, L;
-// nominal parameters: common::CraneParameters, see crane_audit_parameters()): three channels, each
+// nominal parameters: common::CraneParameters, named as in audit_parameters.hpp): three channels, each
 // audited as above, then combined.
 //  - trolley and slew: each drive is the axis model of audit_models.hpp (K_m, b, c from the drive gain
 //    and the configuration's volt-equivalent friction, with its asymmetries and static excess as the
-//    nominal dc, db, Delta_s, dDelta_s: drive_axis_audit_parameters()) in its row of the full model,
+//    nominal dc, db, Delta_s, dDelta_s: drive_axis_parameters()) in its row of the full model,
 //    I a + C = I_drive (drive - friction), I_drive = M_drive (trolley) or J_o (slew). I and C come
 //    from the inverse dynamics of the full model with the measured motion (rates by central
 //    differences, swing angles low-passed at 5 Hz, swing accelerations eliminated through the swing
@@ -51,52 +51,32 @@
 // pendulum L, damping) are fitted first and refitted with every candidate, and candidates that they
 // absorb are skipped (gain_error; cable_length_error, pendulum_viscous_damping).
 //
-// Offline: allocates; throws common::ConfigError for bad options and DataError (measured_data.hpp)
-// for bad data, each naming the field, row or column.
+// Structure: one audit per plant model behind one interface (src/channel_audit.hpp), each with its
+// catalog (src/axis_catalog.cpp, src/pendulum_audit.cpp); a new cause is one catalog entry
+// (docs/model_audit.md). The report files are written outside this library (audit_report.hpp of
+// crane::model_audit_report).
+//
+// Offline: allocates, writes no files; throws common::ConfigError for bad options and DataError
+// (measured_data.hpp) for bad data, each naming the field, row or column.
 
 #include <cstddef>
 #include <filesystem>
-#include <map>
 #include <string>
 #include <vector>
 
-#include "crane/common/crane_parameters.hpp"
+#include "crane/model_audit/audit_parameters.hpp"
 #include "crane/model_audit/measured_data.hpp"
 #include "crane/model_audit/residual_analysis.hpp"
 
 namespace crane::model_audit {
 
-enum class AuditPlant { axis, pendulum, crane };
 enum class AuditChannel { position, effort };  // effort: axis only (crane: always as a second opinion)
 
-/// Catalog entry names of a plant, in catalog order. Crane: every axis entry once per drive axis,
-/// prefixed "trolley_" and "slew_" (e.g. trolley_stiction, slew_stribeck), then the pendulum
+/// Catalog entry names of a plant, in catalog order, generated from the models' catalogs (one table
+/// per model: src/axis_catalog.cpp, src/pendulum_audit.cpp). Crane: every axis entry once per drive
+/// axis, prefixed "trolley_" and "slew_" (e.g. trolley_stiction, slew_stribeck), then the pendulum
 /// entries (fitted on the swing channel), then payload_mass_error.
 [[nodiscard]] const std::vector<std::string>& audit_catalog(AuditPlant plant);
-/// Nominal parameter names accepted by --param: axis K_m [m/s^2/V], b [1/s], c [m/s^2] and, optional
-/// (default 0), the nominal coulomb_asymmetry dc [m/s^2], viscous_asymmetry db [1/s], stiction
-/// Delta_s [m/s^2] and stiction_asymmetry dDelta_s [m/s^2] of audit_models.hpp (the catalog entries
-/// add to them); pendulum L [m], damping [1/s], theta_zero [rad] (measured angle of hanging down;
-/// unknown = estimated), gravity [m/s^2]; crane: the fields of common::CraneParameters that the
-/// model uses, named as crane_audit_parameters() lists them (all required).
-[[nodiscard]] const std::vector<std::string>& audit_parameter_names(AuditPlant plant);
-
-/// The crane parameters as audit parameters: gravity, load_mass, trolley_drive_mass, trolley_mass,
-/// jib_inertia, trolley_drive_gain, slew_drive_gain, and trolley_/slew_ + viscous_positive,
-/// viscous_negative, coulomb_positive, coulomb_negative, static_positive, static_negative (volt
-/// equivalents, as in the configuration).
-[[nodiscard]] std::map<std::string, double> crane_audit_parameters(const common::CraneParameters& crane);
-/// Axis nominal parameters (audit_parameter_names(axis)) of a crane drive axis from its volt-equivalent
-/// friction `friction` and drive gain `gain` K_m [m/s^2/V] (trolley) or [rad/s^2/V] (slew):
-/// b = K_m (b+ + b-)/2, viscous_asymmetry = K_m (b+ - b-)/2, likewise c and coulomb_asymmetry, and the
-/// breakaway excess K_m (max(static, coulomb) - coulomb) of each direction as stiction +-
-/// stiction_asymmetry (the plant's rule, axis_friction.hpp).
-[[nodiscard]] std::map<std::string, double> drive_axis_audit_parameters(const common::AxisFriction& friction,
-                                                                        double gain);
-/// The inverse: `parameters` overrides the fields of `base` it names. Throws common::ConfigError for
-/// an unknown name or an invalid result (common::validate).
-[[nodiscard]] common::CraneParameters crane_parameters_from_audit(const std::map<std::string, double>& parameters,
-                                                                  const common::CraneParameters& base = {});
 
 /// Uniformly sampled measured data. Axis: input u [V], output x [m]. Pendulum: output theta [rad]
 /// as measured, optional trolley_position x [m] (driven swing); input unused. Crane: input u_x [V],
@@ -144,8 +124,7 @@ struct AuditData {
 inline constexpr double kCraneResolutionQuanta = 2.0;
 
 struct AuditOptions {
-  AuditPlant plant{AuditPlant::axis};
-  std::map<std::string, double> parameters;  // nominal, names from audit_parameter_names()
+  AuditNominal nominal;  // the nominal model; its alternative chooses the plant (audit_parameters.hpp)
   bool calibrate{false};
   std::vector<std::string> causes;           // restrict to these catalog names; empty = all
   AuditChannel channel{AuditChannel::position};
@@ -168,8 +147,8 @@ struct AuditOptions {
   std::size_t max_lag{20};          // [samples] Ljung-Box lags
 };
 
-/// Throws common::ConfigError naming the field: unknown --param name (lists the valid ones),
-/// missing required nominal parameter, unknown cause (lists the catalog), out-of-range option.
+/// Throws common::ConfigError naming the field: a nominal parameter out of its bounds
+/// (validate(AuditNominal)), an unknown cause (lists the catalog), an out-of-range option.
 void validate(const AuditOptions& options);
 
 struct FittedParameter {
@@ -230,10 +209,5 @@ struct AuditReport {
 /// Runs the audit (validates first). Throws common::ConfigError / DataError (too few samples for the
 /// windows, a channel the plant does not have).
 [[nodiscard]] AuditReport run_audit(const AuditData& data, const AuditOptions& options);
-
-/// Writes DIR/report.json, DIR/report.md and DIR/series.csv (t, measured, nominal, extended,
-/// holdout). `command_line` goes into the markdown. Creates DIR. Throws DataError on I/O failure.
-void write_audit_report(const AuditReport& report, const std::filesystem::path& directory,
-                        const std::string& command_line);
 
 }  // namespace crane::model_audit

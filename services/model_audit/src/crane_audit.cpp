@@ -1,0 +1,341 @@
+// The crane audit (model_audit.hpp): three channels (trolley, slew, swing), each an audit of its own
+// (AxisAudit per drive with the coupling of the full model, SwingAudit), combined.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "axis_audit.hpp"
+#include "crane/common/validation.hpp"
+#include "crane/model_audit/zero_phase_filter.hpp"
+#include "pendulum_audit.hpp"
+
+namespace crane::model_audit::detail {
+
+namespace {
+
+constexpr const char* kTrolleyPrefix = "trolley_";  // crane catalog names of the trolley axis entries
+constexpr const char* kSlewPrefix = "slew_";
+constexpr double kSwingWindow = 5.0;  // [s] shortest replay window of the crane swing channel
+constexpr double kSwingCutoff = 5.0;  // [Hz] low-pass of the swing angles in the drives' coupling (swing ~0.5 Hz)
+
+// Causes of one channel requested by the crane options: names with `prefix` stripped, pendulum
+// names, or payload_mass_error. `requested` = false when the options name causes but none here.
+std::vector<std::string> channel_causes(const std::vector<std::string>& causes, const std::string& prefix,
+                                        const std::vector<std::string>& catalog, bool with_payload, bool& requested) {
+  requested = causes.empty();
+  std::vector<std::string> out;
+  for (const auto& cause : causes) {
+    std::string name = cause;
+    if (!prefix.empty()) {
+      if (cause == "payload_mass_error" && with_payload) {
+        out.push_back(cause);
+        continue;
+      }
+      if (cause.rfind(prefix, 0) != 0) continue;
+      name = cause.substr(prefix.size());
+    }
+    if (std::find(catalog.begin(), catalog.end(), name) != catalog.end()) out.push_back(name);
+  }
+  requested = requested || !out.empty();
+  return out;
+}
+
+// Measured motion of the crane per sample: central differences (one-sided copies at the ends).
+struct CraneMotion {
+  std::vector<plant::ModelState> state;
+  std::vector<plant::CoordinateVector> acceleration;
+  std::vector<plant::HoistMotion> hoist;
+};
+
+CraneMotion crane_motion(const AuditData& data, double sample_time) {
+  const std::size_t n = data.time.size();
+  const std::vector<double>* q[plant::kNumCoordinates] = {&data.output, &data.swing_in_plane, &data.slew_angle,
+                                                           &data.swing_out_of_plane};
+  CraneMotion m;
+  m.state.resize(n);
+  m.acceleration.resize(n);
+  m.hoist.resize(n);
+  const double t = sample_time;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t c = std::clamp<std::size_t>(k, 1, n - 2);  // stencil centre
+    for (int j = 0; j < plant::kNumCoordinates; ++j) {
+      const auto& v = *q[j];
+      m.state[k].position[j] = v[k];
+      m.state[k].velocity[j] = (v[c + 1] - v[c - 1]) / (2.0 * t);
+      m.acceleration[k][j] = (v[c + 1] - 2.0 * v[c] + v[c - 1]) / (t * t);
+    }
+    const auto& L = data.cable_length;
+    m.hoist[k] = {L[k], (L[c + 1] - L[c - 1]) / (2.0 * t), (L[c + 1] - 2.0 * L[c] + L[c - 1]) / (t * t)};
+  }
+  return m;
+}
+
+// Coupling of the drive axes (inverse dynamics of the full model with the measured motion). The
+// swing accelerations are not differentiated twice (the swing encoders' quanta would give several
+// rad/s^2 of noise): the swing rows of TowerCraneModel give them from the drive accelerations,
+// s'' = -M_ss^-1 (M_sa a'' + bias_s), so the drive rows become M_eff a'' + b_eff = (F_x, T_gamma) with
+//   M_eff = M_aa - M_as M_ss^-1 M_sa,  b_eff = bias_a - M_as M_ss^-1 bias_s
+// at the measured positions and (central-difference) rates. Drive i: I_i a_i + C_i with the inertia
+// I_i = M_eff,ii and C_i = b_eff,i + M_eff,ij a_j (the other drive's measured acceleration). The swing
+// rows do not depend on the load mass and the drive rows are affine in it, so I and C are affine in
+// m: I = I(0) + m dI, C = C(0) + m dC.
+struct DriveCoupling {
+  std::vector<double> inertia;           // at the nominal load mass
+  std::vector<double> inertia_per_mass;
+  std::vector<double> force;
+  std::vector<double> force_per_mass;
+};
+
+std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion) {
+  common::CraneParameters massless = crane;
+  massless.load_mass = 0.0;
+  common::CraneParameters unit = crane;
+  unit.load_mass = 1.0;
+  const plant::TowerCraneModel model0(massless);
+  const plant::TowerCraneModel model1(unit);
+  const std::size_t n = motion.state.size();
+  std::pair<DriveCoupling, DriveCoupling> out;
+  for (auto* c : {&out.first, &out.second}) {
+    c->inertia.resize(n);
+    c->inertia_per_mass.resize(n);
+    c->force.resize(n);
+    c->force_per_mass.resize(n);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    plant::CoordinateMatrix mass0;
+    plant::CoordinateMatrix mass1;
+    plant::CoordinateVector bias0;
+    plant::CoordinateVector bias1;
+    model0.compute_dynamics(motion.state[k], motion.hoist[k], mass0, bias0);
+    model1.compute_dynamics(motion.state[k], motion.hoist[k], mass1, bias1);
+    const Eigen::Vector2d a(motion.acceleration[k][plant::kTrolleyIndex], motion.acceleration[k][plant::kSlewIndex]);
+    const SwingElimination e0 = eliminate_swing(mass0, bias0);
+    const SwingElimination e1 = eliminate_swing(mass1, bias1);
+    const Eigen::Matrix2d inertia[2] = {e0.drive_inertia, e1.drive_inertia};
+    const Eigen::Vector2d bias[2] = {e0.drive_bias, e1.drive_bias};
+    for (int i = 0; i < 2; ++i) {
+      DriveCoupling& c = i == 0 ? out.first : out.second;
+      const double force0 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i);
+      const double force1 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i);
+      c.inertia_per_mass[k] = inertia[1](i, i) - inertia[0](i, i);
+      c.force_per_mass[k] = force1 - force0;
+      c.inertia[k] = inertia[0](i, i) + crane.load_mass * c.inertia_per_mass[k];
+      c.force[k] = force0 + crane.load_mass * c.force_per_mass[k];
+    }
+  }
+  return out;
+}
+
+// Drive motion held over [t_k, t_k+1) for the swing replay: position and rates at t_k, the
+// acceleration of the interval (mean of the second differences at k and k+1).
+std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
+  const std::size_t n = m.state.size();
+  std::vector<DriveMotion> out(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t next = std::min(k + 1, n - 1);
+    DriveMotion& d = out[k];
+    d.trolley_position = m.state[k].position[plant::kTrolleyIndex];
+    d.trolley_velocity = m.state[k].velocity[plant::kTrolleyIndex];
+    d.trolley_acceleration = 0.5 * (m.acceleration[k][plant::kTrolleyIndex] + m.acceleration[next][plant::kTrolleyIndex]);
+    d.slew_rate = m.state[k].velocity[plant::kSlewIndex];
+    d.slew_acceleration = 0.5 * (m.acceleration[k][plant::kSlewIndex] + m.acceleration[next][plant::kSlewIndex]);
+    d.cable_length = m.hoist[k].cable_length;
+    d.cable_length_rate = m.hoist[k].cable_length_rate;
+    d.cable_length_acceleration = m.hoist[k].cable_length_acceleration;
+  }
+  return out;
+}
+
+// The slew's units: the axis model's metres are radians there ("m/s^2/m" -> "rad/s^2/rad").
+std::string slew_unit(const std::string& unit) {
+  std::string out;
+  std::size_t start = 0;
+  while (start <= unit.size()) {
+    const std::size_t end = std::min(unit.find('/', start), unit.size());
+    const std::string token = unit.substr(start, end - start);
+    out += (token == "m" ? "rad" : token.rfind("m^", 0) == 0 ? "rad" + token.substr(1) : token);
+    if (end < unit.size()) out += '/';
+    start = end + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) {
+  if (options.calibrate) {
+    throw common::ConfigError("calibrate: not available for the crane model (give the nominal parameters with "
+                              "--config and --param)");
+  }
+  if (options.channel == AuditChannel::effort) {
+    throw common::ConfigError("channel: the crane audit fits the position and swing channels and reports the "
+                              "effort channel of each drive as a second opinion; do not give --channel effort");
+  }
+  const std::size_t n = data.time.size();
+  if (n < 50) throw DataError(data.source + ": too few samples: " + std::to_string(n) + " (minimum 50)");
+  for (const auto* column : {&data.input, &data.output, &data.slew_input, &data.slew_angle, &data.swing_in_plane,
+                             &data.swing_out_of_plane, &data.cable_length}) {
+    if (column->size() != n) throw DataError(data.source + ": crane columns of different lengths");
+  }
+  const common::CraneParameters& crane = std::get<common::CraneParameters>(options.nominal);
+  const double sample_time = (data.time.back() - data.time.front()) / static_cast<double>(n - 1);
+  const CraneMotion motion = crane_motion(data, sample_time);
+  // The coupling uses the swing angles low-passed (zero phase, kSwingCutoff): their encoder quanta
+  // would otherwise reach the drives through the rates in the centripetal and Coriolis terms.
+  AuditData smoothed = data;
+  if (sample_time < 0.25 / kSwingCutoff) {
+    smoothed.swing_in_plane = zero_phase_low_pass(data.swing_in_plane, kSwingCutoff, 1.0 / sample_time);
+    smoothed.swing_out_of_plane = zero_phase_low_pass(data.swing_out_of_plane, kSwingCutoff, 1.0 / sample_time);
+  }
+  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, crane_motion(smoothed, sample_time));
+
+  AuditReport report;
+  report.plant = "crane";
+  report.sample_time = sample_time;
+  report.samples = n;
+  for (const auto& [name, value] : parameter_values(crane)) report.nominal.push_back({name, "", value, 0.0});
+
+  // Drive axes.
+  const auto& drive_catalog = audit_catalog(AuditPlant::axis);
+  const auto drive_channel = [&](const std::string& prefix, const std::vector<double>& input,
+                                 const std::vector<double>& position, const DriveCoupling& coupling,
+                                 double drive_inertia, const common::AxisFriction& friction,
+                                 double gain) -> std::optional<AuditReport> {
+    bool requested = false;
+    AuditOptions axis_options = options;
+    axis_options.causes = channel_causes(options.causes, prefix, drive_catalog, true, requested);
+    if (!requested) return std::nullopt;
+    axis_options.nominal = drive_axis_parameters(friction, gain);
+    axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    axis_options.every_grid_start = true;
+    AuditData axis_data;
+    axis_data.source = data.source;
+    axis_data.time = data.time;
+    axis_data.input = input;
+    axis_data.output = position;
+    axis_data.coupling_inertia = coupling.inertia;
+    axis_data.coupling_inertia_per_mass = coupling.inertia_per_mass;
+    axis_data.coupling_force = coupling.force;
+    axis_data.coupling_force_per_mass = coupling.force_per_mass;
+    axis_data.drive_inertia = drive_inertia;
+    axis_data.load_mass = crane.load_mass;
+    validate(axis_options);
+    AuditReport channel =
+        run_channel_audit(AxisAudit(axis_data, std::get<AxisAuditParameters>(axis_options.nominal), axis_options), axis_options);
+    channel.plant = prefix.substr(0, prefix.size() - 1);
+    const bool slew = prefix == kSlewPrefix;
+    if (slew) channel.unit = slew_unit(channel.unit);
+    for (auto& candidate : channel.candidates) {
+      if (candidate.name != "payload_mass_error") candidate.name = prefix + candidate.name;
+      for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
+    }
+    for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
+    if (channel.cause != "none" && channel.cause != "payload_mass_error") channel.cause = prefix + channel.cause;
+    return channel;
+  };
+  if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
+                             crane.trolley_friction, crane.trolley_drive_gain)) {
+    report.channels.push_back(std::move(*c));
+  }
+  if (auto c = drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, slew_coupling, crane.jib_inertia,
+                             crane.slew_friction, crane.slew_drive_gain)) {
+    report.channels.push_back(std::move(*c));
+  }
+
+  // Swing.
+  {
+    bool requested = false;
+    AuditOptions swing_options = options;
+    swing_options.causes = channel_causes(options.causes, "", audit_catalog(AuditPlant::pendulum), false, requested);
+    double mean_length = 0.0;
+    for (const double L : data.cable_length) mean_length += L / static_cast<double>(n);
+    PendulumAuditParameters swing_nominal;
+    swing_nominal.length = mean_length;
+    swing_nominal.gravity = crane.gravity;
+    swing_options.nominal = swing_nominal;
+    swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
+    swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    if (requested) {
+      std::vector<double> measured(2 * n);
+      for (std::size_t k = 0; k < n; ++k) {
+        measured[2 * k] = data.swing_in_plane[k];
+        measured[2 * k + 1] = data.swing_out_of_plane[k];
+      }
+      AuditData swing_data;
+      swing_data.source = data.source;
+      swing_data.time = data.time;
+      swing_data.output = data.swing_in_plane;
+      validate(swing_options);
+      const SwingAudit swing(swing_data, std::make_shared<const plant::TowerCraneModel>(crane), swing_drive_motion(motion),
+                             std::move(measured), mean_length, crane.gravity, swing_options);
+      report.channels.push_back(run_channel_audit(swing, swing_options));
+    }
+  }
+
+  // Combine: the qualifying candidate with the lowest delta-BIC over the channels whose nominal
+  // residual is not white; payload_mass_error (fitted on both drives) keeps its better fit.
+  const AuditReport* chosen_channel = nullptr;
+  const CandidateReport* chosen = nullptr;
+  const CandidateReport* payload = nullptr;
+  for (const auto& channel : report.channels) {
+    const bool white = channel.before.whiteness.lags > 0 && channel.before.whiteness.p_value >= 0.05;
+    for (const auto& candidate : channel.candidates) {
+      if (candidate.name == "payload_mass_error" && candidate.fitted &&
+          (payload == nullptr || candidate.delta_bic < payload->delta_bic)) {
+        payload = &candidate;
+      }
+      if (white || !candidate.qualifies) continue;
+      if (chosen == nullptr || candidate.delta_bic < chosen->delta_bic) {
+        chosen = &candidate;
+        chosen_channel = &channel;
+      }
+    }
+  }
+  for (const auto& channel : report.channels) {
+    for (const auto& candidate : channel.candidates) {
+      if (candidate.name == "payload_mass_error" && candidate.fitted && &candidate != payload) continue;
+      report.candidates.push_back(candidate);
+    }
+  }
+  std::stable_sort(report.candidates.begin(), report.candidates.end(), [](const auto& a, const auto& b) {
+    if (a.fitted != b.fitted) return a.fitted;
+    return a.fitted && a.delta_bic < b.delta_bic;
+  });
+  const AuditReport& shown = chosen_channel != nullptr ? *chosen_channel : report.channels.front();
+  report.channel = shown.plant + " " + shown.channel;
+  report.unit = shown.unit;
+  report.before = shown.before;
+  report.after = shown.after;
+  report.holdout_before = shown.holdout_before;
+  report.holdout_after = shown.holdout_after;
+  report.holdout_percent = shown.holdout_percent;
+  report.effort_holdout_before = shown.effort_holdout_before;
+  report.effort_holdout_after = shown.effort_holdout_after;
+  report.time = shown.time;
+  report.measured = shown.measured;
+  report.nominal_prediction = shown.nominal_prediction;
+  report.extended_prediction = shown.extended_prediction;
+  report.holdout = shown.holdout;
+  if (chosen != nullptr) {
+    report.cause = chosen->name;
+    report.parameters = chosen->parameters;
+    report.extended_nominal = shown.extended_nominal;
+    if (chosen->name == "payload_mass_error") {
+      const double dm = chosen->parameters.front().value;
+      report.parameters.push_back({"load_mass", "kg", crane.load_mass + dm, chosen->parameters.front().standard_error});
+    }
+    report.stop_reason = "selected " + chosen->name + " on the " + report.channel +
+                         " channel (lowest delta-BIC among qualifying candidates of all channels)";
+  } else {
+    report.stop_reason = "no channel has a candidate that earns its parameters (";
+    for (const auto& channel : report.channels) {
+      report.stop_reason += channel.plant + " " + channel.channel + ": " + channel.stop_reason + "; ";
+    }
+    report.stop_reason.resize(report.stop_reason.size() - 2);
+    report.stop_reason += ")";
+  }
+  return report;
+}
+
+}  // namespace crane::model_audit::detail

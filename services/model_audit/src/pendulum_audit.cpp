@@ -1,0 +1,268 @@
+#include "pendulum_audit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+namespace crane::model_audit::detail {
+
+const std::vector<PendulumCause>& pendulum_catalog() {
+  static const std::vector<PendulumCause> catalog{
+      {.name = "pendulum_viscous_damping",
+       .parameter = [](double) -> ParameterSpec {
+         return {"extra_viscous_damping", "1/s", 0.1, -1.0, 20.0, linspace(0.0, 0.6, 61)};
+       },
+       .apply = [](const double* p, PendulumModel& m) { m.extra_viscous = std::max(p[0], -m.damping); },
+       .apply_swing = [](const double* p, SwingEffects& e) { e.extra_viscous = p[0]; },
+       .calibration_note = "absorbed by the calibrated nominal parameters"},
+      {.name = "pendulum_coulomb_damping",
+       .parameter = [](double omega2) -> ParameterSpec {
+         return {"coulomb_damping", "rad/s^2", 0.005 * omega2, 0.0, 2.0 * omega2,
+                 linspace(0.0002 * omega2, 0.012 * omega2, 60)};
+       },
+       .apply = [](const double* p, PendulumModel& m) { m.coulomb = std::max(p[0], 0.0); },
+       .apply_swing = [](const double* p, SwingEffects& e) { e.coulomb = std::max(p[0], 0.0); }},
+      {.name = "pendulum_quadratic_damping",
+       .parameter = [](double) -> ParameterSpec {
+         return {"quadratic_damping", "1/rad", 0.1, 0.0, 50.0, linspace(0.0, 1.0, 51)};
+       },
+       .apply = [](const double* p, PendulumModel& m) { m.quadratic = std::max(p[0], 0.0); },
+       .apply_swing = [](const double* p, SwingEffects& e) { e.quadratic = std::max(p[0], 0.0); }},
+      {.name = "cable_length_error",
+       .parameter = [](double) -> ParameterSpec {
+         return {"length_error", "-", 0.05, -0.8, 2.0, linspace(-0.25, 0.25, 51)};
+       },
+       .apply = [](const double* p, PendulumModel& m) { m.length_error = std::max(p[0], -0.9); },
+       .apply_swing = [](const double* p, SwingEffects& e) { e.length_error = std::max(p[0], -0.9); },
+       .calibration_note = "absorbed by the calibrated nominal parameters"},
+      {.name = "encoder_offset",
+       .parameter = [](double) -> ParameterSpec {
+         return {"encoder_offset", "rad", 0.02, -0.5, 0.5, linspace(-0.1, 0.1, 41)};
+       },
+       .apply = [](const double* p, PendulumModel& m) { m.encoder_offset = p[0]; },
+       .apply_swing = [](const double* p, SwingEffects& e) { e.encoder_offset = p[0]; },
+       .needs_known_zero = true},
+  };
+  return catalog;
+}
+
+struct PendulumSeries {
+  std::vector<double> theta;
+  std::vector<double> trolley_acceleration;
+  double sample_time{0.0};
+  double gravity{9.80665};
+  int substeps{4};
+  const PendulumCause* cause{nullptr};  // nullptr: the nominal model
+};
+
+struct SwingSeries {
+  std::shared_ptr<const plant::TowerCraneModel> model;
+  std::vector<DriveMotion> motion;
+  std::vector<double> measured;  // interleaved phi, theta [rad] (2 per sample)
+  double sample_time{0.0};
+  int substeps{1};
+  const PendulumCause* cause{nullptr};  // nullptr: the nominal model
+};
+
+namespace {
+
+constexpr std::size_t kPendulumBase = 3;  // L, damping, theta_zero
+
+std::vector<Candidate> candidates_of(double omega_squared) {
+  std::vector<Candidate> list;
+  const auto& catalog = pendulum_catalog();
+  for (std::size_t i = 0; i < catalog.size(); ++i) {
+    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, ""});
+  }
+  return list;
+}
+
+
+
+PendulumModel pendulum_model(const PendulumSeries& s, const std::vector<double>& full) {
+  PendulumModel m;
+  m.length = std::max(full[0], 1e-6);
+  m.damping = std::max(full[1], 0.0);
+  m.theta_zero = full[2];
+  m.gravity = s.gravity;
+  if (s.cause != nullptr) s.cause->apply(full.data() + kPendulumBase, m);
+  return m;
+}
+
+Problem pendulum_problem(const std::shared_ptr<PendulumSeries>& s, const std::vector<double>& segment,
+                         double holdout_fraction, const std::vector<double>& base) {
+  Problem problem;
+  const std::size_t n = s->theta.size();
+  std::size_t first = 0;
+  for (std::size_t k = 1; k <= n; ++k) {
+    if (k == n || (!segment.empty() && segment[k] != segment[k - 1])) {
+      Window w;
+      w.first = first;
+      w.count = k - first;
+      w.train_count = static_cast<std::size_t>(std::floor((1.0 - holdout_fraction) * static_cast<double>(w.count)));
+      if (w.count >= 10) problem.windows.push_back(w);
+      first = k;
+    }
+  }
+  problem.nuisance_size = 2;
+  const double zero = base[2];
+  problem.initial_nuisance = [s, zero](const Window& w, double* out) {
+    const auto [a0, r0] = local_state(s->theta, w.first, w.first + w.count, s->sample_time);
+    out[0] = a0 - zero;
+    out[1] = r0;
+  };
+  problem.residual = [s](const std::vector<double>& full, const double* nuisance, const Window& w, std::size_t count,
+                         double* out) {
+    const PendulumModel model = pendulum_model(*s, full);
+    PendulumState initial{nuisance[0], nuisance[1]};
+    std::span<double> prediction(out, count);
+    replay_pendulum(model, s->trolley_acceleration, s->sample_time, w.first, initial, s->substeps, prediction);
+    for (std::size_t i = 0; i < count; ++i) out[i] = s->theta[w.first + i] - out[i];
+  };
+  return problem;
+}
+
+
+
+
+// The swing channel has no base parameters: the candidate's parameter comes first.
+SwingEffects swing_effects(const SwingSeries& s, const std::vector<double>& full) {
+  SwingEffects e;
+  if (full.empty() || s.cause == nullptr) return e;
+  s.cause->apply_swing(full.data(), e);
+  return e;
+}
+
+// Windows of window_duration [s] (in the interleaved index space: 2 residuals per sample, phi then
+// theta); the windows in the last holdout_fraction are held out; nuisance: the initial swing state.
+Problem crane_swing_problem(const std::shared_ptr<SwingSeries>& s, double window_duration,
+                            double holdout_fraction) {
+  Problem problem;
+  const std::size_t n = s->motion.size();
+  const auto length = std::max<std::size_t>(static_cast<std::size_t>(std::llround(window_duration / s->sample_time)), 10);
+  const auto holdout_start = static_cast<std::size_t>(std::floor((1.0 - holdout_fraction) * static_cast<double>(n)));
+  for (std::size_t first = 0; first + 10 <= n; first += length) {
+    const std::size_t count = std::min(length, n - first);
+    problem.windows.push_back({2 * first, 2 * count, first >= holdout_start ? 0 : 2 * count});
+  }
+  problem.nuisance_size = 4;
+  problem.initial_nuisance = [s](const Window& w, double* out) {
+    std::vector<double> phi(w.count / 2);
+    std::vector<double> theta(w.count / 2);
+    for (std::size_t i = 0; i < phi.size(); ++i) {
+      phi[i] = s->measured[w.first + 2 * i];
+      theta[i] = s->measured[w.first + 2 * i + 1];
+    }
+    const auto [phi0, phi_rate] = local_state(phi, 0, phi.size(), s->sample_time);
+    const auto [theta0, theta_rate] = local_state(theta, 0, theta.size(), s->sample_time);
+    out[0] = phi0;
+    out[1] = phi_rate;
+    out[2] = theta0;
+    out[3] = theta_rate;
+  };
+  problem.residual = [s](const std::vector<double>& full, const double* nuisance, const Window& w, std::size_t count,
+                         double* out) {
+    const SwingEffects effects = swing_effects(*s, full);
+    const SwingState initial{nuisance[0] - effects.encoder_offset, nuisance[1], nuisance[2], nuisance[3]};
+    replay_crane_swing(*s->model, effects, s->motion, s->sample_time, w.first / 2, count / 2, initial, s->substeps,
+                       std::span<double>(out, count));
+    for (std::size_t i = 0; i < count; ++i) out[i] = s->measured[w.first + i] - out[i];
+  };
+  return problem;
+}
+
+
+}  // namespace
+
+PendulumAudit::PendulumAudit(const AuditData& data, const PendulumAuditParameters& nominal, const AuditOptions& options)
+    : data_(data),
+      sample_time_(checked_sample_time(data)),
+      holdout_fraction_(options.holdout_fraction),
+      theta_zero_known_(nominal.theta_zero.has_value()),
+      gravity_(nominal.gravity) {
+  const std::size_t n = data.time.size();
+  if (data.output.size() != n) throw DataError(data.source + ": columns of different lengths");
+  const double length = nominal.length;
+  const double damping = nominal.damping;
+  double zero = nominal.theta_zero.value_or(0.0);
+  if (!theta_zero_known_) {  // estimate: the median of the measured angle
+    std::vector<double> sorted = data.output;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
+    zero = sorted[n / 2];
+  }
+  base_ = {length, damping, zero};
+  base_specs_ = {{"L", "m", length, 1e-3 * length, 100 * length, {}},
+                 {"damping", "1/s", std::max(damping, 0.05), 0.0, 100.0, {}},
+                 {"theta_zero", "rad", 0.02, zero - 1.0, zero + 1.0, {}}};
+  auto s = std::make_shared<PendulumSeries>();
+  s->theta = data.output;
+  s->sample_time = sample_time_;
+  s->gravity = gravity_;
+  s->substeps = options.substeps;
+  if (!data.trolley_position.empty()) {
+    auto& acc = s->trolley_acceleration;
+    acc.assign(n, 0.0);
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      acc[k] = (data.trolley_position[k + 1] - 2.0 * data.trolley_position[k] + data.trolley_position[k - 1]) /
+               (sample_time_ * sample_time_);
+    }
+  }
+  series_ = std::move(s);
+}
+
+PendulumAudit::~PendulumAudit() = default;
+
+std::vector<std::size_t> PendulumAudit::nominal_free(bool calibrate) const {
+  std::vector<std::size_t> free;
+  if (calibrate) free = {0, 1};
+  if (!theta_zero_known_) free.push_back(2);
+  return free;
+}
+
+std::vector<Candidate> PendulumAudit::candidates() const { return candidates_of(gravity_ / base_[0]); }
+
+std::string PendulumAudit::unavailable(const Candidate& candidate) const {
+  if (!theta_zero_known_ && pendulum_catalog()[candidate.entry].needs_known_zero) {
+    return "theta_zero is estimated (give --param theta_zero=VALUE to test an offset)";
+  }
+  return {};
+}
+
+Problem PendulumAudit::problem(const Candidate* candidate) const {
+  auto s = std::make_shared<PendulumSeries>(*series_);
+  s->cause = candidate != nullptr ? &pendulum_catalog()[candidate->entry] : nullptr;
+  return pendulum_problem(s, data_.segment, holdout_fraction_, base_);
+}
+
+SwingAudit::SwingAudit(const AuditData& data, std::shared_ptr<const plant::TowerCraneModel> model,
+                       std::vector<DriveMotion> motion, std::vector<double> measured, double mean_cable_length,
+                       double gravity, const AuditOptions& options)
+    : data_(data),
+      sample_time_(checked_sample_time(data)),
+      holdout_fraction_(options.holdout_fraction),
+      window_duration_(options.window_duration),
+      omega_squared_(gravity / mean_cable_length) {
+  auto s = std::make_shared<SwingSeries>();
+  s->model = std::move(model);
+  s->motion = std::move(motion);
+  s->measured = std::move(measured);
+  s->sample_time = sample_time_;
+  s->substeps = 1;
+  series_ = std::move(s);
+}
+
+SwingAudit::~SwingAudit() = default;
+
+std::vector<Candidate> SwingAudit::candidates() const { return candidates_of(omega_squared_); }
+
+Problem SwingAudit::problem(const Candidate* candidate) const {
+  auto s = std::make_shared<SwingSeries>(*series_);
+  s->cause = candidate != nullptr ? &pendulum_catalog()[candidate->entry] : nullptr;
+  return crane_swing_problem(s, window_duration_, holdout_fraction_);
+}
+
+double SwingAudit::quantum() const { return resolution_quantum(series_->measured, 2); }
+
+double SwingAudit::measured(std::size_t k) const { return series_->measured[2 * k]; }
+
+}  // namespace crane::model_audit::detail

@@ -1,0 +1,108 @@
+#pragma once
+// The pendulum audit (private to crane_model_audit): the catalog of candidate causes of the swing
+// (audit_models.hpp for the planar pendulum, crane_swing.hpp for the crane's swing) and two
+// ChannelAudits: the pendulum (one window per maneuver, the last part of each held out) and the
+// crane's swing channel (phi and theta replayed with the measured drive and hoist motion).
+//
+// A new swing cause is one PendulumCause in pendulum_catalog() (pendulum_audit.cpp): its name, its
+// parameter, and what it changes in PendulumModel and in SwingEffects. The crane's catalog gets it
+// under the same name.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "channel_audit.hpp"
+#include "crane/model_audit/audit_models.hpp"
+#include "crane/model_audit/audit_parameters.hpp"
+#include "crane/model_audit/crane_swing.hpp"
+
+namespace crane::model_audit::detail {
+
+struct PendulumCause {
+  const char* name;
+  ParameterSpec (*parameter)(double omega_squared);  // g / L [1/s^2] sets the scale
+  void (*apply)(const double* parameters, PendulumModel& model);   // model with its base parameters
+  void (*apply_swing)(const double* parameters, SwingEffects& effects);
+  const char* calibration_note{""};  // non-empty: absorbed by the calibrated nominal (skipped)
+  bool needs_known_zero{false};      // not identifiable when theta_zero is estimated
+};
+
+/// The pendulum catalog in catalog order.
+[[nodiscard]] const std::vector<PendulumCause>& pendulum_catalog();
+
+struct PendulumSeries;
+struct SwingSeries;
+
+class PendulumAudit final : public ChannelAudit {
+ public:
+  /// Checks the data (DataError: too few samples, columns of different lengths).
+  PendulumAudit(const AuditData& data, const PendulumAuditParameters& nominal, const AuditOptions& options);
+  ~PendulumAudit() override;
+
+  [[nodiscard]] std::string plant() const override { return "pendulum"; }
+  [[nodiscard]] std::string channel() const override { return "angle"; }
+  [[nodiscard]] std::string unit() const override { return "rad"; }
+  [[nodiscard]] const std::string& source() const override { return data_.source; }
+  [[nodiscard]] const std::vector<double>& time() const override { return data_.time; }
+  [[nodiscard]] std::size_t samples() const override { return data_.time.size(); }
+  [[nodiscard]] double sample_time() const override { return sample_time_; }
+  [[nodiscard]] const std::vector<double>& base() const override { return base_; }
+  [[nodiscard]] const std::vector<ParameterSpec>& base_specs() const override { return base_specs_; }
+  [[nodiscard]] std::vector<std::size_t> nominal_free(bool calibrate) const override;
+  [[nodiscard]] std::vector<Candidate> candidates() const override;
+  [[nodiscard]] std::string unavailable(const Candidate& candidate) const override;
+  [[nodiscard]] Problem problem(const Candidate* candidate) const override;
+  [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_input_; }
+  [[nodiscard]] double quantum() const override { return resolution_quantum(data_.output, 1); }
+  [[nodiscard]] double measured(std::size_t k) const override { return data_.output[k]; }
+
+ private:
+  const AuditData& data_;
+  double sample_time_;
+  double holdout_fraction_;
+  bool theta_zero_known_;
+  double gravity_;
+  std::vector<double> base_;
+  std::vector<ParameterSpec> base_specs_;
+  std::vector<double> no_input_;
+  std::shared_ptr<const PendulumSeries> series_;
+};
+
+/// The crane's swing channel: `measured` interleaves phi and theta [rad] per sample; `motion` is the
+/// drive and hoist motion held per sample (crane_swing.hpp); L is the mean cable length (scales).
+class SwingAudit final : public ChannelAudit {
+ public:
+  SwingAudit(const AuditData& data, std::shared_ptr<const plant::TowerCraneModel> model, std::vector<DriveMotion> motion,
+             std::vector<double> measured, double mean_cable_length, double gravity, const AuditOptions& options);
+  ~SwingAudit() override;
+
+  [[nodiscard]] std::string plant() const override { return "swing"; }
+  [[nodiscard]] std::string channel() const override { return "angle"; }
+  [[nodiscard]] std::string unit() const override { return "rad"; }
+  [[nodiscard]] const std::string& source() const override { return data_.source; }
+  [[nodiscard]] const std::vector<double>& time() const override { return data_.time; }
+  [[nodiscard]] std::size_t samples() const override { return data_.time.size(); }
+  [[nodiscard]] std::size_t residuals_per_sample() const override { return 2; }
+  [[nodiscard]] double sample_time() const override { return sample_time_; }
+  [[nodiscard]] const std::vector<double>& base() const override { return no_base_; }
+  [[nodiscard]] const std::vector<ParameterSpec>& base_specs() const override { return no_specs_; }
+  [[nodiscard]] std::vector<std::size_t> nominal_free(bool) const override { return {}; }
+  [[nodiscard]] std::vector<Candidate> candidates() const override;
+  [[nodiscard]] Problem problem(const Candidate* candidate) const override;
+  [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_base_; }
+  [[nodiscard]] double quantum() const override;
+  [[nodiscard]] double measured(std::size_t k) const override;
+
+ private:
+  const AuditData& data_;
+  double sample_time_;
+  double holdout_fraction_;
+  double window_duration_;
+  double omega_squared_;
+  std::vector<double> no_base_;
+  std::vector<ParameterSpec> no_specs_;
+  std::shared_ptr<const SwingSeries> series_;
+};
+
+}  // namespace crane::model_audit::detail
