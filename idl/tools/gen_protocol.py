@@ -11,10 +11,17 @@ writes what repeats them:
   gen_protocol.py IDL --dds OUT.hpp        to_dds() / from_dds() between those structs and the
                                            fastddsgen classes (the DDS transport's types)
   gen_protocol.py IDL --msg-dir DIR        the ROS 2 interface files DIR/<Name>.msg (rosidl's .msg
-                                           syntax, constants included)
+                                           syntax, constants and the IDL's comments included)
+  gen_protocol.py IDL --ros2-package DIR --package-files SRC
+                                           the complete ROS 2 interface package in DIR: package.xml,
+                                           CMakeLists.txt and README.md copied from SRC
+                                           (deploy/ros2/crane_msgs), msg/<Name>.msg (.msg files of
+                                           messages no longer in the IDL are removed) and
+                                           msg_files.cmake, the list of them for CMakeLists.txt
 
 Exit 1 with a message on an IDL construct the parser (idl_structs.py) does not know.
 """
+import argparse
 import pathlib
 import sys
 
@@ -101,7 +108,8 @@ template <class T, std::size_t N>
         out.append(f'  static constexpr std::string_view kTypeName = "{s.scoped_name}";\n')
         codes = by_owner.get(name, [])
         for c in codes:
-            out.append(f"  static constexpr {CPP_TYPES[c.idl_type]} {c.name} = {c.value};\n")
+            comment = f"  // {c.comment}" if c.comment else ""
+            out.append(f"  static constexpr {CPP_TYPES[c.idl_type]} {c.name} = {c.value};{comment}\n")
         if codes:
             out.append(f"  static constexpr std::array<NamedCode, {len(codes)}> kCodes{{{{\n")
             for c in codes:
@@ -187,30 +195,63 @@ namespace crane::protocol {
     return "".join(out)
 
 
+def msg_comment(text):
+    """A comment for a .msg file: rosidl reads everything after the first # as the comment."""
+    return f"# {text}" if text else "#"
+
+
 def msg_files(structs, constants, idl_name):
-    """{file name: text} of the ROS 2 .msg files of module crane_msgs::msg::dds_."""
+    """{file name: text} of the ROS 2 .msg files of module crane_msgs::msg::dds_.
+
+    rosidl's .msg syntax (rosidl_adapter.parser): the leading # lines are the message's comment, a
+    constant is `TYPE NAME=VALUE`, a field `TYPE name` or `TYPE[N] name`, a type of another package
+    `pkg/Type`; a trailing `# ...` and whole-line comments right above belong to the element below.
+    """
     files = {}
+    modules_of = {s.name: s.modules for s in structs}
     for s in structs:
         if s.modules != ["crane_msgs", "msg", "dds_"]:
             continue
         name = plain(s.name)
-        lines = [f"# Generated from {idl_name} by idl/tools/gen_protocol.py. Do not edit.", ""]
-        for c in constants:
-            if c.owner == name:
-                lines.append(f"{ROS_TYPES[c.idl_type]} {c.name}={c.value}")
-        if any(c.owner == name for c in constants):
+        lines = [msg_comment(line) for line in s.leading]
+        lines += [f"# Generated from {idl_name} ({s.scoped_name}) by idl/tools/gen_protocol.py. Do not edit.", ""]
+        codes = [c for c in constants if c.owner == name]
+        for c in codes:
+            lines += [msg_comment(line) for line in c.leading]
+            comment = f"  # {c.comment}" if c.comment else ""
+            lines.append(f"{ROS_TYPES[c.idl_type]} {c.name}={c.value}{comment}")
+        if codes:
             lines.append("")
         for f in s.fields:
             if f.primitive:
                 ros = ROS_TYPES[f.idl_type]
-            elif f.idl_type == "Time_":
-                ros = "builtin_interfaces/Time"
+            elif modules_of[f.idl_type][0] != "crane_msgs":
+                ros = f"{modules_of[f.idl_type][0]}/{plain(f.idl_type)}"  # builtin_interfaces/Time
             else:
                 ros = plain(f.idl_type)
+            lines += [msg_comment(line) for line in f.leading]
             comment = f"  # {f.comment}" if f.comment else ""
             lines.append(f"{ros}{f'[{f.size}]' if f.size else ''} {f.name}{comment}")
         files[f"{name}.msg"] = "\n".join(lines) + "\n"
     return files
+
+
+def ros2_package(structs, constants, idl_name, out_dir, package_files):
+    """Writes the ROS 2 package into out_dir (see the module's docstring)."""
+    out_dir = pathlib.Path(out_dir)
+    for name in ("package.xml", "CMakeLists.txt", "README.md"):
+        write_if_changed(out_dir / name, (pathlib.Path(package_files) / name).read_text())
+    files = msg_files(structs, constants, idl_name)
+    for name, text in files.items():
+        write_if_changed(out_dir / "msg" / name, text)
+    for stale in (out_dir / "msg").glob("*.msg"):
+        if stale.name not in files:
+            stale.unlink()
+    listing = "".join(f'  "msg/{name}"\n' for name in files)
+    write_if_changed(out_dir / "msg_files.cmake",
+                     f"# Generated from {idl_name} by idl/tools/gen_protocol.py. Do not edit.\n"
+                     f"# The interface files of this package, one per struct of crane_msgs::msg::dds_.\n"
+                     f"set(CRANE_MSG_FILES\n{listing})\n")
 
 
 def write_if_changed(target, text):
@@ -221,17 +262,29 @@ def write_if_changed(target, text):
 
 
 def main():
-    if len(sys.argv) != 4 or sys.argv[2] not in ("--messages", "--dds", "--msg-dir"):
-        raise SystemExit("usage: gen_protocol.py IDL --messages OUT.hpp | --dds OUT.hpp | --msg-dir DIR")
-    idl = pathlib.Path(sys.argv[1])
+    parser = argparse.ArgumentParser(description="Generates the protocol's code from the IDL.")
+    parser.add_argument("idl", type=pathlib.Path)
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--messages", metavar="OUT.hpp")
+    what.add_argument("--dds", metavar="OUT.hpp")
+    what.add_argument("--msg-dir", metavar="DIR")
+    what.add_argument("--ros2-package", metavar="DIR")
+    parser.add_argument("--package-files", metavar="SRC", help="with --ros2-package: package.xml, "
+                        "CMakeLists.txt and README.md are copied from SRC")
+    args = parser.parse_args()
+    if args.ros2_package and not args.package_files:
+        parser.error("--ros2-package needs --package-files")
+    idl = args.idl
     structs, constants = idl_structs.parse_all(idl.read_text())
-    if sys.argv[2] == "--messages":
-        write_if_changed(sys.argv[3], messages(structs, constants, idl.name))
-    elif sys.argv[2] == "--dds":
-        write_if_changed(sys.argv[3], dds(structs, idl.name))
-    else:
+    if args.messages:
+        write_if_changed(args.messages, messages(structs, constants, idl.name))
+    elif args.dds:
+        write_if_changed(args.dds, dds(structs, idl.name))
+    elif args.msg_dir:
         for name, text in msg_files(structs, constants, idl.name).items():
-            write_if_changed(pathlib.Path(sys.argv[3]) / name, text)
+            write_if_changed(pathlib.Path(args.msg_dir) / name, text)
+    else:
+        ros2_package(structs, constants, idl.name, args.ros2_package, args.package_files)
     return 0
 
 

@@ -1,7 +1,7 @@
 """Parser of the struct subset of IDL that idl/crane_msgs.idl uses (ROS 2 style, fixed size).
 
-One parser for every tool that reads the IDL: the build-time generator of the Cyclone DDS type
-support (gen_cyclone_support.py) and the checks of tests/ros2 (check_msgs.py).
+One parser for every tool that reads the IDL: the build-time generators (gen_cyclone_support.py,
+gen_protocol.py) and the check of the generated ROS 2 package (tests/ros2/check_msg_package.py).
 
 Supported: nested modules, `@final struct Name { TYPE name; TYPE name[N]; };` with primitive
 types and other structs of the file, and integer constants `const TYPE NAME = VALUE;` in a module
@@ -20,6 +20,7 @@ class Field:
         self.name = name
         self.size = size          # array length, or None
         self.comment = ""         # the IDL's trailing comment of the declaration (units, meaning)
+        self.leading = []         # whole-line comments right above the declaration
 
     @property
     def primitive(self):
@@ -32,6 +33,8 @@ class Constant:
         self.idl_type = idl_type  # integer primitive
         self.name = name          # "FAULT_STAGE_SILENT"
         self.value = value        # int
+        self.comment = ""         # the IDL's trailing comment of the declaration
+        self.leading = []         # whole-line comments right above the declaration
 
     @property
     def owner(self):              # the struct the constant belongs to, without the trailing _: "SupervisorStatus"
@@ -51,6 +54,7 @@ class Struct:
         self.modules = modules    # ["crane_msgs", "msg", "dds_"]
         self.name = name          # "SensorSample_"
         self.fields = fields      # [Field]
+        self.leading = []         # whole-line comments right above the struct (and its annotations)
 
     @property
     def scoped_name(self):        # crane_msgs::msg::dds_::SensorSample_ (C++ class, DDS type name)
@@ -68,23 +72,39 @@ def parse(text):
 
 def parse_all(text):
     """([Struct], [Constant]) in file order. Raises SystemExit naming an unparsed declaration."""
-    comments = {}  # (struct, field) -> trailing comment, and its continuation lines
+    # Comments, by a line-wise pass: trailing comments (and their continuation lines, aligned under
+    # them) of fields and constants, and the whole-line comments right above a struct, a field or a
+    # constant. Keys: ("field", struct, name), ("const", module, name), ("struct", name).
+    comments = {}
+    leading = {}
+    pending = []   # whole-line comments not yet attached
     current = None
+    module = None
     last = None
     for line in text.splitlines():
         s = re.match(r"\s*(?:@\w+\s*)*struct\s+(\w+)", line)
+        mod = re.match(r"\s*module\s+(\w+)", line)
+        d = re.match(r"\s*[\w:]+\s+(\w+)(?:\[\d+\])?\s*;\s*(?://\s*(.*))?$", line)
+        c = re.match(r"\s*const\s+\w+\s+(\w+)\s*=\s*[^;]+;\s*(?://\s*(.*))?$", line)
+        full = re.match(r"\s*//\s?(.*)$", line)
         if s:
             current, last = s.group(1), None
-            continue
-        d = re.match(r"\s*[\w:]+\s+(\w+)(?:\[\d+\])?\s*;\s*(?://\s*(.*))?$", line)
-        if d and current:
-            last = (current, d.group(1))
-            comments[last] = (d.group(2) or "").strip()
-        elif last and re.match(r"\s*//", line) and comments.get(last) and \
-                len(line) - len(line.lstrip()) > 20:  # a continuation aligned under the comment
-            comments[last] += " " + line.strip()[2:].strip()
-        else:
+            leading[("struct", current)], pending = pending, []
+        elif mod:
+            module, current, last, pending = mod.group(1), None, None, []
+        elif (d and current) or c:
+            last = ("field", current, d.group(1)) if d and current else ("const", module, c.group(1))
+            comments[last] = ((d or c).group(2) or "").strip()
+            leading[last], pending = pending, []
+        elif full and last and comments.get(last) and len(line) - len(line.lstrip()) > 20:
+            comments[last] += " " + full.group(1).strip()  # a continuation aligned under the comment
+        elif full:
+            pending.append(full.group(1).rstrip())
             last = None
+        elif re.fullmatch(r"\s*(?:@\w+(?:\([^)]*\))?\s*)+", line):
+            pass  # an annotation line between a comment and its struct
+        else:
+            last, pending = None, []
     text = re.sub(r"//[^\n]*", "", text)
     text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
     structs = []
@@ -139,8 +159,13 @@ def parse_all(text):
                 modules.pop()
             depth -= 1
     for s in structs:
+        s.leading = leading.get(("struct", s.name), [])
         for f in s.fields:
-            f.comment = comments.get((s.name, f.name), "")
+            f.comment = comments.get(("field", s.name, f.name), "")
+            f.leading = leading.get(("field", s.name, f.name), [])
+    for c in constants:
+        c.comment = comments.get(("const", c.modules[-1], c.name), "")
+        c.leading = leading.get(("const", c.modules[-1], c.name), [])
     owners = {s.name[:-1] for s in structs}
     for c in constants:
         if c.owner not in owners:

@@ -14,10 +14,11 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <thread>
 
+#include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/supervisor/supervisor.hpp"
 
 namespace {
 
@@ -25,64 +26,57 @@ using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 
-std::string fault_list(std::uint32_t bits) {
+using Status = protocol::SupervisorStatus;  // the protocol's codes: MODE_*, FAULT_*, STAGE_*, ...
+
+/// The names of the codes of `group` (FAULT, STAGE: one bit each, in the IDL's order) whose bit is
+/// set in `bits` (or clear, with want_set false), joined by `separator`, each between `quote`s.
+std::string bit_names(std::string_view group, std::uint32_t bits, bool want_set, const char* separator,
+                      const char* quote) {
   std::string text;
-  for (int bit = 0; bit < supervisor::kFaultBits; ++bit) {
-    if ((bits & (1U << bit)) == 0) continue;
-    if (!text.empty()) text += ",";
-    text += supervisor::fault_name(1U << bit);
+  for (const auto& code : Status::kCodes) {
+    if (code.group != group || ((bits & code.value) != 0) != want_set) continue;
+    if (!text.empty()) text += separator;
+    text += quote + std::string(code.name) + quote;
   }
   return text;
 }
 
-std::string quoted_list(std::uint32_t bits) {
-  std::string text;
-  for (int bit = 0; bit < supervisor::kFaultBits; ++bit) {
-    if ((bits & (1U << bit)) == 0) continue;
-    if (!text.empty()) text += ", ";
-    text += std::string("\"") + supervisor::fault_name(1U << bit) + "\"";
-  }
-  return "[" + text + "]";
-}
-
-std::string stage_list(std::uint32_t alive, bool want_alive) {
-  std::string text;
-  for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
-    if (((alive >> i) & 1U) != (want_alive ? 1U : 0U)) continue;
-    if (!text.empty()) text += ",";
-    text += supervisor::stage_name(static_cast<supervisor::Stage>(i));
-  }
-  return text;
+std::string fault_list(std::uint32_t bits) { return bit_names("FAULT", bits, true, ",", ""); }
+std::string quoted_list(std::uint32_t bits) { return "[" + bit_names("FAULT", bits, true, ", ", "\"") + "]"; }
+std::string stage_list(std::uint32_t alive, bool want_alive) { return bit_names("STAGE", alive, want_alive, ",", ""); }
+std::string code_name(std::string_view group, std::uint64_t value) {
+  return std::string(protocol::code_name(Status::kCodes, group, value));
 }
 
 void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
-  const auto mode = supervisor::mode_name(static_cast<supervisor::Mode>(s.mode()));
+  const auto mode = code_name("MODE", s.mode());
   if (json) {
     std::printf(
         "{\"mode\": \"%s\", \"motion_enabled\": %s, \"brakes_released\": %s, \"active_faults\": %s, "
         "\"latched_faults\": %s, \"fault_count\": %u, \"last_fault\": \"%s\", \"last_fault_seq\": %llu, "
         "\"stages_alive\": %u, \"warnings\": %u, \"trolley_voltage_limit_V\": %g, \"slew_voltage_limit_V\": %g, "
         "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu}\n",
-        mode, s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
+        mode.c_str(), s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
         quoted_list(s.active_faults()).c_str(), quoted_list(s.latched_faults()).c_str(), s.fault_count(),
-        s.last_fault() != 0 ? supervisor::fault_name(s.last_fault()) : "", static_cast<unsigned long long>(s.last_fault_seq()),
+        s.last_fault() != 0 ? code_name("FAULT", s.last_fault()).c_str() : "",
+        static_cast<unsigned long long>(s.last_fault_seq()),
         s.stages_alive(), s.warnings(), s.trolley_voltage_limit(), s.slew_voltage_limit(), s.trolley_velocity(),
         s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()));
     return;
   }
-  std::printf("mode            %s\n", mode);
+  std::printf("mode            %s\n", mode.c_str());
   std::printf("motion          %s, brakes %s\n", s.motion_enabled() ? "enabled" : "disabled",
               s.brakes_released() ? "released" : "engaged");
   std::printf("active faults   %s\n", s.active_faults() ? fault_list(s.active_faults()).c_str() : "none");
   std::printf("latched faults  %s\n", s.latched_faults() ? fault_list(s.latched_faults()).c_str() : "none");
   std::printf("faults raised   %u, last: %s at cycle %llu\n", s.fault_count(),
-              s.last_fault() ? supervisor::fault_name(s.last_fault()) : "none",
+              s.last_fault() ? code_name("FAULT", s.last_fault()).c_str() : "none",
               static_cast<unsigned long long>(s.last_fault_seq()));
   std::printf("stages alive    %s%s%s\n", stage_list(s.stages_alive(), true).c_str(),
-              s.stages_alive() != 0x3FU ? "; silent: " : "",
-              s.stages_alive() != 0x3FU ? stage_list(s.stages_alive(), false).c_str() : "");
+              s.stages_alive() != Status::STAGES_ALL ? "; silent: " : "",
+              s.stages_alive() != Status::STAGES_ALL ? stage_list(s.stages_alive(), false).c_str() : "");
   std::printf("voltage limits  trolley %.2f V, slew %.2f V%s\n", s.trolley_voltage_limit(), s.slew_voltage_limit(),
-              (s.warnings() & supervisor::kWarningSpeedLimited) ? " (approach speed exceeded)" : "");
+              (s.warnings() & Status::WARNING_SPEED_LIMITED) ? " (approach speed exceeded)" : "");
   std::printf("speeds          trolley %.3f m/s, slew %.3f rad/s\n", s.trolley_velocity(), s.slew_rate());
   std::printf("cycle           %llu\n", static_cast<unsigned long long>(s.header().seq()));
 }
@@ -123,7 +117,11 @@ int main(int argc, char** argv) {
       return 1;
     }
 
-    const std::uint8_t code = action == "arm" ? 1 : action == "disarm" ? 2 : action == "estop" ? 3 : 4;
+    using Command = protocol::SupervisorCommand;
+    const std::uint8_t code = action == "arm"      ? Command::COMMAND_ARM
+                              : action == "disarm" ? Command::COMMAND_DISARM
+                              : action == "estop"  ? Command::COMMAND_EMERGENCY_STOP
+                                                   : Command::COMMAND_RESET;
     auto writer = participant->make_writer<tp::SafetyCommand>();
     while (writer->health().matched_readers == 0 && Clock::now() < deadline) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -143,15 +141,15 @@ int main(int argc, char** argv) {
     while (Clock::now() < deadline) {
       while (status_reader->take_next(status)) {
         if (status.last_request_id() != request_id) continue;
-        const bool accepted = status.last_request_result() == 1;
+        const bool accepted = status.last_request_result() == Status::RESULT_ACCEPTED;
         std::printf("%s %s: mode %s, brakes %s\n", action.c_str(), accepted ? "accepted" : "refused",
-                    supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())),
+                    code_name("MODE", status.mode()).c_str(),
                     status.brakes_released() ? "released" : "engaged");
         if (!accepted) {
           std::printf("  latched faults: %s; active: %s; silent stages: %s\n",
                       status.latched_faults() ? fault_list(status.latched_faults()).c_str() : "none",
                       status.active_faults() ? fault_list(status.active_faults()).c_str() : "none",
-                      status.stages_alive() == 0x3FU ? "none" : stage_list(status.stages_alive(), false).c_str());
+                      status.stages_alive() == Status::STAGES_ALL ? "none" : stage_list(status.stages_alive(), false).c_str());
         }
         return accepted ? 0 : 3;
       }

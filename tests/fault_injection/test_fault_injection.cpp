@@ -31,15 +31,15 @@
 #include "crane/hardware_bridge/shm_board.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/supervisor/supervisor.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 namespace tp = crane::transport::topics;
 namespace hb = crane::hardware_bridge;
-namespace sv = crane::supervisor;
+using Status = crane::protocol::SupervisorStatus;  // its codes: MODE_*, FAULT_*, WARNING_*, STAGES_ALL
 using crane::launch::ProcessGroup;
 using Clock = std::chrono::steady_clock;
 
@@ -208,7 +208,8 @@ class HilStack {
       if (auto exit = group_.poll()) return ::testing::AssertionFailure() << exit->describe() << "; see " << dir_;
       run_for(0.02);
       const auto w = monitor_->writes();
-      if (status_ && status_->stages_alive() == 0x3FU && (status_->mode() == 2 || status_->mode() == 3) &&
+      if (status_ && status_->stages_alive() == Status::STAGES_ALL &&
+          (status_->mode() == Status::MODE_READY || status_->mode() == Status::MODE_OPERATING) &&
           status_->brakes_released() && !w.empty() && energized(w.back()) && !command_arrivals_.empty()) {
         return ::testing::AssertionSuccess();
       }
@@ -223,8 +224,8 @@ class HilStack {
     tp::msgs::MoveRequest_ goal;
     crane::runtime::stamp_header(goal.header(), 0, crane::runtime::now_stamp());
     goal.request_id(7);
-    goal.profile(1);  // trapezoid (3.43)
-    goal.axes(0x3);
+    goal.profile(crane::protocol::MoveRequest::PROFILE_TRAPEZOID);  // (3.43)
+    goal.axes(crane::protocol::MoveRequest::AXIS_TROLLEY | crane::protocol::MoveRequest::AXIS_SLEW);
     goal.trolley_target(target);
     goal.slew_target(0.0);
     goal.cable_length_target(1.0);
@@ -234,7 +235,7 @@ class HilStack {
     goal.slew_max_acceleration(2.0796);
     const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
     while (Clock::now() < deadline) {
-      if (!status_ || status_->mode() != 3) goal_writer_->write(goal);  // until the move is under way
+      if (!status_ || status_->mode() != Status::MODE_OPERATING) goal_writer_->write(goal);  // until the move is under way
       run_for(0.05);
       if (status_ && std::fabs(status_->trolley_velocity()) > speed) return ::testing::AssertionSuccess();
     }
@@ -356,8 +357,8 @@ void kill_stage_in_mid_move(const std::string& stage, std::uint32_t domain,
   }
   // The supervisor saw it too: the stage silent, on the status topic and in the fault log.
   ASSERT_TRUE(stack.status().has_value());
-  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultStageSilent);
-  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::fault));
+  EXPECT_TRUE(stack.status()->latched_faults() & Status::FAULT_STAGE_SILENT);
+  EXPECT_EQ(stack.status()->mode(), Status::MODE_FAULT);
   const auto log = stack.fault_log();
   EXPECT_NE(log.find("\"fault\": \"stage_silent\""), std::string::npos) << log;
   EXPECT_NE(log.find("\"" + stage + "\""), std::string::npos) << "the fault log must name the silent stage: " << log;
@@ -466,7 +467,7 @@ TEST(FaultInjection, NonFiniteAndOutOfRangeCommandsAreRejectedAndCounted) {
   ASSERT_FALSE(writes.empty());
   EXPECT_TRUE(safe(writes.back())) << "a second actuator writer must stop motion";
   ASSERT_TRUE(stack.status().has_value());
-  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultMultipleActuatorWriters);
+  EXPECT_TRUE(stack.status()->latched_faults() & Status::FAULT_MULTIPLE_ACTUATOR_WRITERS);
   const auto log = stack.fault_log();
   EXPECT_NE(log.find("multiple_actuator_writers"), std::string::npos) << log;
   const auto stats = stack.bridge_stats();
@@ -504,7 +505,7 @@ TEST(FaultInjection, MoveTowardATravelLimitStopsBeforeIt) {
   double furthest = 0.0;
   for (const auto& s : stack.sensors()) furthest = std::max(furthest, s.trolley_position());
   bool limited = false;
-  for (const auto& s : stack.status_log()) limited = limited || (s.warnings() & sv::kWarningSpeedLimited);
+  for (const auto& s : stack.status_log()) limited = limited || (s.warnings() & Status::WARNING_SPEED_LIMITED);
   const auto& last = *stack.status();
   std::printf("[ figure   ] move to 1.0 m with the travel limit at 0.90 m: the trolley stopped at %.4f m, %.1f mm "
               "before the limit (speed limited in the approach zone: %s; latched faults 0x%x)\n",
@@ -531,7 +532,7 @@ TEST(FaultInjection, SecondSensorWriterRefusesMotion) {
   }
   stack.run_for(0.3);
   ASSERT_TRUE(stack.status().has_value());
-  EXPECT_TRUE(stack.status()->latched_faults() & sv::kFaultMultipleSensorWriters);
+  EXPECT_TRUE(stack.status()->latched_faults() & Status::FAULT_MULTIPLE_SENSOR_WRITERS);
   EXPECT_FALSE(stack.status()->motion_enabled());
   const auto writes = stack.monitor().writes();
   ASSERT_FALSE(writes.empty());
@@ -540,7 +541,7 @@ TEST(FaultInjection, SecondSensorWriterRefusesMotion) {
   EXPECT_FALSE(stack.start_move(1.0, 0.05, 3.0)) << "the trolley moved with two sensor writers";
   EXPECT_NE(stack.fault_log().find("multiple_sensor_writers"), std::string::npos);
   std::printf("[ figure   ] second writer on rt/crane/hw/sensors: supervisor mode %s, motion refused\n",
-              sv::mode_name(static_cast<sv::Mode>(stack.status()->mode())));
+              std::string(crane::protocol::code_name(Status::kCodes, "MODE", stack.status()->mode())).c_str());
   stack.stop_observing();
 }
 
@@ -562,7 +563,7 @@ TEST(FaultInjection, EmergencyStopInputAndCommandBrakeAtOnce) {
   ASSERT_TRUE(f.first_safe.has_value());
   const double input_ms = static_cast<double>(f.first_safe->ns - pressed_ns) / 1e6;
   ASSERT_TRUE(stack.status().has_value());
-  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::emergency_stop));
+  EXPECT_EQ(stack.status()->mode(), Status::MODE_EMERGENCY_STOP);
   // The operator's CLI: reset refused while the button is pressed (exit code 3), accepted once released.
   EXPECT_EQ(run(safety + " status" + domain), 0);
   EXPECT_EQ(run(safety + " reset" + domain), 3);
@@ -574,12 +575,12 @@ TEST(FaultInjection, EmergencyStopInputAndCommandBrakeAtOnce) {
   // The operator's emergency stop in mid-move: supervisor, then the bridge.
   ASSERT_TRUE(stack.start_move(1.0));
   const std::int64_t command_ns = hb::monotonic_time_ns();
-  stack.send_command(3, 101);
+  stack.send_command(crane::protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP, 101);
   stack.run_for(0.5);
   f = fail_safe_after(stack.monitor().writes(), command_ns);
   ASSERT_TRUE(f.first_safe.has_value());
   const double command_ms = static_cast<double>(f.first_safe->ns - command_ns) / 1e6;
-  EXPECT_EQ(stack.status()->mode(), static_cast<std::uint8_t>(sv::Mode::emergency_stop));
+  EXPECT_EQ(stack.status()->mode(), Status::MODE_EMERGENCY_STOP);
   EXPECT_EQ(stack.status()->last_request_id(), 101U);
   std::printf("[ figure   ] emergency stop: brakes engaged %.1f ms after the board's input was pressed, %.1f ms "
               "after the operator's command\n",

@@ -18,6 +18,7 @@
 
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
 namespace {
@@ -26,6 +27,7 @@ namespace fs = std::filesystem;
 namespace tp = crane::transport::topics;
 using crane::launch::ProcessGroup;
 using Clock = std::chrono::steady_clock;
+using Status = crane::protocol::SupervisorStatus;  // its codes: STAGES_ALL, FAULT_*, MODE_*
 
 const std::string kBin = CRANE_BIN_DIR;
 const std::string kConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml";
@@ -387,7 +389,7 @@ TEST(Stack, CraneTopicListsMeasuresEchoesAndRecords) {
   ASSERT_EQ(run("echo rt/crane/safety/status --count 1", logs / "echo.json"), 0);
   std::ifstream echo_file(logs / "echo.json");
   const auto status = nlohmann::json::parse(echo_file);
-  EXPECT_EQ(status["stages_alive"], 63);
+  EXPECT_EQ(status["stages_alive"], Status::STAGES_ALL);
 
   ASSERT_EQ(run("record --out " + (logs / "run.csv").string() + " --duration 2", logs / "record.log"), 0);
   std::ifstream csv(logs / "run.csv");
@@ -447,12 +449,12 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
   // Wait until the chain is up.
   tp::msgs::SupervisorStatus_ status;
   const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
-  while (status.stages_alive() != 0x3FU && Clock::now() < ready_deadline) {
+  while (status.stages_alive() != Status::STAGES_ALL && Clock::now() < ready_deadline) {
     ASSERT_FALSE(group.poll().has_value()) << "a stage died during start-up; see " << logs;
     status_reader->take_latest(status);
     wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
-  ASSERT_EQ(status.stages_alive(), 0x3FU) << "stack not ready; see " << logs;
+  ASSERT_EQ(status.stages_alive(), Status::STAGES_ALL) << "stack not ready; see " << logs;
 
   // Rogue writers on every topic a stage reads. (A second sensor writer is also a supervisor fault
   // of its own.)
@@ -532,7 +534,7 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
   }
   // The supervisor saw the NaN and latched the fault: brakes stay engaged until a reset.
   status_reader->take_latest(status);
-  EXPECT_NE(status.latched_faults() & (1U << 3), 0U);
+  EXPECT_NE(status.latched_faults() & Status::FAULT_NON_FINITE, 0U);
   EXPECT_FALSE(status.brakes_released());
   for (const auto& e : group.stop_all()) {
     EXPECT_TRUE(WIFEXITED(e.status) && WEXITSTATUS(e.status) == 0) << e.describe();

@@ -20,7 +20,7 @@
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 #include "crane_msgs_random.hpp"
-#include "topic_fields.hpp"
+#include "message_json.hpp"
 
 namespace {
 
@@ -54,8 +54,8 @@ void flatten(const json& j, const std::string& path, std::map<std::string, std::
 template <class Message>
 std::string differing_fields(const Message& a, const Message& b) {
   std::map<std::string, std::string> fa, fb;
-  flatten(crane::launch::topic_fields::to_json(a), "", fa);
-  flatten(crane::launch::topic_fields::to_json(b), "", fb);
+  flatten(crane::launch::message_json(a), "", fa);
+  flatten(crane::launch::message_json(b), "", fb);
   std::string out;
   for (const auto& [path, value] : fa) {
     if (fb[path] != value) out += path + ": sent " + value + ", received " + fb[path] + "; ";
@@ -104,10 +104,10 @@ void round_trip(Participant& fast, Participant& cyclone, std::set<std::string>& 
   for (auto& m : sent) {
     crane::transport::testing::fill_random(m, rng);
     std::map<std::string, std::string> leaves;
-    flatten(crane::launch::topic_fields::to_json(m), "", leaves);
+    flatten(crane::launch::message_json(m), "", leaves);
     for (const auto& [path, value] : leaves) values_per_field[path].insert(value);
   }
-  // Every field (as crane_topic's tables name them, checked against the IDL by tests/ros2) took
+  // Every field (as crane_topic names them: the IDL's, through the generated visit_fields) took
   // more than one value, so no field was left at its default on both sides by the generator.
   for (const auto& [path, values] : values_per_field) {
     EXPECT_GE(values.size(), 2U) << path << " was not exercised by the random filler";

@@ -35,6 +35,7 @@
 
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
 namespace {
@@ -43,6 +44,7 @@ using namespace crane;
 namespace fs = std::filesystem;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
+using Status = protocol::SupervisorStatus;  // its codes: MODE_*, STAGES_ALL, WARNING_*
 using nlohmann::json;
 
 double ns(const builtin_interfaces::msg::dds_::Time_& t) { return static_cast<double>(runtime::to_nanoseconds(t)); }
@@ -157,7 +159,8 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
   tp::msgs::SupervisorStatus_ status;
   tp::msgs::Reference_ reference;
   const auto ready_deadline = Clock::now() + std::chrono::seconds(60);
-  while (!(status.stages_alive() == 0x3FU && status.mode() == 2 && goal_writer->health().matched_readers > 0)) {
+  while (!(status.stages_alive() == Status::STAGES_ALL && status.mode() == Status::MODE_READY &&
+           goal_writer->health().matched_readers > 0)) {
     if (Clock::now() > ready_deadline || runtime::stop_requested()) {
       std::fprintf(stderr, "crane_bench soak: the stack did not become ready; see %s\n", dir.string().c_str());
       return 1;
@@ -178,8 +181,8 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
     while (Clock::now() < end && !runtime::stop_requested() && died.empty()) {
       while (status_reader->take_next(status)) {
         ++statuses;
-        if (status.mode() != 2 && status.mode() != 3) ++not_ready;
-        if (status.warnings() & 0x8U) ++late;
+        if (status.mode() != Status::MODE_READY && status.mode() != Status::MODE_OPERATING) ++not_ready;
+        if (status.warnings() & Status::WARNING_STAGE_LATE) ++late;
         faults = status.fault_count();
       }
       while (references->take_next(reference)) {
@@ -197,8 +200,8 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
     runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
     const auto id = static_cast<std::uint32_t>(i + 1);
     goal.request_id(id);
-    goal.profile(1);
-    goal.axes(0x3);
+    goal.profile(protocol::MoveRequest::PROFILE_TRAPEZOID);
+    goal.axes(protocol::MoveRequest::AXIS_TROLLEY | protocol::MoveRequest::AXIS_SLEW);
     goal.trolley_target(i % 2 == 0 ? 0.9 : 0.4);
     goal.slew_target(i % 2 == 0 ? 0.5 : 0.0);
     goal.cable_length_target(1.0);
@@ -207,7 +210,7 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
     const bool ok = watch(30.0, [&] {
       if (!seen) goal_writer->write(goal);
       seen = seen || reference.request_id() == id;
-      return seen && reference.request_id() == id && reference.phase() == 2;
+      return seen && reference.request_id() == id && reference.phase() == protocol::Reference::PHASE_ARRIVED;
     });
     if (ok) ++arrived;
     watch(5.0, nullptr);  // let the load settle before the next move
@@ -350,11 +353,11 @@ int main(int argc, char** argv) {
     auto actuators = participant->make_recording_reader<tp::Actuators>(&wakeup, 8192);
     tp::msgs::SupervisorStatus_ status;
     const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
-    while (status.stages_alive() != 0x3FU && Clock::now() < ready_deadline) {
+    while (status.stages_alive() != Status::STAGES_ALL && Clock::now() < ready_deadline) {
       status_reader->take_latest(status);
       wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
     }
-    if (status.stages_alive() != 0x3FU) throw std::runtime_error("the stack did not become ready; see " + dir.string());
+    if (status.stages_alive() != Status::STAGES_ALL) throw std::runtime_error("the stack did not become ready; see " + dir.string());
     std::this_thread::sleep_for(std::chrono::seconds(1));
     // Forget what came before; record `duration` seconds.
     std::map<std::uint64_t, std::array<double, 6>> stamps;  // seq -> write stamps [ns] per stage

@@ -47,7 +47,7 @@ struct DemoOptions {
   std::string python{"/usr/bin/python3"};
   double ready_timeout{60.0};
   std::string profile{"trapezoid"};
-  std::uint8_t profile_code{1};
+  std::uint8_t profile_code{protocol::MoveRequest::PROFILE_TRAPEZOID};
   std::string controller;             // --controller, see main(); "auto" picks per maneuver (time_optimal)
   std::string anti_swing_controller;  // derived from controller
   std::string tracking_controller;    // derived from controller
@@ -255,7 +255,9 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
                            rec.sensors.rbegin()->second.writer_pid() == static_cast<std::uint32_t>(plant_pid) &&
                            !rec.sensors.rbegin()->second.brakes_engaged() && !rec.references.empty() &&
                            !rec.linear.empty() && !rec.actuators.empty();
-    if (status && status->stages_alive() == 0x3FU && status->mode() == 2 && op.goal_matches() > 0 && recording) break;
+    if (status && status->stages_alive() == protocol::SupervisorStatus::STAGES_ALL &&
+        status->mode() == protocol::SupervisorStatus::MODE_READY && op.goal_matches() > 0 && recording)
+      break;
 
     if (Clock::now() > ready_deadline) {
       throw RunFailure(
@@ -292,7 +294,8 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   goal.request_id(request_id);
   goal.profile(options.profile_code);  // MoveRequest_.profile code (idl/crane_msgs.idl)
   const bool hoists = m.cable_length_target != cfg.crane.cable_length;
-  goal.axes(hoists ? 0x7 : 0x3);  // bit 2: hoisting during the move
+  goal.axes(static_cast<std::uint8_t>(protocol::MoveRequest::AXIS_TROLLEY | protocol::MoveRequest::AXIS_SLEW |
+                                      (hoists ? protocol::MoveRequest::AXIS_HOIST : 0)));
   goal.trolley_target(m.trolley_target);
   goal.slew_target(m.slew_target);
   goal.cable_length_target(m.cable_length_target);
@@ -321,7 +324,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     }
     if (!start_seq) {
       for (const auto& [seq, r] : rec.references) {
-        if (r.request_id() == request_id && r.phase() != 0) {
+        if (r.request_id() == request_id && r.phase() != protocol::Reference::PHASE_HOLDING) {
           start_seq = seq;
           break;
         }
@@ -523,9 +526,9 @@ int main(int argc, char** argv) {
     options.anti_swing_controller = options.controller;
   }
   {
-    static const std::vector<std::string> kProfiles{"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"};
-    options.profile_code = static_cast<std::uint8_t>(
-        std::find(kProfiles.begin(), kProfiles.end(), options.profile) - kProfiles.begin());
+    for (const auto& code : protocol::MoveRequest::kCodes) {  // the PROFILE_* code named by --profile
+      if (code.group == "PROFILE" && code.name == options.profile) options.profile_code = static_cast<std::uint8_t>(code.value);
+    }
   }
 
   try {

@@ -13,8 +13,8 @@
 
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/supervisor/supervisor.hpp"
 
 int main(int argc, char** argv) {
   using namespace crane;
@@ -105,6 +105,7 @@ int main(int argc, char** argv) {
       const pid_t pid = group.start(spec);
       spdlog::info("started {} (pid {}), log {}", spec.name, pid, spec.log_path);
     }
+    using Status = protocol::SupervisorStatus;  // its codes: MODE_*, STAGES_ALL
     tp::msgs::SupervisorStatus_ status;
     bool ready = false;
     int exit_code = 0;
@@ -117,10 +118,10 @@ int main(int argc, char** argv) {
         break;
       }
       status_reader->take_latest(status);
-      if (!ready && status.stages_alive() == 0x3FU) {
+      if (!ready && status.stages_alive() == Status::STAGES_ALL) {
         ready = true;
         spdlog::info("all stages matched and alive, supervisor mode {}; Ctrl-C stops the stack",
-                     supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())));
+                     protocol::code_name(Status::kCodes, "MODE", status.mode()));
       }
       if (!ready && Clock::now() > ready_deadline) {
         spdlog::error("the stack did not become ready within {} s (stages alive 0x{:x}); see {}", ready_timeout,
@@ -131,7 +132,7 @@ int main(int argc, char** argv) {
       if (ready && Clock::now() >= next_report) {
         next_report = Clock::now() + std::chrono::seconds(5);
         spdlog::info("mode {}, stages alive 0x{:x}, latched faults 0x{:x}, cycle {}",
-                     supervisor::mode_name(static_cast<supervisor::Mode>(status.mode())), status.stages_alive(),
+                     protocol::code_name(Status::kCodes, "MODE", status.mode()), status.stages_alive(),
                      status.latched_faults(), status.header().seq());
       }
       wakeup.wait_until(Clock::now() + std::chrono::milliseconds(50));

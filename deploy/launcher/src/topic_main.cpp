@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "crane/runtime/node_runtime.hpp"
-#include "topic_fields.hpp"
+#include "message_json.hpp"
 
 namespace {
 
@@ -34,7 +34,6 @@ using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
-namespace topic_fields = crane::launch::topic_fields;
 
 const std::vector<std::string>& topic_names() {
   static const std::vector<std::string> names{tp::Sensors::name,       tp::Actuators::name,    tp::StateEstimate::name,
@@ -208,7 +207,7 @@ int main(int argc, char** argv) {
           while (reader->take_next(m)) {
             status = 0;
             if (echo_cmd->parsed()) {
-              std::printf("%s\n", topic_fields::to_json(m).dump().c_str());
+              std::printf("%s\n", launch::message_json(m).dump().c_str());
               std::fflush(stdout);
               if (count > 0 && ++printed >= count) return;
             } else {
@@ -258,7 +257,9 @@ int main(int argc, char** argv) {
         drains.push_back([reader, &samples, &sensors, name] {
           typename T::Message m;
           while (reader->take_next(m)) {
-            samples << json{{"topic", name}, {"receive_ns", runtime::now_nanoseconds()}, {"sample", topic_fields::to_json(m)}}.dump()
+            samples << json{{"topic", name}, {"receive_ns", runtime::now_nanoseconds()},
+                            {"sample", launch::message_json(m)}}
+                           .dump()
                     << '\n';
             if constexpr (std::is_same_v<T, tp::Sensors>) sensors[m.header().seq()] = m;
           }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "crane/protocol/dds.hpp"
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 
@@ -137,14 +138,16 @@ class DiagnosticsPublisher {
   std::chrono::steady_clock::time_point next_;
 };
 
-/// NaN/Inf gate at the entry of each topic: true when every floating-point field is finite.
-[[nodiscard]] bool all_finite(const msgs::SensorSample_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::ActuatorCommand_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::CraneState_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::MoveRequest_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::Reference_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::AntiSwingCommand_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::LinearCommand_& m) noexcept;
-[[nodiscard]] bool all_finite(const msgs::SupervisorStatus_& m) noexcept;
+/// NaN/Inf gate at the entry of each topic: true when every floating-point field of the DDS
+/// message `m` (arrays and nested structs included) is finite. The checks are generated from the
+/// IDL (crane::protocol::all_finite, idl/tools/gen_protocol.py); this converts `m` to its plain
+/// struct on the stack first (no allocation, no lock). Any fastddsgen message type of the IDL.
+template <class DdsMessage>
+  requires requires { typename protocol::PlainOf<DdsMessage>::type; }
+[[nodiscard]] bool all_finite(const DdsMessage& m) noexcept {
+  typename protocol::PlainOf<DdsMessage>::type plain;
+  protocol::from_dds(m, plain);
+  return protocol::all_finite(plain);
+}
 
 }  // namespace crane::runtime
