@@ -1,16 +1,17 @@
 // hardware_bridge process: the encoder/DAC/digital-IO board on the DDS bus. The sensor writer (and
 // the only clock) of the stack when it runs against a crane: at cycle k it reads the counters and
 // digital inputs, publishes rt/crane/hw/sensors{seq = k, source = 2}, and writes the outputs for the
-// actuator command of cycle k as soon as it arrives (BridgeCore: clamped to the supervisor's
-// limits, 0 V and brakes when its rules say so, its own watchdog).
+// actuator command of cycle k as soon as it arrives (BridgeCore: the actuation gate the simulated
+// plant applies too, supervisor/actuation_gate.hpp, then the board's DAC ranges).
 //
 //   --clock timer  absolute sample_period deadlines on the monotonic clock (a real board);
 //   --clock board  the emulated board's sample clock (shm only): each sample the simulated plant
 //                  publishes is answered once, so the plant can run in lockstep behind the board.
 //                  Times given to BridgeCore are then simulated (k * sample_period), and sample k is
 //                  answered only with the command of cycle k gated by the supervisor's status of
-//                  cycle k-1 (or without a command when that status inhibits motion); a wait longer
-//                  than plant.lockstep_hang_timeout is reported as a hung chain.
+//                  cycle k-1 (or without a command when that status reports a dead stage: the
+//                  lockstep rules of supervisor::lockstep_may_run); a wait longer than
+//                  stack.lockstep_hang_timeout is reported as a hung chain.
 //
 // Fail-safe: safe outputs (0 V, brakes engaged, drives disabled) are written right after the board
 // opens, whenever BridgeCore says so (no valid command for watchdog_timeout, no fresh supervisor
@@ -28,12 +29,15 @@
 #include <thread>
 #include <vector>
 
-#include "crane/config/stack_config.hpp"
+#include "crane/config/config_document.hpp"
 #include "crane/hardware_bridge/board.hpp"
+#include "crane/hardware_bridge/bridge_config.hpp"
 #include "crane/hardware_bridge/bridge_core.hpp"
 #include "crane/hardware_bridge/shm_board.hpp"
-#include "crane/supervisor/supervisor.hpp"
+#include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/supervisor/actuation_gate.hpp"
+#include "crane/supervisor/supervisor_stage.hpp"
 
 namespace {
 
@@ -100,19 +104,24 @@ int main(int argc, char** argv) {
 
   try {
     runtime::configure_logging(options.log_level, "hardware_bridge");
-    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    const auto cfg = config::ConfigDocument::load(options.config_path);
+    const auto gate_params = cfg.read("actuation", supervisor::read_actuation_params);
+    const auto bridge_config =
+        cfg.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
+          return hb::read_params(block, facts, gate_params);
+        });
     if (clock == "board" && board_uri.rfind("shm:", 0) != 0) {
       throw std::invalid_argument("--clock board needs the emulated board (shm:NAME), not " + board_uri);
     }
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
-    auto board = open_with_retry(board_uri, cfg.hardware_bridge.board, open_timeout);
-    hb::BridgeCore core(cfg.hardware_bridge.bridge, board->analog_ranges());
+    auto board = open_with_retry(board_uri, bridge_config.board, open_timeout);
+    hb::BridgeCore core(bridge_config.bridge, board->analog_ranges());
     board->write_outputs(core.safe_outputs());
     SafeOnExit safe_on_exit(*board, core.safe_outputs());
     auto* shm_board = dynamic_cast<hb::ShmBoard*>(board.get());
     spdlog::info("board {}: {} clock, watchdog {} ms, status timeout {} ms", board->describe(), clock,
-                 cfg.hardware_bridge.bridge.watchdog_timeout * 1e3, cfg.hardware_bridge.bridge.status_timeout * 1e3);
+                 gate_params.watchdog_timeout * 1e3, gate_params.status_timeout * 1e3);
 
     auto participant = runtime::make_participant(options, "hardware_bridge");
     auto sensors = participant->make_writer<tp::Sensors>();
@@ -126,14 +135,14 @@ int main(int argc, char** argv) {
     std::vector<double> latency_log;
     latency_log.reserve(1 << 16);
 
-    const hb::EncoderScaling scaling(cfg.crane);
+    const hb::EncoderScaling scaling(cfg.facts().crane);
     std::array<hb::CounterUnwrapper, hb::kCounterCount> unwrap{
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits())};
-    const double period_s = cfg.plant.sample_period;
+    const double period_s = cfg.facts().sample_period;
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
     const auto hang_timeout =
-        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.facts().lockstep_hang_timeout));
     const auto republish = std::chrono::milliseconds(10);
     const bool board_clock = clock == "board";
     const auto epoch = Clock::now();
@@ -147,7 +156,8 @@ int main(int argc, char** argv) {
     out.board = core.safe_outputs();
     std::uint64_t status_seq = 0;  // cycle of the supervisor status applied last
     std::array<std::optional<tp::msgs::SupervisorStatus_>, 8> recent_statuses;  // board clock: by cycle
-    bool board_command = false;    // board clock: a valid command of the current cycle is held in `in`
+    bool board_command = false;    // board clock: a valid command of the current cycle is held
+    protocol::ActuatorCommand board_command_plain;
     std::uint64_t seq = 0;
     std::uint64_t tick = 0;
     std::uint64_t stale_commands = 0;  // valid commands for another cycle than the current one
@@ -163,9 +173,9 @@ int main(int argc, char** argv) {
       std::array<std::int64_t, hb::kCounterCount> counts{};
       for (std::size_t i = 0; i < hb::kCounterCount; ++i) counts[i] = unwrap[i].update(raw[i]);
       const std::uint32_t inputs = board->read_digital_inputs();
-      const auto m = scaling.measurement(counts, cfg.crane.cable_length);
+      const auto m = scaling.measurement(counts, cfg.facts().crane.cable_length);
       runtime::stamp_header(sample.header(), k, runtime::now_stamp());
-      sample.source(2);
+      sample.source(protocol::SensorSample::SOURCE_HARDWARE_BRIDGE);
       sample.writer_pid(static_cast<std::uint32_t>(getpid()));
       sample.trolley_position(m.trolley_position);
       sample.slew_angle(m.slew_angle);
@@ -178,7 +188,10 @@ int main(int argc, char** argv) {
       sample.brakes_engaged(out.brakes_engaged);
       const bool estop = (inputs >> static_cast<unsigned>(hb::DigitalInput::emergency_stop)) & 1U;
       sample.emergency_stop_input(estop);
-      sample.limit_switches(static_cast<std::uint8_t>(inputs & 0x0FU));  // bits 0-3: the four limit switches
+      constexpr unsigned kLimitSwitches = protocol::SensorSample::SWITCH_TROLLEY_MIN | protocol::SensorSample::SWITCH_TROLLEY_MAX |
+                                          protocol::SensorSample::SWITCH_SLEW_MIN | protocol::SensorSample::SWITCH_SLEW_MAX;
+      static_assert(kLimitSwitches == 0x0FU, "the board's inputs 0-3 are the four limit switches, in this order");
+      sample.limit_switches(static_cast<std::uint8_t>(inputs & kLimitSwitches));
       in.emergency_stop_pressed = estop;
     };
     // Takes what arrived; returns true once a valid command for cycle k went to the board.
@@ -209,7 +222,7 @@ int main(int argc, char** argv) {
           ++counters.nonfinite_rejected;
           continue;
         }
-        const auto& limits = cfg.hardware_bridge.bridge;
+        const auto& limits = gate_params;
         if (std::fabs(incoming.trolley_voltage()) > limits.max_drive_voltage ||
             std::fabs(incoming.slew_voltage()) > limits.max_drive_voltage ||
             std::fabs(incoming.hoist_speed()) > limits.hoist_speed_limit) {
@@ -227,6 +240,7 @@ int main(int argc, char** argv) {
         in.command_arrival_time = now_s;
         if (board_clock) {  // applied once the status of this cycle is there (board_step below)
           board_command = true;
+          protocol::from_dds(incoming, board_command_plain);
           const double us = static_cast<double>(arrival_ns - runtime::to_nanoseconds(sample.header().origin())) / 1000.0;
           latency.record(us);
           if (latency_log.size() < latency_log.capacity()) latency_log.push_back(us);
@@ -258,28 +272,20 @@ int main(int argc, char** argv) {
     // when that status reports a dead stage. That status is fresh in simulated time.
     // The status that gates sample k, when it has arrived (nullptr otherwise).
     auto gating_status = [&](std::uint64_t k) -> const tp::msgs::SupervisorStatus_* {
-      const std::uint64_t gate_seq = k == 0 ? 0 : k - 1;
+      const std::uint64_t gate_seq = supervisor::gating_cycle(k);
       const auto& slot = recent_statuses[gate_seq % recent_statuses.size()];
       return slot.has_value() && slot->header().seq() == gate_seq ? &*slot : nullptr;
     };
-    auto board_step = [&](std::uint64_t k, double now_s) {
+    auto board_step = [&](std::uint64_t k) {
       const auto* gate = gating_status(k);
-      const bool status_ready = gate != nullptr;
-      if (status_ready) {
-        in.status_received = true;
-        in.status.motion_enabled = gate->motion_enabled();
-        in.status.brakes_released = gate->brakes_released();
-        in.status.trolley_voltage_limit = gate->trolley_voltage_limit();
-        in.status.slew_voltage_limit = gate->slew_voltage_limit();
-        status_seq = gate->header().seq();
-      }
-      if (!status_ready) return false;
+      if (gate == nullptr) return false;
+      protocol::SupervisorStatus gating;
+      protocol::from_dds(*gate, gating);
+      status_seq = gating.header.seq;
       // Only a dead stage (stage_silent latched) lets a sample pass without the chain's command.
-      const bool chain_dead = status_ready && (gate->latched_faults() & supervisor::kFaultStageSilent) != 0;
-      if (!board_command && !chain_dead) return false;
-      in.time = now_s;
-      in.status_arrival_time = status_ready ? now_s : -1e9;
-      in.command_received = board_command;
+      if (!supervisor::lockstep_may_run(board_command, gating)) return false;
+      in = supervisor::lockstep_gate_input(k, period_s, board_command ? &board_command_plain : nullptr, gating,
+                                           in.emergency_stop_pressed);
       const auto status = core.step(in, out);
       in.command_received = false;
       board_command = false;
@@ -317,7 +323,7 @@ int main(int argc, char** argv) {
       bool hang_reported = false;
       while (!runtime::stop_requested()) {
         applied = drain(seq, board_clock ? now_s : seconds_since(epoch, Clock::now()));
-        if (board_clock) applied = board_step(seq, now_s);
+        if (board_clock) applied = board_step(seq);
         if (applied) break;
         const auto now = Clock::now();
         if (board_clock && now >= next_republish) {
@@ -334,7 +340,7 @@ int main(int argc, char** argv) {
             hang_reported = true;
             ++counters.overruns;
             spdlog::error("lockstep: cycle {} has waited {} s for {}: the chain is hung (the cycle keeps waiting)", seq,
-                          cfg.plant.lockstep_hang_timeout,
+                          cfg.facts().lockstep_hang_timeout,
                           gating_status(seq) == nullptr ? "the supervisor status" : "the actuator command");
           }
         }

@@ -9,9 +9,11 @@
 //   --realtime  absolute deadlines every sample_period on the monotonic clock; a command that has
 //               not arrived by the deadline is an overrun: the last one is held for at most
 //               plant.command_timeout, then 0 V and brakes.
-// Brakes are released and the command applied only while the supervisor's status (of cycle k in
-// lockstep; the latest, no older than safety_status_timeout, in realtime) says so. Non-finite
-// commands are rejected and counted.
+// What reaches the simulated drives is decided by the actuation gate the hardware bridge applies
+// too (supervisor/actuation_gate.hpp, inside plant::PlantStage): the command only while the
+// supervisor's status (of cycle k-1 in lockstep; the latest, within actuation.status_timeout, in
+// realtime) permits it and the command is within actuation.watchdog_timeout; else 0 V and brakes.
+// Non-finite commands are rejected and counted.
 //
 //   --board shm:NAME  the plant sits behind the emulated interface board instead of the DDS bus
 //               (hardware-in-the-loop): it creates the shared-memory board, writes the encoder
@@ -31,44 +33,33 @@
 #include <thread>
 #include <vector>
 
-#include "crane/config/simulator_parameters.hpp"
+#include "crane/config/config_document.hpp"
+#include "crane/hardware_bridge/bridge_config.hpp"
 #include "crane/hardware_bridge/shm_board.hpp"
-#include "crane/plant/crane_simulator.hpp"
 #include "crane/plant/drives_and_sensors.hpp"
+#include "crane/plant/plant_stage.hpp"
+#include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/supervisor/supervisor.hpp"
+#include "crane/supervisor/actuation_gate.hpp"
 
 namespace {
 using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 
-// `cable_length_reading_factor` scales the reported cable length: 1 normally; 1/f when the plant's
-// cable is f times the configured one but the crane (like the lab crane, which has no hoist
-// encoder) reports the configured length, so every controller keeps assuming it.
-void fill_sensors(tp::msgs::SensorSample_& s, const plant::SimulatorOutput& o, std::uint64_t seq,
-                  const builtin_interfaces::msg::dds_::Time_& origin, double cable_length_reading_factor = 1.0) {
-  runtime::stamp_header(s.header(), seq, origin);
-  s.source(1);
-  s.writer_pid(static_cast<std::uint32_t>(getpid()));
-  s.trolley_position(o.measurement.trolley_position);
-  s.slew_angle(o.measurement.slew_angle);
-  s.swing_in_plane(o.measurement.swing_in_plane);
-  s.swing_out_of_plane(o.measurement.swing_out_of_plane);
-  s.cable_length(o.measurement.cable_length * cable_length_reading_factor);
-  s.applied_trolley_voltage(o.applied_trolley_voltage);
-  s.applied_slew_voltage(o.applied_slew_voltage);
-  s.applied_hoist_speed(o.applied_hoist_speed);
-  s.brakes_engaged(o.brakes_engaged);
-  s.emergency_stop_input(false);
-  s.limit_switches(0);
-}
 // The plant behind the emulated board (--board shm:NAME).
-int run_behind_board(const std::string& board_name, const config::StackConfig& cfg, const config::StackConfig& truth,
-                     plant::CraneSimulator& simulator, bool realtime, const runtime::NodeOptions& options,
+int run_behind_board(const std::string& board_name, const config::ConfigDocument& cfg,
+                     const plant::PlantStageParams& params, bool realtime, const runtime::NodeOptions& options,
                      const std::string& stats_path) {
   namespace hb = hardware_bridge;
+  // Behind the board the hardware bridge is the gate: the plant applies what the board's outputs say.
+  plant::CraneSimulator simulator(plant::simulated_truth(params.simulator, params.mismatch));
+  const auto& truth = simulator.parameters();
   const plant::DrivesAndSensors sensors_model(truth.crane);
+  const auto gate = cfg.read("actuation", supervisor::read_actuation_params);
+  const auto bridge = cfg.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
+    return hb::read_params(block, facts, gate);
+  });
   const auto encoder_counts = [&] {
     const auto& m = simulator.output().measurement;
     return std::array<std::int64_t, hb::kCounterCount>{
@@ -79,16 +70,16 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
   };
   // The initial state is on the counters before the board exists for the bridge (a bridge that
   // read zeros here saw the trolley at 0 m, outside its travel, then jumping to 0.25 m).
-  auto board = hb::ShmBoardEmulator::create(board_name, cfg.crane, cfg.hardware_bridge.board.counter_bits,
+  auto board = hb::ShmBoardEmulator::create(board_name, cfg.facts().crane, bridge.board.counter_bits,
                                             encoder_counts());
   auto participant = runtime::make_participant(options, "plant");
   transport::Wakeup wakeup;
   runtime::install_stop_handlers(&wakeup);
   runtime::DiagnosticsPublisher diagnostics(*participant, runtime::ProcessId::plant);
   runtime::LoopCounters counters;
-  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
-  const auto hang_timeout =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.facts().sample_period));
+  const auto hang_timeout = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(cfg.facts().lockstep_hang_timeout));
   auto publish = [&] { return board.publish_sample(encoder_counts()); };
   const auto bit = [](hb::DigitalOutput line) { return 1U << static_cast<unsigned>(line); };
   spdlog::info("behind the emulated board {} ({} clock): counters {} bits, DAC [{}, {}] V", board.segment_path(),
@@ -116,7 +107,7 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
           hang_reported = true;
           ++counters.overruns;
           spdlog::error("lockstep: no board outputs for sample {} in {} s: the chain behind the bridge is hung "
-                        "(the sample keeps waiting)", tick, cfg.plant.lockstep_hang_timeout);
+                        "(the sample keeps waiting)", tick, cfg.facts().lockstep_hang_timeout);
         }
       }
       if (!answered) break;
@@ -133,7 +124,7 @@ int run_behind_board(const std::string& board_name, const config::StackConfig& c
       input.slew_voltage = board.output_volts(outputs, hb::AnalogOutput::slew_drive);
       if ((digital & bit(hb::DigitalOutput::brake_release_hoist)) != 0) {
         input.hoist_speed = board.output_volts(outputs, hb::AnalogOutput::hoist_speed) *
-                            cfg.hardware_bridge.bridge.hoist_speed_per_volt;
+                            bridge.bridge.hoist_speed_per_volt;
       }
     }
     if (simulator.step(input) != common::StepStatus::ok) {
@@ -173,15 +164,20 @@ int main(int argc, char** argv) {
   app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle");
   app.add_option("--initial-swing", initial_swing, "[rad] initial in-plane swing");
   app.add_option("--stats-out", stats_path, "write loop statistics (JSON) here on exit");
-  double cable_length_factor = 1.0;
-  double load_mass_factor = 1.0;
-  app.add_option("--cable-length-factor", cable_length_factor,
+  plant::PlantMismatch mismatch;
+  app.add_option("--cable-length-factor", mismatch.cable_length_factor,
                  "the simulated crane's cable length is this times the configured one, while the sensors still "
                  "report the configured length (robustness studies)")
       ->check(CLI::Range(0.1, 10.0));
-  app.add_option("--load-mass-factor", load_mass_factor,
+  app.add_option("--load-mass-factor", mismatch.load_mass_factor,
                  "the simulated load mass is this times the configured one (controllers unaware)")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--friction-factor", mismatch.friction_factor,
+                 "every friction coefficient of the simulated drives is this times the configured one")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--sensor-delay", mismatch.sensor_delay_cycles,
+                 "[cycles] the sensor sample of cycle k reports the encoders of cycle k - this")
+      ->check(CLI::Range(0, plant::PlantStage::kMaxSensorDelay));
   std::string board_uri;
   app.add_option("--board", board_uri,
                  "shm:NAME: sit behind the emulated interface board (the hardware bridge reads and writes it) "
@@ -190,26 +186,28 @@ int main(int argc, char** argv) {
 
   try {
     runtime::configure_logging(options.log_level, "plant");
-    const config::StackConfig cfg = config::load_stack_config(options.config_path);
-    plant::PlantState initial;
-    initial.trolley_position = initial_trolley;
-    initial.slew_angle = initial_slew;
-    initial.swing_in_plane = initial_swing;
-    config::StackConfig truth = cfg;  // what the plant simulates; the controllers read cfg itself
-    truth.crane.cable_length *= cable_length_factor;
-    truth.crane.load_mass *= load_mass_factor;
-    const auto sim_params = config::simulator_parameters(truth, initial);
-    if (cable_length_factor != 1.0 || load_mass_factor != 1.0) {
-      spdlog::warn("plant differs from the configuration: L = {} m, m = {} kg (configured {} m, {} kg)",
-                   truth.crane.cable_length, truth.crane.load_mass, cfg.crane.cable_length, cfg.crane.load_mass);
+    const auto cfg = config::ConfigDocument::load(options.config_path);
+    plant::PlantStageParams params;
+    params.simulator = cfg.read("plant", plant::read_params);
+    params.simulator.initial_state.trolley_position = initial_trolley;
+    params.simulator.initial_state.slew_angle = initial_slew;
+    params.simulator.initial_state.swing_in_plane = initial_swing;
+    params.gate = cfg.read("actuation", supervisor::read_actuation_params);
+    params.mismatch = mismatch;
+    if (mismatch.cable_length_factor != 1.0 || mismatch.load_mass_factor != 1.0 || mismatch.friction_factor != 1.0 ||
+        mismatch.sensor_delay_cycles != 0) {
+      spdlog::warn("plant differs from the configuration: L x {}, m x {}, friction x {}, sensors {} cycles late",
+                   mismatch.cable_length_factor, mismatch.load_mass_factor, mismatch.friction_factor,
+                   mismatch.sensor_delay_cycles);
     }
-    plant::CraneSimulator simulator(sim_params);
     if (!board_uri.empty()) {
       if (board_uri.rfind("shm:", 0) != 0) {
         throw std::invalid_argument("--board " + board_uri + ": the plant can only sit behind an emulated board, shm:NAME");
       }
-      return run_behind_board(board_uri.substr(4), cfg, truth, simulator, realtime, options, stats_path);
+      return run_behind_board(board_uri.substr(4), cfg, params, realtime, options, stats_path);
     }
+    plant::PlantStage plant(params);
+    const double dt = cfg.facts().sample_period;
 
     auto participant = runtime::make_participant(options, "plant");
     transport::Wakeup wakeup;
@@ -225,87 +223,69 @@ int main(int argc, char** argv) {
     std::vector<double> latency_log;
     latency_log.reserve(1 << 16);
 
-    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.plant.sample_period));
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(dt));
     const auto hang_timeout = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout));
-    const auto status_timeout = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(cfg.plant.safety_status_timeout));
+        std::chrono::duration<double>(cfg.facts().lockstep_hang_timeout));
 
     tp::msgs::SensorSample_ sample;
-    tp::msgs::ActuatorCommand_ command;
+    protocol::SensorSample sample_plain;
+    protocol::ActuatorCommand command;
     tp::msgs::ActuatorCommand_ incoming;
-    tp::msgs::SupervisorStatus_ status;
+    protocol::SupervisorStatus status;
     tp::msgs::SupervisorStatus_ incoming_status;
-    Clock::time_point status_received{};
-    bool have_status = false;
-    bool have_command = false;
     std::uint64_t reoffered = 0;  // lockstep: cycles offered again (a best-effort sample lost, or start-up)
     std::uint64_t hangs = 0;      // lockstep: cycles that waited longer than lockstep_hang_timeout
     auto next_brake_report = Clock::now() + std::chrono::seconds(2);
-    std::uint64_t last_command_seq = 0;
     bool started = false;      // the chain has answered once
     bool chain_ready = false;  // and the supervisor has seen every stage alive: overruns count from here
-    std::uint64_t seq = 0;
     builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
     std::int64_t origin_ns = runtime::to_nanoseconds(origin);
     const auto publish = [&] {
-      fill_sensors(sample, simulator.output(), seq, origin, 1.0 / cable_length_factor);
+      plant.sample(sample_plain);
+      protocol::from_dds(origin, sample_plain.header.origin);
+      sample_plain.writer_pid = static_cast<std::uint32_t>(getpid());
+      protocol::to_dds(sample_plain, sample);
+      sample.header().stamp(runtime::now_stamp());
       sensors->write(sample);
     };
     const auto new_origin = [&] {
       origin = runtime::now_stamp();
       origin_ns = runtime::to_nanoseconds(origin);
     };
-    // The actuation rule: the command applies only while the supervisor's status says motion
-    // enabled and brakes released, clamped to its current voltage limits (lowered near a travel
-    // limit); otherwise 0 V and brakes engaged.
-    const auto gated_input = [&](bool command_valid, bool status_valid) {
-      plant::DriveInput input;  // default: 0 V, brakes engaged
-      if (command_valid && status_valid && status.brakes_released() && status.motion_enabled()) {
-        input.trolley_voltage = std::clamp(command.trolley_voltage(), -status.trolley_voltage_limit(),
-                                           status.trolley_voltage_limit());
-        input.slew_voltage = std::clamp(command.slew_voltage(), -status.slew_voltage_limit(), status.slew_voltage_limit());
-        input.hoist_speed = command.hoist_speed();
-        input.brakes_engaged = false;
-      }
-      return input;
-    };
     const auto record_arrival = [&](std::int64_t arrival_ns) {
       const double us = static_cast<double>(arrival_ns - origin_ns) / 1000.0;
       latency.record(us);
       if (latency_log.size() < latency_log.capacity()) latency_log.push_back(us);
     };
-    runtime::LatencyStatistics step_cost(1 << 16);  // [us] of simulator.step(): where a lockstep cycle goes
-    const auto step = [&](const plant::DriveInput& input) {
+    runtime::LatencyStatistics step_cost(1 << 16);  // [us] of the plant's step: where a lockstep cycle goes
+    const auto step = [&](const supervisor::GateInput& input) {
       const auto step_start = Clock::now();
-      const auto step_status = simulator.step(input);
+      const auto step_status = plant.step(input);
       step_cost.record(std::chrono::duration<double, std::micro>(Clock::now() - step_start).count());
       if (step_status != common::StepStatus::ok) {
-        spdlog::error("plant step at cycle {} returned status {}", seq, static_cast<int>(step_status));
+        spdlog::error("plant step at cycle {} returned status {}", plant.cycle() - 1, static_cast<int>(step_status));
       }
       ++counters.cycles;
-      ++seq;
-      counters.last_seq = seq;
+      counters.last_seq = plant.cycle();
     };
     publish();
-    spdlog::info("simulating at {} Hz, {} clock, x0 = {} m, gamma0 = {} rad", 1.0 / cfg.plant.sample_period,
-                 realtime ? "realtime" : "lockstep", initial_trolley, initial_slew);
+    spdlog::info("simulating at {} Hz, {} clock, x0 = {} m, gamma0 = {} rad", 1.0 / dt, realtime ? "realtime" : "lockstep",
+                 initial_trolley, initial_slew);
 
     if (!realtime) {
-      std::array<std::optional<tp::msgs::SupervisorStatus_>, 8> recent_statuses;
+      std::array<std::optional<protocol::SupervisorStatus>, 8> recent_statuses;
       tp::msgs::SensorSample_ previous_sample;  // of cycle k-1, offered again with cycle k
-      // Lockstep (docs/architecture.md, "The 100 Hz cycle"): cycle k is integrated only with the
+      // Lockstep (docs/architecture.md, "The 100 Hz cycle"; the rules in one place:
+      // supervisor::lockstep_may_run and lockstep_gate_input): cycle k is integrated only with the
       // command of cycle k, gated by the supervisor's status of cycle k-1 (computed from every
       // stage's output of cycle k-1, while the chain computes cycle k: the supervisor is off the
       // chain's path, and its decision lags the command by one cycle as in realtime). Cycle 0 waits
-      // for the status of cycle 0, so the supervisor always has a cycle done before the next one
-      // exists. Nothing is guessed and nothing depends on wall time: a slow machine slows the
-      // simulation, never changes it. While it waits, the plant offers cycle k again (after 10 ms,
-      // then doubling to 80 ms): a lost best-effort sample is recovered, and every stage and the
-      // supervisor answer a repeated cycle from their stored output. Only a status that reports a
-      // dead stage (stage_silent latched: its writer is gone) lets a cycle run, braked, without a
-      // command: every other cycle waits for the chain's answer.
+      // for the status of cycle 0. Nothing is guessed and nothing depends on wall time: a slow
+      // machine slows the simulation, never changes it. While it waits, the plant offers cycle k
+      // again (after 10 ms, then doubling to 80 ms): a lost best-effort sample is recovered, and
+      // every stage and the supervisor answer a repeated cycle from their stored output.
       while (!runtime::stop_requested()) {
+        const std::uint64_t seq = plant.cycle();
         bool got_command = false;
         bool got_status = false;
         std::int64_t arrival_ns = 0;
@@ -321,7 +301,7 @@ int main(int argc, char** argv) {
               continue;
             }
             if (incoming.header().seq() == seq && !got_command) {
-              command = incoming;
+              protocol::from_dds(incoming, command);
               got_command = true;
               arrival_ns = runtime::now_nanoseconds();
             }
@@ -333,19 +313,17 @@ int main(int argc, char** argv) {
               continue;
             }
             // Kept by cycle: one for a later cycle may arrive before this cycle is done.
-            recent_statuses[incoming_status.header().seq() % recent_statuses.size()] = incoming_status;
+            protocol::from_dds(incoming_status, recent_statuses[incoming_status.header().seq() % recent_statuses.size()].emplace());
           }
           if (!got_status) {
-            const std::uint64_t gate_seq = seq == 0 ? 0 : seq - 1;
+            const std::uint64_t gate_seq = supervisor::gating_cycle(seq);
             const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
-            if (gate.has_value() && gate->header().seq() == gate_seq) {
+            if (gate.has_value() && gate->header.seq == gate_seq) {
               status = *gate;
               got_status = true;
             }
           }
-          // A dead stage (the supervisor latched stage_silent) will never answer: the cycle runs braked.
-          const bool chain_dead = got_status && (status.latched_faults() & supervisor::kFaultStageSilent) != 0;
-          if (got_status && (got_command || chain_dead)) break;
+          if (got_status && supervisor::lockstep_may_run(got_command, status)) break;
           const auto now = Clock::now();
           if (now >= next_reoffer) {
             if (started) {
@@ -377,17 +355,21 @@ int main(int argc, char** argv) {
         started = true;
         if (got_command) record_arrival(arrival_ns);
         previous_sample = sample;
-        step(gated_input(got_command, got_status));
+        step(supervisor::lockstep_gate_input(seq, dt, got_command ? &command : nullptr, status));
         new_origin();
         publish();
         diagnostics.maybe_publish(counters, &latency);
       }
     } else {
       // Realtime: absolute deadlines every sample period on the monotonic clock. A command missing at
-      // the deadline is an overrun; the last valid one is held while it is at most
-      // plant.command_timeout old (a drive amplifier holds its input), then 0 V and brakes.
+      // the deadline is an overrun; the gate keeps the last valid one while it is within
+      // actuation.watchdog_timeout (a drive amplifier holds its input), then 0 V and brakes.
+      const auto epoch = Clock::now();
+      const auto seconds = [&](Clock::time_point t) { return std::chrono::duration<double>(t - epoch).count(); };
+      supervisor::GateInput in;
       auto next_deadline = Clock::now() + period;
       while (!runtime::stop_requested()) {
+        const std::uint64_t seq = plant.cycle();
         bool got = false;
         std::int64_t arrival_ns = 0;
         while (!runtime::stop_requested()) {
@@ -397,9 +379,10 @@ int main(int argc, char** argv) {
               continue;
             }
             if (incoming.header().seq() == seq) {
-              command = incoming;
+              protocol::from_dds(incoming, command);
               got = true;
               arrival_ns = runtime::now_nanoseconds();
+              in.command_arrival_time = seconds(Clock::now());
             }
           }
           while (safety->take_next(incoming_status)) {
@@ -407,10 +390,11 @@ int main(int argc, char** argv) {
               ++counters.nonfinite_rejected;
               continue;
             }
-            status = incoming_status;
-            status_received = Clock::now();
-            have_status = true;
-            chain_ready = chain_ready || status.stages_alive() == 0x3FU;
+            protocol::from_dds(incoming_status, status);
+            in.status_received = true;
+            in.status = supervisor::permit_of(status);
+            in.status_arrival_time = seconds(Clock::now());
+            chain_ready = chain_ready || status.stages_alive == protocol::SupervisorStatus::STAGES_ALL;
           }
           if (Clock::now() >= next_deadline) break;
           wakeup.wait_until(next_deadline);
@@ -420,32 +404,26 @@ int main(int argc, char** argv) {
         const bool count_overrun = !got && started && chain_ready;
         if (got) {
           started = true;
-          last_command_seq = seq;
-          have_command = true;
           record_arrival(arrival_ns);
         }
-        const bool command_valid =
-            have_command && static_cast<double>(seq - last_command_seq) * cfg.plant.sample_period <=
-                                cfg.plant.command_timeout + 1e-9;
-        const bool status_fresh = have_status && Clock::now() - status_received <= status_timeout;
-        const auto input = gated_input(command_valid, status_fresh);
-        if (input.brakes_engaged && Clock::now() >= next_brake_report) {
+        in.time = seconds(Clock::now());
+        in.command_received = got;
+        in.command = {command.trolley_voltage, command.slew_voltage, command.hoist_speed};
+        step(in);
+        const auto& gate = plant.gate_output();
+        if (gate.brakes_engaged && Clock::now() >= next_brake_report) {
           // Off the hot path: at most once every 2 s while the brakes stay on.
           next_brake_report = Clock::now() + std::chrono::seconds(2);
           const auto health = safety->health();
-          spdlog::info("brakes on at cycle {}: supervisor status {} (matched writers {}, alive {}, samples {}), "
-                       "motion {}, command {}",
-                       seq, have_status ? (status_fresh ? "fresh" : "stale") : "never received", health.matched_writers,
-                       health.alive_writers, health.samples,
-                       have_status && status.motion_enabled() ? "enabled" : "disabled",
-                       command_valid ? "valid" : "missing");
+          spdlog::info("brakes on at cycle {}: {} (supervisor status writers matched {}, alive {}, samples {})", seq,
+                       supervisor::reason_name(gate.reason), health.matched_writers, health.alive_writers,
+                       health.samples);
         }
         if (count_overrun) {
           ++counters.overruns;
-          spdlog::warn("overrun: no command for cycle {} within {} ms; {}", seq, cfg.plant.sample_period * 1e3,
-                       command_valid ? "the last command is held" : "0 V and brakes for this cycle");
+          spdlog::warn("overrun: no command for cycle {} within {} ms; {}", seq, dt * 1e3,
+                       gate.brakes_engaged ? "0 V and brakes for this cycle" : "the last command is held");
         }
-        step(input);
         std::this_thread::sleep_until(next_deadline);
         next_deadline += period;
         new_origin();
@@ -454,6 +432,7 @@ int main(int argc, char** argv) {
       }
     }
 
+    const auto& simulator = plant.simulator();
     runtime::leave_realtime();
     diagnostics.publish_final(counters, &latency);
     spdlog::info("stopping at t = {:.2f} s: {} cycles, {} overruns, {} cycles offered again, {} hung, {} non-finite "

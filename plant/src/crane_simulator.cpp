@@ -30,7 +30,7 @@ double slew_torque_per_volt(const common::CraneParameters& c) { return c.jib_ine
 }  // namespace
 
 const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& p) {
-  common::validate(p.crane, "simulator.crane");
+  common::validate(p.crane, "simulator.crane");  // the cable range (the hoist's) included
   common::require_in_range("simulator.sample_period", p.sample_period, 1e-6, 1.0);
   common::require_greater("simulator.relative_tolerance", p.relative_tolerance, 0.0);
   common::require_in_range("simulator.relative_tolerance", p.relative_tolerance, 0.0, 1e-2);
@@ -38,8 +38,6 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
   common::require_in_range("simulator.absolute_tolerance", p.absolute_tolerance, 0.0, 1e-2);
   common::require_in_range("simulator.brake_holding_factor", p.brake_holding_factor, 0.0, 1e6);
   common::require_greater("simulator.hoist_max_acceleration", p.hoist_max_acceleration, 0.0);
-  common::require_greater("simulator.min_cable_length", p.min_cable_length, 0.0);
-  common::require_greater("simulator.max_cable_length", p.max_cable_length, p.min_cable_length);
   return p;
 }
 
@@ -72,8 +70,8 @@ void CraneSimulator::validate_state(const PlantState& s) const {
   common::require_in_range(p + "swing_in_plane_rate", s.swing_in_plane_rate, -limit, limit);
   common::require_in_range(p + "swing_out_of_plane", s.swing_out_of_plane, -swing_limit, swing_limit);
   common::require_in_range(p + "swing_out_of_plane_rate", s.swing_out_of_plane_rate, -limit, limit);
-  common::require_in_range(p + "cable_length", s.cable_length, parameters_.min_cable_length,
-                           parameters_.max_cable_length);
+  common::require_in_range(p + "cable_length", s.cable_length, parameters_.crane.min_cable_length,
+                           parameters_.crane.max_cable_length);
   common::require_in_range(p + "cable_length_rate", s.cable_length_rate, -limit, limit);
 }
 
@@ -129,8 +127,8 @@ common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
     if (discriminant <= 0.0) return 0.0;
     return std::max(0.0, (-a_max * T_s + std::sqrt(discriminant)) / 2.0);
   };
-  const double lowering_limit = max_speed_toward_limit(parameters_.max_cable_length - L, L_dot);
-  const double raising_limit = -max_speed_toward_limit(L - parameters_.min_cable_length, -L_dot);
+  const double lowering_limit = max_speed_toward_limit(parameters_.crane.max_cable_length - L, L_dot);
+  const double raising_limit = -max_speed_toward_limit(L - parameters_.crane.min_cable_length, -L_dot);
   const double target_rate = std::clamp(safe.hoist_speed, raising_limit, lowering_limit);
   const double L_ddot = std::clamp((target_rate - L_dot) / T_s, -a_max, a_max);
 

@@ -245,6 +245,15 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
   N_VScale(1.0, y_, y_saved_);
   const auto saved_modes = modes_;
   if (!(input == input_)) {
+    if (input.brakes_engaged != input_.brakes_engaged) {
+      // The brake changes what holds an axis at rest: one at exactly zero velocity is decided again
+      // (a frictionless axis that slipped at rest with the brake off would otherwise keep its
+      // direction, and the engaged brake's sliding force would push it from rest).
+      const double* y = N_VGetArrayPointer(y_);
+      for (int a = 0; a < kNumFrictionAxes; ++a) {
+        if (y[kVelocityOffset + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
+      }
+    }
     input_ = input;
     settle_modes();
     needs_reinit_ = true;

@@ -23,9 +23,10 @@
 #include <string>
 #include <thread>
 
-#include "crane/config/stack_config.hpp"
+#include "crane/config/config_document.hpp"
+#include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/supervisor/supervisor.hpp"
+#include "crane/supervisor/supervisor_stage.hpp"
 
 namespace {
 
@@ -145,15 +146,17 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "supervisor");
-    const config::StackConfig cfg = config::load_stack_config(options.config_path);
-    supervisor::SupervisorParams params = cfg.supervisor;
-    params.expected_sensor_source = sensor_source == "plant" ? 1 : sensor_source == "bridge" ? 2 : 0;
+    const auto cfg = config::ConfigDocument::load(options.config_path);
+    supervisor::SupervisorParams params = cfg.read("supervisor", supervisor::read_params);
+    params.expected_sensor_source = sensor_source == "plant"    ? protocol::SensorSample::SOURCE_PLANT
+                                    : sensor_source == "bridge" ? protocol::SensorSample::SOURCE_HARDWARE_BRIDGE
+                                                                : protocol::SensorSample::SOURCE_UNKNOWN;
     std::ofstream fault_log;
     if (!fault_log_path.empty()) {
       fault_log.open(fault_log_path, std::ios::app);
       if (!fault_log) throw std::runtime_error("cannot open the fault log " + fault_log_path);
     }
-    supervisor::Supervisor core(params);
+    supervisor::SupervisorStage stage(params);
 
     auto participant = runtime::make_participant(options, "supervisor");
     transport::Wakeup wakeup;
@@ -187,14 +190,11 @@ int main(int argc, char** argv) {
     tp::msgs::ActuatorCommand_ last_actuators;
     std::array<Watched, supervisor::kStageCount> watched{};
     runtime::LoopCounters counters;
-    supervisor::SupervisorOutput out;
     supervisor::Mode logged_mode = supervisor::Mode::starting;
     tp::msgs::SupervisorCommand_ command;
     bool pending_command = false;
-    std::uint32_t last_request_id = 0;
-    std::uint8_t last_request_result = 0;
     tp::msgs::SupervisorStatus_ status;
-    const double dt = cfg.plant.sample_period;
+    const double dt = cfg.facts().sample_period;
     using supervisor::Stage;
 
     // Takes every sample that arrived (lockstep: kept by cycle too); says whether a sensor sample
@@ -221,84 +221,73 @@ int main(int argc, char** argv) {
           actuators->health()};
     };
 
-    // One supervision step on what was observed, then the status (stamped with the sensor cycle).
+    // One supervision step on what was observed (the stage object), then the status (stamped with
+    // the sensor cycle).
+    protocol::SensorSample sensors_plain;
+    protocol::ActuatorCommand actuators_plain;
+    protocol::Reference reference_plain;
+    protocol::SupervisorCommand command_plain;
+    protocol::SupervisorStatus status_plain;
     const auto supervise = [&](Clock::time_point now, const std::array<transport::ReaderHealth, supervisor::kStageCount>& h) {
-      supervisor::SupervisorInput in;
+      supervisor::SupervisorCycle cycle;
       for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
-        in.stages[i] = watched[i].observe(now, h[i], lockstep, last_sensors.header().seq(), dt);
+        cycle.stages[i] = watched[i].observe(now, h[i], lockstep, last_sensors.header().seq(), dt);
       }
-      in.sensors_valid = watched[0].seen;
-      in.sensor_seq = last_sensors.header().seq();
-      in.sensor_source = last_sensors.source();
-      in.trolley_position = last_sensors.trolley_position();
-      in.slew_angle = last_sensors.slew_angle();
-      in.swing_in_plane = last_sensors.swing_in_plane();
-      in.swing_out_of_plane = last_sensors.swing_out_of_plane();
-      in.limit_switches = last_sensors.limit_switches();
-      in.emergency_stop_input = last_sensors.emergency_stop_input();
-      in.actuators_valid = watched[5].seen;
-      in.actuator_seq = last_actuators.header().seq();
-      in.trolley_voltage = last_actuators.trolley_voltage();
-      in.slew_voltage = last_actuators.slew_voltage();
-      in.sensor_writers = h[0].matched_writers;
-      in.actuator_writers = h[5].matched_writers;
-      in.nonfinite_seen = nonfinite;
+      if (watched[static_cast<int>(Stage::sensors)].seen) {
+        protocol::from_dds(last_sensors, sensors_plain);
+        cycle.sensors = &sensors_plain;
+      }
+      if (watched[static_cast<int>(Stage::friction_compensation)].seen) {
+        protocol::from_dds(last_actuators, actuators_plain);
+        cycle.actuators = &actuators_plain;
+      }
+      if (watched[static_cast<int>(Stage::trajectory_planner)].seen) {
+        protocol::from_dds(last_reference, reference_plain);
+        cycle.reference = &reference_plain;
+      }
+      cycle.sensor_writers = h[0].matched_writers;
+      cycle.actuator_writers = h[5].matched_writers;
+      cycle.nonfinite_seen = nonfinite;
       nonfinite = false;
-      in.move_in_progress = last_reference.phase() == 1;
+      cycle.nonfinite_rejected = static_cast<std::uint32_t>(counters.nonfinite_rejected);
       // One operator command per cycle; a second one waits for the next cycle (nothing is dropped).
       if (!pending_command && commands->take_next(command)) pending_command = true;
-      if (pending_command && command.command() >= 1 && command.command() <= 4) {
-        in.command = static_cast<supervisor::Command>(command.command());
+      if (pending_command) {
+        protocol::from_dds(command, command_plain);
+        cycle.command = &command_plain;
       }
-      core.step(in, out);
+      stage.step(cycle, status_plain);
+      const supervisor::SupervisorInput& in = stage.input();
+      const supervisor::SupervisorOutput& out = stage.output();
       if (pending_command) {
         pending_command = false;
-        last_request_id = command.request_id();
-        last_request_result = out.command_refused ? 2 : 1;
-        const char* names[] = {"none", "arm", "disarm", "emergency_stop", "reset"};
-        const char* name = command.command() <= 4 ? names[command.command()] : "invalid";
+        const auto code = command_plain.command;
+        const std::string name(protocol::code_name(protocol::SupervisorCommand::kCodes, "COMMAND", code));
         if (out.command_refused) {
           spdlog::warn("command {} (request {}) refused: mode {}, latched faults 0x{:x}, active 0x{:x}, stages "
-                       "alive 0x{:x}", name, last_request_id, supervisor::mode_name(out.mode), out.latched_faults,
-                       out.active_faults, out.stages_alive);
+                       "alive 0x{:x}", name, status_plain.last_request_id, supervisor::mode_name(out.mode),
+                       out.latched_faults, out.active_faults, out.stages_alive);
         } else {
-          spdlog::info("command {} (request {}) accepted: mode {}", name, last_request_id,
+          spdlog::info("command {} (request {}) accepted: mode {}", name, status_plain.last_request_id,
                        supervisor::mode_name(out.mode));
         }
         if (fault_log.is_open()) {
           fault_log << "{\"time_ns\": " << runtime::now_nanoseconds() << ", \"event\": \"command\", \"command\": \""
-                    << name << "\", \"request_id\": " << last_request_id << ", \"result\": \""
+                    << name << "\", \"request_id\": " << status_plain.last_request_id << ", \"result\": \""
                     << (out.command_refused ? "refused" : "accepted") << "\", \"mode\": \""
                     << supervisor::mode_name(out.mode) << "\"}" << std::endl;
         }
       }
-
-      runtime::stamp_header(status.header(), last_sensors.header().seq(), last_sensors.header().origin());
-      status.mode(static_cast<uint8_t>(out.mode));
-      status.motion_enabled(out.motion_enabled);
-      status.brakes_released(out.brakes_released);
-      status.active_faults(out.active_faults);
-      status.latched_faults(out.latched_faults);
-      status.fault_count(out.fault_count);
-      status.stages_alive(out.stages_alive);
-      status.nonfinite_rejected(static_cast<uint32_t>(counters.nonfinite_rejected));
-      status.trolley_voltage_limit(out.trolley_voltage_limit);
-      status.slew_voltage_limit(out.slew_voltage_limit);
-      status.warnings(out.warnings);
-      status.last_fault(out.last_fault);
-      status.last_fault_seq(out.last_fault_seq);
-      status.trolley_velocity(out.trolley_velocity);
-      status.slew_rate(out.slew_rate);
-      status.last_request_id(last_request_id);
-      status.last_request_result(last_request_result);
+      protocol::to_dds(status_plain, status);
+      status.header().stamp(runtime::now_stamp());
       status_writer->write(status);
       ++counters.cycles;
       counters.last_seq = last_sensors.header().seq();
 
       for (int bit = 0; bit < supervisor::kFaultBits; ++bit) {
         const std::uint32_t fault = 1U << bit;
-        const bool raised = (core.newly_raised() & fault) != 0;
-        const bool cleared = (core.newly_cleared() & fault) != 0;
+        const bool raised = (stage.core().newly_raised() & fault) != 0;
+        const bool cleared = (stage.core().newly_cleared() & fault) != 0;
         if (!raised && !cleared) continue;
         const std::string record = fault_record(raised ? "raised" : "cleared", fault, counters.last_seq, in, out);
         if (raised) {
@@ -327,7 +316,7 @@ int main(int argc, char** argv) {
     if (lockstep) {
       // Every cycle in order, exactly once: cycle k is supervised when the sensor sample of k and
       // every stage's output of k have arrived (or a stage's writer is gone).
-      const auto hang_timeout = std::chrono::duration<double>(cfg.plant.lockstep_hang_timeout);
+      const auto hang_timeout = std::chrono::duration<double>(cfg.facts().lockstep_hang_timeout);
       std::array<bool, supervisor::kStageCount> was_matched{};
       bool stepped_any = false;
       std::uint64_t stepped_seq = 0;
@@ -426,7 +415,7 @@ int main(int argc, char** argv) {
         }
         drain_all(now);
         const auto in = supervise(now, healths());
-        if (out.stages_alive != 0x3FU && now >= next_health_log) {
+        if (stage.output().stages_alive != protocol::SupervisorStatus::STAGES_ALL && now >= next_health_log) {
           next_health_log = now + std::chrono::seconds(2);
           log_stages(in, "");
         }

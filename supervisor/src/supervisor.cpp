@@ -10,47 +10,15 @@
 namespace crane::supervisor {
 
 const char* stage_name(Stage stage) noexcept {
-  switch (stage) {
-    case Stage::sensors: return "sensors";
-    case Stage::state_estimator: return "state_estimator";
-    case Stage::trajectory_planner: return "trajectory_planner";
-    case Stage::anti_swing: return "anti_swing";
-    case Stage::tracking: return "tracking";
-    case Stage::friction_compensation: return "friction_compensation";
-  }
-  return "unknown";
+  return protocol::code_name(StatusCodes::kCodes, "STAGE", 1U << static_cast<unsigned>(stage)).data();
 }
 
 const char* mode_name(Mode mode) noexcept {
-  switch (mode) {
-    case Mode::starting: return "starting";
-    case Mode::standby: return "standby";
-    case Mode::ready: return "ready";
-    case Mode::operating: return "operating";
-    case Mode::fault: return "fault";
-    case Mode::emergency_stop: return "emergency_stop";
-  }
-  return "unknown";
+  return protocol::code_name(StatusCodes::kCodes, "MODE", static_cast<std::uint64_t>(mode)).data();
 }
 
 const char* fault_name(std::uint32_t fault_bit) noexcept {
-  switch (fault_bit) {
-    case kFaultStageSilent: return "stage_silent";
-    case kFaultTrolleyTravel: return "trolley_travel";
-    case kFaultVoltage: return "voltage";
-    case kFaultNonFinite: return "non_finite";
-    case kFaultEmergencyStop: return "emergency_stop";
-    case kFaultMultipleSensorWriters: return "multiple_sensor_writers";
-    case kFaultSwing: return "swing";
-    case kFaultSlewRange: return "slew_range";
-    case kFaultTrolleyOverspeed: return "trolley_overspeed";
-    case kFaultSlewOverspeed: return "slew_overspeed";
-    case kFaultVoltageRate: return "voltage_rate";
-    case kFaultMultipleActuatorWriters: return "multiple_actuator_writers";
-    case kFaultSensorSource: return "sensor_source";
-    case kFaultLimitSwitch: return "limit_switch";
-    default: return "unknown";
-  }
+  return protocol::code_name(StatusCodes::kCodes, "FAULT", fault_bit).data();
 }
 
 namespace {

@@ -7,10 +7,10 @@
 #include <cmath>
 
 #include "crane/anti_swing/anti_swing.hpp"
-#include "crane/config/stack_config.hpp"
 #include "crane/friction_compensation/friction_compensation.hpp"
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/stack/stack_config.hpp"
 #include "crane/state_estimator/state_estimator.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
@@ -19,9 +19,9 @@ namespace {
 using namespace crane;
 using Clock = std::chrono::steady_clock;
 
-const config::StackConfig& stack() {
-  static const config::StackConfig cfg =
-      config::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml");
+const crane::stack::StackConfig& lab() {
+  static const crane::stack::StackConfig cfg =
+      crane::stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml");
   return cfg;
 }
 
@@ -29,7 +29,7 @@ const config::StackConfig& stack() {
 // reverses every 0.5 s so the trolley keeps sticking and slipping.
 void BM_PlantSample(benchmark::State& state) {
   plant::SimulatorParameters p;
-  p.crane = stack().crane;
+  p.crane = lab().facts.crane;
   p.initial_state.trolley_position = 0.6;
   p.initial_state.cable_length = p.crane.cable_length;
   plant::CraneSimulator simulator(p);
@@ -52,10 +52,10 @@ BENCHMARK(BM_PlantSample)->Iterations(6000);
 
 // The whole control chain of one cycle: estimator, anti-swing, tracking, friction compensation.
 void BM_ControlChainCycle(benchmark::State& state) {
-  state_estimator::StateEstimator estimator(stack().state_estimator);
-  anti_swing::AntiSwing anti_swing(stack().anti_swing);
-  tracking::TrackingController tracking(stack().tracking);
-  friction_compensation::FrictionCompensation compensation(stack().friction_compensation);
+  state_estimator::StateEstimator estimator(lab().state_estimator);
+  anti_swing::AntiSwing anti_swing(lab().anti_swing.anti_swing);
+  tracking::TrackingController tracking(lab().tracking.tracking);
+  friction_compensation::FrictionCompensation compensation(lab().friction_compensation);
   common::CraneMeasurement m;
   common::CraneStateEstimate e;
   anti_swing::AntiSwingOutput a;

@@ -31,13 +31,13 @@ constexpr double kMaxFinalPositionError = 0.005;   // [m]
 constexpr double kMaxFinalSlewError = 0.005;       // [rad]
 constexpr double kMaxResidualSwing = 0.5 * kDeg;   // [rad] over the last 2 s
 
-const crane::config::StackConfig& lab_config() {
-  static const crane::config::StackConfig cfg =
-      crane::config::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml");
+const crane::stack::StackConfig& lab_config() {
+  static const crane::stack::StackConfig cfg =
+      crane::stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml");
   return cfg;
 }
 
-const crane::config::ManeuverConfig& maneuver(const std::string& name) {
+const crane::stack::ManeuverConfig& maneuver(const std::string& name) {
   for (const auto& m : lab_config().maneuvers) {
     if (m.name == name) return m;
   }
@@ -50,14 +50,7 @@ void maybe_write_csv(const Trace& t, const std::string& suffix = "") {
   std::ofstream out(std::string(dir) + "/" + t.maneuver + (t.friction_compensation ? "_fc_on" : "_fc_off") + suffix +
                     ".csv");
   out.precision(9);
-  out << "t,x,gamma,phi,theta,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,u_x,u_gamma,xdot_true\n";
-  for (const auto& s : t.samples) {
-    out << s.time << ',' << s.trolley_position << ',' << s.slew_angle << ',' << s.swing_in_plane << ','
-        << s.swing_out_of_plane << ',' << s.trolley_reference << ',' << s.slew_reference << ','
-        << s.trolley_linear_voltage << ',' << s.slew_linear_voltage << ',' << s.trolley_friction_voltage << ','
-        << s.slew_friction_voltage << ',' << s.trolley_voltage << ',' << s.slew_voltage << ','
-        << s.trolley_velocity_true << '\n';
-  }
+  crane::stack::write_csv(out, t.samples);
 }
 
 void print_header() {
@@ -81,7 +74,7 @@ void print_row(const Trace& t, const std::string& label) {
 TEST(ClosedLoop, PrintsTableOfAllRuns) {
   std::printf("\nswing period T = 2 pi sqrt(L/g) = %.4f s; V_flip = sign changes of the applied voltages "
               "over the last 2 s; tail_x = trolley travel over the last 2 s\n",
-              2.0 * kPi * std::sqrt(lab_config().crane.cable_length / lab_config().crane.gravity));
+              2.0 * kPi * std::sqrt(lab_config().facts.crane.cable_length / lab_config().facts.crane.gravity));
   print_header();
   for (const bool on : {true, false}) {
     for (const auto& m : lab_config().maneuvers) {
@@ -133,19 +126,20 @@ INSTANTIATE_TEST_SUITE_P(Maneuvers, CompensationOn, ::testing::Values("trolley",
 
 /// Lower bound of the swing amplitude below which the delayed-feedback anti-swing voltage cannot
 /// exceed the smaller trolley breakaway voltage.
-double trolley_stick_swing(const crane::config::StackConfig& cfg) {
-  const double L = cfg.crane.cable_length;
-  const double T = 2.0 * kPi * std::sqrt(L / cfg.crane.gravity);
-  const double volts_per_radian = (L / (T * T) * std::fabs(cfg.anti_swing.delay_gain) +
-                                   cfg.crane.mass_ratio() * cfg.crane.gravity) / cfg.crane.trolley_drive_gain;
-  const double breakaway = std::min(cfg.crane.trolley_friction.static_positive, cfg.crane.trolley_friction.static_negative);
+double trolley_stick_swing(const crane::stack::StackConfig& cfg) {
+  const auto& crane = cfg.facts.crane;
+  const double L = crane.cable_length;
+  const double T = 2.0 * kPi * std::sqrt(L / crane.gravity);
+  const double volts_per_radian = (L / (T * T) * std::fabs(cfg.anti_swing.anti_swing.delay_gain) +
+                                   crane.mass_ratio() * crane.gravity) / crane.trolley_drive_gain;
+  const double breakaway = std::min(crane.trolley_friction.static_positive, crane.trolley_friction.static_negative);
   return breakaway / volts_per_radian;
 }
 
 class CompensationOff : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CompensationOff, StictionLeavesTheSwingUndampedAndTheErrorLarger) {
-  if (lab_config().anti_swing.kind != crane::anti_swing::AntiSwingKind::delayed_feedback) {
+  if (lab_config().anti_swing.law != crane::anti_swing::AntiSwingLaw::delay1) {
     GTEST_SKIP() << "the stick-swing bound below is derived for the delayed-feedback law";
   }
   const Trace on = run_closed_loop(lab_config(), maneuver(GetParam()), true);
@@ -184,13 +178,12 @@ TEST(ClosedLoopFrictionless, MatchesTheLinearLoopAndSettlesWithinOneMillimetre) 
   print_header();
   for (const auto& m : lab_config().maneuvers) {
     auto cfg = lab_config();
-    auto plant = crane::closed_loop::simulator_parameters(cfg, m);
-    plant.crane.trolley_friction = {};
-    plant.crane.slew_friction = {};
-    const Trace linear = run_closed_loop(cfg, m, false, &plant);
+    crane::plant::PlantMismatch plant;
+    plant.friction_factor = 0.0;  // a frictionless plant
+    const Trace linear = run_closed_loop(cfg, m, false, plant);
     cfg.friction_compensation.trolley.friction = {};
     cfg.friction_compensation.slew.friction = {};
-    const Trace matched = run_closed_loop(cfg, m, true, &plant);
+    const Trace matched = run_closed_loop(cfg, m, true, plant);
     print_row(linear, "lin");
     print_row(matched, "on0");
     EXPECT_EQ(matched.plant_step_failures, 0) << m.name;
@@ -200,11 +193,11 @@ TEST(ClosedLoopFrictionless, MatchesTheLinearLoopAndSettlesWithinOneMillimetre) 
     EXPECT_TRUE(std::isfinite(matched.metrics.settle_time)) << m.name;
     ASSERT_EQ(matched.samples.size(), linear.samples.size());
     for (std::size_t i = 0; i < matched.samples.size(); ++i) {
-      ASSERT_EQ(matched.samples[i].trolley_voltage, linear.samples[i].trolley_voltage) << m.name << " cycle " << i;
-      ASSERT_EQ(matched.samples[i].slew_voltage, linear.samples[i].slew_voltage) << m.name << " cycle " << i;
+      ASSERT_EQ(matched.samples[i].u_x, linear.samples[i].u_x) << m.name << " cycle " << i;
+      ASSERT_EQ(matched.samples[i].u_gamma, linear.samples[i].u_gamma) << m.name << " cycle " << i;
     }
     // Information only: the lab compensation model on a frictionless plant.
-    const Trace mismatched = run_closed_loop(lab_config(), m, true, &plant);
+    const Trace mismatched = run_closed_loop(lab_config(), m, true, plant);
     print_row(mismatched, "onL");
   }
   std::printf("lin = frictionless plant, no compensation; on0 = compensation with a zero friction model; onL = "

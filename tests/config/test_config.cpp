@@ -1,4 +1,4 @@
-// Tests of crane::config: the real lab configuration against the dissertation (H. M. Omar,
+// Tests of crane::config and crane::stack (the whole file, block by block): the real lab configuration against the dissertation (H. M. Omar,
 // "Control of Gantry and Tower Cranes", Virginia Tech 2003), and the messages of bad files.
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -12,9 +12,10 @@
 #include <vector>
 
 #include "crane/common/validation.hpp"
-#include "crane/config/stack_config.hpp"
+#include "crane/config/config_document.hpp"
+#include "crane/stack/stack_config.hpp"
 
-namespace cfg = crane::config;
+namespace cfg = crane::stack;
 
 namespace {
 
@@ -100,21 +101,21 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   const auto c = cfg::load_stack_config(kLabConfig);
 
   // Section 4.5: m = 2 kg, L = 1 m.
-  EXPECT_DOUBLE_EQ(c.crane.load_mass, 2.0);
-  EXPECT_DOUBLE_EQ(c.crane.cable_length, 1.0);
-  EXPECT_DOUBLE_EQ(c.crane.gravity, 9.8);
+  EXPECT_DOUBLE_EQ(c.facts.crane.load_mass, 2.0);
+  EXPECT_DOUBLE_EQ(c.facts.crane.cable_length, 1.0);
+  EXPECT_DOUBLE_EQ(c.facts.crane.gravity, 9.8);
   // (4.17): m_t = m/M = 2/22.222 = 0.0900009.
-  EXPECT_NEAR(c.crane.mass_ratio(), 0.09, 1e-3);
+  EXPECT_NEAR(c.facts.crane.mass_ratio(), 0.09, 1e-3);
   // (4.17): m_r = m/J_o = 2/7.143 = 0.27999.
-  EXPECT_NEAR(c.crane.load_inertia_ratio(), 0.28, 1e-3);
+  EXPECT_NEAR(c.facts.crane.load_inertia_ratio(), 0.28, 1e-3);
   // (4.6): M_r = M/J_o = 1.93/7.143 = 0.27020.
-  EXPECT_NEAR(c.crane.trolley_inertia_ratio(), 0.27, 2e-3);
+  EXPECT_NEAR(c.facts.crane.trolley_inertia_ratio(), 0.27, 2e-3);
   // (4.4), (4.5): drive gains.
-  EXPECT_DOUBLE_EQ(c.crane.trolley_drive_gain, 2.0);
-  EXPECT_DOUBLE_EQ(c.crane.slew_drive_gain, 1.14);
+  EXPECT_DOUBLE_EQ(c.facts.crane.trolley_drive_gain, 2.0);
+  EXPECT_DOUBLE_EQ(c.facts.crane.slew_drive_gain, 1.14);
 
   // Trolley friction (4.12), static (4.13), in volt-equivalents.
-  const auto& tf = c.crane.trolley_friction;
+  const auto& tf = c.facts.crane.trolley_friction;
   EXPECT_DOUBLE_EQ(tf.viscous_positive, 1.5);
   EXPECT_DOUBLE_EQ(tf.viscous_negative, 6.0);
   EXPECT_DOUBLE_EQ(tf.coulomb_positive, 0.9);
@@ -122,7 +123,7 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   EXPECT_DOUBLE_EQ(tf.static_positive, 1.0);
   EXPECT_DOUBLE_EQ(tf.static_negative, 1.2);
   // Slew friction (4.16), static (4.15).
-  const auto& sf = c.crane.slew_friction;
+  const auto& sf = c.facts.crane.slew_friction;
   EXPECT_DOUBLE_EQ(sf.viscous_positive, 1.5);
   EXPECT_DOUBLE_EQ(sf.viscous_negative, 0.05);
   EXPECT_DOUBLE_EQ(sf.coulomb_positive, 0.7);
@@ -134,11 +135,35 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   EXPECT_DOUBLE_EQ(c.friction_compensation.trolley.friction.viscous_negative, tf.viscous_negative);
   EXPECT_DOUBLE_EQ(c.friction_compensation.slew.friction.coulomb_positive, sf.coulomb_positive);
   // The tracking controller's model ratios are the crane's.
-  EXPECT_DOUBLE_EQ(c.tracking.mass_ratio, c.crane.mass_ratio());
-  EXPECT_DOUBLE_EQ(c.tracking.load_inertia_ratio, c.crane.load_inertia_ratio());
-  EXPECT_DOUBLE_EQ(c.tracking.trolley_inertia_ratio, c.crane.trolley_inertia_ratio());
+  EXPECT_DOUBLE_EQ(c.tracking.tracking.mass_ratio, c.facts.crane.mass_ratio());
+  EXPECT_DOUBLE_EQ(c.tracking.tracking.load_inertia_ratio, c.facts.crane.load_inertia_ratio());
+  EXPECT_DOUBLE_EQ(c.tracking.tracking.trolley_inertia_ratio, c.facts.crane.trolley_inertia_ratio());
   // 100 Hz: the estimator's sample rate is 1 / sample_period = 1 / 0.01.
   EXPECT_NEAR(c.state_estimator.sample_rate, 100.0, 1e-9);
+
+  // One source for each shared fact (stack: and crane:), and every stage gets it from there.
+  EXPECT_DOUBLE_EQ(c.facts.sample_period, 0.01);
+  EXPECT_DOUBLE_EQ(c.plant.sample_period, c.facts.sample_period);
+  EXPECT_DOUBLE_EQ(c.actuation.sample_period, c.facts.sample_period);
+  EXPECT_DOUBLE_EQ(c.supervisor.sample_period, c.facts.sample_period);
+  EXPECT_DOUBLE_EQ(c.anti_swing.anti_swing.sample_period, c.facts.sample_period);
+  EXPECT_DOUBLE_EQ(c.facts.voltage_limit, 10.0);
+  EXPECT_DOUBLE_EQ(c.tracking.tracking.voltage_limit, c.facts.voltage_limit);
+  EXPECT_DOUBLE_EQ(c.tracking.gain_scheduling.voltage_limit, c.facts.voltage_limit);
+  EXPECT_DOUBLE_EQ(c.friction_compensation.voltage_limit, c.facts.voltage_limit);
+  EXPECT_DOUBLE_EQ(c.supervisor.voltage_limit, c.facts.voltage_limit);
+  EXPECT_DOUBLE_EQ(c.actuation.max_drive_voltage, c.facts.voltage_limit);
+  EXPECT_DOUBLE_EQ(c.hardware_bridge.bridge.gate.watchdog_timeout, c.actuation.watchdog_timeout);
+  EXPECT_DOUBLE_EQ(c.facts.crane.min_cable_length, 0.2);
+  EXPECT_DOUBLE_EQ(c.facts.crane.max_cable_length, 2.0);
+  EXPECT_DOUBLE_EQ(c.plant.crane.max_cable_length, c.facts.crane.max_cable_length);
+  EXPECT_DOUBLE_EQ(c.trajectory_planner.cable_min_length, c.facts.crane.min_cable_length);
+  EXPECT_DOUBLE_EQ(c.trajectory_planner.cable_max_length, c.facts.crane.max_cable_length);
+  EXPECT_DOUBLE_EQ(c.anti_swing.anti_swing.min_cable_length, c.facts.crane.min_cable_length);
+  EXPECT_DOUBLE_EQ(c.anti_swing.anti_swing.max_cable_length, c.facts.crane.max_cable_length);
+  EXPECT_DOUBLE_EQ(c.tracking.tracking.min_cable_length, c.facts.crane.min_cable_length);
+  EXPECT_DOUBLE_EQ(c.tracking.gain_scheduling.min_cable_length, c.facts.crane.min_cable_length);
+  EXPECT_EQ(c.anti_swing.law, crane::anti_swing::AntiSwingLaw::delay1);
 
   // Section 3.3.3: trolley (3.54), slew (3.55), combined; then (3.54) while hoisting.
   ASSERT_EQ(c.maneuvers.size(), 4U);
@@ -146,7 +171,7 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   EXPECT_EQ(c.maneuvers[1].name, "slew");
   EXPECT_EQ(c.maneuvers[2].name, "combined");
   EXPECT_EQ(c.maneuvers[3].name, "trolley_hoist");
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(c.maneuvers[i].cable_length_target, c.crane.cable_length);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(c.maneuvers[i].cable_length_target, c.facts.crane.cable_length);
   EXPECT_DOUBLE_EQ(c.maneuvers[3].cable_length_target, 1.5);
   // trolley: 0.25 -> 1.0 m, no slew.
   EXPECT_DOUBLE_EQ(c.maneuvers[0].initial_trolley_position, 0.25);
@@ -241,7 +266,7 @@ TEST_F(LabConfigText, InvalidEnumListsAllowedValues) {
   EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
   EXPECT_TRUE(contains(message, "anti_swing.controller")) << message;
   EXPECT_TRUE(contains(message, "'foo'")) << message;
-  for (const char* allowed : {"none", "pd", "delayed_feedback"}) {
+  for (const char* allowed : {"none", "pd", "delay1", "delay2", "fuzzy"}) {
     EXPECT_TRUE(contains(message, allowed)) << message;
   }
 
@@ -288,4 +313,28 @@ TEST_F(LabConfigText, DuplicateField) {
   EXPECT_TRUE(contains(message, "field crane.cable_length appears twice (lines " + std::to_string(first_line) + " and " +
                                     std::to_string(first_line + 1) + ")"))
       << message;
+}
+
+// A process reads only its own blocks: a whole block of another stage missing does not concern it
+// (the whole-stack loader refuses the file).
+TEST_F(LabConfigText, AProcessReadsItsOwnBlockOnly) {
+  std::string text = text_;
+  const auto start = text.find("\ntracking:");
+  ASSERT_NE(start, std::string::npos);
+  const auto end = text.find("\n\n", start + 1);
+  text.erase(start + 1, end - start);
+  const auto doc = crane::config::ConfigDocument::parse(text, "test.yaml");
+  const auto estimator = doc.read("state_estimator", crane::state_estimator::read_params);
+  EXPECT_NEAR(estimator.sample_rate, 100.0, 1e-9);
+  EXPECT_TRUE(contains(error_of(text), "missing field tracking")) << error_of(text);
+}
+
+// The shared facts are read once: a bad sample period is refused by name, whoever reads.
+TEST_F(LabConfigText, SharedFactsAreCheckedWhereTheyAreRead) {
+  const auto message = error_of(edit_line(text_, "stack:", "sample_period:", "sample_period: 0").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "sample_period = 0")) << message;
+  EXPECT_TRUE(contains(message, "[0.0001, 0.1]")) << message;
+  const auto range = error_of(edit_line(text_, "crane:", "max_cable_length:", "max_cable_length: 0.1").text);
+  EXPECT_TRUE(contains(range, "crane.max_cable_length = 0.1")) << range;
 }

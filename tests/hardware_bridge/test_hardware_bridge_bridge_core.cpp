@@ -378,24 +378,24 @@ TEST(BridgeCore, ParametersAndRangesAreValidated) {
   };
   EXPECT_EQ(error_of(BridgeParams{}, plant_ranges()), "");
   BridgeParams p;
-  p.watchdog_timeout = 0.0;
-  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.watchdog_timeout = 0 is out of range: must be in "
+  p.gate.watchdog_timeout = 0.0;
+  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "actuation.watchdog_timeout = 0 is out of range: must be in "
                                                     "[0.01, 1]"))
       << error_of(p, plant_ranges());
-  p.watchdog_timeout = 1.5;
-  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.watchdog_timeout = 1.5")) << error_of(p, plant_ranges());
+  p.gate.watchdog_timeout = 1.5;
+  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "actuation.watchdog_timeout = 1.5")) << error_of(p, plant_ranges());
   p = BridgeParams{};
-  p.status_timeout = 0.005;  // shorter than one period: the bridge could never drive
-  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.status_timeout = 0.005")) << error_of(p, plant_ranges());
+  p.gate.status_timeout = 0.005;  // shorter than one period: the bridge could never drive
+  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "actuation.status_timeout = 0.005")) << error_of(p, plant_ranges());
   p = BridgeParams{};
-  p.sample_period = 0.0;
-  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.sample_period = 0")) << error_of(p, plant_ranges());
+  p.gate.sample_period = 0.0;
+  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "actuation.sample_period = 0")) << error_of(p, plant_ranges());
   p = BridgeParams{};
   p.hoist_speed_per_volt = -0.1;
   EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.hoist_speed_per_volt = -0.1"));
   p = BridgeParams{};
-  p.max_drive_voltage = std::nan("");
-  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "hardware_bridge.max_drive_voltage = nan"))
+  p.gate.max_drive_voltage = std::nan("");
+  EXPECT_TRUE(contains(error_of(p, plant_ranges()), "actuation.max_drive_voltage = nan"))
       << error_of(p, plant_ranges());
 
   auto ranges = plant_ranges();

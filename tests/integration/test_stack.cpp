@@ -108,6 +108,41 @@ nlohmann::json run_demo(const std::string& name, unsigned domain, const std::vec
   return nlohmann::json::parse(file);
 }
 
+// Runs crane_sim demo (every stage object in one process, no DDS) with the demo's `options` into a
+// fresh directory, which it returns (empty path, and a test failure, if it fails).
+fs::path run_sim(const std::string& name, const std::vector<std::string>& options) {
+  const fs::path out = fresh_directory(name);
+  std::vector<std::string> arguments{"demo", "--config", kConfig, "--out", out.string()};
+  arguments.insert(arguments.end(), options.begin(), options.end());
+  ProcessGroup group;
+  group.start({"crane_sim", kBin + "/crane_sim", arguments, (out / "sim.log").string()});
+  std::optional<crane::launch::ChildExit> exit;
+  const auto deadline = Clock::now() + std::chrono::seconds(120);
+  while (!(exit = group.poll()) && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (!exit || !WIFEXITED(exit->status) || WEXITSTATUS(exit->status) != 0) {
+    ADD_FAILURE() << name << ": crane_sim failed or timed out; see " << out;
+    return {};
+  }
+  return out;
+}
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+// Every CSV of a crane_demo run (its summary) equals crane_sim's of the same name, to the last bit.
+void expect_sim_equals_demo(const nlohmann::json& summary, const fs::path& demo_out, const fs::path& sim_out) {
+  ASSERT_FALSE(sim_out.empty());
+  for (const auto& m : summary["maneuvers"]) {
+    const std::string csv = m["csv"];
+    const std::string demo = file_bytes(demo_out / csv);
+    ASSERT_GT(demo.size(), 1000U) << csv;
+    EXPECT_TRUE(file_bytes(sim_out / csv) == demo) << csv << ": crane_sim (" << sim_out << ") differs from crane_demo ("
+                                                   << demo_out << ")";
+  }
+}
+
 // Lockstep never guesses (docs/architecture.md, "The 100 Hz cycle"): the same maneuvers run again
 // and again give the same CSV files to the last bit and the same figures, with 0 overruns and no
 // fault, whatever the machine does meanwhile. Repetition 0 runs clean; every later one drops a
@@ -170,6 +205,8 @@ TEST(Lockstep, RepeatedRunsAreBitIdenticalWithLostSamplesAndUnderLoad) {
     }
     if (r == 0) {
       first = summary;
+      // The in-process runner gives the same files: the same stage objects on the same inputs.
+      expect_sim_equals_demo(summary, out, run_sim("lockstep_sim", options));
     } else {
       for (std::size_t i = 0; i < 4; ++i) {
         for (const auto& key : compared) {
@@ -422,6 +459,27 @@ TEST_P(StackController, TrolleyManeuverMeetsTheCriteria) {
 
 INSTANTIATE_TEST_SUITE_P(Controllers, StackController,
                          ::testing::Values("pd", "delay2", "fuzzy", "gain_scheduling_partial"));
+
+// crane_sim (every stage object in one thread, no DDS) gives the DDS lockstep demo's run to the last
+// bit for every controller of crane_demo (docs/architecture.md, "The in-process runner"): the
+// combined maneuver (trolley and slew), friction compensation on; the Lockstep test above compares
+// the default controller on two maneuvers with compensation on and off.
+class SimMatchesDemo : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SimMatchesDemo, CraneSimGivesTheLockstepDemoToTheBit) {
+  const std::string controller = GetParam();
+  const std::vector<std::string> options{"--maneuver", "combined", "--friction-compensation", "on", "--controller",
+                                         controller};
+  const auto summary = run_demo("sim_vs_demo_" + controller, 31, options);
+  ASSERT_FALSE(summary.is_null());
+  EXPECT_TRUE(summary["loop"]["failures"].empty()) << summary["loop"]["failures"];
+  const fs::path demo_out = fs::temp_directory_path() / ("crane_test_sim_vs_demo_" + controller + "_" + std::to_string(getpid()));
+  expect_sim_equals_demo(summary, demo_out, run_sim("sim_" + controller, options));
+}
+
+INSTANTIATE_TEST_SUITE_P(Controllers, SimMatchesDemo,
+                         ::testing::Values("none", "pd", "delay2", "fuzzy", "gain_scheduling_partial",
+                                           "gain_scheduling_full", "auto"));
 
 // NaN and Inf injected on the bus by a rogue participant are rejected where they enter, counted,
 // and never reach a drive: the voltages the plant applies stay finite and in range.

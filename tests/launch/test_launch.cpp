@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "crane/launch/maneuver_metrics.hpp"
+#include "crane/stack/maneuver_metrics.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 
@@ -34,8 +34,8 @@ constexpr double kTrolleyTarget = 1.0;             // [m]
 constexpr double kSlewTarget = std::numbers::pi / 2.0;  // [rad]
 
 /// `count` cycles every `dt` seconds from t = 0, all exactly at the targets, no swing, no voltage.
-std::vector<la::RecordedCycle> settled_run(std::size_t count, double dt) {
-  std::vector<la::RecordedCycle> cycles(count);
+std::vector<crane::stack::RecordedCycle> settled_run(std::size_t count, double dt) {
+  std::vector<crane::stack::RecordedCycle> cycles(count);
   for (std::size_t i = 0; i < count; ++i) {
     cycles[i].time = static_cast<double>(i) * dt;
     cycles[i].trolley_position = kTrolleyTarget;
@@ -49,7 +49,7 @@ std::vector<la::RecordedCycle> settled_run(std::size_t count, double dt) {
 
 TEST(ManeuverMetrics, SettledFromTheStart) {
   const auto cycles = settled_run(501, 0.01);  // 0 .. 5 s
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_EQ(m.settle_time, 0.0);  // no violation at all: settled at the first cycle, t = 0
   EXPECT_EQ(m.final_position_error, 0.0);
   EXPECT_EQ(m.final_slew_error, 0.0);
@@ -66,7 +66,7 @@ TEST(ManeuverMetrics, SettleTimeIsTheSampleAfterTheLastSwingViolation) {
   for (std::size_t i = 0; i < cycles.size(); ++i) {
     cycles[i].swing_in_plane = (i <= 32 ? 1.0 : 0.2) * kDeg * (i % 2 == 0 ? 1.0 : -1.0);
   }
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_DOUBLE_EQ(m.settle_time, cycles[33].time);
   EXPECT_NEAR(m.settle_time, 3.3, 1e-12);
   EXPECT_NEAR(m.max_swing, 1.0 * kDeg, 1e-15);
@@ -75,7 +75,7 @@ TEST(ManeuverMetrics, SettleTimeIsTheSampleAfterTheLastSwingViolation) {
 
   // The same with the violation in the out-of-plane swing.
   for (auto& c : cycles) std::swap(c.swing_in_plane, c.swing_out_of_plane);
-  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).settle_time, cycles[33].time);
+  EXPECT_DOUBLE_EQ(crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).settle_time, cycles[33].time);
 }
 
 TEST(ManeuverMetrics, TransientViolationAfterSettlingMovesTheSettleTime) {
@@ -83,7 +83,7 @@ TEST(ManeuverMetrics, TransientViolationAfterSettlingMovesTheSettleTime) {
   // means the settle time is the next cycle, t = 4.1 s, not the first good cycle.
   auto cycles = settled_run(61, 0.1);
   cycles[40].trolley_position = kTrolleyTarget + 0.006;
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_DOUBLE_EQ(m.settle_time, cycles[41].time);
   EXPECT_EQ(m.final_position_error, 0.0);
 }
@@ -92,7 +92,7 @@ TEST(ManeuverMetrics, SlewToleranceCounts) {
   // Slew 6 mrad (> 5 mrad) off until cycle 10 (t = 1.0 s), then on target: settles at t = 1.1 s.
   auto cycles = settled_run(31, 0.1);
   for (std::size_t i = 0; i <= 10; ++i) cycles[i].slew_angle = kSlewTarget - 0.006;
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_DOUBLE_EQ(m.settle_time, cycles[11].time);
 }
 
@@ -100,14 +100,14 @@ TEST(ManeuverMetrics, NeverWithinToleranceIsNaN) {
   // 6 mm short of the target the whole run (tolerance 5 mm): never settled.
   auto cycles = settled_run(301, 0.01);
   for (auto& c : cycles) c.trolley_position = kTrolleyTarget - 0.006;
-  auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_TRUE(std::isnan(m.settle_time));
   EXPECT_NEAR(m.final_position_error, 0.006, 1e-12);
 
   // Within tolerance everywhere except the very last cycle: still never settled "for good".
   cycles = settled_run(301, 0.01);
   cycles.back().trolley_position = kTrolleyTarget + 0.006;
-  m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_TRUE(std::isnan(m.settle_time));
 }
 
@@ -119,16 +119,16 @@ TEST(ManeuverMetrics, ResidualSwingOnlyOverTheLastTwoSeconds) {
   cycles[31].swing_in_plane = 0.1;        // t = 7.75
   cycles[34].swing_in_plane = 0.02;       // t = 8.5
   cycles[38].swing_out_of_plane = -0.03;  // t = 9.5
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_DOUBLE_EQ(m.max_swing, 0.1);
   EXPECT_DOUBLE_EQ(m.residual_swing, 0.03);
 
   // A shorter window (1 s: t >= 9) drops the 0.02 too but keeps the 0.03.
-  la::SettleCriteria criteria;
+  crane::stack::SettleCriteria criteria;
   criteria.residual_window = 1.0;
-  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.03);
+  EXPECT_DOUBLE_EQ(crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.03);
   criteria.residual_window = 0.25;  // t >= 9.75: nothing
-  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.0);
+  EXPECT_DOUBLE_EQ(crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget, criteria).residual_swing, 0.0);
 }
 
 TEST(ManeuverMetrics, MaxVoltageOverBothDrivesAndFinalErrors) {
@@ -139,18 +139,18 @@ TEST(ManeuverMetrics, MaxVoltageOverBothDrivesAndFinalErrors) {
   cycles[6].slew_voltage = 6.0;
   cycles.back().trolley_position = kTrolleyTarget - 0.002;
   cycles.back().slew_angle = kSlewTarget + 0.003;
-  const auto m = la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
+  const auto m = crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget);
   EXPECT_DOUBLE_EQ(m.max_voltage, 7.5);
   EXPECT_NEAR(m.final_position_error, 0.002, 1e-12);
   EXPECT_NEAR(m.final_slew_error, 0.003, 1e-12);
 
   // Trolley drive the largest: |-8| > 7.5.
   cycles[3].trolley_voltage = -8.0;
-  EXPECT_DOUBLE_EQ(la::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).max_voltage, 8.0);
+  EXPECT_DOUBLE_EQ(crane::stack::evaluate_maneuver(cycles, kTrolleyTarget, kSlewTarget).max_voltage, 8.0);
 }
 
 TEST(ManeuverMetrics, EmptyRecordingThrows) {
-  EXPECT_THROW((void)la::evaluate_maneuver({}, kTrolleyTarget, kSlewTarget), std::invalid_argument);
+  EXPECT_THROW((void)crane::stack::evaluate_maneuver({}, kTrolleyTarget, kSlewTarget), std::invalid_argument);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -39,8 +39,8 @@ TEST(Configuration, BadParametersThrowNamingTheField) {
   p.crane.slew_friction.coulomb_positive = -0.1;
   expect_config_error(p, "simulator.crane.slew_friction.coulomb_positive");
   p = {};
-  p.max_cable_length = 0.1;
-  expect_config_error(p, "simulator.max_cable_length");
+  p.crane.max_cable_length = 0.1;
+  expect_config_error(p, "simulator.crane.max_cable_length");
   p = {};
   p.initial_state.cable_length = 5.0;
   expect_config_error(p, "simulator.initial_state.cable_length");
@@ -109,7 +109,7 @@ TEST(Hoist, RateLimitedSpeedCommandAndLengthLimits) {
   EXPECT_NEAR(sim.output().applied_hoist_speed, 0.2, 1e-12);
   // Keep lowering: the length stops at max_cable_length (up to a discrete overshoot).
   for (int k = 0; k < 2000; ++k) ASSERT_EQ(sim.step(DriveInput{0.0, 0.0, 0.5, true}), common::StepStatus::ok);
-  EXPECT_NEAR(sim.state().cable_length, p.max_cable_length, p.hoist_max_acceleration * 0.01 * 0.01);
+  EXPECT_NEAR(sim.state().cable_length, p.crane.max_cable_length, p.hoist_max_acceleration * 0.01 * 0.01);
   EXPECT_EQ(sim.state().cable_length_rate, 0.0);
   EXPECT_EQ(sim.integrator_failure_count(), 0);
 }

@@ -15,11 +15,12 @@
 #include <optional>
 #include <thread>
 
-#include "crane/config/stack_config.hpp"
-#include "crane/launch/maneuver_metrics.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/stack/maneuver_run.hpp"
+#include "crane/stack/stack_config.hpp"
 
 namespace {
 
@@ -49,8 +50,6 @@ struct DemoOptions {
   std::string profile{"trapezoid"};
   std::uint8_t profile_code{protocol::MoveRequest::PROFILE_TRAPEZOID};
   std::string controller;             // --controller, see main(); "auto" picks per maneuver (time_optimal)
-  std::string anti_swing_controller;  // derived from controller
-  std::string tracking_controller;    // derived from controller
   double plant_cable_length_factor{1.0};
   double plant_load_mass_factor{1.0};
 };
@@ -66,7 +65,7 @@ struct RunResult {
   std::string maneuver;
   std::string controller;        // anti-swing or gain-scheduling law of this run
   bool friction_compensation{true};
-  launch::ManeuverMetrics metrics;
+  stack::ManeuverMetrics metrics;
   double swing_period{0.0};      // [s] T = 2 pi sqrt(L/g)
   std::size_t samples{0};        // cycles recorded and evaluated
   std::size_t missing{0};        // cycles of the move missing from the recording
@@ -174,15 +173,10 @@ void check_children(launch::ProcessGroup& group) {
   if (runtime::stop_requested()) throw RunFailure("interrupted");
 }
 
-std::string format_number(double v, int precision) {
-  if (!std::isfinite(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof(b), "%.*f", precision, v);
-  return b;
-}
+using stack::format_number;
 
 
-RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cfg, const config::ManeuverConfig& m,
+RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg, const stack::ManeuverConfig& m,
                        bool compensation, Operator& op, std::uint32_t request_id, unsigned domain_id) {
   const std::string run_name = m.name + (compensation ? "_fc_on" : "_fc_off");
   const fs::path out(options.out_dir);
@@ -203,32 +197,23 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   stack.plant_stats_path = (log_dir / "plant_stats.json").string();
   stack.plant_cable_length_factor = options.plant_cable_length_factor;
   stack.plant_load_mass_factor = options.plant_load_mass_factor;
-  stack.anti_swing_controller = options.anti_swing_controller;
-  stack.tracking_controller = options.tracking_controller;
+  // What the controller name stands for (one place for crane_demo and crane_sim).
+  const auto choice = stack::choose_controller(options.controller, m, options.acceleration_feedforward);
+  stack.anti_swing_controller = std::string(anti_swing::law_name(choice.anti_swing));
+  stack.tracking_controller = std::string(tracking::law_name(choice.tracking));
+  stack.tracking_acceleration_feedforward = choice.acceleration_feedforward;
   stack.fault_log_path = (log_dir / "faults.jsonl").string();
-  stack.tracking_acceleration_feedforward = options.acceleration_feedforward;
   // Realtime runs as crane_launch does: the stages on SCHED_FIFO where the system allows it.
   if (options.realtime && launch::probe_realtime(80).empty()) stack.realtime_priority = 70;
-  if (options.controller == "auto") {
-    // The best measured for the time-optimal profile (docs/architecture.md): a trolley move is
-    // swing-free by itself and tracked by PD with acceleration feedforward, no anti-swing law to
-    // disturb it; a slew leaves swing the linear design does not foresee (centripetal coupling),
-    // which the second delayed-feedback law (3.50) damps without exceeding the speed limits.
-    const bool slews = std::fabs(m.slew_target - m.initial_slew_angle) > 1e-9;
-    stack.anti_swing_controller = slews ? "delay2" : "none";
-    stack.tracking_acceleration_feedforward = true;
-  }
   // One emulated board per run, named after this process so parallel demos do not share one.
   if (options.hardware == "shm") stack.hardware = "shm:demo_" + std::to_string(getpid());
 
   RunResult result;
   result.maneuver = m.name;
-  result.controller = stack.tracking_controller == "tracking" ? stack.anti_swing_controller : stack.tracking_controller;
-  if (stack.tracking_acceleration_feedforward) result.controller += "+feedforward";
+  result.controller = choice.label;
   result.friction_compensation = compensation;
   result.domain_id = domain_id;
-  // Swing period at the cable length the move ends with (the one the load settles at).
-  result.swing_period = 2.0 * kPi * std::sqrt(m.cable_length_target / cfg.crane.gravity);
+  result.swing_period = stack::swing_period(m, cfg.facts);
 
   launch::ProcessGroup group;
   op.drain_all();
@@ -256,8 +241,9 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
                            !rec.sensors.rbegin()->second.brakes_engaged() && !rec.references.empty() &&
                            !rec.linear.empty() && !rec.actuators.empty();
     if (status && status->stages_alive() == protocol::SupervisorStatus::STAGES_ALL &&
-        status->mode() == protocol::SupervisorStatus::MODE_READY && op.goal_matches() > 0 && recording)
+        status->mode() == protocol::SupervisorStatus::MODE_READY && op.goal_matches() > 0 && recording) {
       break;
+    }
 
     if (Clock::now() > ready_deadline) {
       throw RunFailure(
@@ -285,30 +271,18 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
   //    start moves (and the run is repeatable only with runs that moved it alike). A goal that
   //    arrives after its start cycle starts at once: the run is then failed. The recording so far
   //    is kept: the first cycle of the move may be in it.
-  constexpr std::uint64_t kStartCycle = 400;  // 4 s of simulated rest: 0.1-1 s of wall time
   constexpr std::uint64_t kStartAhead = 100;  // [cycles] at least, for the goal's delivery
-  const std::uint64_t start_at = options.realtime ? 0 : std::max(kStartCycle, ready_seq + kStartAhead);
+  const std::uint64_t start_at = options.realtime ? 0 : std::max(stack::kMoveStartCycle, ready_seq + kStartAhead);
   result.move_start_cycle = start_at;
   tp::msgs::MoveRequest_ goal;
-  runtime::stamp_header(goal.header(), start_at, runtime::now_stamp());
-  goal.request_id(request_id);
-  goal.profile(options.profile_code);  // MoveRequest_.profile code (idl/crane_msgs.idl)
-  const bool hoists = m.cable_length_target != cfg.crane.cable_length;
-  goal.axes(static_cast<std::uint8_t>(protocol::MoveRequest::AXIS_TROLLEY | protocol::MoveRequest::AXIS_SLEW |
-                                      (hoists ? protocol::MoveRequest::AXIS_HOIST : 0)));
-  goal.trolley_target(m.trolley_target);
-  goal.slew_target(m.slew_target);
-  goal.cable_length_target(m.cable_length_target);
-  goal.trolley_max_velocity(m.trolley_max_velocity);
-  goal.trolley_max_acceleration(m.trolley_max_acceleration);
-  goal.slew_max_velocity(m.slew_max_velocity);
-  goal.slew_max_acceleration(m.slew_max_acceleration);
+  protocol::to_dds(stack::move_request(m, cfg.facts, request_id, options.profile_code, start_at), goal);
+  goal.header().stamp(runtime::now_stamp());
   if (!op.send_goal(goal)) throw RunFailure(run_name + ": the move request could not be written");
   spdlog::info("{}: stack ready, move {} sent", run_name, request_id);
   auto next_resend = Clock::now() + std::chrono::milliseconds(100);
 
   // 3. Record until `duration` seconds of cycles after the move started.
-  const double dt = cfg.plant.sample_period;
+  const double dt = cfg.facts.sample_period;
   const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
   std::optional<std::uint64_t> start_seq;
   std::optional<Clock::time_point> tail_deadline;
@@ -352,7 +326,7 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     spdlog::error("{}: {}", run_name, result.failures.back());
   }
   result.wall_time_s = std::chrono::duration<double>(Clock::now() - ready_time).count();
-  result.simulated_time_s = static_cast<double>(rec.sensors.rbegin()->first - ready_seq) * cfg.plant.sample_period;
+  result.simulated_time_s = static_cast<double>(rec.sensors.rbegin()->first - ready_seq) * cfg.facts.sample_period;
 
   // 4. Stop the stack; every stage publishes its final loop diagnostics on the way out. A stage that
   //    does not stop cleanly (it aborted, or had to be killed) fails the run.
@@ -394,15 +368,10 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
     }
   }
 
-  // 5. Assemble the cycles of the move and evaluate them.
-  std::vector<launch::RecordedCycle> cycles;
+  // 5. Assemble the cycles of the move and evaluate them (the CSV and the figures: stack::record_of,
+  //    one place with crane_sim).
+  std::vector<stack::CycleRecord> records;
   const fs::path csv_path = out / (run_name + ".csv");
-  std::ofstream csv(csv_path);
-  // Every column is a function of the simulation alone (t counts from the move's first cycle), so
-  // two runs of the same maneuver give the same file to the last bit (the lockstep's promise).
-  csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,"
-         "u_x_cmd,u_gamma_cmd,brakes\n";
-  csv.precision(9);
   for (std::uint64_t seq = *start_seq; seq <= *start_seq + cycles_needed; ++seq) {
     const auto s = rec.sensors.find(seq);
     const auto next = rec.sensors.find(seq + 1);
@@ -410,35 +379,29 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
       ++result.missing;
       continue;
     }
-    const double t = static_cast<double>(seq - *start_seq) * dt;
-    launch::RecordedCycle c;
-    c.time = t;
-    c.trolley_position = s->second.trolley_position();
-    c.slew_angle = s->second.slew_angle();
-    c.swing_in_plane = s->second.swing_in_plane();
-    c.swing_out_of_plane = s->second.swing_out_of_plane();
-    c.trolley_voltage = next->second.applied_trolley_voltage();
-    c.slew_voltage = next->second.applied_slew_voltage();
-    cycles.push_back(c);
+    protocol::SensorSample sensors, next_sensors;
+    protocol::from_dds(s->second, sensors);
+    protocol::from_dds(next->second, next_sensors);
+    protocol::Reference reference;
+    protocol::LinearCommand linear;
+    protocol::ActuatorCommand actuators;
     const auto r = rec.references.find(seq);
     const auto l = rec.linear.find(seq);
     const auto a = rec.actuators.find(seq);
+    if (r != rec.references.end()) protocol::from_dds(r->second, reference);
+    if (l != rec.linear.end()) protocol::from_dds(l->second, linear);
+    if (a != rec.actuators.end()) protocol::from_dds(a->second, actuators);
     // A cycle whose reference, linear or actuator command was not recorded counts as missing too.
     if (r == rec.references.end() || l == rec.linear.end() || a == rec.actuators.end()) ++result.missing;
-    const double nan = std::nan("");
-    csv << t << ',' << c.trolley_voltage << ',' << c.slew_voltage << ',' << c.trolley_position << ','
-        << c.slew_angle << ',' << c.swing_in_plane << ',' << c.swing_out_of_plane << ','
-        << s->second.cable_length() << ','
-        << (r != rec.references.end() ? r->second.trolley_position() : nan) << ','
-        << (r != rec.references.end() ? r->second.slew_angle() : nan) << ','
-        << (l != rec.linear.end() ? l->second.trolley_voltage() : nan) << ','
-        << (l != rec.linear.end() ? l->second.slew_voltage() : nan) << ','
-        << (a != rec.actuators.end() ? a->second.trolley_friction_voltage() : nan) << ','
-        << (a != rec.actuators.end() ? a->second.slew_friction_voltage() : nan) << ','
-        << (a != rec.actuators.end() ? a->second.trolley_voltage() : nan) << ','
-        << (a != rec.actuators.end() ? a->second.slew_voltage() : nan) << ','
-        << (next->second.brakes_engaged() ? 1 : 0) << '\n';
-    if (next->second.brakes_engaged()) ++result.braked_cycles;
+    records.push_back(stack::record_of(static_cast<double>(seq - *start_seq) * dt, sensors, next_sensors,
+                                       r != rec.references.end() ? &reference : nullptr,
+                                       l != rec.linear.end() ? &linear : nullptr,
+                                       a != rec.actuators.end() ? &actuators : nullptr));
+    if (next_sensors.brakes_engaged) ++result.braked_cycles;
+  }
+  {
+    std::ofstream csv(csv_path);
+    stack::write_csv(csv, records);
   }
   if (result.missing > 0) {
     spdlog::warn("{}: {} of {} cycles missing from the recording (move started at cycle {}, {} sensor samples from "
@@ -447,15 +410,15 @@ RunResult run_maneuver(const DemoOptions& options, const config::StackConfig& cf
                  rec.sensors.empty() ? 0 : rec.sensors.begin()->first,
                  rec.sensors.empty() ? 0 : rec.sensors.rbegin()->first);
   }
-  if (cycles.empty()) {
+  if (records.empty()) {
     throw RunFailure(run_name + ": no cycle was recorded (move started at cycle " + std::to_string(*start_seq) +
                      ", " + std::to_string(rec.sensors.size()) + " sensor samples from cycle " +
                      (rec.sensors.empty() ? std::string("-") : std::to_string(rec.sensors.begin()->first)) + " to " +
                      (rec.sensors.empty() ? std::string("-") : std::to_string(rec.sensors.rbegin()->first)) + ")");
   }
-  result.samples = cycles.size();
+  result.samples = records.size();
   result.csv = csv_path.filename().string();
-  result.metrics = launch::evaluate_maneuver(cycles, m.trolley_target, m.slew_target);
+  result.metrics = stack::evaluate(records, m);
   return result;
 }
 
@@ -516,25 +479,14 @@ int main(int argc, char** argv) {
                              "auto"}));
   CLI11_PARSE(app, argc, argv);
   if (options.controller.empty()) options.controller = options.profile == "time_optimal" ? "auto" : "delay1";
-  if (options.controller.rfind("gain_scheduling", 0) == 0) {
-    options.tracking_controller = options.controller;
-    options.anti_swing_controller = "none";
-    // The dissertation drives the gain-scheduling controller with step references (section 3.2).
-    if (profile_option->count() == 0) options.profile = "step";
-  } else {
-    options.tracking_controller = "tracking";
-    options.anti_swing_controller = options.controller;
-  }
-  {
-    for (const auto& code : protocol::MoveRequest::kCodes) {  // the PROFILE_* code named by --profile
-      if (code.group == "PROFILE" && code.name == options.profile) options.profile_code = static_cast<std::uint8_t>(code.value);
-    }
-  }
+  // The dissertation drives the gain-scheduling controller with step references (section 3.2).
+  if (options.controller.rfind("gain_scheduling", 0) == 0 && profile_option->count() == 0) options.profile = "step";
+  options.profile_code = stack::profile_code(options.profile);
 
   try {
     runtime::configure_logging("info", "demo");
-    const config::StackConfig cfg = config::load_stack_config(options.config_path);
-    std::vector<config::ManeuverConfig> selected;
+    const stack::StackConfig cfg = stack::load_stack_config(options.config_path);
+    std::vector<stack::ManeuverConfig> selected;
     for (const auto& m : cfg.maneuvers) {
       if (options.maneuvers.empty() ||
           std::find(options.maneuvers.begin(), options.maneuvers.end(), m.name) != options.maneuvers.end()) {
@@ -674,16 +626,10 @@ int main(int argc, char** argv) {
     const fs::path summary_path = fs::path(options.out_dir) / "summary.json";
     std::ofstream(summary_path) << summary.dump(2) << '\n';
 
-    // Table.
-    std::printf("\n%-13s %-9s %9s %7s %10s %11s %10s %12s %8s\n", "maneuver", "friction", "settle_s", "settle_T",
-                "pos_err_mm", "slew_err_mrad", "max_swing_deg", "resid_swing_deg", "max_V");
+    // Table (stack::table_row: one place with crane_sim).
+    std::printf("\n%s\n", stack::table_header().c_str());
     for (const auto& r : results) {
-      std::printf("%-13s %-9s %9s %7s %10s %11s %10s %12s %8s\n", r.maneuver.c_str(),
-                  r.friction_compensation ? "comp_on" : "comp_off", format_number(r.metrics.settle_time, 2).c_str(),
-                  format_number(r.metrics.settle_time / r.swing_period, 2).c_str(),
-                  format_number(r.metrics.final_position_error * 1e3, 2).c_str(), format_number(r.metrics.final_slew_error * 1e3, 2).c_str(),
-                  format_number(r.metrics.max_swing * 180 / kPi, 2).c_str(), format_number(r.metrics.residual_swing * 180 / kPi, 3).c_str(),
-                  format_number(r.metrics.max_voltage, 2).c_str());
+      std::printf("%s\n", stack::table_row(r.maneuver, r.friction_compensation, r.metrics, r.swing_period).c_str());
     }
     std::printf("\nloop: %llu cycles, %llu overruns, latency sensor->command p50 %.0f us, p99 %.0f us, max %.0f us (%s)\n",
                 static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(overruns),

@@ -20,6 +20,8 @@ void validate(const CraneParameters& c, const char* prefix) {
   const std::string p(prefix);
   require_in_range(p + ".gravity", c.gravity, 9.0, 10.5);
   require_in_range(p + ".load_mass", c.load_mass, 0.0, 1.0e5);
+  require_in_range(p + ".min_cable_length", c.min_cable_length, 0.05, 200.0);
+  require_in_range(p + ".max_cable_length", c.max_cable_length, c.min_cable_length, 200.0);
   require_in_range(p + ".cable_length", c.cable_length, 0.05, 200.0);
   require_greater(p + ".trolley_drive_mass", c.trolley_drive_mass, 0.0);
   require_greater(p + ".trolley_mass", c.trolley_mass, 0.0);

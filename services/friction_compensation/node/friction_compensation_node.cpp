@@ -1,9 +1,11 @@
 // friction_compensation process: joins rt/crane/control/linear and rt/crane/state/estimate of the
-// same cycle -> u = V + F_f/K_m (3.5) -> rt/crane/hw/actuators. `--disable` passes V through
-// unchanged (the dissertation's "without friction compensation" runs, figures 4.19-4.22).
+// same cycle -> FrictionCompensationStage, u = V + F_f/K_m (3.5) -> rt/crane/hw/actuators.
+// `--disable` passes V through unchanged (the dissertation's "without friction compensation" runs,
+// figures 4.19-4.22).
+#include <array>
 #include <optional>
 
-#include "crane/friction_compensation/friction_compensation.hpp"
+#include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/runtime/stage_node.hpp"
 
 int main(int argc, char** argv) {
@@ -15,9 +17,9 @@ int main(int argc, char** argv) {
       "friction_compensation: u = V + F_f/K_m (3.5) with the friction model (3.1)-(3.3)",
       [](CLI::App& app) { app.add_flag("--disable", disable, "pass the linear command through (no compensation)"); },
       [](runtime::StageContext& ctx) -> std::function<void()> {
-        auto params = ctx.config.friction_compensation;
+        auto params = ctx.config.read("friction_compensation", friction_compensation::read_params);
         if (disable) params.enabled = false;
-        auto compensator = std::make_shared<friction_compensation::FrictionCompensation>(params);
+        auto stage = std::make_shared<friction_compensation::FrictionCompensationStage>(params);
         // The estimate of cycle k does not wake this stage: the linear command of k is computed from
         // it two stages later, so it arrives after it (the loop's 5 ms poll covers the rest).
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(nullptr));
@@ -26,50 +28,34 @@ int main(int argc, char** argv) {
         auto watch = std::make_shared<runtime::SequenceWatch>();
         // The estimate of cycle k arrives before the linear command of cycle k (it is one of its
         // inputs), so keep a few recent estimates to join by seq.
-        auto recent = std::make_shared<std::array<tp::msgs::CraneState_, 8>>();
-        auto out = std::make_shared<tp::msgs::ActuatorCommand_>();
+        auto recent = std::make_shared<std::array<protocol::CraneState, 8>>();
+        auto out = std::make_shared<protocol::ActuatorCommand>();
         // The linear command of cycle k may overtake the estimate of cycle k (they travel on
         // different topics), so a command waits here until its estimate arrives.
-        auto pending = std::make_shared<std::optional<tp::msgs::LinearCommand_>>();
+        auto pending = std::make_shared<std::optional<protocol::LinearCommand>>();
         return [=, &ctx] {
-          tp::msgs::CraneState_ state;
-          while (runtime::take_finite(*states, state, ctx.counters)) {
-            (*recent)[state.header().seq() % recent->size()] = state;
-          }
-          tp::msgs::LinearCommand_ command;
-          while (runtime::take_finite(*commands, command, ctx.counters)) {
-            *pending = command;
-          }
+          protocol::CraneState state;
+          while (runtime::take_plain(*states, state, ctx.counters)) (*recent)[state.header.seq % recent->size()] = state;
+          protocol::LinearCommand command;
+          while (runtime::take_plain(*commands, command, ctx.counters)) *pending = command;
           if (!pending->has_value()) return;
-          const auto seq = (*pending)->header().seq();
+          const auto seq = (*pending)->header.seq;
           const auto& matching = (*recent)[seq % recent->size()];
-          if (matching.header().seq() != seq) return;  // its estimate is still on the way
-          const tp::msgs::LinearCommand_ linear = **pending;
+          if (matching.header.seq != seq) return;  // its estimate is still on the way
+          const protocol::LinearCommand linear = **pending;
           pending->reset();
           switch (watch->classify(seq, ctx.counters)) {
             case runtime::CycleKind::stale: return;
             case runtime::CycleKind::repeat: break;  // answered again from *out, the compensator untouched
-            case runtime::CycleKind::new_cycle: {
+            case runtime::CycleKind::new_cycle:
               ++ctx.counters.cycles;
-              friction_compensation::FrictionCompensationInput in;
-              in.estimate = runtime::to_estimate(matching);
-              in.command.trolley_voltage = linear.trolley_voltage();
-              in.command.slew_voltage = linear.slew_voltage();
-              in.command.hoist_speed = linear.hoist_speed();
-              friction_compensation::FrictionCompensationOutput result;
-              if (compensator->step(in, result) != common::StepStatus::ok) ++ctx.counters.nonfinite_rejected;
-              out->trolley_voltage(result.command.trolley_voltage);
-              out->slew_voltage(result.command.slew_voltage);
-              out->hoist_speed(result.command.hoist_speed);
-              out->trolley_friction_voltage(result.trolley_friction);
-              out->slew_friction_voltage(result.slew_friction);
+              if (stage->step(matching, linear, *out) != common::StepStatus::ok) ++ctx.counters.nonfinite_rejected;
               watch->answered(seq);
               break;
-            }
           }
-          runtime::stamp_header(out->header(), seq, linear.header().origin());
-          writer->write(*out);
-          runtime::record_latency(ctx.latency, out->header());
+          out->header.origin = linear.header.origin;  // a re-offer may carry a newer origin
+          runtime::write_plain(*writer, *out);
+          runtime::record_latency(ctx.latency, out->header);
         };
       });
 }

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "crane/common/validation.hpp"
-#include "crane/config/stack_config.hpp"
+#include "crane/config/config_document.hpp"
 #include "crane/model_audit/audit_report.hpp"
 #include "crane/model_audit/hidden_effect_generator.hpp"
 #include "crane/model_audit/measured_data.hpp"
@@ -71,7 +71,7 @@ std::map<std::string, double> parse_parameters(const std::vector<std::string>& e
 // Nominal model of `plant` from the stack configuration `path` (empty: none).
 std::optional<ma::AuditNominal> config_nominal(const std::string& path, ma::AuditPlant plant) {
   if (path.empty()) return std::nullopt;
-  const crane::common::CraneParameters crane = crane::config::load_stack_config(path).crane;
+  const crane::common::CraneParameters crane = crane::config::ConfigDocument::load(path).facts().crane;
   if (plant == ma::AuditPlant::crane) return ma::AuditNominal{crane};
   if (plant == ma::AuditPlant::axis) {
     return ma::AuditNominal{ma::drive_axis_parameters(crane.trolley_friction, crane.trolley_drive_gain)};

@@ -25,18 +25,7 @@
 namespace crane::runtime {
 
 const char* process_name(ProcessId id) noexcept {
-  switch (id) {
-    case ProcessId::plant: return "plant";
-    case ProcessId::hardware_bridge: return "hardware_bridge";
-    case ProcessId::state_estimator: return "state_estimator";
-    case ProcessId::trajectory_planner: return "trajectory_planner";
-    case ProcessId::anti_swing: return "anti_swing";
-    case ProcessId::tracking: return "tracking";
-    case ProcessId::friction_compensation: return "friction_compensation";
-    case ProcessId::supervisor: return "supervisor";
-    case ProcessId::operator_console: return "operator";
-  }
-  return "unknown";
+  return protocol::code_name(protocol::LoopDiagnostics::kCodes, "PROCESS", static_cast<std::uint64_t>(id)).data();
 }
 
 void add_node_options(CLI::App& app, NodeOptions& options) {

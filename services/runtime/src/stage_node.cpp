@@ -20,6 +20,11 @@ void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header
   latency.record(static_cast<double>(now_nanoseconds() - to_nanoseconds(header.origin())) / 1000.0);
 }
 
+void record_latency(LatencyStatistics& latency, const protocol::CycleHeader& header) noexcept {
+  const std::int64_t origin = static_cast<std::int64_t>(header.origin.sec) * 1'000'000'000 + header.origin.nanosec;
+  latency.record(static_cast<double>(now_nanoseconds() - origin) / 1000.0);
+}
+
 int run_stage(int argc, char** argv, ProcessId process, const std::string& description,
               const std::function<void(CLI::App&)>& add_options,
               const std::function<std::function<void()>(StageContext&)>& setup) {
@@ -35,7 +40,7 @@ int run_stage(int argc, char** argv, ProcessId process, const std::string& descr
   const std::string name = process_name(process);
   try {
     configure_logging(options.log_level, name);
-    const config::StackConfig cfg = config::load_stack_config(options.config_path);
+    const auto cfg = config::ConfigDocument::load(options.config_path);
     auto participant = make_participant(options, name);
     transport::Wakeup wakeup;
     install_stop_handlers(&wakeup);

@@ -1,7 +1,7 @@
-// state_estimator process: rt/crane/hw/sensors -> section 4.3 filter and differentiator ->
-// rt/crane/state/estimate, once per sensor cycle, same seq and origin.
+// state_estimator process: rt/crane/hw/sensors -> StateEstimatorStage (section 4.3 filter and
+// differentiator) -> rt/crane/state/estimate, once per sensor cycle, same seq and origin.
 #include "crane/runtime/stage_node.hpp"
-#include "crane/state_estimator/state_estimator.hpp"
+#include "crane/state_estimator/state_estimator_stage.hpp"
 
 int main(int argc, char** argv) {
   using namespace crane;
@@ -10,32 +10,30 @@ int main(int argc, char** argv) {
       argc, argv, runtime::ProcessId::state_estimator,
       "state_estimator: Butterworth filter and Al-Alaoui differentiator (section 4.3) on the sensor stream", {},
       [](runtime::StageContext& ctx) -> std::function<void()> {
-        auto estimator = std::make_shared<state_estimator::StateEstimator>(ctx.config.state_estimator);
+        auto stage = std::make_shared<state_estimator::StateEstimatorStage>(
+            ctx.config.read("state_estimator", state_estimator::read_params));
         auto sensors = std::shared_ptr(ctx.participant.make_reader<tp::Sensors>(&ctx.wakeup));
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::StateEstimate>());
         auto watch = std::make_shared<runtime::SequenceWatch>();
-        auto out = std::make_shared<tp::msgs::CraneState_>();
-        auto estimate = std::make_shared<common::CraneStateEstimate>();
+        auto out = std::make_shared<protocol::CraneState>();
         return [=, &ctx] {
-          tp::msgs::SensorSample_ sample;
-          while (runtime::take_finite(*sensors, sample, ctx.counters)) {
-            const auto seq = sample.header().seq();
-            switch (watch->classify(seq, ctx.counters)) {
+          protocol::SensorSample sample;
+          while (runtime::take_plain(*sensors, sample, ctx.counters)) {
+            switch (watch->classify(sample.header.seq, ctx.counters)) {
               case runtime::CycleKind::stale: continue;
               case runtime::CycleKind::repeat: break;  // answered again from *out, filters untouched
               case runtime::CycleKind::new_cycle:
-                if (estimator->step(runtime::to_measurement(sample), *estimate) != common::StepStatus::ok) {
+                if (stage->step(sample, *out) != common::StepStatus::ok) {
                   ++ctx.counters.nonfinite_rejected;
                   continue;
                 }
                 ++ctx.counters.cycles;
-                runtime::from_estimate(*estimate, *out);
-                watch->answered(seq);
+                watch->answered(sample.header.seq);
                 break;
             }
-            runtime::stamp_header(out->header(), seq, sample.header().origin());
-            writer->write(*out);
-            runtime::record_latency(ctx.latency, out->header());
+            out->header.origin = sample.header.origin;  // a re-offer may carry a newer origin
+            runtime::write_plain(*writer, *out);
+            runtime::record_latency(ctx.latency, out->header);
           }
         };
       });

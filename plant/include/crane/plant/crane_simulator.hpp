@@ -8,7 +8,7 @@
 //        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
 // The cable length follows the hoist speed command kinematically: the commanded speed is limited so
-// the hoist can still stop inside [min_cable_length, max_cable_length] at hoist_max_acceleration
+// the hoist can still stop inside [crane.min_cable_length, crane.max_cable_length] at hoist_max_acceleration
 // (accounting for the distance covered during this sample), then rate limited to
 // hoist_max_acceleration (L_ddot is constant over each sample). A discrete overshoot of the length
 // limits of order hoist_max_acceleration * sample_period^2 remains possible.
@@ -63,9 +63,8 @@ struct SimulatorParameters {
   double absolute_tolerance{1e-10};    // [SI] CVODE atol in (0, 1e-2]
   double brake_holding_factor{20.0};   // [-] brake holding force / drive force at full DAC range, >= 0
   double hoist_max_acceleration{0.5};  // [m/s^2] > 0
-  double min_cable_length{0.2};        // [m] > 0
-  double max_cable_length{3.0};        // [m] > min_cable_length
-  PlantState initial_state{};          // finite; cable_length within [min, max]; |swing| < pi/2
+  PlantState initial_state{};          // finite; cable_length within the crane's [min_cable_length,
+                                       // max_cable_length]; |swing| < pi/2
 };
 
 struct SimulatorOutput {

@@ -31,9 +31,12 @@
 #include <array>
 #include <cstdint>
 
+#include "crane/protocol/messages.hpp"
+
 namespace crane::supervisor {
 
-/// Stages of the chain the supervisor watches, in data-flow order.
+/// Stages of the chain the supervisor watches, in data-flow order (bit i of
+/// SupervisorStatus.stages_alive is Stage(i): the IDL's STAGE_* codes).
 enum class Stage : std::uint8_t {
   sensors = 0,          // plant or hardware bridge
   state_estimator = 1,
@@ -43,42 +46,51 @@ enum class Stage : std::uint8_t {
   friction_compensation = 5,  // the actuator command
 };
 inline constexpr std::size_t kStageCount = 6;
+static_assert((1U << kStageCount) - 1U == protocol::SupervisorStatus::STAGES_ALL);
+/// "sensors", "state_estimator", ... (the IDL's code names).
 [[nodiscard]] const char* stage_name(Stage stage) noexcept;
 
-/// Operation modes (SupervisorStatus_.mode).
-enum class Mode : std::uint8_t { starting = 0, standby = 1, ready = 2, operating = 3, fault = 4, emergency_stop = 5 };
+/// Operation modes (SupervisorStatus.mode, the IDL's MODE_* codes).
+enum class Mode : std::uint8_t {
+  starting = protocol::SupervisorStatus::MODE_STARTING,
+  standby = protocol::SupervisorStatus::MODE_STANDBY,
+  ready = protocol::SupervisorStatus::MODE_READY,
+  operating = protocol::SupervisorStatus::MODE_OPERATING,
+  fault = protocol::SupervisorStatus::MODE_FAULT,
+  emergency_stop = protocol::SupervisorStatus::MODE_EMERGENCY_STOP,
+};
 [[nodiscard]] const char* mode_name(Mode mode) noexcept;
 
-/// Fault codes (protective functions that tripped): one bit each in SupervisorStatus_.active_faults /
-/// latched_faults / last_fault.
+/// Fault codes (protective functions that tripped): one bit each in SupervisorStatus.active_faults /
+/// latched_faults / last_fault. Defined in the IDL (FAULT_*, with their meaning); named here.
+using StatusCodes = protocol::SupervisorStatus;  // the codes of SupervisorStatus
 enum Fault : std::uint32_t {
-  kFaultStageSilent = 1U << 0,          // a stage of the chain stopped publishing or lost liveliness
-  kFaultTrolleyTravel = 1U << 1,        // travel limiter: outside [trolley_min, trolley_max] or inside the
-                                        // stop margin moving toward it
-  kFaultVoltage = 1U << 2,              // an actuator command beyond the voltage limit
-  kFaultNonFinite = 1U << 3,            // NaN or Inf arrived on a watched topic
-  kFaultEmergencyStop = 1U << 4,        // emergency stop commanded or input pressed
-  kFaultMultipleSensorWriters = 1U << 5,  // more than one writer on rt/crane/hw/sensors
-  kFaultSwing = 1U << 6,                // sway limiter: swing angle beyond max_swing
-  kFaultSlewRange = 1U << 7,            // slew limiter: outside [slew_min, slew_max] or inside its stop margin
-  kFaultTrolleyOverspeed = 1U << 8,     // |trolley velocity| > trolley_max_speed
-  kFaultSlewOverspeed = 1U << 9,        // |slew rate| > slew_max_rate
-  kFaultVoltageRate = 1U << 10,         // a drive command changed faster than max_voltage_rate
-  kFaultMultipleActuatorWriters = 1U << 11,  // more than one writer on rt/crane/hw/actuators
-  kFaultSensorSource = 1U << 12,        // sensors come from another source than the launch mode expects
-  kFaultLimitSwitch = 1U << 13,         // a hardware limit switch input is active
+  kFaultStageSilent = StatusCodes::FAULT_STAGE_SILENT,
+  kFaultTrolleyTravel = StatusCodes::FAULT_TROLLEY_TRAVEL,
+  kFaultVoltage = StatusCodes::FAULT_VOLTAGE,
+  kFaultNonFinite = StatusCodes::FAULT_NON_FINITE,
+  kFaultEmergencyStop = StatusCodes::FAULT_EMERGENCY_STOP,
+  kFaultMultipleSensorWriters = StatusCodes::FAULT_MULTIPLE_SENSOR_WRITERS,
+  kFaultSwing = StatusCodes::FAULT_SWING,
+  kFaultSlewRange = StatusCodes::FAULT_SLEW_RANGE,
+  kFaultTrolleyOverspeed = StatusCodes::FAULT_TROLLEY_OVERSPEED,
+  kFaultSlewOverspeed = StatusCodes::FAULT_SLEW_OVERSPEED,
+  kFaultVoltageRate = StatusCodes::FAULT_VOLTAGE_RATE,
+  kFaultMultipleActuatorWriters = StatusCodes::FAULT_MULTIPLE_ACTUATOR_WRITERS,
+  kFaultSensorSource = StatusCodes::FAULT_SENSOR_SOURCE,
+  kFaultLimitSwitch = StatusCodes::FAULT_LIMIT_SWITCH,
 };
 inline constexpr int kFaultBits = 14;
 /// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
 [[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
 
-/// Warnings (SupervisorStatus_.warnings): reported, motion continues.
+/// Warnings (SupervisorStatus.warnings, the IDL's WARNING_* codes): reported, motion continues.
 enum Warning : std::uint32_t {
-  kWarningTrolleyApproach = 1U << 0,    // trolley inside its approach margin, moving toward the limit
-  kWarningSlewApproach = 1U << 1,       // jib inside its approach margin, moving toward the limit
-  kWarningSpeedLimited = 1U << 2,       // an approach speed was exceeded: drive voltage limited
-  kWarningStageLate = 1U << 3,          // a stage is late (not fresh, or a DDS deadline missed): motion
-                                        // inhibited while it lasts, not yet dead
+  kWarningTrolleyApproach = StatusCodes::WARNING_TROLLEY_APPROACH,  // trolley in its approach margin, moving toward the limit
+  kWarningSlewApproach = StatusCodes::WARNING_SLEW_APPROACH,        // jib in its approach margin, moving toward the limit
+  kWarningSpeedLimited = StatusCodes::WARNING_SPEED_LIMITED,        // an approach speed was exceeded: drive voltage limited
+  kWarningStageLate = StatusCodes::WARNING_STAGE_LATE,              // a stage is late (not fresh, or a DDS deadline missed):
+                                                              // motion inhibited while it lasts, not yet dead
 };
 
 /// One axis's range and approach behaviour. Units: [m] and [m/s] for the trolley, [rad] and [rad/s]
@@ -138,7 +150,14 @@ struct StageObservation {
   bool deadline_missed{false};        // a DDS requested-deadline-missed event since the last step
 };
 
-enum class Command : std::uint8_t { none = 0, arm = 1, disarm = 2, emergency_stop = 3, reset = 4 };
+/// Operator commands (SupervisorCommand.command, the IDL's COMMAND_* codes).
+enum class Command : std::uint8_t {
+  none = protocol::SupervisorCommand::COMMAND_NONE,
+  arm = protocol::SupervisorCommand::COMMAND_ARM,
+  disarm = protocol::SupervisorCommand::COMMAND_DISARM,
+  emergency_stop = protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP,
+  reset = protocol::SupervisorCommand::COMMAND_RESET,
+};
 
 struct SupervisorInput {
   std::array<StageObservation, kStageCount> stages{};

@@ -25,6 +25,9 @@ struct CraneParameters {
   double gravity{9.8};             // [m/s^2] 9.8 reproduces the dissertation's digits (ERRATA)
   double load_mass{2.0};           // [kg] m (section 4.5)
   double cable_length{1.0};        // [m] L, initial cable length
+  double min_cable_length{0.2};    // [m] shortest cable the hoist allows (planner targets, controllers'
+                                   // floor on the measured L, the plant's hoist stop)
+  double max_cable_length{2.0};    // [m] longest cable the hoist allows (sizes the anti-swing delay lines)
   double trolley_drive_mass{22.222};  // [kg] M: mass seen by the trolley drive along the jib,
                                       // trolley plus reflected leadscrew/rotor inertia; m_t = m/M = 0.09
   double trolley_mass{1.93};       // [kg] physical trolley mass (slewing inertia), M_r = M/J_o = 0.27

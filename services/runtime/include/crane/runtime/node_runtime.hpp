@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "crane/protocol/dds.hpp"
+#include "crane/protocol/messages.hpp"
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 
@@ -23,18 +24,19 @@ namespace crane::runtime {
 
 namespace msgs = crane_msgs::msg::dds_;
 
-/// Process identifiers carried in LoopDiagnostics_.process.
+/// Process identifiers carried in LoopDiagnostics_.process (the IDL's PROCESS_* codes).
 enum class ProcessId : std::uint8_t {
-  plant = 1,
-  hardware_bridge = 2,
-  state_estimator = 3,
-  trajectory_planner = 4,
-  anti_swing = 5,
-  tracking = 6,
-  friction_compensation = 7,
-  supervisor = 8,
-  operator_console = 9,
+  plant = protocol::LoopDiagnostics::PROCESS_PLANT,
+  hardware_bridge = protocol::LoopDiagnostics::PROCESS_HARDWARE_BRIDGE,
+  state_estimator = protocol::LoopDiagnostics::PROCESS_STATE_ESTIMATOR,
+  trajectory_planner = protocol::LoopDiagnostics::PROCESS_TRAJECTORY_PLANNER,
+  anti_swing = protocol::LoopDiagnostics::PROCESS_ANTI_SWING,
+  tracking = protocol::LoopDiagnostics::PROCESS_TRACKING,
+  friction_compensation = protocol::LoopDiagnostics::PROCESS_FRICTION_COMPENSATION,
+  supervisor = protocol::LoopDiagnostics::PROCESS_SUPERVISOR,
+  operator_console = protocol::LoopDiagnostics::PROCESS_OPERATOR,
 };
+/// "plant", "state_estimator", ..., "operator" (the IDL's code names).
 [[nodiscard]] const char* process_name(ProcessId id) noexcept;
 
 /// Options every node accepts.

@@ -1,24 +1,26 @@
 #pragma once
-// The skeleton every data-driven stage shares: parse options, load the configuration, open the
-// participant, then loop: wait for a wake-up (data or status change, at most `idle` apart), let the
-// stage poll its readers, publish diagnostics once a second; stop cleanly on SIGINT/SIGTERM.
+// The skeleton every data-driven stage process shares: parse options, open the configuration,
+// open the participant, then loop: wait for a wake-up (data or status change, at most 5 ms apart),
+// let the node poll its readers, publish diagnostics once a second; stop cleanly on SIGINT/SIGTERM.
 //
-// Stages run when the inputs of cycle k have arrived (not on a timer of their own), stamp their
-// output with seq = k and the origin of sensor sample k, and count as an overrun every cycle whose
-// inputs they never saw complete (a jump in seq).
+// A node only translates: DDS samples to the protocol's plain structs (take_plain), its stage
+// object's step(), the output back to DDS (write_plain). The stage runs when the inputs of cycle k
+// have arrived (not on a timer of its own), its output carries seq = k and the origin of sensor
+// sample k, and the node counts as an overrun every cycle whose inputs it never saw complete (a
+// jump in seq).
 
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 
-#include "crane/config/stack_config.hpp"
+#include "crane/config/config_document.hpp"
+#include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
-#include "crane/runtime/translate.hpp"
 
 namespace crane::runtime {
 
 struct StageContext {
-  const config::StackConfig& config;
+  const config::ConfigDocument& config;  // read your own blocks: config.read("tracking", tracking::read_params)
   transport::Participant& participant;
   transport::Wakeup& wakeup;
   LoopCounters& counters;
@@ -66,8 +68,27 @@ bool take_finite(ReaderT& reader, Message& message, LoopCounters& counters) noex
   return false;
 }
 
+/// take_finite into the plain protocol struct (crane/protocol/messages.hpp) of the topic's message.
+template <class ReaderT, class Plain>
+bool take_plain(ReaderT& reader, Plain& plain, LoopCounters& counters) noexcept {
+  typename std::remove_reference_t<decltype(reader)>::Message message;
+  if (!take_finite(reader, message, counters)) return false;
+  protocol::from_dds(message, plain);
+  return true;
+}
+
+/// Writes `plain` (its header stamped now; seq and origin as they are) as the topic's message.
+template <class WriterT, class Plain>
+bool write_plain(WriterT& writer, const Plain& plain) noexcept {
+  typename std::remove_reference_t<decltype(writer)>::Message message;
+  protocol::to_dds(plain, message);
+  message.header().stamp(now_stamp());
+  return writer.write(message);
+}
+
 /// Records (now - origin) of a header in microseconds.
 void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header) noexcept;
+void record_latency(LatencyStatistics& latency, const protocol::CycleHeader& header) noexcept;
 
 /// Runs a stage process. `add_options` may add stage-specific options to the command line;
 /// `setup` creates readers/writers and returns the poll function called after every wake-up.

@@ -1,11 +1,11 @@
-#include "crane/launch/maneuver_metrics.hpp"
+#include "crane/stack/maneuver_metrics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-namespace crane::launch {
+namespace crane::stack {
 
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
                                   double slew_target, const SettleCriteria& criteria) {
@@ -33,4 +33,4 @@ ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, doub
   return m;
 }
 
-}  // namespace crane::launch
+}  // namespace crane::stack

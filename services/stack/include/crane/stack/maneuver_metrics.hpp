@@ -3,7 +3,7 @@
 
 #include <vector>
 
-namespace crane::launch {
+namespace crane::stack {
 
 /// One cycle of a recorded maneuver, as measured by the sensors.
 struct RecordedCycle {
@@ -37,4 +37,4 @@ struct ManeuverMetrics {
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
                                   double slew_target, const SettleCriteria& criteria = {});
 
-}  // namespace crane::launch
+}  // namespace crane::stack

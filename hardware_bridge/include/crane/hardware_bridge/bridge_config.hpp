@@ -1,0 +1,27 @@
+#pragma once
+// The hardware bridge's configuration: its output logic (the actuation gate and the hoist scaling)
+// and the interface board's channel map, read from the `hardware_bridge:` block.
+
+#include "crane/common/stack_facts.hpp"
+#include "crane/hardware_bridge/board_config.hpp"
+#include "crane/hardware_bridge/bridge_core.hpp"
+
+namespace crane::config {
+class YamlSection;
+}
+
+namespace crane::hardware_bridge {
+
+struct HardwareBridgeConfig {
+  BridgeParams bridge;   // the actuation gate and the hoist scaling
+  BoardConfig board;     // counter width, comedi subdevices/channels/bits
+};
+
+/// Reads the `hardware_bridge:` block (hoist_speed_per_volt [m/s/V] in [1e-4, 100], counter_bits
+/// in [2, 32], comedi: counters, analog_outputs, digital_outputs, digital_inputs); the gate's
+/// params are `gate` (the `actuation:` block, supervisor::read_actuation_params). Throws
+/// common::ConfigError naming the field, value and bound.
+[[nodiscard]] HardwareBridgeConfig read_params(config::YamlSection& block, const common::StackFacts& facts,
+                                               const supervisor::ActuationGateParams& gate);
+
+}  // namespace crane::hardware_bridge

@@ -1,0 +1,99 @@
+#include "crane/plant/plant_stage.hpp"
+
+#include "crane/common/validation.hpp"
+#include "crane/config/yaml_section.hpp"
+
+namespace crane::plant {
+
+namespace {
+
+common::AxisFriction scaled(common::AxisFriction f, double factor) {
+  f.viscous_positive *= factor;
+  f.viscous_negative *= factor;
+  f.coulomb_positive *= factor;
+  f.coulomb_negative *= factor;
+  f.static_positive *= factor;
+  f.static_negative *= factor;
+  return f;
+}
+
+}  // namespace
+
+void validate(const PlantMismatch& m) {
+  common::require_in_range("plant.mismatch.cable_length_factor", m.cable_length_factor, 0.1, 10.0);
+  common::require_in_range("plant.mismatch.load_mass_factor", m.load_mass_factor, 0.0, 10.0);
+  common::require_in_range("plant.mismatch.friction_factor", m.friction_factor, 0.0, 10.0);
+  common::require_in_range("plant.mismatch.sensor_delay_cycles", m.sensor_delay_cycles, 0, PlantStage::kMaxSensorDelay);
+}
+
+SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {
+  SimulatorParameters p;
+  p.crane = facts.crane;
+  p.sample_period = facts.sample_period;
+  p.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
+  p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
+  p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);
+  p.hoist_max_acceleration = s.number("hoist_max_acceleration", 1e-3, 100.0);
+  s.finish();
+  p.initial_state.cable_length = facts.crane.cable_length;
+  return p;
+}
+
+SimulatorParameters simulated_truth(const SimulatorParameters& configured, const PlantMismatch& mismatch) {
+  validate(mismatch);
+  SimulatorParameters truth = configured;
+  truth.crane.cable_length *= mismatch.cable_length_factor;
+  truth.crane.load_mass *= mismatch.load_mass_factor;
+  truth.crane.trolley_friction = scaled(truth.crane.trolley_friction, mismatch.friction_factor);
+  truth.crane.slew_friction = scaled(truth.crane.slew_friction, mismatch.friction_factor);
+  truth.initial_state.cable_length = truth.crane.cable_length;
+  return truth;
+}
+
+PlantStage::PlantStage(const PlantStageParams& params)
+    : mismatch_(params.mismatch),
+      simulator_(simulated_truth(params.simulator, params.mismatch)),
+      gate_(params.gate),
+      cable_length_reading_factor_(1.0 / params.mismatch.cable_length_factor) {
+  measurements_.fill(simulator_.output().measurement);  // at rest before cycle 0
+}
+
+void PlantStage::sample(protocol::SensorSample& s) const noexcept {
+  const auto delay = static_cast<std::uint64_t>(mismatch_.sensor_delay_cycles);
+  const std::uint64_t measured = cycle_ >= delay ? cycle_ - delay : 0;
+  const common::CraneMeasurement& m =
+      delay == 0 ? simulator_.output().measurement : measurements_[measured % measurements_.size()];
+  const SimulatorOutput o = simulator_.output();
+  s.header.seq = cycle_;
+  s.source = protocol::SensorSample::SOURCE_PLANT;
+  s.trolley_position = m.trolley_position;
+  s.slew_angle = m.slew_angle;
+  s.swing_in_plane = m.swing_in_plane;
+  s.swing_out_of_plane = m.swing_out_of_plane;
+  s.cable_length = m.cable_length * cable_length_reading_factor_;
+  s.applied_trolley_voltage = o.applied_trolley_voltage;
+  s.applied_slew_voltage = o.applied_slew_voltage;
+  s.applied_hoist_speed = o.applied_hoist_speed;
+  s.brakes_engaged = o.brakes_engaged;
+  s.emergency_stop_input = false;
+  s.limit_switches = 0;
+}
+
+void PlantStage::remember_measurement() noexcept {
+  measurements_[cycle_ % measurements_.size()] = simulator_.output().measurement;
+}
+
+common::StepStatus PlantStage::step(const supervisor::GateInput& input) noexcept {
+  gate_.step(input, gate_output_);
+  DriveInput drive;  // default: 0 V, brakes engaged
+  drive.trolley_voltage = gate_output_.drive.trolley_voltage;
+  drive.slew_voltage = gate_output_.drive.slew_voltage;
+  drive.hoist_speed = gate_output_.drive.hoist_speed;
+  drive.brakes_engaged = gate_output_.brakes_engaged;
+  const auto status = simulator_.step(drive);
+  ++cycle_;
+  remember_measurement();
+  return status;
+}
+
+}  // namespace crane::plant

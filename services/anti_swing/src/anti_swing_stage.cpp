@@ -1,0 +1,112 @@
+#include "crane/anti_swing/anti_swing_stage.hpp"
+
+#include <string>
+
+#include "crane/common/protocol_signals.hpp"
+#include "crane/common/validation.hpp"
+#include "crane/config/yaml_section.hpp"
+
+namespace crane::anti_swing {
+
+namespace {
+
+using Core = std::variant<AntiSwing, anti_swing_analysis::FuzzyAntiSwing, anti_swing_analysis::DelayedTrajectoryAntiSwing>;
+
+Core make_core(const AntiSwingStageParams& params) {
+  const AntiSwingParams& cfg = params.anti_swing;
+  switch (params.law) {
+    case AntiSwingLaw::fuzzy: {
+      anti_swing_analysis::FuzzyAntiSwingParams p;
+      p.gravity = cfg.gravity;
+      p.min_cable_length = cfg.min_cable_length;
+      p.max_cable_length = cfg.max_cable_length;
+      p.slew_enabled = cfg.slew_enabled;
+      return Core(std::in_place_type<anti_swing_analysis::FuzzyAntiSwing>, p);
+    }
+    case AntiSwingLaw::delay2: {
+      anti_swing_analysis::DelayedTrajectoryAntiSwingParams p;
+      p.sample_period = cfg.sample_period;
+      p.gravity = cfg.gravity;
+      p.min_cable_length = cfg.min_cable_length;
+      p.max_cable_length = cfg.max_cable_length;
+      p.slew_enabled = cfg.slew_enabled;
+      return Core(std::in_place_type<anti_swing_analysis::DelayedTrajectoryAntiSwing>, p);
+    }
+    case AntiSwingLaw::none:
+    case AntiSwingLaw::pd:
+    case AntiSwingLaw::delay1: break;
+  }
+  auto p = cfg;
+  p.kind = params.law == AntiSwingLaw::none ? AntiSwingKind::none
+           : params.law == AntiSwingLaw::pd ? AntiSwingKind::pd
+                                            : AntiSwingKind::delayed_feedback;
+  return Core(std::in_place_type<AntiSwing>, p);
+}
+
+}  // namespace
+
+std::string_view law_name(AntiSwingLaw law) noexcept {
+  return protocol::code_name(protocol::AntiSwingCommand::kCodes, "CONTROLLER", static_cast<std::uint64_t>(law));
+}
+
+AntiSwingLaw law_from_name(std::string_view name, std::string_view field) {
+  std::string choices;
+  for (const auto& code : protocol::AntiSwingCommand::kCodes) {
+    if (code.group != "CONTROLLER") continue;
+    if (code.name == name) return static_cast<AntiSwingLaw>(code.value);
+    choices += (choices.empty() ? "" : ", ") + std::string(code.name);
+  }
+  throw common::ConfigError(std::string(field) + " = '" + std::string(name) + "' is not one of: " + choices);
+}
+
+AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
+  AntiSwingStageParams p;
+  p.law = law_from_name(s.text("controller"), s.field("controller"));
+  auto& a = p.anti_swing;
+  a.pd_proportional_gain = s.number("pd_proportional_gain", -1000.0, 1000.0);
+  a.pd_derivative_gain = s.number("pd_derivative_gain", -1000.0, 1000.0);
+  a.delay_gain = s.number("delay_gain", -1000.0, 1000.0);
+  a.normalized_delay = s.number("normalized_delay", 1e-3, 5.0);
+  a.slew_enabled = s.flag("slew_enabled");
+  s.finish();
+  a.sample_period = facts.sample_period;
+  a.gravity = facts.crane.gravity;
+  a.min_cable_length = facts.crane.min_cable_length;
+  a.max_cable_length = facts.crane.max_cable_length;
+  AntiSwingStage{p};  // the law's own invariants, same message format
+  return p;
+}
+
+AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params) : law_(params.law), core_(make_core(params)) {}
+
+common::StepStatus AntiSwingStage::step(const protocol::CraneState& estimate,
+                                        protocol::AntiSwingCommand& command) noexcept {
+  if (!protocol::all_finite(estimate)) return common::StepStatus::rejected_nonfinite;
+  const auto current = common::to_estimate(estimate);
+  AntiSwingOutput action;
+  anti_swing_analysis::TrajectoryCorrection correction;
+  common::StepStatus status = common::StepStatus::ok;
+  if (auto* a = std::get_if<AntiSwing>(&core_)) {
+    status = a->step(current, action);
+  } else if (auto* f = std::get_if<anti_swing_analysis::FuzzyAntiSwing>(&core_)) {
+    status = f->step(current, action);
+  } else if (auto* d = std::get_if<anti_swing_analysis::DelayedTrajectoryAntiSwing>(&core_)) {
+    status = d->step(current, correction);
+  }
+  if (status == common::StepStatus::rejected_nonfinite) return status;
+  if (status != common::StepStatus::ok) {  // not_ready: every field 0, the safe value
+    action = {};
+    correction = {};
+  }
+  command.controller = static_cast<std::uint8_t>(law_);
+  command.trolley_action = action.trolley_action;
+  command.slew_action = action.slew_action;
+  command.trolley_reference_correction = correction.trolley_position_correction;
+  command.trolley_reference_rate_correction = correction.trolley_velocity_correction;
+  command.slew_reference_correction = correction.slew_angle_correction;
+  command.slew_reference_rate_correction = correction.slew_rate_correction;
+  common::same_cycle(estimate.header, command.header);
+  return status;
+}
+
+}  // namespace crane::anti_swing

@@ -1,0 +1,80 @@
+#pragma once
+// The core signal structs (crane_signals.hpp) of the protocol's messages (crane/protocol/
+// messages.hpp, generated from the IDL), field for field, SI: what every stage object reads from
+// and writes to its messages. Header-only (target crane::common_protocol).
+
+#include "crane/common/crane_signals.hpp"
+#include "crane/protocol/messages.hpp"
+
+namespace crane::common {
+
+[[nodiscard]] inline CraneMeasurement to_measurement(const protocol::SensorSample& s) noexcept {
+  CraneMeasurement m;
+  m.trolley_position = s.trolley_position;
+  m.slew_angle = s.slew_angle;
+  m.swing_in_plane = s.swing_in_plane;
+  m.swing_out_of_plane = s.swing_out_of_plane;
+  m.cable_length = s.cable_length;
+  return m;
+}
+
+[[nodiscard]] inline CraneStateEstimate to_estimate(const protocol::CraneState& s) noexcept {
+  CraneStateEstimate e;
+  e.trolley_position = s.trolley_position;
+  e.trolley_velocity = s.trolley_velocity;
+  e.slew_angle = s.slew_angle;
+  e.slew_rate = s.slew_rate;
+  e.swing_in_plane = s.swing_in_plane;
+  e.swing_in_plane_rate = s.swing_in_plane_rate;
+  e.swing_out_of_plane = s.swing_out_of_plane;
+  e.swing_out_of_plane_rate = s.swing_out_of_plane_rate;
+  e.cable_length = s.cable_length;
+  e.cable_length_rate = s.cable_length_rate;
+  e.trolley_velocity_raw = s.trolley_velocity_raw;
+  e.slew_rate_raw = s.slew_rate_raw;
+  return e;
+}
+
+inline void from_estimate(const CraneStateEstimate& e, protocol::CraneState& s) noexcept {
+  s.trolley_position = e.trolley_position;
+  s.trolley_velocity = e.trolley_velocity;
+  s.slew_angle = e.slew_angle;
+  s.slew_rate = e.slew_rate;
+  s.swing_in_plane = e.swing_in_plane;
+  s.swing_in_plane_rate = e.swing_in_plane_rate;
+  s.swing_out_of_plane = e.swing_out_of_plane;
+  s.swing_out_of_plane_rate = e.swing_out_of_plane_rate;
+  s.cable_length = e.cable_length;
+  s.cable_length_rate = e.cable_length_rate;
+  s.trolley_velocity_raw = e.trolley_velocity_raw;
+  s.slew_rate_raw = e.slew_rate_raw;
+}
+
+[[nodiscard]] inline MotionReference to_reference(const protocol::Reference& r) noexcept {
+  MotionReference m;
+  m.trolley = {r.trolley_position, r.trolley_velocity, r.trolley_acceleration};
+  m.slew = {r.slew_angle, r.slew_rate, r.slew_acceleration};
+  m.cable_length = {r.cable_length, r.cable_length_rate, r.cable_length_acceleration};
+  return m;
+}
+
+inline void from_reference(const MotionReference& m, protocol::Reference& r) noexcept {
+  r.trolley_position = m.trolley.position;
+  r.trolley_velocity = m.trolley.velocity;
+  r.trolley_acceleration = m.trolley.acceleration;
+  r.slew_angle = m.slew.position;
+  r.slew_rate = m.slew.velocity;
+  r.slew_acceleration = m.slew.acceleration;
+  r.cable_length = m.cable_length.position;
+  r.cable_length_rate = m.cable_length.velocity;
+  r.cable_length_acceleration = m.cable_length.acceleration;
+}
+
+/// The output's header belongs to the input's cycle: same seq and origin (the node stamps `stamp`
+/// when it writes).
+inline void same_cycle(const protocol::CycleHeader& input, protocol::CycleHeader& output) noexcept {
+  output.seq = input.seq;
+  output.origin = input.origin;
+}
+
+}  // namespace crane::common

@@ -1,0 +1,84 @@
+#pragma once
+// One demo run of a maneuver, whoever runs it (crane_demo over DDS, crane_sim in one process): the
+// controller a name stands for, the move request, the record of each cycle (the CSV), the figures
+// of merit and the table row. One place, so the two runners print the same table from the same
+// numbers.
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "crane/anti_swing/anti_swing_stage.hpp"
+#include "crane/common/stack_facts.hpp"
+#include "crane/protocol/messages.hpp"
+#include "crane/stack/maneuver_metrics.hpp"
+#include "crane/stack/stack_config.hpp"
+#include "crane/tracking/tracking_stage.hpp"
+
+namespace crane::stack {
+
+/// Lockstep moves start at this cycle (4 s of simulated rest; docs/architecture.md).
+inline constexpr std::uint64_t kMoveStartCycle = 400;
+
+/// What a demo controller name stands for.
+struct ControllerChoice {
+  anti_swing::AntiSwingLaw anti_swing{anti_swing::AntiSwingLaw::delay1};
+  tracking::TrackingLaw tracking{tracking::TrackingLaw::tracking};
+  bool acceleration_feedforward{false};
+  std::string label;  // "delay1", "gain_scheduling_full", "none+feedforward", ...
+};
+
+/// The demo's controller names: none | pd | delay1 | delay2 | fuzzy (anti-swing with PD tracking),
+/// gain_scheduling_partial | gain_scheduling_full (no anti-swing), auto (per maneuver the best
+/// measured with the time-optimal profile: none for a trolley move, delay2 when the jib slews, both
+/// with acceleration feedforward). Throws std::invalid_argument for another name.
+[[nodiscard]] ControllerChoice choose_controller(std::string_view controller, const ManeuverConfig& maneuver,
+                                                 bool acceleration_feedforward);
+
+/// MoveRequest.profile code of a profile name (step | trapezoid | zv | zvd | ei | time_optimal, the
+/// IDL's PROFILE_* names). Throws std::invalid_argument for another name.
+[[nodiscard]] std::uint8_t profile_code(std::string_view profile);
+
+/// The move request of `maneuver`: its targets and limits, the hoist axis when its cable length
+/// target differs from the crane's, starting at cycle `start_cycle` (header.seq).
+[[nodiscard]] protocol::MoveRequest move_request(const ManeuverConfig& maneuver, const common::StackFacts& facts,
+                                                 std::uint32_t request_id, std::uint8_t profile,
+                                                 std::uint64_t start_cycle);
+
+/// [s] T = 2 pi sqrt(L/g) at the cable length the move ends with (the one the load settles at).
+[[nodiscard]] double swing_period(const ManeuverConfig& maneuver, const common::StackFacts& facts);
+
+/// One cycle of the move, the CSV's row: the sensors of cycle k and what was applied over [k, k+1)
+/// (reported by the sample of k + 1), the reference, linear and actuator commands of cycle k (NaN
+/// where one is missing from a recording).
+struct CycleRecord {
+  double t{0.0};  // [s] since the move's first cycle
+  double u_x{0.0}, u_gamma{0.0};              // [V] applied (after the DAC)
+  double x{0.0}, gamma{0.0}, phi{0.0}, theta{0.0}, L{0.0};  // [m], [rad], [rad], [rad], [m] measured
+  double x_ref{0.0}, gamma_ref{0.0};          // [m], [rad]
+  double V_x{0.0}, V_gamma{0.0};              // [V] tracking output
+  double friction_x{0.0}, friction_gamma{0.0};  // [V] F_f/K_m added by the compensation
+  double u_x_cmd{0.0}, u_gamma_cmd{0.0};      // [V] actuator command
+  bool brakes{false};                         // brakes engaged over [k, k+1)
+};
+[[nodiscard]] CycleRecord record_of(double t, const protocol::SensorSample& sensors, const protocol::SensorSample& next,
+                                    const protocol::Reference* reference, const protocol::LinearCommand* linear,
+                                    const protocol::ActuatorCommand* actuators) noexcept;
+/// The CSV: header line, rows with 9 significant digits. Every column is a function of the
+/// simulation alone, so two lockstep runs give the same file to the last bit.
+void write_csv(std::ostream& out, const std::vector<CycleRecord>& records);
+
+/// The figures of merit of the recorded move (throws std::invalid_argument when empty).
+[[nodiscard]] ManeuverMetrics evaluate(const std::vector<CycleRecord>& records, const ManeuverConfig& maneuver);
+
+/// The table (README, crane_demo, crane_sim): header line and one row per run, numbers rounded as
+/// printed ("-" for a settle time never reached).
+[[nodiscard]] std::string table_header();
+[[nodiscard]] std::string table_row(const std::string& maneuver, bool friction_compensation,
+                                    const ManeuverMetrics& metrics, double swing_period);
+/// `value` with `precision` decimals, "-" when not finite.
+[[nodiscard]] std::string format_number(double value, int precision);
+
+}  // namespace crane::stack

@@ -1,0 +1,64 @@
+#include "crane/stack/stack_config.hpp"
+
+#include <numbers>
+
+#include "crane/config/config_document.hpp"
+
+namespace crane::stack {
+
+namespace {
+
+using common::ConfigError;
+
+ManeuverConfig read_maneuver(config::YamlSection& s) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  ManeuverConfig m;
+  m.name = s.text("name");
+  if (m.name.empty()) throw ConfigError(s.field("name") + " must not be empty");
+  m.initial_trolley_position = s.number("initial_trolley_position", -100.0, 100.0);
+  m.initial_slew_angle = s.number("initial_slew_angle_deg", -3600.0, 3600.0) * kDeg;
+  m.trolley_target = s.number("trolley_target", -100.0, 100.0);
+  m.slew_target = s.number("slew_target_deg", -3600.0, 3600.0) * kDeg;
+  m.trolley_max_velocity = s.number("trolley_max_velocity", 1e-4, 100.0);
+  m.trolley_max_acceleration = s.number("trolley_max_acceleration", 1e-4, 100.0);
+  m.slew_max_velocity = s.number("slew_max_velocity", 1e-4, 100.0);
+  m.cable_length_target = s.number("cable_length_target", 0.05, 200.0);
+  m.slew_max_acceleration = s.number("slew_max_acceleration", 1e-4, 100.0);
+  m.duration = s.number("duration", 0.5, 3600.0);
+  s.finish();
+  return m;
+}
+
+StackConfig read(const config::ConfigDocument& doc) {
+  doc.check_blocks({"stack", "crane", "plant", "actuation", "supervisor", "state_estimator", "trajectory_planner",
+                    "anti_swing", "tracking", "friction_compensation", "hardware_bridge", "maneuvers"});
+  StackConfig c;
+  c.facts = doc.facts();
+  c.plant = doc.read("plant", plant::read_params);
+  c.actuation = doc.read("actuation", supervisor::read_actuation_params);
+  c.supervisor = doc.read("supervisor", supervisor::read_params);
+  c.state_estimator = doc.read("state_estimator", state_estimator::read_params);
+  c.trajectory_planner = doc.read("trajectory_planner", trajectory_planner::read_params);
+  c.anti_swing = doc.read("anti_swing", anti_swing::read_params);
+  c.tracking = doc.read("tracking", tracking::read_params);
+  c.friction_compensation = doc.read("friction_compensation", friction_compensation::read_params);
+  c.hardware_bridge = doc.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
+    return hardware_bridge::read_params(block, facts, c.actuation);
+  });
+  c.maneuvers = doc.read_root([](config::YamlSection& root, const common::StackFacts&) {
+    std::vector<ManeuverConfig> maneuvers;
+    for (auto& item : root.list("maneuvers")) maneuvers.push_back(read_maneuver(item));
+    return maneuvers;
+  });
+  return c;
+}
+
+}  // namespace
+
+StackConfig parse_stack_config(const std::string& yaml_text, const std::string& source_name) {
+  return read(config::ConfigDocument::parse(yaml_text, source_name));
+}
+
+StackConfig load_stack_config(const std::string& path) { return read(config::ConfigDocument::load(path)); }
+
+}  // namespace crane::stack

@@ -1,0 +1,409 @@
+// crane_sim: the crane stack in one process, no DDS (crane::stack::run_in_process: the same stage
+// objects as the processes, in the lockstep order).
+//
+//   crane_sim demo  --config FILE [--controller C] [--profile P] [--maneuver M ...]
+//                   [--friction-compensation on|off|both] [--acceleration-feedforward] [--out DIR]
+//       the demo maneuvers: crane_demo's table (to the printed digit: the same stages on the same
+//       inputs) and its CSV files, and the speed in multiples of real time;
+//   crane_sim sweep --config FILE [--controllers C,C,...] [--grid N | --random N --seed S]
+//                   [--maneuver M] [--jobs J] [--out DIR] [--plot-script F --python P]
+//       plant mismatches (cable length, load mass, friction level, sensor delay) over the
+//       controllers, on J threads (default: every core): sweep.csv, one heat-map PNG per controller,
+//       and the speed in multiples of real time;
+//   crane_sim bench --config FILE [--cases N]
+//       speed figures measured in one run: the demo maneuvers on one core (x real time), and a
+//       sweep of N cases on 1 thread and on every core (the ratio).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "crane/stack/in_process_stack.hpp"
+
+namespace {
+
+using namespace crane;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Selection {
+  std::string config_path;
+  std::string controller;            // empty: delay1, or auto with --profile time_optimal
+  std::string profile{"trapezoid"};  // as crane_demo: step with a gain-scheduling controller unless given
+  bool profile_given{false};
+  std::vector<std::string> maneuvers;
+  std::string compensation{"both"};
+  bool acceleration_feedforward{false};
+};
+
+std::vector<stack::ManeuverConfig> selected_maneuvers(const stack::StackConfig& cfg, const std::vector<std::string>& names) {
+  std::vector<stack::ManeuverConfig> out;
+  for (const auto& name : names) {
+    if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
+      throw std::invalid_argument("--maneuver '" + name + "' is not in the configuration");
+    }
+  }
+  for (const auto& m : cfg.maneuvers) {
+    if (names.empty() || std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
+  }
+  return out;
+}
+
+std::uint8_t profile_of(const std::string& controller, const Selection& s) {
+  // The dissertation drives the gain-scheduling controllers with step references (section 3.2).
+  if (!s.profile_given && controller.rfind("gain_scheduling", 0) == 0) return stack::profile_code("step");
+  return stack::profile_code(s.profile);
+}
+
+std::string default_controller(const Selection& s) {
+  if (!s.controller.empty()) return s.controller;
+  return s.profile == "time_optimal" ? "auto" : "delay1";
+}
+
+// ---------------------------------------------------------------------------------------------
+// demo
+
+struct DemoRun {
+  stack::ManeuverConfig maneuver;
+  bool compensation{true};
+  stack::InProcessResult result;
+};
+
+std::vector<DemoRun> run_demo(const stack::StackConfig& cfg, const Selection& s, double& wall_seconds) {
+  const std::string controller = default_controller(s);
+  std::vector<DemoRun> runs;
+  std::uint32_t request_id = 1;
+  const auto start = Clock::now();
+  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+    for (const bool compensation : {true, false}) {
+      if ((compensation && s.compensation == "off") || (!compensation && s.compensation == "on")) continue;
+      stack::InProcessRun run;
+      run.maneuver = m;
+      run.friction_compensation = compensation;
+      run.controller = stack::choose_controller(controller, m, s.acceleration_feedforward);
+      run.profile = profile_of(controller, s);
+      run.request_id = request_id++;
+      runs.push_back({m, compensation, stack::run_in_process(cfg, run)});
+    }
+  }
+  wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return runs;
+}
+
+double simulated_seconds(const stack::StackConfig& cfg, const std::vector<DemoRun>& runs) {
+  double total = 0.0;
+  for (const auto& r : runs) total += static_cast<double>(r.result.cycles) * cfg.facts.sample_period;
+  return total;
+}
+
+int demo(const Selection& s, const std::string& out_dir) {
+  const auto cfg = stack::load_stack_config(s.config_path);
+  double wall = 0.0;
+  const auto runs = run_demo(cfg, s, wall);
+  if (!out_dir.empty()) {
+    fs::create_directories(out_dir);
+    for (const auto& r : runs) {
+      std::ofstream csv(fs::path(out_dir) / (r.maneuver.name + (r.compensation ? "_fc_on" : "_fc_off") + ".csv"));
+      stack::write_csv(csv, r.result.records);
+    }
+  }
+  std::printf("\n%s\n", stack::table_header().c_str());
+  for (const auto& r : runs) {
+    std::printf("%s\n", stack::table_row(r.maneuver.name, r.compensation, r.result.metrics, r.result.swing_period).c_str());
+  }
+  const double simulated = simulated_seconds(cfg, runs);
+  std::printf("\nspeed: %.1f s simulated in %.3f s on one core (%.0fx real time), controller %s, %zu runs\n", simulated,
+              wall, simulated / wall, default_controller(s).c_str(), runs.size());
+  int failures = 0;
+  for (const auto& r : runs) {
+    if (r.result.plant_step_failures != 0) {
+      std::printf("FAILED: %s: %llu plant steps failed\n", r.maneuver.name.c_str(),
+                  static_cast<unsigned long long>(r.result.plant_step_failures));
+      ++failures;
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}
+
+// ---------------------------------------------------------------------------------------------
+// sweep
+
+struct SweepCase {
+  std::string controller;
+  plant::PlantMismatch mismatch;
+};
+
+struct SweepRow {
+  SweepCase c;
+  stack::ManeuverMetrics metrics;
+  double swing_period{0.0};
+  std::uint64_t cycles{0};
+  std::uint32_t latched_faults{0};
+  std::string error;  // a run that could not complete (the row keeps the case)
+};
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+// Ranges of the mismatches (the robustness the issue asks for: cable length, load mass, friction
+// levels, sensor delay). The grid crosses cable length and load mass (the heat map's axes) with
+// the configured friction and no delay; the random set draws all four.
+constexpr double kCableMin = 0.5, kCableMax = 1.9;    // [-] x 1.0 m: 0.5 .. 1.9 m (within the hoist range)
+constexpr double kMassMin = 0.25, kMassMax = 2.5;     // [-] x 2.0 kg
+constexpr double kFrictionMin = 0.5, kFrictionMax = 1.5;
+constexpr int kDelayMax = 3;                           // [cycles]
+
+std::vector<SweepCase> sweep_cases(const std::vector<std::string>& controllers, int grid, int random, unsigned seed) {
+  std::vector<SweepCase> cases;
+  for (const auto& controller : controllers) {
+    if (grid > 0) {
+      for (int i = 0; i < grid; ++i) {
+        for (int j = 0; j < grid; ++j) {
+          SweepCase c;
+          c.controller = controller;
+          const double u = grid == 1 ? 0.5 : static_cast<double>(i) / (grid - 1);
+          const double v = grid == 1 ? 0.5 : static_cast<double>(j) / (grid - 1);
+          c.mismatch.cable_length_factor = kCableMin + u * (kCableMax - kCableMin);
+          c.mismatch.load_mass_factor = kMassMin + v * (kMassMax - kMassMin);
+          cases.push_back(c);
+        }
+      }
+    } else {
+      std::mt19937_64 rng(seed);  // the same mismatches for every controller
+      std::uniform_real_distribution<double> unit(0.0, 1.0);
+      std::uniform_int_distribution<int> delay(0, kDelayMax);
+      for (int n = 0; n < random; ++n) {
+        SweepCase c;
+        c.controller = controller;
+        c.mismatch.cable_length_factor = kCableMin + unit(rng) * (kCableMax - kCableMin);
+        c.mismatch.load_mass_factor = kMassMin + unit(rng) * (kMassMax - kMassMin);
+        c.mismatch.friction_factor = kFrictionMin + unit(rng) * (kFrictionMax - kFrictionMin);
+        c.mismatch.sensor_delay_cycles = delay(rng);
+        cases.push_back(c);
+      }
+    }
+  }
+  return cases;
+}
+
+// Runs every case on `jobs` threads (each run is independent: its own stages and CVODE instance).
+std::vector<SweepRow> run_sweep(const stack::StackConfig& cfg, const Selection& s, const stack::ManeuverConfig& maneuver,
+                                const std::vector<SweepCase>& cases, unsigned jobs) {
+  std::vector<SweepRow> rows(cases.size());
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t i = next++; i < cases.size(); i = next++) {
+      SweepRow& row = rows[i];
+      row.c = cases[i];
+      try {
+        stack::InProcessRun run;
+        run.maneuver = maneuver;
+        run.controller = stack::choose_controller(cases[i].controller, maneuver, s.acceleration_feedforward);
+        run.profile = profile_of(cases[i].controller, s);
+        run.mismatch = cases[i].mismatch;
+        const auto result = stack::run_in_process(cfg, run);
+        row.metrics = result.metrics;
+        row.swing_period = result.swing_period;
+        row.cycles = result.cycles;
+        row.latched_faults = result.latched_faults;
+      } catch (const std::exception& error) {
+        row.error = error.what();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned t = 1; t < jobs; ++t) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  return rows;
+}
+
+double sweep_simulated_seconds(const stack::StackConfig& cfg, const std::vector<SweepRow>& rows) {
+  double total = 0.0;
+  for (const auto& r : rows) total += static_cast<double>(r.cycles) * cfg.facts.sample_period;
+  return total;
+}
+
+void write_sweep_csv(const fs::path& path, const std::vector<SweepRow>& rows) {
+  std::ofstream out(path);
+  out << "controller,cable_length_factor,load_mass_factor,friction_factor,sensor_delay_cycles,settle_s,settle_T,"
+         "pos_err_mm,slew_err_mrad,max_swing_deg,resid_swing_deg,max_V,latched_faults,error\n";
+  out.precision(6);
+  for (const auto& r : rows) {
+    const auto& m = r.metrics;
+    const bool ok = r.error.empty();
+    const auto num = [&](double v) { return ok && std::isfinite(v) ? std::to_string(v) : std::string(""); };
+    out << r.c.controller << ',' << r.c.mismatch.cable_length_factor << ',' << r.c.mismatch.load_mass_factor << ','
+        << r.c.mismatch.friction_factor << ',' << r.c.mismatch.sensor_delay_cycles << ',' << num(m.settle_time) << ','
+        << num(m.settle_time / r.swing_period) << ',' << num(m.final_position_error * 1e3) << ','
+        << num(m.final_slew_error * 1e3) << ',' << num(m.max_swing * 180 / M_PI) << ','
+        << num(m.residual_swing * 180 / M_PI) << ',' << num(m.max_voltage) << ',' << r.latched_faults << ",\""
+        << r.error << "\"\n";
+  }
+}
+
+unsigned default_jobs() { return std::max(1U, std::thread::hardware_concurrency()); }
+
+int sweep(const Selection& s, const std::string& controllers_text, int grid, int random, unsigned seed, unsigned jobs,
+          const std::string& out_dir, const std::string& plot_script, const std::string& python) {
+  const auto cfg = stack::load_stack_config(s.config_path);
+  const auto maneuvers = selected_maneuvers(cfg, s.maneuvers.empty() ? std::vector<std::string>{"trolley"} : s.maneuvers);
+  if (maneuvers.size() != 1) throw std::invalid_argument("sweep: give one --maneuver");
+  const auto controllers = split_list(controllers_text);
+  for (const auto& c : controllers) (void)stack::choose_controller(c, maneuvers[0], false);  // names checked first
+  const auto cases = sweep_cases(controllers, grid, random, seed);
+  if (jobs == 0) jobs = default_jobs();
+  const auto start = Clock::now();
+  const auto rows = run_sweep(cfg, s, maneuvers[0], cases, jobs);
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  fs::create_directories(out_dir);
+  const fs::path csv = fs::path(out_dir) / "sweep.csv";
+  write_sweep_csv(csv, rows);
+  std::size_t failed = 0;
+  for (const auto& r : rows) failed += r.error.empty() ? 0 : 1;
+  const double simulated = sweep_simulated_seconds(cfg, rows);
+  std::printf("%-24s %6s %9s %12s %12s %10s\n", "controller", "cases", "settled", "settle_T_p50", "resid_deg_p50",
+              "faults");
+  for (const auto& c : controllers) {
+    std::vector<double> settle, resid;
+    std::size_t n = 0, settled = 0, faulted = 0;
+    for (const auto& r : rows) {
+      if (r.c.controller != c || !r.error.empty()) continue;
+      ++n;
+      if (std::isfinite(r.metrics.settle_time)) {
+        ++settled;
+        settle.push_back(r.metrics.settle_time / r.swing_period);
+      }
+      resid.push_back(r.metrics.residual_swing * 180 / M_PI);
+      faulted += r.latched_faults != 0 ? 1 : 0;
+    }
+    const auto median = [](std::vector<double> v) {
+      if (v.empty()) return std::nan("");
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      return v[v.size() / 2];
+    };
+    std::printf("%-24s %6zu %9zu %12s %12s %10zu\n", c.c_str(), n, settled, stack::format_number(median(settle), 2).c_str(),
+                stack::format_number(median(resid), 3).c_str(), faulted);
+  }
+  std::printf("\nsweep: %zu cases (%zu failed to run) on maneuver %s, %u threads: %.1f s simulated in %.2f s (%.0fx real "
+              "time)\ntable: %s\n",
+              rows.size(), failed, maneuvers[0].name.c_str(), jobs, simulated, wall, simulated / wall, csv.string().c_str());
+  std::fflush(stdout);
+  if (!plot_script.empty()) {
+    const std::string command = "'" + python + "' '" + plot_script + "' --csv '" + csv.string() + "' --out '" + out_dir + "'";
+    if (std::system(command.c_str()) != 0) throw std::runtime_error("plot script failed: " + command);
+  }
+  return failed == 0 ? 0 : 1;
+}
+
+// ---------------------------------------------------------------------------------------------
+// bench
+
+int bench(const Selection& s, int cases) {
+  const auto cfg = stack::load_stack_config(s.config_path);
+  // 1. The demo maneuvers, one core, three repetitions: the best (the machine's own noise aside).
+  double best = 1e300;
+  double simulated = 0.0;
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    double wall = 0.0;
+    const auto runs = run_demo(cfg, s, wall);
+    simulated = simulated_seconds(cfg, runs);
+    best = std::min(best, wall);
+  }
+  std::printf("demo maneuvers, one core: %.1f s simulated in %.3f s: %.0fx real time (best of 3)\n", simulated, best,
+              simulated / best);
+  // 2. A sweep on 1 thread and on every core, the same cases.
+  const auto maneuvers = selected_maneuvers(cfg, {"trolley"});
+  const auto all = sweep_cases({default_controller(s)}, 0, cases, 7);
+  const unsigned cores = default_jobs();
+  double one = 0.0, many = 0.0, sim = 0.0;
+  for (const unsigned jobs : {1U, cores}) {
+    const auto start = Clock::now();
+    const auto rows = run_sweep(cfg, s, maneuvers[0], all, jobs);
+    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+    sim = sweep_simulated_seconds(cfg, rows);
+    (jobs == 1 ? one : many) = wall;
+    std::printf("sweep of %d cases on %u thread%s: %.1f s simulated in %.2f s: %.0fx real time\n", cases, jobs,
+                jobs == 1 ? "" : "s", sim, wall, sim / wall);
+  }
+  std::printf("sweep speed-up on %u cores: %.2fx (ideal %ux)\n", cores, one / many, cores);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_sim: the crane stack in one process (no DDS): the demo maneuvers, mismatch sweeps, speed"};
+  app.require_subcommand(1);
+  Selection s;
+  std::string out_dir;
+  const auto common_options = [&](CLI::App* cmd) {
+    cmd->add_option("--config", s.config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("--controller", s.controller,
+                    "none | pd | delay1 | delay2 | fuzzy | gain_scheduling_partial | gain_scheduling_full | auto "
+                    "(as crane_demo; default delay1, auto with --profile time_optimal)");
+    cmd->add_option("--profile", s.profile, "step | trapezoid | zv | zvd | ei | time_optimal (as crane_demo)")
+        ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}))
+        ->each([&](const std::string&) { s.profile_given = true; });
+    cmd->add_option("--maneuver", s.maneuvers, "maneuver names (default: all; sweep: trolley)");
+    cmd->add_flag("--acceleration-feedforward", s.acceleration_feedforward,
+                  "tracking adds the reference acceleration (beyond the dissertation)");
+  };
+  auto* demo_cmd = app.add_subcommand("demo", "the demo maneuvers: crane_demo's table and CSV files, in one process");
+  common_options(demo_cmd);
+  demo_cmd->add_option("--friction-compensation", s.compensation, "on | off | both")
+      ->check(CLI::IsMember({"on", "off", "both"}));
+  demo_cmd->add_option("--out", out_dir, "write <maneuver>_fc_<on|off>.csv here");
+
+  auto* sweep_cmd = app.add_subcommand("sweep", "plant mismatches over the controllers on every core, with heat maps");
+  common_options(sweep_cmd);
+  std::string controllers = "delay1,delay2,pd,fuzzy,none";
+  int grid = 0;
+  int random = 0;
+  unsigned seed = 1;
+  unsigned jobs = 0;
+  std::string plot_script, python = "/usr/bin/python3";
+  sweep_cmd->add_option("--controllers", controllers, "comma-separated controller names (default delay1,delay2,pd,fuzzy,none)");
+  auto* grid_opt = sweep_cmd->add_option("--grid", grid, "N: an N x N grid of cable length x load mass factors")
+                       ->check(CLI::Range(1, 100));
+  sweep_cmd->add_option("--random", random, "N: N seeded random mismatches of all four kinds")
+      ->check(CLI::Range(1, 100000))
+      ->excludes(grid_opt);
+  sweep_cmd->add_option("--seed", seed, "seed of --random");
+  sweep_cmd->add_option("--jobs", jobs, "threads (default: every core)");
+  sweep_cmd->add_option("--out", out_dir, "sweep.csv and the heat maps here")->required();
+  sweep_cmd->add_option("--plot-script", plot_script, "matplotlib script that draws the heat maps");
+  sweep_cmd->add_option("--python", python, "python interpreter with matplotlib");
+
+  auto* bench_cmd = app.add_subcommand("bench", "speed: the demo on one core, a sweep on 1 and on every core");
+  common_options(bench_cmd);
+  int cases = 40;
+  bench_cmd->add_option("--cases", cases, "sweep cases of the scaling figure")->check(CLI::Range(1, 100000));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*demo_cmd) return demo(s, out_dir);
+    if (*sweep_cmd) {
+      if (grid == 0 && random == 0) random = 200;
+      return sweep(s, controllers, grid, random, seed, jobs, out_dir, plot_script, python);
+    }
+    if (*bench_cmd) return bench(s, cases);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_sim: %s\n", error.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,35 @@
+#pragma once
+// The state estimator stage: what the state_estimator process computes each cycle, without DDS,
+// clock or thread. Sensor sample of cycle k -> section 4.3 filter and differentiator -> the
+// estimate of cycle k (same seq and origin).
+
+#include "crane/common/stack_facts.hpp"
+#include "crane/protocol/messages.hpp"
+#include "crane/state_estimator/state_estimator.hpp"
+
+namespace crane::config {
+class YamlSection;
+}
+
+namespace crane::state_estimator {
+
+/// Reads the `state_estimator:` block: cutoff_frequency [Hz] in [1e-3, 0.499 fs], differentiator
+/// (backward (4.8) | al_alaoui_first_order (4.9) | al_alaoui_second_order (4.10)); fs is
+/// 1 / facts.sample_period. Throws common::ConfigError naming the field, value and bound.
+[[nodiscard]] StateEstimatorParams read_params(config::YamlSection& block, const common::StackFacts& facts);
+
+class StateEstimatorStage {
+ public:
+  /// Throws common::ConfigError for invalid params (StateEstimator's constructor).
+  explicit StateEstimatorStage(const StateEstimatorParams& params);
+
+  /// One cycle. ok: `estimate` holds the estimate of `sensors`' cycle. rejected_nonfinite (a NaN or
+  /// Inf field): `estimate` and the filters are untouched. Never throws, never allocates.
+  [[nodiscard]] common::StepStatus step(const protocol::SensorSample& sensors, protocol::CraneState& estimate) noexcept;
+
+ private:
+  StateEstimator estimator_;
+  common::CraneStateEstimate scratch_{};
+};
+
+}  // namespace crane::state_estimator

@@ -1,0 +1,67 @@
+#pragma once
+// The tracking stage: what the tracking process computes each cycle, without DDS, clock or thread.
+// The estimate, the reference and the anti-swing command of cycle k -> LinearCommand of cycle k
+// (same seq and origin). The law registry lives here, one place:
+//   tracking                 PD tracking (3.40)-(3.42) mapped to voltages (3.37)-(3.38), plus the
+//                            anti-swing action; the anti-swing command's reference corrections
+//                            (Masoud's configuration (3.50)) are added to the trolley and slew
+//                            reference position and velocity first
+//   gain_scheduling_partial  gain-scheduling state feedback (3.19) on the reference position
+//   gain_scheduling_full     gain-scheduling state feedback (3.26) on the reference position
+// The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
+// chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "crane/common/stack_facts.hpp"
+#include "crane/gain_scheduling/gain_scheduling_controller.hpp"
+#include "crane/protocol/messages.hpp"
+#include "crane/tracking/tracking_controller.hpp"
+
+namespace crane::config {
+class YamlSection;
+}
+
+namespace crane::tracking {
+
+enum class TrackingLaw : std::uint8_t { tracking, gain_scheduling_partial, gain_scheduling_full };
+/// "tracking" | "gain_scheduling_partial" | "gain_scheduling_full".
+[[nodiscard]] std::string_view law_name(TrackingLaw law) noexcept;
+/// The law named `name`; throws common::ConfigError naming `field`, the value and the choices.
+[[nodiscard]] TrackingLaw law_from_name(std::string_view name, std::string_view field = "tracking law");
+
+struct TrackingStageParams {
+  TrackingLaw law{TrackingLaw::tracking};
+  TrackingParams tracking{};                         // the PD law (model constants from the crane)
+  gain_scheduling::GainSchedulingParams gain_scheduling{};  // the gain-scheduling laws (kind follows law)
+};
+
+/// Reads the `tracking:` block: proportional_gain [-] in [0, 1e4], derivative_gain [-] in [0, 1e3],
+/// min_radius [m] in [1e-3, 100], slew_enabled; the crane's model constants, the voltage limit and
+/// the cable range from facts. The law is `tracking` (processes choose another with --controller).
+/// Throws common::ConfigError naming the field, value and bound.
+[[nodiscard]] TrackingStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
+
+class TrackingStage {
+ public:
+  /// Throws common::ConfigError for invalid params (the law's own constructor).
+  explicit TrackingStage(const TrackingStageParams& params);
+
+  /// One cycle; `estimate`, `reference` and `anti_swing` belong to the same cycle (the caller joins
+  /// them). `command` is always written (its header from the estimate); ok, or rejected_nonfinite
+  /// when a used input is NaN/Inf (then the law's safe output: 0 V). Never throws, never allocates.
+  [[nodiscard]] common::StepStatus step(const protocol::CraneState& estimate, const protocol::Reference& reference,
+                                        const protocol::AntiSwingCommand& anti_swing,
+                                        protocol::LinearCommand& command) noexcept;
+
+  [[nodiscard]] TrackingLaw law() const noexcept { return law_; }
+
+ private:
+  TrackingLaw law_;
+  TrackingController tracking_;
+  std::optional<gain_scheduling::GainSchedulingController> scheduled_;
+};
+
+}  // namespace crane::tracking

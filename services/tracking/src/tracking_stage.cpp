@@ -1,0 +1,84 @@
+#include "crane/tracking/tracking_stage.hpp"
+
+#include <array>
+#include <string>
+
+#include "crane/common/protocol_signals.hpp"
+#include "crane/common/validation.hpp"
+#include "crane/config/yaml_section.hpp"
+
+namespace crane::tracking {
+
+namespace {
+constexpr std::array<std::string_view, 3> kLawNames{"tracking", "gain_scheduling_partial", "gain_scheduling_full"};
+}
+
+std::string_view law_name(TrackingLaw law) noexcept { return kLawNames[static_cast<std::size_t>(law)]; }
+
+TrackingLaw law_from_name(std::string_view name, std::string_view field) {
+  std::string choices;
+  for (std::size_t i = 0; i < kLawNames.size(); ++i) {
+    if (kLawNames[i] == name) return static_cast<TrackingLaw>(i);
+    choices += (choices.empty() ? "" : ", ") + std::string(kLawNames[i]);
+  }
+  throw common::ConfigError(std::string(field) + " = '" + std::string(name) + "' is not one of: " + choices);
+}
+
+TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
+  TrackingStageParams p;
+  // The controller's model is the configured crane (section 3.3: (3.37)-(3.38) need K_m, m_t, m_r,
+  // M_r and g).
+  p.tracking = tracking_params_from(facts.crane);
+  p.tracking.proportional_gain = s.number("proportional_gain", 0.0, 1.0e4);
+  p.tracking.derivative_gain = s.number("derivative_gain", 0.0, 1.0e3);
+  p.tracking.min_radius = s.number("min_radius", 1e-3, 100.0);
+  p.tracking.slew_enabled = s.flag("slew_enabled");
+  s.finish();
+  p.tracking.min_cable_length = facts.crane.min_cable_length;
+  p.tracking.voltage_limit = facts.voltage_limit;
+  p.gain_scheduling = gain_scheduling::gain_scheduling_params_from(facts.crane);
+  p.gain_scheduling.voltage_limit = facts.voltage_limit;
+  p.gain_scheduling.slew_enabled = p.tracking.slew_enabled;
+  p.gain_scheduling.min_cable_length = facts.crane.min_cable_length;
+  TrackingStage{p};
+  return p;
+}
+
+TrackingStage::TrackingStage(const TrackingStageParams& params) : law_(params.law), tracking_(params.tracking) {
+  if (law_ != TrackingLaw::tracking) {
+    auto p = params.gain_scheduling;
+    p.kind = law_ == TrackingLaw::gain_scheduling_full ? gain_scheduling::FeedbackKind::full
+                                                        : gain_scheduling::FeedbackKind::partial;
+    scheduled_.emplace(p);
+  }
+}
+
+common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, const protocol::Reference& reference,
+                                       const protocol::AntiSwingCommand& anti_swing,
+                                       protocol::LinearCommand& command) noexcept {
+  TrackingInput in;
+  in.estimate = common::to_estimate(estimate);
+  in.reference = common::to_reference(reference);
+  TrackingOutput result;
+  common::StepStatus status = common::StepStatus::ok;
+  if (scheduled_) {
+    status = scheduled_->step(in.estimate, in.reference, result.command);
+  } else {
+    in.reference.trolley.position += anti_swing.trolley_reference_correction;
+    in.reference.trolley.velocity += anti_swing.trolley_reference_rate_correction;
+    in.reference.slew.position += anti_swing.slew_reference_correction;
+    in.reference.slew.velocity += anti_swing.slew_reference_rate_correction;
+    in.trolley_anti_swing_action = anti_swing.trolley_action;
+    in.slew_anti_swing_action = anti_swing.slew_action;
+    status = tracking_.step(in, result);
+  }
+  command.trolley_voltage = result.command.trolley_voltage;
+  command.slew_voltage = result.command.slew_voltage;
+  command.hoist_speed = result.command.hoist_speed;
+  command.trolley_tracking_action = result.trolley_tracking_action;
+  command.slew_tracking_action = result.slew_tracking_action;
+  common::same_cycle(estimate.header, command.header);
+  return status;
+}
+
+}  // namespace crane::tracking

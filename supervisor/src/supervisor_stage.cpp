@@ -1,0 +1,107 @@
+#include "crane/supervisor/supervisor_stage.hpp"
+
+#include "crane/config/yaml_section.hpp"
+#include "crane/supervisor/actuation_gate.hpp"
+
+namespace crane::supervisor {
+
+SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
+  SupervisorParams p;
+  p.sample_period = facts.sample_period;
+  p.voltage_limit = facts.voltage_limit;
+  p.trolley_min = s.number("trolley_min", -100.0, 100.0);
+  p.trolley_max = s.number("trolley_max", -100.0, 100.0);
+  p.trolley_approach_margin = s.number("trolley_approach_margin", 0.0, 100.0);
+  p.trolley_stop_margin = s.number("trolley_stop_margin", 0.0, 100.0);
+  p.trolley_approach_speed = s.number("trolley_approach_speed", 0.0, 100.0);
+  p.trolley_max_speed = s.number("trolley_max_speed", 1e-3, 100.0);
+  p.slew_min = s.number("slew_min", -100.0, 100.0);
+  p.slew_max = s.number("slew_max", -100.0, 100.0);
+  p.slew_approach_margin = s.number("slew_approach_margin", 0.0, 100.0);
+  p.slew_stop_margin = s.number("slew_stop_margin", 0.0, 100.0);
+  p.slew_approach_rate = s.number("slew_approach_rate", 0.0, 100.0);
+  p.slew_max_rate = s.number("slew_max_rate", 1e-3, 100.0);
+  p.approach_voltage_limit = s.number("approach_voltage_limit", 0.0, 100.0);
+  p.max_voltage_rate = s.number("max_voltage_rate", 1.0, 1e6);
+  p.max_swing = s.number("max_swing", 0.01, 1.5);
+  p.stage_timeout = s.number("stage_timeout", 0.005, 5.0);
+  p.stage_dead_timeout = s.number("stage_dead_timeout", p.stage_timeout, 60.0);
+  p.arm_on_start = s.flag("arm_on_start");
+  s.finish();
+  validate(p);
+  return p;
+}
+
+ActuationGateParams read_actuation_params(config::YamlSection& s, const common::StackFacts& facts) {
+  ActuationGateParams p;
+  p.sample_period = facts.sample_period;
+  p.max_drive_voltage = facts.voltage_limit;
+  p.watchdog_timeout = s.number("watchdog_timeout", facts.sample_period, 1.0);
+  p.status_timeout = s.number("status_timeout", facts.sample_period, 1.0);
+  p.hoist_speed_limit = s.number("hoist_speed_limit", 1e-3, 100.0);
+  s.finish();
+  validate(p);
+  return p;
+}
+
+SupervisorStage::SupervisorStage(const SupervisorParams& params) : core_(params) {}
+
+void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorStatus& status) noexcept {
+  static const protocol::SensorSample kNoSensors{};
+  static const protocol::ActuatorCommand kNoActuators{};
+  const protocol::SensorSample& sensors = cycle.sensors != nullptr ? *cycle.sensors : kNoSensors;
+  const protocol::ActuatorCommand& actuators = cycle.actuators != nullptr ? *cycle.actuators : kNoActuators;
+  SupervisorInput& in = input_;
+  in = SupervisorInput{};
+  in.stages = cycle.stages;
+  in.sensors_valid = cycle.sensors != nullptr;
+  in.sensor_seq = sensors.header.seq;
+  in.sensor_source = sensors.source;
+  in.trolley_position = sensors.trolley_position;
+  in.slew_angle = sensors.slew_angle;
+  in.swing_in_plane = sensors.swing_in_plane;
+  in.swing_out_of_plane = sensors.swing_out_of_plane;
+  in.limit_switches = sensors.limit_switches;
+  in.emergency_stop_input = sensors.emergency_stop_input;
+  in.actuators_valid = cycle.actuators != nullptr;
+  in.actuator_seq = actuators.header.seq;
+  in.trolley_voltage = actuators.trolley_voltage;
+  in.slew_voltage = actuators.slew_voltage;
+  in.sensor_writers = cycle.sensor_writers;
+  in.actuator_writers = cycle.actuator_writers;
+  in.nonfinite_seen = cycle.nonfinite_seen;
+  in.move_in_progress = cycle.reference != nullptr && cycle.reference->phase == protocol::Reference::PHASE_MOVING;
+  command_handled_ = cycle.command != nullptr;
+  if (command_handled_ && cycle.command->command >= protocol::SupervisorCommand::COMMAND_ARM &&
+      cycle.command->command <= protocol::SupervisorCommand::COMMAND_RESET) {
+    in.command = static_cast<Command>(cycle.command->command);
+  }
+  core_.step(in, output_);
+  if (command_handled_) {
+    last_request_id_ = cycle.command->request_id;
+    last_request_result_ = output_.command_refused ? protocol::SupervisorStatus::RESULT_REFUSED
+                                                   : protocol::SupervisorStatus::RESULT_ACCEPTED;
+  }
+  const SupervisorOutput& out = output_;
+  status.header.seq = sensors.header.seq;
+  status.header.origin = sensors.header.origin;
+  status.mode = static_cast<std::uint8_t>(out.mode);
+  status.motion_enabled = out.motion_enabled;
+  status.brakes_released = out.brakes_released;
+  status.active_faults = out.active_faults;
+  status.latched_faults = out.latched_faults;
+  status.fault_count = out.fault_count;
+  status.stages_alive = out.stages_alive;
+  status.nonfinite_rejected = cycle.nonfinite_rejected;
+  status.trolley_voltage_limit = out.trolley_voltage_limit;
+  status.slew_voltage_limit = out.slew_voltage_limit;
+  status.warnings = out.warnings;
+  status.last_fault = out.last_fault;
+  status.last_fault_seq = out.last_fault_seq;
+  status.trolley_velocity = out.trolley_velocity;
+  status.slew_rate = out.slew_rate;
+  status.last_request_id = last_request_id_;
+  status.last_request_result = last_request_result_;
+}
+
+}  // namespace crane::supervisor
