@@ -592,4 +592,31 @@ TEST(FaultInjection, EmergencyStopInputAndCommandBrakeAtOnce) {
   EXPECT_NE(log.find("\"command\": \"reset\""), std::string::npos) << log;
 }
 
+// The operator's own path, as typed in a shell: `deploy/crane estop` (the script: it never installs
+// or builds, it runs the built crane_safety, which joins the domain, discovers the supervisor and
+// sends the command) in mid-move, from the start of the command to the bridge's safe outputs on the
+// board (issue 14: under 100 ms). The script finds this build through CRANE_BUILD_DIR.
+TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesWithin100Ms) {
+  HilStack stack("estop_shell", 55);
+  ASSERT_TRUE(stack.wait_ready());
+  ASSERT_TRUE(stack.start_move(1.0));
+  const std::string domain = " --domain " + std::to_string(stack.domain());
+  const std::string script =
+      "CRANE_BUILD_DIR='" + kBin + "/..' '" + std::string(CRANE_SOURCE_DIR) + "/deploy/crane' estop" + domain + " > /dev/null";
+  const std::int64_t typed_ns = hb::monotonic_time_ns();
+  const int script_rc = WEXITSTATUS(std::system(script.c_str()));
+  const std::int64_t returned_ns = hb::monotonic_time_ns();
+  stack.run_for(0.3);
+  const auto f = fail_safe_after(stack.monitor().writes(), typed_ns);
+  ASSERT_TRUE(f.first_safe.has_value()) << "no safe outputs after " << script;
+  const double script_ms = static_cast<double>(f.first_safe->ns - typed_ns) / 1e6;
+  std::printf("[ figure   ] deploy/crane estop: brakes engaged %.1f ms after the command started (the command "
+              "returned after %.1f ms, having seen the supervisor answer)\n",
+              script_ms, static_cast<double>(returned_ns - typed_ns) / 1e6);
+  EXPECT_EQ(script_rc, 0) << script;
+  ASSERT_TRUE(stack.status().has_value());
+  EXPECT_EQ(stack.status()->mode(), Status::MODE_EMERGENCY_STOP);
+  EXPECT_LT(script_ms, 100.0) << "from the command's start to the brakes";
+}
+
 }  // namespace

@@ -481,6 +481,49 @@ INSTANTIATE_TEST_SUITE_P(Controllers, SimMatchesDemo,
                          ::testing::Values("none", "pd", "delay2", "fuzzy", "gain_scheduling_partial",
                                            "gain_scheduling_full", "auto"));
 
+// Operating the crane (issue 14, goals with feedback): a stack run by crane_launch (lockstep, so the
+// move takes a second or two of wall time), and `crane_move ... --wait --json` from another process,
+// as an operator's second shell: the move arrives, the load settles within the demo's criteria,
+// and a goal beyond the travel range is refused (exit 2) naming the bound.
+TEST(Operate, MoveArrivesSettledAndAGoalOutOfRangeIsRefusedNamingTheBound) {
+  const fs::path dir = fresh_directory("operate");
+  const std::string domain = "33";
+  ProcessGroup launcher;
+  launcher.start({"crane_launch", kBin + "/crane_launch",
+                  {"--config", kConfig, "--sim", "--lockstep", "--domain", domain, "--log-dir", (dir / "logs").string()},
+                  (dir / "launch.log").string()});
+  const auto deadline = Clock::now() + std::chrono::seconds(60);
+  bool ready = false;
+  while (!ready && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ready = file_bytes(dir / "launch.log").find("all stages matched and alive") != std::string::npos;
+  }
+  ASSERT_TRUE(ready) << "crane_launch not ready; see " << dir;
+  const auto run_move = [&](const std::string& arguments, const fs::path& out) {
+    const std::string command = kBin + "/crane_move --domain " + domain + " " + arguments + " > " + out.string() +
+                                " 2> " + out.string() + ".err";
+    return WEXITSTATUS(std::system(command.c_str()));
+  };
+  ASSERT_EQ(run_move("--trolley 0.8 --slew 45 --hoist 1.2 --wait --json", dir / "move.json"), 0)
+      << file_bytes(dir / "move.json.err");
+  const auto result = nlohmann::json::parse(file_bytes(dir / "move.json"));
+  std::printf("[ figure   ] crane_move --trolley 0.8 --slew 45 --hoist 1.2 --wait --json: %s\n", result.dump().c_str());
+  EXPECT_EQ(result["result"], "arrived");
+  ASSERT_FALSE(result["settle_time_s"].is_null()) << "never settled";
+  EXPECT_LT(result["final_position_error_m"].get<double>(), 0.005);
+  EXPECT_LT(result["final_slew_error_rad"].get<double>(), 0.005);
+  EXPECT_LT(result["residual_swing_rad"].get<double>(), 0.5 * M_PI / 180.0);
+  EXPECT_NEAR(result["final_cable_length_m"].get<double>(), 1.2, 0.01);
+
+  EXPECT_EQ(run_move("--trolley 1.5 --json", dir / "refused.json"), 2);
+  const auto refused = nlohmann::json::parse(file_bytes(dir / "refused.json"));
+  EXPECT_EQ(refused["result"], "rejected");
+  EXPECT_EQ(refused["reason"], "trolley_range");
+  const std::string message = refused["message"];
+  EXPECT_NE(message.find("1.5 m is outside the travel range [0.1, 1.2] m"), std::string::npos) << message;
+  launcher.stop_all();
+}
+
 // NaN and Inf injected on the bus by a rogue participant are rejected where they enter, counted,
 // and never reach a drive: the voltages the plant applies stay finite and in range.
 TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {

@@ -146,6 +146,7 @@ TEST(CrossVendor, EveryMessageTypeRoundTripsFieldByField) {
   round_trip<tp::StateEstimate>(fast, cyclone, covered);
   round_trip<tp::Goal>(fast, cyclone, covered);
   round_trip<tp::Reference>(fast, cyclone, covered);
+  round_trip<tp::MoveStatus>(fast, cyclone, covered);
   round_trip<tp::AntiSwing>(fast, cyclone, covered);
   round_trip<tp::LinearCommand>(fast, cyclone, covered);
   round_trip<tp::SafetyStatus>(fast, cyclone, covered);
@@ -153,7 +154,7 @@ TEST(CrossVendor, EveryMessageTypeRoundTripsFieldByField) {
   round_trip<tp::LoopDiagnostics>(fast, cyclone, covered);
   std::printf("[ figure   ] %zu message types x %d random samples round-tripped fast -> cyclone -> fast\n",
               covered.size(), kSeeds);
-  EXPECT_EQ(covered.size(), 10U);  // every topic's type of the IDL (Time_ and CycleHeader_ are nested in each)
+  EXPECT_EQ(covered.size(), 11U);  // every topic's type of the IDL (Time_ and CycleHeader_ are nested in each)
 }
 
 // Each vendor's discovery lists the other's endpoints with topic, type, QoS and participant name

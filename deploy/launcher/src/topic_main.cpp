@@ -36,27 +36,25 @@ using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
 const std::vector<std::string>& topic_names() {
-  static const std::vector<std::string> names{tp::Sensors::name,       tp::Actuators::name,    tp::StateEstimate::name,
-                                              tp::Goal::name,          tp::Reference::name,    tp::AntiSwing::name,
-                                              tp::LinearCommand::name, tp::SafetyStatus::name, tp::SafetyCommand::name,
-                                              tp::LoopDiagnostics::name};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    tp::for_each_topic([&]<class Topic>() { all.emplace_back(Topic::name); });
+    return all;
+  }();
   return names;
 }
 
 /// Calls f.template operator()<Topic>() for the topic tag named `name`; false if none is.
 template <class F>
 bool with_topic(const std::string& name, F&& f) {
-  if (name == tp::Sensors::name) return f.template operator()<tp::Sensors>(), true;
-  if (name == tp::Actuators::name) return f.template operator()<tp::Actuators>(), true;
-  if (name == tp::StateEstimate::name) return f.template operator()<tp::StateEstimate>(), true;
-  if (name == tp::Goal::name) return f.template operator()<tp::Goal>(), true;
-  if (name == tp::Reference::name) return f.template operator()<tp::Reference>(), true;
-  if (name == tp::AntiSwing::name) return f.template operator()<tp::AntiSwing>(), true;
-  if (name == tp::LinearCommand::name) return f.template operator()<tp::LinearCommand>(), true;
-  if (name == tp::SafetyStatus::name) return f.template operator()<tp::SafetyStatus>(), true;
-  if (name == tp::SafetyCommand::name) return f.template operator()<tp::SafetyCommand>(), true;
-  if (name == tp::LoopDiagnostics::name) return f.template operator()<tp::LoopDiagnostics>(), true;
-  return false;
+  bool found = false;
+  tp::for_each_topic([&]<class Topic>() {
+    if (!found && name == Topic::name) {
+      f.template operator()<Topic>();
+      found = true;
+    }
+  });
+  return found;
 }
 
 Clock::time_point after(double seconds) {

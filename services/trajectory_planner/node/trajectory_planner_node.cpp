@@ -1,7 +1,9 @@
 // trajectory_planner process: rt/crane/planner/goal (MoveRequest) and rt/crane/state/estimate ->
 // TrajectoryPlannerStage (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the
 // time-optimal swing-free profile) -> rt/crane/planner/reference, once per cycle, same seq and
-// origin. Goals are taken only with a new cycle (the stage's rules: trajectory_planner_stage.hpp).
+// origin. Goals are taken only with a new cycle (the stage's rules: trajectory_planner_stage.hpp);
+// their feedback (waiting, rejected with the bound, moving, arrived, aborted) goes to
+// rt/crane/planner/move_status.
 #include <spdlog/spdlog.h>
 
 #include <vector>
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
         auto goals = std::shared_ptr(ctx.participant.make_reader<tp::Goal>(&ctx.wakeup));
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::Reference>());
+        auto feedback = std::shared_ptr(ctx.participant.make_writer<tp::MoveStatus>());
         auto watch = std::make_shared<runtime::SequenceWatch>();
         auto out = std::make_shared<protocol::Reference>();
         auto arrived = std::make_shared<std::vector<protocol::MoveRequest>>();
@@ -70,6 +73,7 @@ int main(int argc, char** argv) {
                 const auto refused_before = stage->nonfinite_goals();
                 const auto status = stage->step(state, *arrived, *out);
                 for (const auto& outcome : stage->goal_outcomes()) log_outcome(outcome);
+                for (const auto& move_status : stage->move_statuses()) runtime::write_plain(*feedback, move_status);
                 ctx.counters.nonfinite_rejected += stage->nonfinite_goals() - refused_before;
                 if (status != common::StepStatus::ok) continue;
                 ++ctx.counters.cycles;

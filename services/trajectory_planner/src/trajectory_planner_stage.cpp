@@ -79,6 +79,40 @@ MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current) no
   return g;
 }
 
+void describe_rejection(GoalStatus status, const MoveGoal& goal, const TrajectoryPlannerParams& params,
+                        protocol::MoveStatus& f) noexcept {
+  using S = protocol::MoveStatus;
+  f.result = S::RESULT_REJECTED;
+  f.value = 0.0;
+  f.bound_min = 0.0;
+  f.bound_max = 0.0;
+  switch (status) {
+    case GoalStatus::accepted: f.result = S::RESULT_MOVING; f.reason = S::REASON_NONE; return;
+    case GoalStatus::rejected_nonfinite: f.reason = S::REASON_NON_FINITE; return;
+    case GoalStatus::rejected_trolley_out_of_range:
+      f.reason = S::REASON_TROLLEY_RANGE;
+      f.value = goal.trolley_target;
+      f.bound_min = params.trolley_min_position;
+      f.bound_max = params.trolley_max_position;
+      return;
+    case GoalStatus::rejected_slew_out_of_range:
+      f.reason = S::REASON_SLEW_RANGE;
+      f.value = goal.slew_target;
+      f.bound_min = params.slew_min_angle;
+      f.bound_max = params.slew_max_angle;
+      return;
+    case GoalStatus::rejected_cable_out_of_range:
+      f.reason = S::REASON_CABLE_RANGE;
+      f.value = goal.cable_target;
+      f.bound_min = params.cable_min_length;
+      f.bound_max = params.cable_max_length;
+      return;
+    case GoalStatus::rejected_invalid_limits: f.reason = S::REASON_LIMITS; return;
+    case GoalStatus::rejected_unknown_profile: f.reason = S::REASON_PROFILE; return;
+    case GoalStatus::rejected_waypoint: f.reason = S::REASON_WAYPOINT; return;
+  }
+}
+
 TrajectoryPlannerStage::TrajectoryPlannerStage(const TrajectoryPlannerParams& params, double sample_period)
     : planner_(params), sample_period_(sample_period) {
   common::require_greater("stack.sample_period", sample_period, 0.0);
@@ -88,17 +122,52 @@ void TrajectoryPlannerStage::record(const GoalOutcome& outcome) noexcept {
   if (outcome_count_ < outcomes_.size()) outcomes_[outcome_count_++] = outcome;
 }
 
+void TrajectoryPlannerStage::report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason) noexcept {
+  if (status_count_ >= statuses_.size()) return;
+  protocol::MoveStatus& s = statuses_[status_count_++];
+  s = protocol::MoveStatus{};
+  if (cycle_estimate_ != nullptr) common::same_cycle(cycle_estimate_->header, s.header);
+  s.request_id = request_id;
+  s.result = result;
+  s.reason = reason;
+  s.trolley_to_go = active_goal_.trolley_target - output_.reference.trolley.position;
+  s.slew_to_go = active_goal_.slew_target - output_.reference.slew.position;
+  s.cable_to_go = active_goal_.cable_target - output_.reference.cable_length.position;
+  s.time_in_move = output_.time_in_move;
+  s.move_duration = output_.move_duration;
+}
+
 common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& estimate,
                                                 std::span<const Request> goals,
                                                 protocol::Reference& reference) noexcept {
   outcome_count_ = 0;
+  status_count_ = 0;
   if (!protocol::all_finite(estimate)) return common::StepStatus::rejected_nonfinite;
+  cycle_estimate_ = &estimate;
   const std::uint64_t seq = estimate.header.seq;
   const auto current = common::to_estimate(estimate);
   if (!holding_) {
     holding_ = planner_.hold(current) == GoalStatus::accepted;
     if (!holding_) return common::StepStatus::not_ready;
   }
+  using Feedback = protocol::MoveStatus;
+  // Starts `r` now: the planner takes it or refuses it (the running move then continues).
+  const auto start = [&](const Request& r) {
+    const MoveGoal goal = to_goal(r, current);
+    const GoalStatus status = planner_.start_move(goal, current);
+    if (status == GoalStatus::accepted) {
+      if (active_ && active_goal_.request_id != goal.request_id) {
+        report(static_cast<std::uint32_t>(active_goal_.request_id), Feedback::RESULT_ABORTED, Feedback::REASON_REPLACED);
+      }
+      active_goal_ = goal;
+      active_ = true;
+      cycles_since_progress_ = kProgressCycles;  // report at this cycle's end
+    } else if (status_count_ < statuses_.size()) {
+      report(r.request_id, Feedback::RESULT_REJECTED);
+      describe_rejection(status, goal, planner_.params(), statuses_[status_count_ - 1]);
+    }
+    return status;
+  };
   const auto outcome = [&](const Request& r, GoalOutcome::When when, GoalStatus status) {
     GoalOutcome o;
     o.request_id = r.request_id;
@@ -114,6 +183,7 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
     if (!protocol::all_finite(request)) {
       ++nonfinite_goals_;
       outcome(request, GoalOutcome::When::now, GoalStatus::rejected_nonfinite);
+      report(request.request_id, Feedback::RESULT_REJECTED, Feedback::REASON_NON_FINITE);
       continue;
     }
     if (request.request_id <= last_request_) {
@@ -124,18 +194,29 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
     if (request.header.seq > seq) {
       pending_ = request;
       outcome(request, GoalOutcome::When::waiting, GoalStatus::accepted);
+      report(request.request_id, Feedback::RESULT_WAITING);
       continue;
     }
     pending_.reset();
     const auto when = request.header.seq != 0 && request.header.seq < seq ? GoalOutcome::When::late : GoalOutcome::When::now;
-    outcome(request, when, planner_.start_move(to_goal(request, current), current));
+    outcome(request, when, start(request));
   }
   if (pending_.has_value() && pending_->header.seq <= seq) {
-    outcome(*pending_, GoalOutcome::When::as_asked, planner_.start_move(to_goal(*pending_, current), current));
+    outcome(*pending_, GoalOutcome::When::as_asked, start(*pending_));
     pending_.reset();
   }
   const auto status = planner_.step(sample_period_, output_);
   if (status != common::StepStatus::ok) return status;
+  if (active_) {
+    const auto id = static_cast<std::uint32_t>(active_goal_.request_id);
+    if (output_.phase == MovePhase::arrived && output_.request_id == active_goal_.request_id) {
+      report(id, Feedback::RESULT_ARRIVED);
+      active_ = false;
+    } else if (++cycles_since_progress_ >= kProgressCycles) {
+      report(id, Feedback::RESULT_MOVING);
+      cycles_since_progress_ = 0;
+    }
+  }
   common::from_reference(output_.reference, reference);
   reference.request_id = static_cast<std::uint32_t>(output_.request_id);
   reference.phase = static_cast<std::uint8_t>(output_.phase);

@@ -25,6 +25,7 @@ CRANE_TOPIC(Actuators, ActuatorCommand_, "rt/crane/hw/actuators", QosKind::strea
 CRANE_TOPIC(StateEstimate, CraneState_, "rt/crane/state/estimate", QosKind::stream);
 CRANE_TOPIC(Goal, MoveRequest_, "rt/crane/planner/goal", QosKind::command);
 CRANE_TOPIC(Reference, Reference_, "rt/crane/planner/reference", QosKind::stream);
+CRANE_TOPIC(MoveStatus, MoveStatus_, "rt/crane/planner/move_status", QosKind::command);
 CRANE_TOPIC(AntiSwing, AntiSwingCommand_, "rt/crane/control/anti_swing", QosKind::stream);
 CRANE_TOPIC(LinearCommand, LinearCommand_, "rt/crane/control/linear", QosKind::stream);
 CRANE_TOPIC(SafetyStatus, SupervisorStatus_, "rt/crane/safety/status", QosKind::safety);
@@ -32,5 +33,22 @@ CRANE_TOPIC(SafetyCommand, SupervisorCommand_, "rt/crane/safety/command", QosKin
 CRANE_TOPIC(LoopDiagnostics, LoopDiagnostics_, "rt/crane/diag/loop", QosKind::diagnostics);
 
 #undef CRANE_TOPIC
+
+/// Calls f.template operator()<Topic>() for every topic of the bus, in the order above: the one
+/// list tools iterate (crane_topic list/echo/record).
+template <class F>
+void for_each_topic(F&& f) {
+  f.template operator()<Sensors>();
+  f.template operator()<Actuators>();
+  f.template operator()<StateEstimate>();
+  f.template operator()<Goal>();
+  f.template operator()<Reference>();
+  f.template operator()<MoveStatus>();
+  f.template operator()<AntiSwing>();
+  f.template operator()<LinearCommand>();
+  f.template operator()<SafetyStatus>();
+  f.template operator()<SafetyCommand>();
+  f.template operator()<LoopDiagnostics>();
+}
 
 }  // namespace crane::transport::topics

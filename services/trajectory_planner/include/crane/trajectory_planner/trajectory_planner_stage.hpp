@@ -11,7 +11,10 @@
 //  - MoveRequest.header.seq > 0 names the cycle the move starts at: a goal arriving earlier waits
 //    here (the latest waiting one wins); one arriving later starts at once (reported as late);
 //  - a goal's axes not named in MoveRequest.axes keep their current position, limits given as 0
-//    keep the planner's defaults, unknown profile codes are rejected (the running move continues).
+//    keep the planner's defaults, unknown profile codes are rejected (the running move continues);
+//  - every request gets feedback, as a ROS 2 action does (MoveStatus, move_statuses()): waiting for
+//    its start cycle, or rejected (reason, the value and the bound it violated), then moving (at the
+//    start and every kProgressCycles), arrived, or aborted (replaced by a newer request).
 
 #include <array>
 #include <cstdint>
@@ -58,9 +61,14 @@ struct GoalOutcome {
   double slew_target{0.0};       // [rad]
 };
 
+/// The feedback of a goal outcome that refused it: reason, value and bound (MoveStatus fields).
+void describe_rejection(GoalStatus status, const MoveGoal& goal, const TrajectoryPlannerParams& params,
+                        protocol::MoveStatus& feedback) noexcept;
+
 class TrajectoryPlannerStage {
  public:
   static constexpr std::size_t kMaxGoalsPerCycle = 8;  // outcomes kept per step; more are counted
+  static constexpr std::uint64_t kProgressCycles = 10; // a moving request's progress every 10 cycles
 
   /// Throws common::ConfigError for invalid params (TrajectoryPlanner's constructor) or a
   /// sample_period that is not positive and finite.
@@ -74,11 +82,16 @@ class TrajectoryPlannerStage {
 
   /// The goals handled by the last step (at most kMaxGoalsPerCycle).
   [[nodiscard]] std::span<const GoalOutcome> goal_outcomes() const noexcept { return {outcomes_.data(), outcome_count_}; }
+  /// The feedback of the last step, for the MoveStatus topic (at most 2 kMaxGoalsPerCycle + 2).
+  [[nodiscard]] std::span<const protocol::MoveStatus> move_statuses() const noexcept {
+    return {statuses_.data(), status_count_};
+  }
   /// Goals refused for a NaN/Inf field since construction.
   [[nodiscard]] std::uint64_t nonfinite_goals() const noexcept { return nonfinite_goals_; }
 
  private:
   void record(const GoalOutcome& outcome) noexcept;
+  void report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason = 0) noexcept;
 
   TrajectoryPlanner planner_;
   double sample_period_;
@@ -89,6 +102,12 @@ class TrajectoryPlannerStage {
   std::array<GoalOutcome, kMaxGoalsPerCycle> outcomes_{};
   std::size_t outcome_count_{0};
   std::uint64_t nonfinite_goals_{0};
+  std::array<protocol::MoveStatus, 2 * kMaxGoalsPerCycle + 2> statuses_{};
+  std::size_t status_count_{0};
+  MoveGoal active_goal_{};           // the request being executed (targets for the distances to go)
+  bool active_{false};               // a move of active_goal_ is under way (not yet arrived or aborted)
+  std::uint64_t cycles_since_progress_{0};
+  const protocol::CraneState* cycle_estimate_{nullptr};  // the step's estimate (header of the feedback)
 };
 
 }  // namespace crane::trajectory_planner

@@ -1,0 +1,146 @@
+// The stage objects of the planner, anti-swing and tracking processes, on protocol messages (no
+// DDS): the planner's goal rules and its feedback (MoveStatus, like a ROS 2 action's), the
+// anti-swing law registry, the tracking stage's (3.50) reference correction.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "crane/anti_swing/anti_swing_stage.hpp"
+#include "crane/common/validation.hpp"
+#include "crane/tracking/tracking_stage.hpp"
+#include "crane/trajectory_planner/trajectory_planner_stage.hpp"
+
+namespace {
+
+using namespace crane;
+using Feedback = protocol::MoveStatus;
+using Request = protocol::MoveRequest;
+
+protocol::CraneState at_rest(std::uint64_t seq, double x = 0.25) {
+  protocol::CraneState s;
+  s.header.seq = seq;
+  s.trolley_position = x;
+  s.cable_length = 1.0;
+  return s;
+}
+
+Request trolley_goal(std::uint32_t id, double target, std::uint64_t start = 0) {
+  Request r;
+  r.header.seq = start;
+  r.request_id = id;
+  r.profile = Request::PROFILE_TRAPEZOID;
+  r.axes = Request::AXIS_TROLLEY;
+  r.trolley_target = target;
+  return r;
+}
+
+// Runs cycles from `first` to `last`, the goals given at their cycle; collects every feedback.
+std::vector<Feedback> run(trajectory_planner::TrajectoryPlannerStage& stage, std::uint64_t first, std::uint64_t last,
+                          const std::vector<std::pair<std::uint64_t, Request>>& goals) {
+  std::vector<Feedback> feedback;
+  protocol::Reference reference;
+  for (std::uint64_t k = first; k <= last; ++k) {
+    std::vector<Request> now;
+    for (const auto& [cycle, goal] : goals) {
+      if (cycle == k) now.push_back(goal);
+    }
+    EXPECT_EQ(stage.step(at_rest(k), now, reference), common::StepStatus::ok);
+    for (const auto& f : stage.move_statuses()) feedback.push_back(f);
+  }
+  return feedback;
+}
+
+trajectory_planner::TrajectoryPlannerStage lab_planner() {
+  trajectory_planner::TrajectoryPlannerParams p;  // trolley [0.1, 1.2] m
+  return trajectory_planner::TrajectoryPlannerStage(p, 0.01);
+}
+
+TEST(PlannerStage, AGoalOutOfRangeIsRejectedWithTheValueAndTheBound) {
+  auto stage = lab_planner();
+  const auto feedback = run(stage, 0, 2, {{1, trolley_goal(5, 1.5)}});
+  ASSERT_EQ(feedback.size(), 1U);
+  EXPECT_EQ(feedback[0].request_id, 5U);
+  EXPECT_EQ(feedback[0].result, Feedback::RESULT_REJECTED);
+  EXPECT_EQ(feedback[0].reason, Feedback::REASON_TROLLEY_RANGE);
+  EXPECT_EQ(feedback[0].value, 1.5);
+  EXPECT_EQ(feedback[0].bound_min, 0.1);
+  EXPECT_EQ(feedback[0].bound_max, 1.2);
+  EXPECT_EQ(feedback[0].header.seq, 1U);
+}
+
+TEST(PlannerStage, AMoveReportsWaitingMovingEveryTenCyclesAndArrived) {
+  auto stage = lab_planner();
+  const auto feedback = run(stage, 0, 400, {{2, trolley_goal(7, 0.55, 10)}});
+  ASSERT_GE(feedback.size(), 3U);
+  EXPECT_EQ(feedback.front().result, Feedback::RESULT_WAITING);
+  EXPECT_EQ(feedback.front().header.seq, 2U);
+  std::vector<std::uint64_t> moving;
+  for (const auto& f : feedback) {
+    EXPECT_EQ(f.request_id, 7U);
+    if (f.result == Feedback::RESULT_MOVING) moving.push_back(f.header.seq);
+  }
+  ASSERT_GE(moving.size(), 2U);
+  EXPECT_EQ(moving[0], 10U);  // at its start cycle
+  for (std::size_t i = 1; i < moving.size(); ++i) EXPECT_EQ(moving[i] - moving[i - 1], 10U);
+  EXPECT_EQ(feedback.back().result, Feedback::RESULT_ARRIVED);
+  EXPECT_NEAR(feedback.back().trolley_to_go, 0.0, 1e-12);
+  EXPECT_GT(feedback.back().move_duration, 0.5);
+  // The distance to go shrinks as the move goes.
+  EXPECT_NEAR(feedback[1].trolley_to_go, 0.30, 1e-3);
+}
+
+TEST(PlannerStage, ANewerRequestAbortsTheRunningOneAndAnOlderIdIsIgnored) {
+  auto stage = lab_planner();
+  const auto feedback = run(stage, 0, 30, {{1, trolley_goal(7, 1.0)}, {15, trolley_goal(8, 0.5)}, {20, trolley_goal(6, 0.9)}});
+  bool aborted = false, ignored_reported = false;
+  for (const auto& f : feedback) {
+    if (f.request_id == 7 && f.result == Feedback::RESULT_ABORTED) {
+      aborted = true;
+      EXPECT_EQ(f.reason, Feedback::REASON_REPLACED);
+      EXPECT_EQ(f.header.seq, 15U);
+    }
+    ignored_reported = ignored_reported || f.request_id == 6;
+  }
+  EXPECT_TRUE(aborted);
+  EXPECT_FALSE(ignored_reported) << "a request id not above the last one is a repeat: no feedback";
+}
+
+TEST(AntiSwingStage, TheLawRegistryNamesAreTheIdlCodes) {
+  for (const char* name : {"none", "pd", "delay1", "delay2", "fuzzy"}) {
+    const auto law = anti_swing::law_from_name(name);
+    EXPECT_EQ(anti_swing::law_name(law), name);
+    anti_swing::AntiSwingStageParams p;
+    p.law = law;
+    anti_swing::AntiSwingStage stage(p);
+    protocol::AntiSwingCommand out;
+    auto state = at_rest(3);
+    state.swing_in_plane = 0.01;
+    EXPECT_NE(stage.step(state, out), common::StepStatus::rejected_nonfinite) << name;
+    EXPECT_EQ(out.controller, static_cast<std::uint8_t>(law)) << name;
+    EXPECT_EQ(out.header.seq, 3U);
+  }
+  EXPECT_THROW((void)anti_swing::law_from_name("delayed_feedback"), common::ConfigError);
+}
+
+// Masoud's configuration (3.50): the anti-swing command's reference corrections move the reference
+// the tracking PD follows; a correction of the position by d equals a reference d further.
+TEST(TrackingStage, ReferenceCorrectionsOfDelay2AreAddedToTheReference) {
+  tracking::TrackingStage stage{tracking::TrackingStageParams{}};
+  auto state = at_rest(4, 0.5);
+  protocol::Reference reference;
+  reference.trolley_position = 0.6;
+  reference.cable_length = 1.0;
+  protocol::AntiSwingCommand corrected;
+  corrected.trolley_reference_correction = 0.05;
+  protocol::LinearCommand with_correction, moved_reference;
+  ASSERT_EQ(stage.step(state, reference, corrected, with_correction), common::StepStatus::ok);
+  reference.trolley_position = 0.65;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, moved_reference), common::StepStatus::ok);
+  EXPECT_DOUBLE_EQ(with_correction.trolley_voltage, moved_reference.trolley_voltage);
+  EXPECT_GT(with_correction.trolley_voltage, 0.0);
+  EXPECT_EQ(with_correction.header.seq, 4U);
+}
+
+}  // namespace
