@@ -138,7 +138,16 @@ int main(int argc, char** argv) {
     command.request_id(request_id);
     command.command(code);
     writer->write(command);
+    // Discovery is not symmetric: this writer may match the supervisor's reader before that reader
+    // matches it, and a volatile command written then is lost to it. Every command is idempotent
+    // (a second estop, arm, disarm or reset of the same request changes nothing), so it is sent
+    // again every 50 ms until the status echoes its request id.
+    auto next_send = Clock::now() + std::chrono::milliseconds(50);
     while (Clock::now() < deadline) {
+      if (Clock::now() >= next_send) {
+        writer->write(command);
+        next_send = Clock::now() + std::chrono::milliseconds(50);
+      }
       while (status_reader->take_next(status)) {
         if (status.last_request_id() != request_id) continue;
         const bool accepted = status.last_request_result() == Status::RESULT_ACCEPTED;
