@@ -3,12 +3,13 @@
 // over one sample period) and integrates the nonlinear model to k+1.
 //
 //   --lockstep  integrate cycle k as soon as the command of cycle k and the supervisor's status of
-//               cycle k have arrived, never before and never with another cycle's command; the
-//               cycle is offered again while it waits (a lost best-effort sample), and a wait longer
-//               than plant.lockstep_hang_timeout is reported as a hung chain;
+//               cycle k-1 have arrived (supervisor::lockstep_may_run), never before and never with
+//               another cycle's command; the cycle is offered again while it waits (a lost
+//               best-effort sample), and a wait longer than stack.lockstep_hang_timeout is reported
+//               as a hung chain;
 //   --realtime  absolute deadlines every sample_period on the monotonic clock; a command that has
-//               not arrived by the deadline is an overrun: the last one is held for at most
-//               plant.command_timeout, then 0 V and brakes.
+//               not arrived by the deadline is an overrun: the gate holds the last one while it is
+//               within actuation.watchdog_timeout, then 0 V and brakes.
 // What reaches the simulated drives is decided by the actuation gate the hardware bridge applies
 // too (supervisor/actuation_gate.hpp, inside plant::PlantStage): the command only while the
 // supervisor's status (of cycle k-1 in lockstep; the latest, within actuation.status_timeout, in

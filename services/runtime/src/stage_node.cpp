@@ -21,8 +21,9 @@ void record_latency(LatencyStatistics& latency, const msgs::CycleHeader_& header
 }
 
 void record_latency(LatencyStatistics& latency, const protocol::CycleHeader& header) noexcept {
-  const std::int64_t origin = static_cast<std::int64_t>(header.origin.sec) * 1'000'000'000 + header.origin.nanosec;
-  latency.record(static_cast<double>(now_nanoseconds() - origin) / 1000.0);
+  builtin_interfaces::msg::dds_::Time_ origin;
+  protocol::to_dds(header.origin, origin);
+  latency.record(static_cast<double>(now_nanoseconds() - to_nanoseconds(origin)) / 1000.0);
 }
 
 int run_stage(int argc, char** argv, ProcessId process, const std::string& description,
