@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <string>
+#include <string_view>
 
 #include "crane/common/validation.hpp"
 
@@ -19,6 +20,10 @@ const char* mode_name(Mode mode) noexcept {
 
 const char* fault_name(std::uint32_t fault_bit) noexcept {
   return protocol::code_name(StatusCodes::kCodes, "FAULT", fault_bit).data();
+}
+
+const char* operating_mode_name(std::uint8_t code) noexcept {
+  return protocol::code_name(StatusCodes::kCodes, "OPERATION", code).data();
 }
 
 namespace {
@@ -81,14 +86,21 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.stage_dead_timeout", p.stage_dead_timeout, p.stage_timeout, 60.0);
   require_in_range("supervisor.sample_period", p.sample_period, 1e-4, 1.0);
   require_in_range("supervisor.expected_sensor_source", p.expected_sensor_source, 0.0, 2.0);
+  require_in_range("supervisor.trolley_braking_deceleration", p.trolley_braking_deceleration, 1e-3, 1e3);
+  require_in_range("supervisor.slew_braking_deceleration", p.slew_braking_deceleration, 1e-3, 1e3);
+  common::validate(p.site, "site");
 }
 
-Supervisor::Supervisor(const SupervisorParams& params) : params_(params) { validate(params_); }
+Supervisor::Supervisor(const SupervisorParams& params) : params_(params) {
+  validate(params_);
+  zones_enabled_ = params_.site.enabled_at_start();
+}
 
 void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept {
   std::uint32_t alive_mask = 0;
   std::uint32_t dead_mask = 0;
   std::uint32_t warnings = 0;
+  out.zone = -1;
   for (std::size_t i = 0; i < kStageCount; ++i) {
     const auto& s = in.stages[i];
     const bool fresh = s.alive && s.present && s.seconds_since_sample <= params_.stage_timeout;
@@ -140,6 +152,28 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       active |= kFaultSwing;
     }
     if (in.limit_switches != 0) active |= kFaultLimitSwitch;
+    if (zones_enabled_ != 0 && std::isfinite(in.cable_length) && std::isfinite(in.swing_in_plane) &&
+        std::isfinite(in.swing_out_of_plane)) {
+      // The load itself, then where it stops if both drives brake now.
+      const common::Site& site = params_.site;
+      const auto load = common::load_position(site, in.trolley_position, in.slew_angle, in.swing_in_plane,
+                                              in.swing_out_of_plane, in.cable_length);
+      const int inside = common::intruded_zone(site, zones_enabled_, {load[0], load[1]}, load[2], 0.0);
+      const double x_stop = in.trolley_position +
+                            trolley_velocity_ * std::fabs(trolley_velocity_) / (2.0 * params_.trolley_braking_deceleration);
+      const double slew_stop =
+          in.slew_angle + slew_rate_ * std::fabs(slew_rate_) / (2.0 * params_.slew_braking_deceleration);
+      const auto stop = common::load_position(site, x_stop, slew_stop, in.swing_in_plane, in.swing_out_of_plane,
+                                              in.cable_length);
+      const int ahead = common::intruded_zone(site, zones_enabled_, {stop[0], stop[1]}, stop[2], 0.0);
+      if (inside >= 0) {
+        active |= kFaultZone;
+        out.zone = inside;
+      } else if (ahead >= 0) {
+        warnings |= kWarningZoneApproach;
+        out.zone = ahead;
+      }
+    }
     if (params_.expected_sensor_source != 0 && in.sensor_source != params_.expected_sensor_source) {
       active |= kFaultSensorSource;
     }
@@ -190,6 +224,18 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       refused = active != 0 || !chain_healthy;
       if (!refused) latched_ = 0;
       break;
+    case Command::set_operating_mode:
+      refused = std::string_view(operating_mode_name(in.command_operating_mode)) == "unknown";
+      if (!refused) operating_mode_ = in.command_operating_mode;
+      break;
+    case Command::enable_zone:
+    case Command::disable_zone:
+      refused = in.command_zone >= params_.site.zones.size();
+      if (!refused) {
+        const std::uint32_t bit = 1U << in.command_zone;
+        zones_enabled_ = in.command == Command::enable_zone ? (zones_enabled_ | bit) : (zones_enabled_ & ~bit);
+      }
+      break;
     case Command::emergency_stop:
     case Command::none: break;
   }
@@ -226,6 +272,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   out.slew_voltage_limit = enabled ? slew_limit : 0.0;
   out.trolley_velocity = trolley_velocity_;
   out.slew_rate = slew_rate_;
+  out.operating_mode = operating_mode_;
+  out.zones_enabled = zones_enabled_;
   out.command_refused = refused;
 }
 

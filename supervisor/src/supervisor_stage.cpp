@@ -27,7 +27,10 @@ SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& f
   p.stage_timeout = s.number("stage_timeout", 0.005, 5.0);
   p.stage_dead_timeout = s.number("stage_dead_timeout", p.stage_timeout, 60.0);
   p.arm_on_start = s.flag("arm_on_start");
+  p.trolley_braking_deceleration = s.number("trolley_braking_deceleration", 1e-3, 1e3);
+  p.slew_braking_deceleration = s.number("slew_braking_deceleration", 1e-3, 1e3);
   s.finish();
+  p.site = facts.site;
   validate(p);
   return p;
 }
@@ -61,6 +64,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.slew_angle = sensors.slew_angle;
   in.swing_in_plane = sensors.swing_in_plane;
   in.swing_out_of_plane = sensors.swing_out_of_plane;
+  in.cable_length = sensors.cable_length;
   in.limit_switches = sensors.limit_switches;
   in.emergency_stop_input = sensors.emergency_stop_input;
   in.actuators_valid = cycle.actuators != nullptr;
@@ -73,8 +77,10 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.move_in_progress = cycle.reference != nullptr && cycle.reference->phase == protocol::Reference::PHASE_MOVING;
   command_handled_ = cycle.command != nullptr;
   if (command_handled_ && cycle.command->command >= protocol::SupervisorCommand::COMMAND_ARM &&
-      cycle.command->command <= protocol::SupervisorCommand::COMMAND_RESET) {
+      cycle.command->command <= protocol::SupervisorCommand::COMMAND_DISABLE_ZONE) {
     in.command = static_cast<Command>(cycle.command->command);
+    in.command_operating_mode = cycle.command->operating_mode;
+    in.command_zone = cycle.command->zone;
   }
   core_.step(in, output_);
   if (command_handled_) {
@@ -102,6 +108,8 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   status.slew_rate = out.slew_rate;
   status.last_request_id = last_request_id_;
   status.last_request_result = last_request_result_;
+  status.operating_mode = out.operating_mode;
+  status.zones_enabled = out.zones_enabled;
 }
 
 }  // namespace crane::supervisor

@@ -2,11 +2,15 @@
 //
 //   crane_safety arm | disarm | estop | reset   send the command on rt/crane/safety/command and wait
 //                                              for the supervisor to answer it on the status topic
+//   crane_safety mode manual | semiautomatic | fullautomatic | maintenance
+//                                              change the operating mode (OPC 40020): the same
+//   crane_safety zone enable | disable N        switch no-go zone N (index in site.zones): the same
 //   crane_safety status [--json]                print the supervisor's latest status
 //
 // Exit codes: 0 done (command accepted / status printed), 1 no supervisor answered within
 // --timeout, 2 bad usage, 3 the supervisor refused the command (the reason is in its log: arm needs
-// a healthy chain and no latched fault, reset needs a healthy chain and no active fault).
+// a healthy chain and no latched fault, reset needs a healthy chain and no active fault, zone needs
+// an index of site.zones).
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -16,6 +20,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -48,23 +53,39 @@ std::string code_name(std::string_view group, std::uint64_t value) {
   return std::string(protocol::code_name(Status::kCodes, group, value));
 }
 
+std::string zone_list(std::uint32_t enabled) {
+  std::string text;
+  for (int i = 0; i < 32; ++i) {
+    if ((enabled & (1U << i)) == 0) continue;
+    if (!text.empty()) text += ",";
+    text += std::to_string(i);
+  }
+  return text.empty() ? "none" : text;
+}
+
 void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
   const auto mode = code_name("MODE", s.mode());
+  const auto operating = code_name("OPERATION", s.operating_mode());
   if (json) {
     std::printf(
         "{\"mode\": \"%s\", \"motion_enabled\": %s, \"brakes_released\": %s, \"active_faults\": %s, "
         "\"latched_faults\": %s, \"fault_count\": %u, \"last_fault\": \"%s\", \"last_fault_seq\": %llu, "
         "\"stages_alive\": %u, \"warnings\": %u, \"trolley_voltage_limit_V\": %g, \"slew_voltage_limit_V\": %g, "
-        "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu}\n",
+        "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu, "
+        "\"operating_mode\": \"%s\", \"zones_enabled\": %u}\n",
         mode.c_str(), s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
         quoted_list(s.active_faults()).c_str(), quoted_list(s.latched_faults()).c_str(), s.fault_count(),
         s.last_fault() != 0 ? code_name("FAULT", s.last_fault()).c_str() : "",
         static_cast<unsigned long long>(s.last_fault_seq()),
         s.stages_alive(), s.warnings(), s.trolley_voltage_limit(), s.slew_voltage_limit(), s.trolley_velocity(),
-        s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()));
+        s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()), operating.c_str(),
+        s.zones_enabled());
     return;
   }
   std::printf("mode            %s\n", mode.c_str());
+  std::printf("operating mode  %s\n", operating.c_str());
+  std::printf("zones enforced  %s%s\n", zone_list(s.zones_enabled()).c_str(),
+              (s.warnings() & Status::WARNING_ZONE_APPROACH) ? " (approaching one: soft stop)" : "");
   std::printf("motion          %s, brakes %s\n", s.motion_enabled() ? "enabled" : "disabled",
               s.brakes_released() ? "released" : "engaged");
   std::printf("active faults   %s\n", s.active_faults() ? fault_list(s.active_faults()).c_str() : "none");
@@ -89,14 +110,52 @@ int main(int argc, char** argv) {
   runtime::NodeOptions options;
   double timeout = 3.0;
   bool json = false;
-  app.add_option("action", action, "arm | disarm | estop | reset | status")
+  std::vector<std::string> arguments;
+  app.add_option("action", action, "arm | disarm | estop | reset | status | mode | zone")
       ->required()
-      ->check(CLI::IsMember({"arm", "disarm", "estop", "reset", "status"}));
+      ->check(CLI::IsMember({"arm", "disarm", "estop", "reset", "status", "mode", "zone"}));
+  app.add_option("arguments", arguments, "mode: manual | semiautomatic | fullautomatic | maintenance; "
+                                         "zone: enable | disable N");
   app.add_option("--dds", options.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--timeout", timeout, "[s] longest wait for the supervisor")->check(CLI::Range(0.1, 60.0));
   app.add_flag("--json", json, "status as one JSON object");
   CLI11_PARSE(app, argc, argv);
+  using Command = protocol::SupervisorCommand;
+  std::uint8_t operating_mode = 0, zone = 0;
+  std::uint8_t zone_command = 0;
+  if (action == "mode") {
+    for (const auto& code : Status::kCodes) {
+      if (code.group == "OPERATION" && arguments.size() == 1 && code.name == arguments[0]) {
+        operating_mode = static_cast<std::uint8_t>(code.value);
+      }
+    }
+    if (operating_mode == 0) {
+      std::fprintf(stderr, "crane_safety: mode needs one of manual, semiautomatic, fullautomatic, maintenance\n");
+      return 2;
+    }
+  } else if (action == "zone") {
+    const bool shape = arguments.size() == 2 && (arguments[0] == "enable" || arguments[0] == "disable");
+    int index = -1;
+    if (shape) {
+      try {
+        std::size_t used = 0;
+        index = std::stoi(arguments[1], &used);
+        if (used != arguments[1].size()) index = -1;
+      } catch (const std::exception&) {
+        index = -1;
+      }
+    }
+    if (!shape || index < 0 || index > 31) {
+      std::fprintf(stderr, "crane_safety: zone needs enable | disable and a zone index in [0, 31]\n");
+      return 2;
+    }
+    zone = static_cast<std::uint8_t>(index);
+    zone_command = arguments[0] == "enable" ? Command::COMMAND_ENABLE_ZONE : Command::COMMAND_DISABLE_ZONE;
+  } else if (!arguments.empty()) {
+    std::fprintf(stderr, "crane_safety: %s takes no argument\n", action.c_str());
+    return 2;
+  }
   try {
     runtime::configure_logging("warn", "crane_safety");
     auto participant = runtime::make_participant(options, "operator");
@@ -117,10 +176,11 @@ int main(int argc, char** argv) {
       return 1;
     }
 
-    using Command = protocol::SupervisorCommand;
     const std::uint8_t code = action == "arm"      ? Command::COMMAND_ARM
                               : action == "disarm" ? Command::COMMAND_DISARM
                               : action == "estop"  ? Command::COMMAND_EMERGENCY_STOP
+                              : action == "mode"   ? Command::COMMAND_SET_OPERATING_MODE
+                              : action == "zone"   ? zone_command
                                                    : Command::COMMAND_RESET;
     auto writer = participant->make_writer<tp::SafetyCommand>();
     while (writer->health().matched_readers == 0 && Clock::now() < deadline) {
@@ -137,6 +197,8 @@ int main(int argc, char** argv) {
     runtime::stamp_header(command.header(), 0, runtime::now_stamp());
     command.request_id(request_id);
     command.command(code);
+    command.operating_mode(operating_mode);
+    command.zone(zone);
     writer->write(command);
     // Discovery is not symmetric: this writer may match the supervisor's reader before that reader
     // matches it, and a volatile command written then is lost to it. Every command is idempotent
@@ -151,8 +213,10 @@ int main(int argc, char** argv) {
       while (status_reader->take_next(status)) {
         if (status.last_request_id() != request_id) continue;
         const bool accepted = status.last_request_result() == Status::RESULT_ACCEPTED;
-        std::printf("%s %s: mode %s, brakes %s\n", action.c_str(), accepted ? "accepted" : "refused",
-                    code_name("MODE", status.mode()).c_str(),
+        std::printf("%s%s%s %s: mode %s, operating mode %s, zones enforced %s, brakes %s\n", action.c_str(),
+                    arguments.empty() ? "" : " ", arguments.empty() ? "" : arguments.back().c_str(),
+                    accepted ? "accepted" : "refused", code_name("MODE", status.mode()).c_str(),
+                    code_name("OPERATION", status.operating_mode()).c_str(), zone_list(status.zones_enabled()).c_str(),
                     status.brakes_released() ? "released" : "engaged");
         if (!accepted) {
           std::printf("  latched faults: %s; active: %s; silent stages: %s\n",

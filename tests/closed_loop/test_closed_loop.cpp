@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -196,9 +197,14 @@ TEST(ClosedLoopFrictionless, MatchesTheLinearLoopAndSettlesWithinOneMillimetre) 
       ASSERT_EQ(matched.samples[i].u_x, linear.samples[i].u_x) << m.name << " cycle " << i;
       ASSERT_EQ(matched.samples[i].u_gamma, linear.samples[i].u_gamma) << m.name << " cycle " << i;
     }
-    // Information only: the lab compensation model on a frictionless plant.
-    const Trace mismatched = run_closed_loop(lab_config(), m, true, plant);
-    print_row(mismatched, "onL");
+    // Information only: the lab compensation model on a frictionless plant. It runs away at rest
+    // (the supervisor stops the crane before the move, and the planner refuses the goal then).
+    try {
+      const Trace mismatched = run_closed_loop(lab_config(), m, true, plant);
+      print_row(mismatched, "onL");
+    } catch (const std::runtime_error& error) {
+      std::printf("%-9s onL  %s\n", m.name.c_str(), error.what());
+    }
   }
   std::printf("lin = frictionless plant, no compensation; on0 = compensation with a zero friction model; onL = "
               "compensation with the lab friction model (over-compensation, runs away)\n");

@@ -285,6 +285,24 @@ TEST_F(LabConfigText, YamlSyntaxErrorNamesTheLine) {
   EXPECT_TRUE(contains(message, "YAML syntax error at line " + std::to_string(edit.line))) << message;
 }
 
+// No-go zones: a self-intersecting or empty polygon is refused at start, naming the zone.
+TEST_F(LabConfigText, BadZonePolygonsAreRefusedNamingTheZone) {
+  auto message = error_of(edit_line(text_, "site:", "polygon:", "polygon: [[0, 0], [1, 1], [1, 0], [0, 1]]").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "site.zones[0] (control desk): polygon is self-intersecting: edges 0 and 2 cross"))
+      << message;
+  message = error_of(edit_line(text_, "site:", "polygon:", "polygon: []").text);
+  EXPECT_TRUE(contains(message, "site.zones[0] (control desk): polygon has 0 vertices: at least 3")) << message;
+  message = error_of(edit_line(text_, "site:", "polygon:", "polygon: [[0, 0], [1, x], [1, 1]]").text);
+  EXPECT_TRUE(contains(message, "site.zones[0].polygon[1] must be an [x, y] pair of numbers")) << message;
+  // The site is a shared fact: the planner and the supervisor get the same zones.
+  const auto config = cfg::load_stack_config(kLabConfig);
+  ASSERT_EQ(config.facts.site.zones.size(), 1U);
+  EXPECT_EQ(config.trajectory_planner.site.zones.size(), 1U);
+  EXPECT_EQ(config.supervisor.site.zones.size(), 1U);
+  EXPECT_EQ(config.facts.site.zones[0].name, "control desk");
+}
+
 TEST(LabConfig, MissingFileNamesThePath) {
   const std::string path = std::string(CRANE_SOURCE_DIR) + "/deploy/config/no_such_crane.yaml";
   try {

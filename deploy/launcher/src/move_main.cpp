@@ -1,7 +1,9 @@
 // crane_move: send the crane somewhere and follow it, like a ROS 2 action client (deploy/crane move).
 //
 //   crane_move [--trolley M] [--slew DEG] [--hoist M] [--profile NAME] [--trolley-max-velocity V] ...
-//              [--waypoint X,SLEW_DEG,L ...] [--wait] [--json] [--domain N] [--timeout S]
+//              [--waypoint X,SLEW_DEG,L ...] [--wait] [--json] [--domain N] [--timeout S] [--config F]
+//   crane_move --stop [--json]    a controlled anti-sway stop (deploy/crane stop): prints the stopping
+//                                 position the planner predicts, then where the crane came to rest
 //
 // Publishes a MoveRequest_ (the axes given; the others keep their position) and follows the
 // planner's MoveStatus_ feedback: rejected (the message names the field, the value and the bound),
@@ -10,9 +12,12 @@
 // demo's criteria: trolley within 5 mm, slew within 0.005 rad, swing within 0.5 deg, for 2 s) and
 // prints the settle time, the final errors and the residual swing.
 //
-// Exit codes: 0 accepted (without --wait) or arrived, 1 no planner answered within --timeout,
-// 2 rejected or bad usage, 3 aborted (replaced by another request, a supervisor fault, an
-// emergency stop).
+// With --config (deploy/crane passes its configuration) a goal refused for a no-go zone names it.
+//
+// Exit codes: 0 accepted (without --wait) or arrived (a stop: at rest), 1 no planner answered
+// within --timeout, 2 rejected (the operating mode, a zone, a bound) or bad usage, 3 aborted
+// (replaced by another request, stopped, the operating mode changed, a supervisor fault, an
+// emergency stop, a zone approach).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "crane/config/config_document.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
 #include "crane/stack/maneuver_metrics.hpp"
@@ -55,6 +61,8 @@ struct MoveOptions {
   double timeout{30.0};                 // [s] for the planner's first answer
   double settle_timeout{60.0};          // [s] after arrival, for the load to settle (--wait)
   double sample_period{0.01};           // [s] of the sensor stream
+  bool stop{false};                     // a stop request instead of a move
+  std::string config;                   // the stack's configuration (names the zones)
 };
 
 // Request ids only increase (the planner ignores one not above the last it took): tenths of a
@@ -69,10 +77,39 @@ std::string reason_name(std::uint8_t reason) {
   return std::string(protocol::code_name(Feedback::kCodes, "REASON", reason));
 }
 
+// The zone's name from the configuration ("" without one).
+std::string zone_name(const std::string& config, double index) {
+  if (config.empty()) return "";
+  try {
+    const auto site = config::ConfigDocument::load(config).facts().site;
+    const auto i = static_cast<std::size_t>(index);
+    if (index >= 0.0 && i < site.zones.size()) return site.zones[i].name;
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
 // "trolley target 1.5 m is outside its range [0.1, 1.2] m" and the like.
-std::string rejection_message(const Feedback& f) {
+std::string rejection_message(const Feedback& f, const std::string& config) {
   char b[256];
   switch (f.reason) {
+    case Feedback::REASON_ZONE: {
+      const std::string name = zone_name(config, f.value);
+      std::snprintf(b, sizeof(b), "the target is in no-go zone %g%s%s%s, or no route around the zones keeps out of it",
+                    f.value, name.empty() ? "" : " (", name.c_str(), name.empty() ? "" : ")");
+      return b;
+    }
+    case Feedback::REASON_MODE:
+      return "goals are not taken in operating mode " +
+             std::string(protocol::code_name(protocol::SupervisorStatus::kCodes, "OPERATION",
+                                             static_cast<std::uint64_t>(f.value))) +
+             " (deploy/crane mode fullautomatic or semiautomatic)";
+    case Feedback::REASON_FAULT:
+      return "the supervisor has stopped the crane (mode " +
+             std::string(protocol::code_name(protocol::SupervisorStatus::kCodes, "MODE",
+                                             static_cast<std::uint64_t>(f.value))) +
+             "): deploy/crane status, then reset";
+    case Feedback::REASON_MANUAL_MOTION: return "operator speed control is moving the crane";
     case Feedback::REASON_TROLLEY_RANGE:
       std::snprintf(b, sizeof(b), "trolley target %g m is outside the travel range [%g, %g] m", f.value, f.bound_min,
                     f.bound_max);
@@ -132,6 +169,63 @@ protocol::MoveRequest build_request(const MoveOptions& o, std::uint32_t id) {
   return r;
 }
 
+// deploy/crane stop: a stop request; its feedback: the predicted stopping position, then at rest.
+int run_stop(const MoveOptions& o, const runtime::NodeOptions& node) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  auto participant = runtime::make_participant(node, "operator");
+  transport::Wakeup wakeup;
+  runtime::install_stop_handlers(&wakeup);
+  auto goals = participant->make_writer<tp::Goal>();
+  auto feedback = participant->make_recording_reader<tp::MoveStatus>(&wakeup, 64);
+  const std::uint32_t id = fresh_request_id();
+  protocol::MoveRequest request;
+  request.request_id = id;
+  request.command = protocol::MoveRequest::COMMAND_STOP;
+  tp::msgs::MoveRequest_ message;
+  protocol::to_dds(request, message);
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.timeout));
+  auto next_send = Clock::now();
+  bool answered = false;
+  json out{{"request_id", id}};
+  while (!runtime::stop_requested() && Clock::now() < deadline) {
+    if (!answered && Clock::now() >= next_send) {
+      message.header().stamp(runtime::now_stamp());
+      goals->write(message);
+      next_send = Clock::now() + std::chrono::milliseconds(100);
+    }
+    tp::msgs::MoveStatus_ incoming;
+    while (feedback->take_next(incoming)) {
+      if (incoming.request_id() != id) continue;
+      Feedback f;
+      protocol::from_dds(incoming, f);
+      answered = true;
+      if (f.result == Feedback::RESULT_STOPPING) {
+        out["predicted_trolley_m"] = f.rest_trolley_position;
+        out["predicted_slew_rad"] = f.rest_slew_angle;
+        out["predicted_cable_length_m"] = f.rest_cable_length;
+        if (!o.json) {
+          std::printf("stopping: predicted rest at trolley %.3f m, slew %.1f deg, cable %.3f m\n", f.rest_trolley_position,
+                      f.rest_slew_angle / kDeg, f.rest_cable_length);
+        }
+      }
+      if (f.result == Feedback::RESULT_ARRIVED) {
+        out["result"] = "at_rest";
+        out["rest_trolley_m"] = f.rest_trolley_position;
+        out["rest_slew_rad"] = f.rest_slew_angle;
+        out["rest_cable_length_m"] = f.rest_cable_length;
+        if (o.json) std::printf("%s\n", out.dump().c_str());
+        else std::printf("at rest: trolley %.3f m, slew %.1f deg, cable %.3f m (the reference; the load settles)\n",
+                         f.rest_trolley_position, f.rest_slew_angle / kDeg, f.rest_cable_length);
+        return 0;
+      }
+    }
+    wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+  }
+  std::fprintf(stderr, "crane_move: %s\n", answered ? "the stop did not come to rest in time"
+                                                     : "no planner answered the stop request (is the stack running?)");
+  return 1;
+}
+
 int run(const MoveOptions& o, const runtime::NodeOptions& node) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines as they come, in order with stderr
   auto participant = runtime::make_participant(node, "operator");
@@ -181,7 +275,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
       protocol::from_dds(incoming, f);
       last = f;
       if (f.result == Feedback::RESULT_REJECTED) {
-        const std::string text = rejection_message(f);
+        const std::string text = rejection_message(f, o.config);
         if (o.json) {
           std::printf("%s\n", json{{"result", "rejected"}, {"request_id", id}, {"reason", reason_name(f.reason)},
                                    {"value", f.value}, {"bound_min", f.bound_min}, {"bound_max", f.bound_max},
@@ -192,7 +286,13 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
         return 2;
       }
       if (f.result == Feedback::RESULT_ABORTED) {
-        abort_reason = "replaced by a newer request (" + reason_name(f.reason) + ")";
+        abort_reason = f.reason == Feedback::REASON_REPLACED ? "replaced by a newer request"
+                       : f.reason == Feedback::REASON_STOPPED ? "stopped (deploy/crane stop)"
+                       : f.reason == Feedback::REASON_MODE    ? "the operating mode changed (a soft stop first)"
+                       : f.reason == Feedback::REASON_FAULT   ? "the supervisor stopped the crane"
+                       : f.reason == Feedback::REASON_ZONE    ? "approaching a no-go zone (a soft stop)"
+                       : f.reason == Feedback::REASON_MANUAL_MOTION ? "the operator's stick took over"
+                                                                   : reason_name(f.reason);
         break;
       }
       if (f.result == Feedback::RESULT_MOVING && !start_seq) start_seq = f.header.seq;
@@ -321,7 +421,18 @@ int main(int argc, char** argv) {
   app.add_option("--timeout", o.timeout, "[s] for the planner's answer")->check(CLI::PositiveNumber);
   app.add_option("--settle-timeout", o.settle_timeout, "[s] after arrival, for the load to settle")->check(CLI::PositiveNumber);
   app.add_option("--sample-period", o.sample_period, "[s] of the sensor stream")->check(CLI::PositiveNumber);
+  app.add_flag("--stop", o.stop, "a controlled anti-sway stop of whatever moves (deploy/crane stop)");
+  app.add_option("--config", o.config, "the stack's configuration: names the no-go zones in messages");
   CLI11_PARSE(app, argc, argv);
+  if (o.stop) {
+    try {
+      runtime::configure_logging("warn", "move");
+      return run_stop(o, node);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_move: %s\n", error.what());
+      return 1;
+    }
+  }
   if (!o.trolley && !o.slew_deg && !o.hoist && o.waypoints.empty()) {
     std::fprintf(stderr, "crane_move: give at least one of --trolley, --slew, --hoist\n");
     return 2;

@@ -49,6 +49,25 @@ common::CraneParameters read_crane(YamlSection& s) {
   return c;
 }
 
+common::Site read_site(YamlSection& s) {
+  common::Site site;
+  site.jib_height = s.number("jib_height", 0.0, 1.0e3);
+  site.zone_clearance = s.number("zone_clearance", 0.0, 100.0);
+  for (auto& z : s.list("zones")) {
+    common::Zone zone;
+    zone.name = z.text("name");
+    zone.polygon = z.points("polygon");
+    zone.bottom = z.number("bottom", -1.0e3, 1.0e3);
+    zone.top = z.number("top", -1.0e3, 1.0e3);
+    zone.enabled = z.flag("enabled");
+    z.finish();
+    site.zones.push_back(std::move(zone));
+  }
+  s.finish();
+  common::validate(site, "site");
+  return site;
+}
+
 ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
     : root_(std::move(root)), source_name_(std::move(source_name)) {
   facts_ = guarded([&] {
@@ -61,6 +80,10 @@ ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
     facts.voltage_limit = stack.number("voltage_limit", 0.1, 100.0);
     facts.lockstep_hang_timeout = stack.number("lockstep_hang_timeout", 0.1, 3600.0);
     stack.finish();
+    if (root_["site"]) {
+      YamlSection site = document.child("site");
+      facts.site = read_site(site);
+    }
     return facts;
   });
 }

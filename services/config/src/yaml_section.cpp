@@ -87,6 +87,25 @@ std::vector<YamlSection> YamlSection::list(const std::string& key) {
   return items;
 }
 
+std::vector<std::array<double, 2>> YamlSection::points(const std::string& key) {
+  YAML::Node value = required(key);
+  if (!value.IsSequence()) throw ConfigError(field(key) + " must be a list of [x, y] pairs");
+  std::vector<std::array<double, 2>> points;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string name = field(key) + "[" + std::to_string(i) + "]";
+    if (!value[i].IsSequence() || value[i].size() != 2) throw ConfigError(name + " must be an [x, y] pair");
+    std::array<double, 2> p{};
+    for (std::size_t j = 0; j < 2; ++j) {
+      if (!value[i][j].IsScalar() || !YAML::convert<double>::decode(value[i][j], p[j])) {
+        throw ConfigError(name + " must be an [x, y] pair of numbers");
+      }
+      common::require_finite(name, p[j]);
+    }
+    points.push_back(p);
+  }
+  return points;
+}
+
 void YamlSection::finish() const {
   for (const auto& entry : node_) {
     const std::string key = entry.first.as<std::string>();

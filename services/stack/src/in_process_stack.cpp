@@ -10,52 +10,68 @@
 #include "crane/supervisor/actuation_gate.hpp"
 #include "crane/supervisor/supervisor_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
-#include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 
 namespace crane::stack {
+namespace {
 
-InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) {
-  const ManeuverConfig& m = run.maneuver;
-  const double dt = cfg.facts.sample_period;
-  if (run.start_cycle == 0) throw std::invalid_argument("run_in_process: start_cycle must be > 0");
+plant::PlantStageParams plant_params(const StackConfig& cfg, const InProcessOptions& o) {
+  plant::PlantStageParams p;
+  p.simulator = cfg.plant;
+  p.simulator.initial_state.trolley_position = o.initial_trolley_position;
+  p.simulator.initial_state.slew_angle = o.initial_slew_angle;
+  p.gate = cfg.actuation;
+  p.mismatch = o.mismatch;
+  return p;
+}
+anti_swing::AntiSwingStageParams anti_swing_params(const StackConfig& cfg, const InProcessOptions& o) {
+  auto p = cfg.anti_swing;
+  p.law = o.controller.anti_swing;
+  return p;
+}
+tracking::TrackingStageParams tracking_params(const StackConfig& cfg, const InProcessOptions& o) {
+  auto p = cfg.tracking;
+  p.law = o.controller.tracking;
+  p.tracking.acceleration_feedforward = o.controller.acceleration_feedforward;
+  return p;
+}
+friction_compensation::FrictionCompensationParams compensation_params(const StackConfig& cfg,
+                                                                      const InProcessOptions& o) {
+  auto p = cfg.friction_compensation;
+  if (!o.friction_compensation) p.enabled = false;
+  return p;
+}
+supervisor::SupervisorParams supervisor_params(const StackConfig& cfg) {
+  auto p = cfg.supervisor;
+  p.expected_sensor_source = protocol::SensorSample::SOURCE_PLANT;
+  return p;
+}
 
-  plant::PlantStageParams plant_params;
-  plant_params.simulator = cfg.plant;
-  plant_params.simulator.initial_state.trolley_position = m.initial_trolley_position;
-  plant_params.simulator.initial_state.slew_angle = m.initial_slew_angle;
-  plant_params.gate = cfg.actuation;
-  plant_params.mismatch = run.mismatch;
-  plant::PlantStage plant(plant_params);
+}  // namespace
 
-  state_estimator::StateEstimatorStage estimator(cfg.state_estimator);
-  trajectory_planner::TrajectoryPlannerStage planner(cfg.trajectory_planner, dt);
-  auto anti_swing_params = cfg.anti_swing;
-  anti_swing_params.law = run.controller.anti_swing;
-  anti_swing::AntiSwingStage anti_swing(anti_swing_params);
-  auto tracking_params = cfg.tracking;
-  tracking_params.law = run.controller.tracking;
-  tracking_params.tracking.acceleration_feedforward = run.controller.acceleration_feedforward;
-  tracking::TrackingStage tracking(tracking_params);
-  auto compensation_params = cfg.friction_compensation;
-  if (!run.friction_compensation) compensation_params.enabled = false;
-  const friction_compensation::FrictionCompensationStage compensation(compensation_params);
-  auto supervisor_params = cfg.supervisor;
-  supervisor_params.expected_sensor_source = protocol::SensorSample::SOURCE_PLANT;
-  supervisor::SupervisorStage supervisor(supervisor_params);
-
-  const protocol::MoveRequest goal =
-      move_request(m, cfg.facts, run.request_id, run.profile, run.start_cycle);
-  const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
-
-  InProcessResult result;
-  result.swing_period = swing_period(m, cfg.facts);
-  result.records.reserve(static_cast<std::size_t>(cycles_needed + 1));
-
-  // Every stage fresh and present, one writer on each topic: what the lockstep supervisor sees of
-  // a complete cycle over DDS.
+struct InProcessStack::Stages {
+  Stages(const StackConfig& cfg, const InProcessOptions& o)
+      : dt(cfg.facts.sample_period),
+        plant(plant_params(cfg, o)),
+        estimator(cfg.state_estimator),
+        planner(cfg.trajectory_planner, dt),
+        anti_swing(anti_swing_params(cfg, o)),
+        tracking(tracking_params(cfg, o)),
+        compensation(compensation_params(cfg, o)),
+        supervisor(supervisor_params(cfg)) {
+    // Every stage fresh and present, one writer on each topic: what the lockstep supervisor sees
+    // of a complete cycle over DDS.
+    for (auto& stage : observed.stages) stage = supervisor::StageObservation{true, true, 0.0, false};
+    plant.sample(next_sensors);
+  }
+  double dt;
+  plant::PlantStage plant;
+  state_estimator::StateEstimatorStage estimator;
+  trajectory_planner::TrajectoryPlannerStage planner;
+  anti_swing::AntiSwingStage anti_swing;
+  tracking::TrackingStage tracking;
+  const friction_compensation::FrictionCompensationStage compensation;
+  supervisor::SupervisorStage supervisor;
   supervisor::SupervisorCycle observed;
-  for (auto& stage : observed.stages) stage = supervisor::StageObservation{true, true, 0.0, false};
-
   protocol::SensorSample sensors, next_sensors;
   protocol::CraneState estimate;
   protocol::Reference reference;
@@ -63,57 +79,105 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   protocol::LinearCommand linear;
   protocol::ActuatorCommand actuators;
   protocol::SupervisorStatus status, gating;
+  std::uint64_t k{0};
+  std::uint64_t plant_step_failures{0};
+};
+
+InProcessStack::InProcessStack(const StackConfig& config, const InProcessOptions& options)
+    : stages_(std::make_unique<Stages>(config, options)) {}
+InProcessStack::~InProcessStack() = default;
+
+void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::span<const protocol::OperatorSpeed> speeds,
+                          const protocol::SupervisorCommand* command) {
+  Stages& s = *stages_;
+  const std::uint64_t k = s.k;
+  s.sensors = s.next_sensors;
+  if (s.estimator.step(s.sensors, s.estimate) != common::StepStatus::ok) {
+    throw std::runtime_error("in-process run: the estimator refused the sensor sample of cycle " + std::to_string(k));
+  }
+  // The planner sees the supervisor's status of the previous cycle (none before cycle 1).
+  const trajectory_planner::PlannerCycle cycle{&s.estimate, goals, speeds, k == 0 ? nullptr : &s.gating};
+  if (s.planner.step(cycle, s.reference) != common::StepStatus::ok) {
+    throw std::runtime_error("in-process run: the planner did not answer cycle " + std::to_string(k));
+  }
+  if (s.anti_swing.step(s.estimate, s.action) == common::StepStatus::rejected_nonfinite) {
+    throw std::runtime_error("in-process run: the anti-swing law refused the estimate of cycle " + std::to_string(k));
+  }
+  (void)s.tracking.step(s.estimate, s.reference, s.action, s.linear);  // 0 V on a refusal, as the node
+  (void)s.compensation.step(s.estimate, s.linear, s.actuators);
+  s.observed.sensors = &s.sensors;
+  s.observed.actuators = &s.actuators;
+  s.observed.reference = &s.reference;
+  s.observed.command = command;
+  s.supervisor.step(s.observed, s.status);
+  if (k == 0) s.gating = s.status;  // cycle 0 is gated by the status of cycle 0, cycle k by that of k - 1
+  if (s.plant.step(supervisor::lockstep_gate_input(k, s.dt, &s.actuators, s.gating)) != common::StepStatus::ok) {
+    ++s.plant_step_failures;
+  }
+  s.gating = s.status;
+  s.plant.sample(s.next_sensors);
+  ++s.k;
+}
+
+std::uint64_t InProcessStack::cycle() const noexcept { return stages_->k; }
+const protocol::SensorSample& InProcessStack::sensors() const noexcept { return stages_->sensors; }
+const protocol::SensorSample& InProcessStack::next_sensors() const noexcept { return stages_->next_sensors; }
+const protocol::Reference& InProcessStack::reference() const noexcept { return stages_->reference; }
+const protocol::LinearCommand& InProcessStack::linear() const noexcept { return stages_->linear; }
+const protocol::ActuatorCommand& InProcessStack::actuators() const noexcept { return stages_->actuators; }
+const protocol::SupervisorStatus& InProcessStack::status() const noexcept { return stages_->status; }
+const trajectory_planner::TrajectoryPlannerStage& InProcessStack::planner() const noexcept { return stages_->planner; }
+const plant::PlantStage& InProcessStack::plant() const noexcept { return stages_->plant; }
+std::uint64_t InProcessStack::plant_step_failures() const noexcept { return stages_->plant_step_failures; }
+
+InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) {
+  const ManeuverConfig& m = run.maneuver;
+  const double dt = cfg.facts.sample_period;
+  if (run.start_cycle == 0) throw std::invalid_argument("run_in_process: start_cycle must be > 0");
+  InProcessOptions options;
+  options.friction_compensation = run.friction_compensation;
+  options.controller = run.controller;
+  options.mismatch = run.mismatch;
+  options.initial_trolley_position = m.initial_trolley_position;
+  options.initial_slew_angle = m.initial_slew_angle;
+  InProcessStack stack(cfg, options);
+
+  const protocol::MoveRequest goal = move_request(m, cfg.facts, run.request_id, run.profile, run.start_cycle);
+  const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
+
+  InProcessResult result;
+  result.swing_period = swing_period(m, cfg.facts);
+  result.records.reserve(static_cast<std::size_t>(cycles_needed + 1));
   bool started = false;
   std::uint64_t start_seq = 0;
-  plant.sample(sensors);
   for (std::uint64_t k = 0;; ++k) {
-    if (estimator.step(sensors, estimate) != common::StepStatus::ok) {
-      throw std::runtime_error("in-process run: the estimator refused the sensor sample of cycle " + std::to_string(k));
-    }
     // The goal arrives while the crane rests (over DDS: a few cycles after the stack is ready) and
     // waits in the planner for its start cycle.
-    const std::span<const protocol::MoveRequest> goals = k == 0 ? std::span(&goal, 1) : std::span<const protocol::MoveRequest>();
-    if (planner.step(estimate, goals, reference) != common::StepStatus::ok) {
-      throw std::runtime_error("in-process run: the planner did not answer cycle " + std::to_string(k));
-    }
-    for (const auto& outcome : planner.goal_outcomes()) {
+    stack.step(k == 0 ? std::span(&goal, 1) : std::span<const protocol::MoveRequest>());
+    for (const auto& outcome : stack.planner().goal_outcomes()) {
       if (outcome.status != trajectory_planner::GoalStatus::accepted) {
         throw std::runtime_error("in-process run: move request refused at cycle " + std::to_string(k) + ": " +
                                  trajectory_planner::goal_status_name(outcome.status));
       }
     }
-    if (anti_swing.step(estimate, action) == common::StepStatus::rejected_nonfinite) {
-      throw std::runtime_error("in-process run: the anti-swing law refused the estimate of cycle " + std::to_string(k));
-    }
-    (void)tracking.step(estimate, reference, action, linear);            // 0 V on a refusal, as the node
-    (void)compensation.step(estimate, linear, actuators);
-    observed.sensors = &sensors;
-    observed.actuators = &actuators;
-    observed.reference = &reference;
-    supervisor.step(observed, status);
-    if (k == 0) gating = status;  // cycle 0 is gated by the status of cycle 0, cycle k by that of k - 1
-    if (plant.step(supervisor::lockstep_gate_input(k, dt, &actuators, gating)) != common::StepStatus::ok) {
-      ++result.plant_step_failures;
-    }
-    gating = status;
-    plant.sample(next_sensors);
+    const auto& reference = stack.reference();
     if (!started && reference.request_id == goal.request_id && reference.phase != protocol::Reference::PHASE_HOLDING) {
       started = true;
       start_seq = k;
     }
     if (started) {
-      result.records.push_back(record_of(static_cast<double>(k - start_seq) * dt, sensors, next_sensors, &reference,
-                                         &linear, &actuators));
-      if (next_sensors.brakes_engaged) ++result.braked_cycles;
+      result.records.push_back(record_of(static_cast<double>(k - start_seq) * dt, stack.sensors(), stack.next_sensors(),
+                                         &reference, &stack.linear(), &stack.actuators()));
+      if (stack.next_sensors().brakes_engaged) ++result.braked_cycles;
       if (k == start_seq + cycles_needed) break;
     } else if (k > run.start_cycle + 10) {
       throw std::runtime_error("in-process run: the move did not start by cycle " + std::to_string(k));
     }
-    sensors = next_sensors;
   }
-  result.cycles = plant.cycle();
-  result.friction_events = plant.simulator().friction_event_count();
-  result.latched_faults = status.latched_faults;
+  result.cycles = stack.plant().cycle();
+  result.plant_step_failures = stack.plant_step_failures();
+  result.friction_events = stack.plant().simulator().friction_event_count();
+  result.latched_faults = stack.status().latched_faults;
   result.metrics = evaluate(result.records, m);
   return result;
 }

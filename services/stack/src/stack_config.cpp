@@ -30,7 +30,7 @@ ManeuverConfig read_maneuver(config::YamlSection& s) {
 }
 
 StackConfig read(const config::ConfigDocument& doc) {
-  doc.check_blocks({"stack", "crane", "plant", "actuation", "supervisor", "state_estimator", "trajectory_planner",
+  doc.check_blocks({"stack", "crane", "site", "plant", "actuation", "supervisor", "state_estimator", "trajectory_planner",
                     "anti_swing", "tracking", "friction_compensation", "hardware_bridge", "maneuvers"});
   StackConfig c;
   c.facts = doc.facts();

@@ -1,4 +1,5 @@
-// trajectory_planner process: rt/crane/planner/goal (MoveRequest) and rt/crane/state/estimate ->
+// trajectory_planner process: rt/crane/planner/goal (MoveRequest), rt/crane/operator/speed
+// (OperatorSpeed), rt/crane/safety/status (the operating mode, zones, faults) and rt/crane/state/estimate ->
 // TrajectoryPlannerStage (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the
 // time-optimal swing-free profile) -> rt/crane/planner/reference, once per cycle, same seq and
 // origin. Goals are taken only with a new cycle (the stage's rules: trajectory_planner_stage.hpp);
@@ -6,6 +7,7 @@
 // rt/crane/planner/move_status.
 #include <spdlog/spdlog.h>
 
+#include <optional>
 #include <vector>
 
 #include "crane/runtime/stage_node.hpp"
@@ -49,6 +51,11 @@ int main(int argc, char** argv) {
             ctx.config.read("trajectory_planner", trajectory_planner::read_params), ctx.config.facts().sample_period);
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
         auto goals = std::shared_ptr(ctx.participant.make_reader<tp::Goal>(&ctx.wakeup));
+        auto speeds = std::shared_ptr(ctx.participant.make_reader<tp::OperatorSpeed>(nullptr));
+        auto safety = std::shared_ptr(ctx.participant.make_reader<tp::SafetyStatus>(nullptr));
+        auto status = std::make_shared<std::optional<protocol::SupervisorStatus>>();
+        auto operator_speeds = std::make_shared<std::vector<protocol::OperatorSpeed>>();
+        operator_speeds->reserve(64);
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::Reference>());
         auto feedback = std::shared_ptr(ctx.participant.make_writer<tp::MoveStatus>());
         auto watch = std::make_shared<runtime::SequenceWatch>();
@@ -70,12 +77,22 @@ int main(int argc, char** argv) {
                 while (goals->take_next(request)) {
                   protocol::from_dds(request, arrived->emplace_back());
                 }
-                const auto refused_before = stage->nonfinite_goals();
-                const auto status = stage->step(state, *arrived, *out);
+                operator_speeds->clear();
+                tp::msgs::OperatorSpeed_ speed;
+                while (speeds->take_next(speed) && operator_speeds->size() < operator_speeds->capacity()) {
+                  protocol::from_dds(speed, operator_speeds->emplace_back());
+                }
+                // The latest supervisor status: the operating mode, the zones, a fault or a zone approach.
+                protocol::SupervisorStatus latest;
+                while (runtime::take_plain(*safety, latest, ctx.counters)) *status = latest;
+                const auto refused_before = stage->nonfinite_goals() + stage->rejected_speeds();
+                const trajectory_planner::PlannerCycle cycle{&state, *arrived, *operator_speeds,
+                                                             status->has_value() ? &**status : nullptr};
+                const auto step_status = stage->step(cycle, *out);
                 for (const auto& outcome : stage->goal_outcomes()) log_outcome(outcome);
                 for (const auto& move_status : stage->move_statuses()) runtime::write_plain(*feedback, move_status);
-                ctx.counters.nonfinite_rejected += stage->nonfinite_goals() - refused_before;
-                if (status != common::StepStatus::ok) continue;
+                ctx.counters.nonfinite_rejected += stage->nonfinite_goals() + stage->rejected_speeds() - refused_before;
+                if (step_status != common::StepStatus::ok) continue;
                 ++ctx.counters.cycles;
                 watch->answered(seq);
                 break;

@@ -1,9 +1,12 @@
 #include "crane/trajectory_planner/trajectory_planner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
 
 #include "crane/common/validation.hpp"
+#include "crane/trajectory_planner/zone_guard.hpp"
 
 namespace crane::trajectory_planner {
 namespace {
@@ -53,6 +56,8 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   common::require_greater("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance, 0.0);
   common::require_in_range("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance,
                            0.0, 0.2);
+  validate(params.manual);
+  common::validate(params.site, "site");
 }
 
 bool TrajectoryPlanner::plan_axis(Axis& axis, ProfileKind kind, double start, double target,
@@ -192,6 +197,44 @@ const TrajectoryPlanner::Segment& TrajectoryPlanner::segment_at(double time_in_m
     if (time_in_move < segments_[k].start_time + segments_[k].duration) return segments_[k];
   }
   return segments_[segment_count_ - 1];
+}
+
+common::MotionReference TrajectoryPlanner::sample_now() const noexcept {
+  const Segment& s = segment_at(time_in_move_);
+  const double t = time_in_move_ - s.start_time;
+  return {s.trolley.active().sample(t), s.slew.active().sample(t), s.cable.active().sample(t)};
+}
+
+int TrajectoryPlanner::intruded_zone(std::uint32_t zones_enabled, double spacing) const noexcept {
+  if (!ready_ || zones_enabled == 0 || params_.site.zones.empty() || !(spacing > 0.0)) return -1;
+  const auto sample = [&](double t) {
+    const double at = std::min(t, move_duration_);
+    const Segment& s = segment_at(at);
+    const double local = at - s.start_time;
+    return common::MotionReference{s.trolley.active().sample(local), s.slew.active().sample(local),
+                                   s.cable.active().sample(local)};
+  };
+  // The swing an acceleration excites lasts about a swing period (an input-shaped or time-optimal
+  // profile cancels it within one): each sample keeps the margin of the largest horizontal
+  // acceleration of the last period (zone_guard.hpp). The crane rests before the move.
+  std::array<double, 512> recent{};  // accelerations of the last samples (a ring), at `spacing`
+  std::size_t count = 0;
+  // Where the move starts, the load rests: a zone already within its margin there may be left.
+  const ZoneDistances start = zone_distances(params_.site, sample(time_in_move_));
+  for (double t = time_in_move_;; t += spacing) {
+    const common::MotionReference r = sample(t);
+    recent[count % recent.size()] = horizontal_acceleration(r);
+    ++count;
+    const double cable = std::max(r.cable_length.position, 1e-3);
+    const double period = 2.0 * std::numbers::pi * std::sqrt(cable / params_.gravity);
+    const auto window = std::min<std::size_t>({count, recent.size(),
+                                               static_cast<std::size_t>(std::ceil(period / spacing)) + 1});
+    double peak = 0.0;
+    for (std::size_t i = 0; i < window; ++i) peak = std::max(peak, recent[(count - 1 - i) % recent.size()]);
+    const int zone = trajectory_planner::intruded_zone(params_.site, zones_enabled, r, params_.gravity, peak, &start);
+    if (zone >= 0) return zone;
+    if (t >= move_duration_) return -1;
+  }
 }
 
 common::StepStatus TrajectoryPlanner::step(double dt, PlannerOutput& output) noexcept {

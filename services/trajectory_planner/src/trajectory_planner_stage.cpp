@@ -7,6 +7,7 @@
 #include "crane/common/protocol_signals.hpp"
 #include "crane/common/validation.hpp"
 #include "crane/config/yaml_section.hpp"
+#include "crane/trajectory_planner/zone_paths.hpp"
 
 namespace crane::trajectory_planner {
 
@@ -19,7 +20,22 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.trolley_max_position = s.number("trolley_max_position", p.trolley_min_position, 100.0);
   p.slew_min_angle = s.number("slew_min_angle", -20.0 * kPi, 20.0 * kPi);
   p.slew_max_angle = s.number("slew_max_angle", p.slew_min_angle, 20.0 * kPi);
+  auto m = s.child("manual");
+  const auto axis = [&](const char* name, bool swings) {
+    return SpeedAxisParams{m.number(std::string(name) + "_speed", 0.0, 100.0),
+                           m.number(std::string(name) + "_acceleration", 0.0, 100.0), swings};
+  };
+  p.manual.trolley = axis("trolley", true);
+  p.manual.slew = axis("slew", true);
+  p.manual.hoist = axis("hoist", false);
+  p.manual.micro_speed_fraction = m.number("micro_speed_fraction", 0.0, 1.0);
+  p.manual.maintenance_speed_fraction = m.number("maintenance_speed_fraction", 0.0, 1.0);
+  p.manual.dead_man_timeout = m.number("dead_man_timeout", 0.02, 5.0);
+  const auto shaping = m.text("shaping", {"none", "zv", "zvd"});
+  p.manual.shaping = shaping == "none" ? SpeedShaping::none : shaping == "zv" ? SpeedShaping::zv : SpeedShaping::zvd;
+  m.finish();
   s.finish();
+  p.site = facts.site;
   p.cable_min_length = facts.crane.min_cable_length;
   p.cable_max_length = facts.crane.max_cable_length;
   p.gravity = facts.crane.gravity;
@@ -38,6 +54,10 @@ const char* goal_status_name(GoalStatus s) noexcept {
     case GoalStatus::rejected_unknown_profile: return "rejected: unknown profile code";
     case GoalStatus::rejected_waypoint:
       return "rejected: more than 8 waypoints, or a waypoint non-finite or out of range";
+    case GoalStatus::rejected_zone: return "rejected: the target is in a no-go zone, or no route around the zones";
+    case GoalStatus::rejected_operating_mode: return "rejected: goals are not taken in this operating mode";
+    case GoalStatus::rejected_supervisor_stop: return "rejected: the supervisor has stopped the crane (fault or emergency stop)";
+    case GoalStatus::rejected_manual_motion: return "rejected: operator speed control is moving the crane";
   }
   return "unknown";
 }
@@ -110,20 +130,26 @@ void describe_rejection(GoalStatus status, const MoveGoal& goal, const Trajector
     case GoalStatus::rejected_invalid_limits: f.reason = S::REASON_LIMITS; return;
     case GoalStatus::rejected_unknown_profile: f.reason = S::REASON_PROFILE; return;
     case GoalStatus::rejected_waypoint: f.reason = S::REASON_WAYPOINT; return;
+    case GoalStatus::rejected_zone: f.reason = S::REASON_ZONE; return;
+    case GoalStatus::rejected_operating_mode: f.reason = S::REASON_MODE; return;
+    case GoalStatus::rejected_supervisor_stop: f.reason = S::REASON_FAULT; return;
+    case GoalStatus::rejected_manual_motion: f.reason = S::REASON_MANUAL_MOTION; return;
   }
 }
 
 TrajectoryPlannerStage::TrajectoryPlannerStage(const TrajectoryPlannerParams& params, double sample_period)
-    : planner_(params), sample_period_(sample_period) {
+    : planner_(params), scratch_(params), sample_period_(sample_period) {
   common::require_greater("stack.sample_period", sample_period, 0.0);
+  zones_enabled_ = params.site.enabled_at_start();
 }
 
 void TrajectoryPlannerStage::record(const GoalOutcome& outcome) noexcept {
   if (outcome_count_ < outcomes_.size()) outcomes_[outcome_count_++] = outcome;
 }
 
-void TrajectoryPlannerStage::report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason) noexcept {
-  if (status_count_ >= statuses_.size()) return;
+protocol::MoveStatus* TrajectoryPlannerStage::report(std::uint32_t request_id, std::uint8_t result,
+                                                     std::uint8_t reason) noexcept {
+  if (status_count_ >= statuses_.size()) return nullptr;
   protocol::MoveStatus& s = statuses_[status_count_++];
   s = protocol::MoveStatus{};
   if (cycle_estimate_ != nullptr) common::same_cycle(cycle_estimate_->header, s.header);
@@ -135,13 +161,88 @@ void TrajectoryPlannerStage::report(std::uint32_t request_id, std::uint8_t resul
   s.cable_to_go = active_goal_.cable_target - output_.reference.cable_length.position;
   s.time_in_move = output_.time_in_move;
   s.move_duration = output_.move_duration;
+  s.rest_trolley_position = active_goal_.trolley_target;
+  s.rest_slew_angle = active_goal_.slew_target;
+  s.rest_cable_length = active_goal_.cable_target;
+  return &s;
 }
 
-common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& estimate,
-                                                std::span<const Request> goals,
-                                                protocol::Reference& reference) noexcept {
+void TrajectoryPlannerStage::report_rest(protocol::MoveStatus& s) const noexcept {
+  const auto& p = planner_.params();
+  const auto rest = speed_.rest(sample_period_, p.manual, p.manual.shaping, p.speed_bounds());
+  const auto now = speed_.reference();
+  s.rest_trolley_position = rest[0];
+  s.rest_slew_angle = rest[1];
+  s.rest_cable_length = rest[2];
+  s.trolley_to_go = rest[0] - now.trolley.position;
+  s.slew_to_go = rest[1] - now.slew.position;
+  s.cable_to_go = rest[2] - now.cable_length.position;
+}
+
+void TrajectoryPlannerStage::abort_active(std::uint8_t reason) noexcept {
+  if (active_) report(static_cast<std::uint32_t>(active_goal_.request_id), protocol::MoveStatus::RESULT_ABORTED, reason);
+  active_ = false;
+}
+
+bool TrajectoryPlannerStage::moving() const noexcept {
+  return source_ == Source::speed ? !speed_.at_rest() : output_.phase == MovePhase::moving;
+}
+
+void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id) noexcept {
+  if (source_ == Source::profile) {
+    speed_.start(planner_.sample_now());
+    source_ = Source::speed;
+  }
+  stop_id_ = stop_id;
+  require_neutral_ = true;
+  if (stop_id != 0) {
+    if (auto* s = report(stop_id, protocol::MoveStatus::RESULT_STOPPING)) report_rest(*s);
+  }
+}
+
+void TrajectoryPlannerStage::take_speeds(std::span<const protocol::OperatorSpeed> speeds, std::uint64_t seq) noexcept {
+  using Speed = protocol::OperatorSpeed;
+  for (const auto& sample : speeds) {
+    const double values[] = {sample.trolley, sample.slew, sample.hoist};
+    bool valid = sample.range == Speed::RANGE_NORMAL || sample.range == Speed::RANGE_MICRO;
+    for (const double v : values) valid = valid && std::isfinite(v) && std::abs(v) <= 1.0;
+    if (!valid) {
+      ++rejected_speeds_;
+      continue;
+    }
+    if (operating_mode_ == protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC) {
+      ++speeds_outside_manual_;
+      continue;
+    }
+    operator_speed_ = {sample.trolley, sample.slew, sample.hoist};
+    operator_micro_ = sample.range == Speed::RANGE_MICRO;
+    operator_seq_ = seq;
+    have_operator_input_ = true;
+  }
+}
+
+std::array<double, 3> TrajectoryPlannerStage::targets_of(std::uint64_t seq) const noexcept {
+  const auto& m = planner_.params().manual;
+  const bool silent = !have_operator_input_ ||
+                      static_cast<double>(seq - operator_seq_) * sample_period_ > m.dead_man_timeout + 1e-9;
+  if (silent || require_neutral_ || stop_id_ != 0 || supervisor_stopped_ ||
+      operating_mode_ == protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC) {
+    return {0.0, 0.0, 0.0};
+  }
+  double fraction = operator_micro_ ? m.micro_speed_fraction : 1.0;
+  if (operating_mode_ == protocol::SupervisorStatus::OPERATION_MAINTENANCE) fraction *= m.maintenance_speed_fraction;
+  return {operator_speed_[0] * fraction * m.trolley.rated_speed, operator_speed_[1] * fraction * m.slew.rated_speed,
+          operator_speed_[2] * fraction * m.hoist.rated_speed};
+}
+
+common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, protocol::Reference& reference) noexcept {
+  using Feedback = protocol::MoveStatus;
+  using Status = protocol::SupervisorStatus;
   outcome_count_ = 0;
   status_count_ = 0;
+  held_axes_ = 0;
+  if (cycle.estimate == nullptr) return common::StepStatus::not_ready;
+  const protocol::CraneState& estimate = *cycle.estimate;
   if (!protocol::all_finite(estimate)) return common::StepStatus::rejected_nonfinite;
   cycle_estimate_ = &estimate;
   const std::uint64_t seq = estimate.header.seq;
@@ -150,22 +251,86 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
     holding_ = planner_.hold(current) == GoalStatus::accepted;
     if (!holding_) return common::StepStatus::not_ready;
   }
-  using Feedback = protocol::MoveStatus;
-  // Starts `r` now: the planner takes it or refuses it (the running move then continues).
-  const auto start = [&](const Request& r) {
-    const MoveGoal goal = to_goal(r, current);
-    const GoalStatus status = planner_.start_move(goal, current);
-    if (status == GoalStatus::accepted) {
-      if (active_ && active_goal_.request_id != goal.request_id) {
-        report(static_cast<std::uint32_t>(active_goal_.request_id), Feedback::RESULT_ABORTED, Feedback::REASON_REPLACED);
+  const auto& params = planner_.params();
+
+  // The supervisor's view: operating mode, zones, faults, zone approach.
+  bool zone_warning = false;
+  if (cycle.status != nullptr) {
+    const auto& st = *cycle.status;
+    const std::uint8_t mode = st.operating_mode;
+    if (mode >= Status::OPERATION_MANUAL && mode <= Status::OPERATION_MAINTENANCE && mode != operating_mode_) {
+      if (moving()) {
+        abort_active(Feedback::REASON_MODE);
+        soft_stop(0);
       }
-      active_goal_ = goal;
-      active_ = true;
-      cycles_since_progress_ = kProgressCycles;  // report at this cycle's end
-    } else if (status_count_ < statuses_.size()) {
-      report(r.request_id, Feedback::RESULT_REJECTED);
-      describe_rejection(status, goal, planner_.params(), statuses_[status_count_ - 1]);
+      operating_mode_ = mode;
     }
+    zones_enabled_ = st.zones_enabled;
+    supervisor_mode_ = st.mode;
+    supervisor_stopped_ = st.mode == Status::MODE_FAULT || st.mode == Status::MODE_EMERGENCY_STOP;
+    zone_warning = (st.warnings & Status::WARNING_ZONE_APPROACH) != 0;
+  }
+  if (supervisor_stopped_) {
+    // The brakes hold the crane where it is and the drives are off: the running goal is over. The
+    // reference is left as it runs (a lockstep run gives the same record whatever cycle the status
+    // arrives at); when the supervisor lets the crane move again, it holds the measured position,
+    // so a reset resumes nothing.
+    abort_active(Feedback::REASON_FAULT);
+    if (stop_id_ != 0) report(stop_id_, Feedback::RESULT_ARRIVED);
+    stop_id_ = 0;
+    hold_on_release_ = true;
+    require_neutral_ = true;
+  } else if (hold_on_release_) {
+    hold_on_release_ = false;
+    source_ = Source::profile;
+    (void)planner_.hold(current);
+  } else if (zone_warning && moving() && stop_id_ == 0) {
+    abort_active(Feedback::REASON_ZONE);
+    soft_stop(0);
+  }
+
+  // Start `r` now: the planner takes it or refuses it (the running move then continues).
+  const auto start = [&](const Request& r) {
+    MoveGoal goal = to_goal(r, current);
+    // Refuses with the reason; `value` the mode or zone it names.
+    const auto reject = [&](GoalStatus status, double value) {
+      if (auto* f = report(r.request_id, Feedback::RESULT_REJECTED)) {
+        describe_rejection(status, goal, params, *f);
+        if (status >= GoalStatus::rejected_zone) f->value = value;
+        f->rest_trolley_position = f->rest_slew_angle = f->rest_cable_length = 0.0;
+      }
+      return status;
+    };
+    if (supervisor_stopped_) return reject(GoalStatus::rejected_supervisor_stop, supervisor_mode_);
+    if (operating_mode_ == Status::OPERATION_MANUAL || operating_mode_ == Status::OPERATION_MAINTENANCE) {
+      return reject(GoalStatus::rejected_operating_mode, operating_mode_);
+    }
+    if (source_ == Source::speed && !speed_.at_rest()) return reject(GoalStatus::rejected_manual_motion, 0.0);
+    // The move starts from where the reference rests (the speed reference, or the estimate).
+    common::CraneStateEstimate from = current;
+    if (source_ == Source::speed) {
+      const auto r0 = speed_.reference();
+      from.trolley_position = r0.trolley.position;
+      from.slew_angle = r0.slew.position;
+      from.cable_length = r0.cable_length.position;
+    }
+    if (zones_enabled_ != 0 && !params.site.zones.empty()) {
+      // The goal's own bounds first (travel, limits: their own reason and bound), then the zones.
+      scratch_.reset();
+      const GoalStatus own = scratch_.start_move(goal, from);
+      if (own != GoalStatus::accepted) return reject(own, 0.0);
+      const ZonePlan plan = plan_around_zones(scratch_, goal, from, zones_enabled_);
+      if (!plan.found) return reject(GoalStatus::rejected_zone, plan.zone);
+      goal = plan.goal;
+    }
+    const GoalStatus status = planner_.start_move(goal, from);
+    if (status != GoalStatus::accepted) return reject(status, 0.0);
+    if (active_ && active_goal_.request_id != goal.request_id) abort_active(Feedback::REASON_REPLACED);
+    source_ = Source::profile;
+    stop_id_ = 0;
+    active_goal_ = goal;
+    active_ = true;
+    cycles_since_progress_ = kProgressCycles;  // report at this cycle's end
     return status;
   };
   const auto outcome = [&](const Request& r, GoalOutcome::When when, GoalStatus status) {
@@ -179,7 +344,7 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
     o.slew_target = r.slew_target;
     record(o);
   };
-  for (const auto& request : goals) {
+  for (const auto& request : cycle.goals) {
     if (!protocol::all_finite(request)) {
       ++nonfinite_goals_;
       outcome(request, GoalOutcome::When::now, GoalStatus::rejected_nonfinite);
@@ -191,6 +356,26 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
       continue;
     }
     last_request_ = request.request_id;
+    if (request.command == Request::COMMAND_STOP) {
+      pending_.reset();
+      outcome(request, GoalOutcome::When::now, GoalStatus::accepted);
+      if (supervisor_stopped_ || !moving()) {
+        // Nothing moves (or the brakes hold it): at rest where it is.
+        abort_active(Feedback::REASON_STOPPED);
+        require_neutral_ = true;
+        if (auto* f = report(request.request_id, Feedback::RESULT_ARRIVED)) {
+          // At rest where the reference holds now (the last cycle's).
+          f->rest_trolley_position = output_.reference.trolley.position;
+          f->rest_slew_angle = output_.reference.slew.position;
+          f->rest_cable_length = output_.reference.cable_length.position;
+          f->trolley_to_go = f->slew_to_go = f->cable_to_go = 0.0;
+        }
+        continue;
+      }
+      abort_active(Feedback::REASON_STOPPED);
+      soft_stop(request.request_id);
+      continue;
+    }
     if (request.header.seq > seq) {
       pending_ = request;
       outcome(request, GoalOutcome::When::waiting, GoalStatus::accepted);
@@ -205,25 +390,72 @@ common::StepStatus TrajectoryPlannerStage::step(const protocol::CraneState& esti
     outcome(*pending_, GoalOutcome::When::as_asked, start(*pending_));
     pending_.reset();
   }
-  const auto status = planner_.step(sample_period_, output_);
-  if (status != common::StepStatus::ok) return status;
-  if (active_) {
-    const auto id = static_cast<std::uint32_t>(active_goal_.request_id);
-    if (output_.phase == MovePhase::arrived && output_.request_id == active_goal_.request_id) {
-      report(id, Feedback::RESULT_ARRIVED);
-      active_ = false;
-    } else if (++cycles_since_progress_ >= kProgressCycles) {
-      report(id, Feedback::RESULT_MOVING);
-      cycles_since_progress_ = 0;
+
+  // Operator speeds: taken in the manual modes; in SEMIAUTOMATIC they take over from a goal.
+  take_speeds(cycle.speeds, seq);
+  const auto targets = targets_of(seq);
+  targets_ = targets;
+  const bool commanding = targets[0] != 0.0 || targets[1] != 0.0 || targets[2] != 0.0;
+  if (require_neutral_ && have_operator_input_ && operator_speed_ == std::array<double, 3>{} &&
+      (source_ == Source::profile || speed_.at_rest())) {
+    require_neutral_ = false;
+  }
+  if (commanding && source_ == Source::profile) {
+    if (active_ && output_.phase == MovePhase::moving) abort_active(Feedback::REASON_MANUAL_MOTION);
+    active_ = false;
+    speed_.start(planner_.sample_now());
+    source_ = Source::speed;
+  }
+
+  if (source_ == Source::profile) {
+    const auto status = planner_.step(sample_period_, output_);
+    if (status != common::StepStatus::ok) return status;
+    if (active_) {
+      const auto id = static_cast<std::uint32_t>(active_goal_.request_id);
+      if (output_.phase == MovePhase::arrived && output_.request_id == active_goal_.request_id) {
+        report(id, Feedback::RESULT_ARRIVED);
+        active_ = false;
+      } else if (++cycles_since_progress_ >= kProgressCycles) {
+        report(id, Feedback::RESULT_MOVING);
+        cycles_since_progress_ = 0;
+      }
+    }
+  } else {
+    const SpeedShaping shaping = operating_mode_ == Status::OPERATION_MAINTENANCE ? SpeedShaping::none
+                                                                                        : params.manual.shaping;
+    held_axes_ = speed_.step(targets, sample_period_, params.manual, shaping, params.speed_bounds(), params.site,
+                             zones_enabled_);
+    output_.reference = speed_.reference();
+    output_.request_id = stop_id_;
+    output_.phase = speed_.at_rest() ? MovePhase::arrived : MovePhase::moving;
+    const bool released = was_commanding_ && !commanding;
+    if (stop_id_ == 0 && (released || (!speed_.at_rest() && ++cycles_since_manual_report_ >= kProgressCycles))) {
+      if (auto* s = report(0, Feedback::RESULT_MANUAL)) report_rest(*s);
+      cycles_since_manual_report_ = 0;
+    }
+    if (speed_.at_rest()) {
+      // At rest: back to holding the rest position (goals start from it).
+      if (stop_id_ != 0) {
+        if (auto* s = report(stop_id_, Feedback::RESULT_ARRIVED)) report_rest(*s);
+      }
+      stop_id_ = 0;
+      const auto r = speed_.reference();
+      common::CraneStateEstimate rest = current;
+      rest.trolley_position = r.trolley.position;
+      rest.slew_angle = r.slew.position;
+      rest.cable_length = r.cable_length.position;
+      (void)planner_.hold(rest);
+      source_ = Source::profile;
     }
   }
+  was_commanding_ = commanding;
   common::from_reference(output_.reference, reference);
   reference.request_id = static_cast<std::uint32_t>(output_.request_id);
   reference.phase = static_cast<std::uint8_t>(output_.phase);
   reference.time_in_move = output_.time_in_move;
   reference.move_duration = output_.move_duration;
   common::same_cycle(estimate.header, reference.header);
-  return status;
+  return common::StepStatus::ok;
 }
 
 }  // namespace crane::trajectory_planner

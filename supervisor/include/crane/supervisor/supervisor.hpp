@@ -24,13 +24,22 @@
 //    may not move faster than a speed that falls linearly from max to approach speed; when it does,
 //    the voltage limit of that drive drops to approach_voltage_limit so the drive can only brake
 //    (friction decelerates it); inside stop_margin of the limit, still moving toward it: protective
-//    stop, so the brakes hold it before the hard limit.
+//    stop, so the brakes hold it before the hard limit;
+//  - operating modes after OPC 40020 (MANUAL, SEMIAUTOMATIC, FULLAUTOMATIC, MAINTENANCE) change
+//    only by an operator command here (FULLAUTOMATIC at start); the planner applies them (goals or
+//    operator speeds) and stops softly first when the mode changes while the crane moves;
+//  - no-go zones (common/site.hpp, switched on and off by operator commands): the load measured
+//    inside an enabled zone is a protective stop (fault zone); the load's stopping position
+//    predicted from the measured speeds (braking at trolley_braking_deceleration and
+//    slew_braking_deceleration) inside one is the warning zone_approach, to which the planner
+//    answers with its soft stop (the first reaction, where a hard stop is not yet required).
 // The axis velocities are differentiated here from the sensor samples (seq and positions), not
 // taken from the state estimator: the supervisor does not trust the control processes.
 
 #include <array>
 #include <cstdint>
 
+#include "crane/common/site.hpp"
 #include "crane/protocol/messages.hpp"
 
 namespace crane::supervisor {
@@ -79,8 +88,9 @@ enum Fault : std::uint32_t {
   kFaultMultipleActuatorWriters = StatusCodes::FAULT_MULTIPLE_ACTUATOR_WRITERS,
   kFaultSensorSource = StatusCodes::FAULT_SENSOR_SOURCE,
   kFaultLimitSwitch = StatusCodes::FAULT_LIMIT_SWITCH,
+  kFaultZone = StatusCodes::FAULT_ZONE,
 };
-inline constexpr int kFaultBits = 14;
+inline constexpr int kFaultBits = 15;
 /// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
 [[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
 
@@ -91,7 +101,18 @@ enum Warning : std::uint32_t {
   kWarningSpeedLimited = StatusCodes::WARNING_SPEED_LIMITED,        // an approach speed was exceeded: drive voltage limited
   kWarningStageLate = StatusCodes::WARNING_STAGE_LATE,              // a stage is late (not fresh, or a DDS deadline missed):
                                                               // motion inhibited while it lasts, not yet dead
+  kWarningZoneApproach = StatusCodes::WARNING_ZONE_APPROACH,        // the predicted stopping position is in a zone
 };
+
+/// Operating modes after OPC 40020 (SupervisorStatus.operating_mode, the IDL's OPERATION_* codes).
+enum class OperatingMode : std::uint8_t {
+  manual = StatusCodes::OPERATION_MANUAL,
+  semiautomatic = StatusCodes::OPERATION_SEMIAUTOMATIC,
+  fullautomatic = StatusCodes::OPERATION_FULLAUTOMATIC,
+  maintenance = StatusCodes::OPERATION_MAINTENANCE,
+};
+/// "manual", "semiautomatic", "fullautomatic", "maintenance" (the IDL's names); "unknown" for other codes.
+[[nodiscard]] const char* operating_mode_name(std::uint8_t code) noexcept;
 
 /// One axis's range and approach behaviour. Units: [m] and [m/s] for the trolley, [rad] and [rad/s]
 /// for the slew.
@@ -129,6 +150,9 @@ struct SupervisorParams {
   bool arm_on_start{true};           // arm by itself once the chain is healthy (simulation); a
                                      // real crane sets false and waits for an explicit arm command
   std::uint8_t expected_sensor_source{0};  // 0 any, 1 simulated plant, 2 hardware bridge
+  double trolley_braking_deceleration{0.9929};  // [m/s^2] predicts the trolley's stopping position (zones)
+  double slew_braking_deceleration{2.0796};     // [rad/s^2] predicts the slew's stopping angle (zones)
+  common::Site site{};               // the no-go zones (a shared fact, `site:`)
 
   [[nodiscard]] AxisLimits trolley() const noexcept {
     return {trolley_min, trolley_max, trolley_approach_margin, trolley_stop_margin, trolley_approach_speed,
@@ -157,6 +181,9 @@ enum class Command : std::uint8_t {
   disarm = protocol::SupervisorCommand::COMMAND_DISARM,
   emergency_stop = protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP,
   reset = protocol::SupervisorCommand::COMMAND_RESET,
+  set_operating_mode = protocol::SupervisorCommand::COMMAND_SET_OPERATING_MODE,
+  enable_zone = protocol::SupervisorCommand::COMMAND_ENABLE_ZONE,
+  disable_zone = protocol::SupervisorCommand::COMMAND_DISABLE_ZONE,
 };
 
 struct SupervisorInput {
@@ -168,6 +195,7 @@ struct SupervisorInput {
   double slew_angle{0.0};             // [rad]
   double swing_in_plane{0.0};         // [rad]
   double swing_out_of_plane{0.0};     // [rad]
+  double cable_length{1.0};           // [m]
   std::uint8_t limit_switches{0};     // SensorSample_.limit_switches (bit 0 trolley min, 1 max, 2 slew min, 3 max)
   bool actuators_valid{false};        // an actuator command has been received
   std::uint64_t actuator_seq{0};      // cycle number of the latest actuator command
@@ -179,6 +207,8 @@ struct SupervisorInput {
   bool nonfinite_seen{false};         // a watched sample was rejected for NaN/Inf since last step
   bool move_in_progress{false};       // the planner reports a move (ready -> operating)
   Command command{Command::none};
+  std::uint8_t command_operating_mode{0};  // set_operating_mode: an OPERATION_* code (others refused)
+  std::uint8_t command_zone{0};            // enable_zone / disable_zone: index in site.zones (others refused)
 };
 
 struct SupervisorOutput {
@@ -197,6 +227,9 @@ struct SupervisorOutput {
   double slew_voltage_limit{0.0};     // [V]
   double trolley_velocity{0.0};       // [m/s] differentiated from the sensor samples
   double slew_rate{0.0};              // [rad/s]
+  std::uint8_t operating_mode{StatusCodes::OPERATION_FULLAUTOMATIC};  // an OPERATION_* code
+  std::uint32_t zones_enabled{0};     // bit i: site.zones[i] enforced
+  int zone{-1};                       // the zone of fault zone or warning zone_approach (-1: none)
   bool command_refused{false};        // the step's command was refused: arm with latched faults or an
                                       // unhealthy chain, reset with a fault still active or an unhealthy chain
 };
@@ -226,6 +259,8 @@ class Supervisor {
   bool chain_was_up_{false};  // every stage has been fresh once: a death from now on is a fault
   std::uint64_t last_fault_seq_{0};
   bool armed_{false};
+  std::uint8_t operating_mode_{StatusCodes::OPERATION_FULLAUTOMATIC};
+  std::uint32_t zones_enabled_{0};
   bool drives_enabled_previous_{false};
   // Velocity from successive sensor samples.
   bool have_previous_sample_{false};

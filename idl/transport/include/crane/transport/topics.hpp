@@ -31,6 +31,7 @@ CRANE_TOPIC(LinearCommand, LinearCommand_, "rt/crane/control/linear", QosKind::s
 CRANE_TOPIC(SafetyStatus, SupervisorStatus_, "rt/crane/safety/status", QosKind::safety);
 CRANE_TOPIC(SafetyCommand, SupervisorCommand_, "rt/crane/safety/command", QosKind::command);
 CRANE_TOPIC(LoopDiagnostics, LoopDiagnostics_, "rt/crane/diag/loop", QosKind::diagnostics);
+CRANE_TOPIC(OperatorSpeed, OperatorSpeed_, "rt/crane/operator/speed", QosKind::command);
 
 #undef CRANE_TOPIC
 
@@ -49,6 +50,7 @@ void for_each_topic(F&& f) {
   f.template operator()<SafetyStatus>();
   f.template operator()<SafetyCommand>();
   f.template operator()<LoopDiagnostics>();
+  f.template operator()<OperatorSpeed>();
 }
 
 }  // namespace crane::transport::topics

@@ -1,10 +1,11 @@
 #pragma once
-// The facts every stage of the stack shares, read once from the configuration (the `stack:` and
-// `crane:` blocks, crane::config::read_facts) and handed to each stage's constructor: the one
+// The facts every stage of the stack shares, read once from the configuration (the `stack:`, `crane:` and
+// `site:` blocks, crane::config::read_facts) and handed to each stage's constructor: the one
 // place for the sample period, the drive voltage limit and the crane itself (its cable range
 // included). A stage's own block never repeats them.
 
 #include "crane/common/crane_parameters.hpp"
+#include "crane/common/site.hpp"
 
 namespace crane::common {
 
@@ -15,6 +16,7 @@ struct StackFacts {
   double lockstep_hang_timeout{5.0};   // [s] lockstep: wall time a cycle may wait before the chain is
                                        // reported hung (nothing is guessed: the cycle keeps waiting)
   CraneParameters crane;               // the crane as configured (cable range included)
+  Site site;                           // the jib height and the no-go zones (`site:`, optional: none)
 };
 
 }  // namespace crane::common

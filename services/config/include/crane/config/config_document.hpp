@@ -25,6 +25,9 @@ namespace crane::config {
 
 /// Reads the `crane:` block (every field of common::CraneParameters) and validates it.
 [[nodiscard]] common::CraneParameters read_crane(YamlSection& block);
+/// Reads the `site:` block (jib_height, zone_clearance, zones: name, polygon [[x, y], ...], bottom, top,
+/// enabled). Throws common::ConfigError naming the field or the zone (common::validate(Site)).
+[[nodiscard]] common::Site read_site(YamlSection& block);
 
 class ConfigDocument {
  public:

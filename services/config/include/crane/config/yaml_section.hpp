@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <set>
 #include <string>
 
@@ -27,6 +28,8 @@ class YamlSection {
   std::string text(const std::string& key, const std::set<std::string>& allowed = {});
   /// Required nested mapping.
   YamlSection child(const std::string& key);
+  /// Required sequence of [x, y] pairs of finite numbers (a polygon's vertices).
+  std::vector<std::array<double, 2>> points(const std::string& key);
   /// Required sequence of mappings.
   std::vector<YamlSection> list(const std::string& key);
   /// Throws ConfigError naming the first field that was never read (unknown field).

@@ -14,13 +14,58 @@
 // the transport. Used by crane_sim (the demo maneuvers, the mismatch sweep) and tests/closed_loop.
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "crane/plant/plant_stage.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
+#include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 
 namespace crane::stack {
+
+/// The whole stack in one thread, one cycle per step(): the composition run_in_process and the
+/// operator tests (manual mode, stops, zones) share. The plant starts at rest at the configured
+/// crane, trolley at `initial_trolley_position` [m], jib at `initial_slew_angle` [rad].
+struct InProcessOptions {
+  bool friction_compensation{true};
+  ControllerChoice controller{};
+  plant::PlantMismatch mismatch{};
+  double initial_trolley_position{0.25};  // [m]
+  double initial_slew_angle{0.0};         // [rad]
+};
+
+class InProcessStack {
+ public:
+  /// Throws common::ConfigError for invalid params.
+  InProcessStack(const StackConfig& config, const InProcessOptions& options);
+  ~InProcessStack();
+  InProcessStack(const InProcessStack&) = delete;
+  InProcessStack& operator=(const InProcessStack&) = delete;
+
+  /// One cycle k: the sensors of k through the chain (the planner with these goals, stop requests
+  /// and operator speeds, and the supervisor status of cycle k - 1), the supervisor with
+  /// `command` (nullptr: none), then the plant over [k, k+1) gated by the status of k - 1. Throws
+  /// std::runtime_error naming the cycle when the estimator or the planner refuses its input.
+  void step(std::span<const protocol::MoveRequest> goals = {}, std::span<const protocol::OperatorSpeed> speeds = {},
+            const protocol::SupervisorCommand* command = nullptr);
+
+  [[nodiscard]] std::uint64_t cycle() const noexcept;             // cycles stepped
+  [[nodiscard]] const protocol::SensorSample& sensors() const noexcept;       // of the last cycle
+  [[nodiscard]] const protocol::SensorSample& next_sensors() const noexcept;  // sampled after it
+  [[nodiscard]] const protocol::Reference& reference() const noexcept;
+  [[nodiscard]] const protocol::LinearCommand& linear() const noexcept;
+  [[nodiscard]] const protocol::ActuatorCommand& actuators() const noexcept;
+  [[nodiscard]] const protocol::SupervisorStatus& status() const noexcept;
+  [[nodiscard]] const trajectory_planner::TrajectoryPlannerStage& planner() const noexcept;
+  [[nodiscard]] const plant::PlantStage& plant() const noexcept;
+  [[nodiscard]] std::uint64_t plant_step_failures() const noexcept;
+
+ private:
+  struct Stages;
+  std::unique_ptr<Stages> stages_;
+};
 
 struct InProcessRun {
   ManeuverConfig maneuver;

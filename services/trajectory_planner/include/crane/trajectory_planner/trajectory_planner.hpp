@@ -21,7 +21,9 @@
 #include <cstdint>
 
 #include "crane/common/crane_signals.hpp"
+#include "crane/common/site.hpp"
 #include "crane/trajectory_planner/shaped_profile.hpp"
+#include "crane/trajectory_planner/speed_reference.hpp"
 #include "crane/trajectory_planner/step_profile.hpp"
 #include "crane/trajectory_planner/time_optimal_profile.hpp"
 #include "crane/trajectory_planner/trapezoid_profile.hpp"
@@ -52,6 +54,15 @@ struct TrajectoryPlannerParams {
   double gravity{9.8};                // [m/s^2] swing model, w = sqrt(gravity / cable_length)
   double swing_damping_ratio{0.0};    // [-] swing damping used by the zv/zvd/ei shapers, 0..0.3
   double ei_vibration_tolerance{0.05};  // [-] EI residual-vibration tolerance V, (0, 0.2]
+  ManualParams manual{};              // operator speed control and stops (speed_reference.hpp)
+  common::Site site{};                // the no-go zones (goals refused inside, paths planned around)
+
+  /// The bounds the speed reference keeps (the travel above).
+  [[nodiscard]] SpeedBounds speed_bounds() const noexcept {
+    return {{trolley_min_position, slew_min_angle, cable_min_length},
+            {trolley_max_position, slew_max_angle, cable_max_length},
+            gravity};
+  }
 };
 
 /// An intermediate point of a move.
@@ -86,6 +97,11 @@ enum class [[nodiscard]] GoalStatus {
   rejected_invalid_limits,        // a limit is <= 0, or an axis profile could not be planned
   rejected_unknown_profile,       // the goal's profile is not a ProfileKind (e.g. an unknown wire code)
   rejected_waypoint,              // more than kMaxWaypoints, or a waypoint non-finite or out of range
+  // Refusals of the planner stage (trajectory_planner_stage.hpp), never of start_move():
+  rejected_zone,                  // the target is in a no-go zone, or no route around the zones
+  rejected_operating_mode,        // goals are not taken in the operating mode (MANUAL, MAINTENANCE)
+  rejected_supervisor_stop,       // the supervisor reports a fault or an emergency stop
+  rejected_manual_motion,         // operator speed control is moving the crane
 };
 
 enum class MovePhase {
@@ -105,8 +121,9 @@ struct PlannerOutput {
 class TrajectoryPlanner {
  public:
   /// Throws common::ConfigError naming the field unless every bound is finite and min < max,
-  /// cable_min_length > 0, gravity > 0, 0 <= swing_damping_ratio <= 0.3 and
-  /// 0 < ei_vibration_tolerance <= 0.2.
+  /// cable_min_length > 0, gravity > 0, 0 <= swing_damping_ratio <= 0.3,
+  /// 0 < ei_vibration_tolerance <= 0.2, the manual params are valid (validate(ManualParams)) and
+  /// the site is (common::validate(Site)).
   explicit TrajectoryPlanner(const TrajectoryPlannerParams& params);
 
   /// Hold the given position (phase holding). Non-finite positions -> rejected_nonfinite.
@@ -126,7 +143,18 @@ class TrajectoryPlanner {
   /// Back to not_ready.
   void reset() noexcept;
 
+  /// The reference of the current time (as the last step() returned it), for a hand-over to the
+  /// speed reference. Precondition: a hold()/start_move() happened.
+  [[nodiscard]] common::MotionReference sample_now() const noexcept;
+
+  /// The zone (index) the move currently planned enters, sampling its reference every `spacing`
+  /// [s] from the current time, or -1 (zone_guard.hpp): each sample with the margin of the largest
+  /// horizontal acceleration of the swing period before it (the swing it excited is still there).
+  [[nodiscard]] int intruded_zone(std::uint32_t zones_enabled, double spacing) const noexcept;
+
   [[nodiscard]] const TrajectoryPlannerParams& params() const noexcept { return params_; }
+  /// Planned duration [s] of the current move (0 while holding).
+  [[nodiscard]] double move_duration() const noexcept { return move_duration_; }
 
  private:
   struct Axis {

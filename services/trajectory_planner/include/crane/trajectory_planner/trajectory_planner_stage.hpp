@@ -14,7 +14,26 @@
 //    keep the planner's defaults, unknown profile codes are rejected (the running move continues);
 //  - every request gets feedback, as a ROS 2 action does (MoveStatus, move_statuses()): waiting for
 //    its start cycle, or rejected (reason, the value and the bound it violated), then moving (at the
-//    start and every kProgressCycles), arrived, or aborted (replaced by a newer request).
+//    start and every kProgressCycles), arrived, or aborted (replaced by a newer request, stopped, the
+//    operating mode changed, a fault, a zone approach);
+//  - a stop request (MoveRequest.command COMMAND_STOP) is a controlled anti-sway stop: the running
+//    reference is handed over to the speed reference (speed_reference.hpp) with every speed 0; its
+//    feedback (RESULT_STOPPING, with the predicted stopping position) is written in the cycle the
+//    deceleration starts, before that cycle's reference; RESULT_ARRIVED when at rest. The same stop
+//    answers a change of operating mode while moving and the supervisor's zone-approach warning;
+//  - operating modes (OPC 40020) come from the supervisor's status: goals are refused in MANUAL and
+//    MAINTENANCE (REASON_MODE, value the mode), operator speeds in FULLAUTOMATIC (counted); in
+//    SEMIAUTOMATIC an operator speed takes over from a running goal (aborted: manual motion);
+//  - operator speeds (OperatorSpeed) are checked (finite, in [-1, 1], a known range; else refused
+//    and counted), scaled by the rated speeds (the micro-speed fraction, the maintenance fraction)
+//    and shaped (none in MAINTENANCE); silence for manual.dead_man_timeout releases every axis (a
+//    soft stop); after a stop the stick must come back to neutral before it moves the crane again;
+//  - when the supervisor reports a fault or an emergency stop, a running goal is aborted (fault) and
+//    goals are refused; when it lets the crane move again, the reference holds the measured
+//    position, so a reset resumes nothing;
+//  - no-go zones (zone_paths.hpp): a goal inside one is refused (REASON_ZONE, value the zone's
+//    index), others are planned around; operator speeds are held back so that the load can always
+//    come to rest outside every zone (SpeedReference).
 
 #include <array>
 #include <cstdint>
@@ -65,6 +84,15 @@ struct GoalOutcome {
 void describe_rejection(GoalStatus status, const MoveGoal& goal, const TrajectoryPlannerParams& params,
                         protocol::MoveStatus& feedback) noexcept;
 
+/// What the planner's process received for one cycle.
+struct PlannerCycle {
+  const protocol::CraneState* estimate{nullptr};      // the cycle's estimate (required)
+  std::span<const protocol::MoveRequest> goals{};     // move and stop requests since the last cycle
+  std::span<const protocol::OperatorSpeed> speeds{};  // operator speed samples since the last cycle
+  const protocol::SupervisorStatus* status{nullptr};  // the latest supervisor status (nullptr: none yet:
+                                                      // FULLAUTOMATIC, the zones enabled at start)
+};
+
 class TrajectoryPlannerStage {
  public:
   static constexpr std::size_t kMaxGoalsPerCycle = 8;  // outcomes kept per step; more are counted
@@ -77,8 +105,12 @@ class TrajectoryPlannerStage {
   /// One new cycle. not_ready: the first estimate could not be held (non-finite), nothing written.
   /// rejected_nonfinite: the estimate is not finite; nothing written, nothing taken. Otherwise ok and
   /// `reference` holds the reference of the estimate's cycle. Never throws, never allocates.
+  [[nodiscard]] common::StepStatus step(const PlannerCycle& cycle, protocol::Reference& reference) noexcept;
+  /// The same without operator speeds or supervisor status.
   [[nodiscard]] common::StepStatus step(const protocol::CraneState& estimate, std::span<const protocol::MoveRequest> goals,
-                                        protocol::Reference& reference) noexcept;
+                                        protocol::Reference& reference) noexcept {
+    return step(PlannerCycle{&estimate, goals, {}, nullptr}, reference);
+  }
 
   /// The goals handled by the last step (at most kMaxGoalsPerCycle).
   [[nodiscard]] std::span<const GoalOutcome> goal_outcomes() const noexcept { return {outcomes_.data(), outcome_count_}; }
@@ -88,12 +120,54 @@ class TrajectoryPlannerStage {
   }
   /// Goals refused for a NaN/Inf field since construction.
   [[nodiscard]] std::uint64_t nonfinite_goals() const noexcept { return nonfinite_goals_; }
+  /// Operator speed samples refused since construction: NaN/Inf, outside [-1, 1] or an unknown range
+  /// code (rejected_speeds), or arriving in FULLAUTOMATIC (speeds_outside_manual).
+  [[nodiscard]] std::uint64_t rejected_speeds() const noexcept { return rejected_speeds_; }
+  [[nodiscard]] std::uint64_t speeds_outside_manual() const noexcept { return speeds_outside_manual_; }
+  /// The operating mode the stage applies (an OPERATION_* code).
+  [[nodiscard]] std::uint8_t operating_mode() const noexcept { return operating_mode_; }
+  /// True while the speed reference (manual motion or a stop) drives the reference.
+  [[nodiscard]] bool under_speed_control() const noexcept { return source_ == Source::speed; }
+  /// The operator's speed targets of the last step [m/s, rad/s, m/s] (0 when released: dead man,
+  /// stop, neutral required, a mode without operator speeds).
+  [[nodiscard]] const std::array<double, 3>& speed_targets() const noexcept { return targets_; }
+  /// AXIS bits held back by the travel or zone bounds in the last step (manual motion).
+  [[nodiscard]] std::uint8_t held_axes() const noexcept { return held_axes_; }
 
  private:
+  enum class Source : std::uint8_t { profile, speed };
   void record(const GoalOutcome& outcome) noexcept;
-  void report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason = 0) noexcept;
+  protocol::MoveStatus* report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason = 0) noexcept;
+  void abort_active(std::uint8_t reason) noexcept;
+  /// Hands the running reference over to the speed reference with every speed 0; `stop_id` (0:
+  /// none) is the stop request answered when at rest.
+  void soft_stop(std::uint32_t stop_id) noexcept;
+  [[nodiscard]] bool moving() const noexcept;
+  void take_speeds(std::span<const protocol::OperatorSpeed> speeds, std::uint64_t seq) noexcept;
+  [[nodiscard]] std::array<double, 3> targets_of(std::uint64_t seq) const noexcept;
+  void report_rest(protocol::MoveStatus& status) const noexcept;
 
   TrajectoryPlanner planner_;
+  TrajectoryPlanner scratch_;        // routes around zones are tried here (same params, no allocation)
+  SpeedReference speed_{};
+  Source source_{Source::profile};
+  std::uint8_t operating_mode_{protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC};
+  std::uint32_t zones_enabled_{0};
+  bool supervisor_stopped_{false};   // the supervisor reports a fault or an emergency stop
+  std::uint8_t supervisor_mode_{0};  // its MODE_* code
+  bool hold_on_release_{false};      // hold the measured position when the supervisor releases the crane
+  std::uint32_t stop_id_{0};         // the stop request being executed (0: none)
+  bool require_neutral_{false};      // after a stop: operator speeds ignored until all are 0
+  std::array<double, 3> operator_speed_{};  // [-1, 1] the latest accepted operator speeds
+  bool operator_micro_{false};
+  std::uint64_t operator_seq_{0};    // cycle at which operator_speed_ arrived
+  bool have_operator_input_{false};
+  bool was_commanding_{false};       // the last cycle had a non-zero operator target
+  std::uint64_t cycles_since_manual_report_{0};
+  std::uint8_t held_axes_{0};
+  std::array<double, 3> targets_{};
+  std::uint64_t rejected_speeds_{0};
+  std::uint64_t speeds_outside_manual_{0};
   double sample_period_;
   bool holding_{false};
   std::uint32_t last_request_{0};

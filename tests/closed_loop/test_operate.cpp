@@ -1,0 +1,434 @@
+// Operating the crane without DDS (crane::stack::InProcessStack: every stage object and the plant
+// in the lockstep order): manual mode with sway control from a scripted stick, the controlled
+// anti-sway stop, the dead-man rule, the operating modes, and the no-go zones over seeded random
+// goals and manual sessions (counts: CRANE_ZONE_GOALS, CRANE_ZONE_SESSIONS).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "crane/stack/in_process_stack.hpp"
+#include "crane/stack/stack_config.hpp"
+#include "crane/trajectory_planner/zone_guard.hpp"
+#include "crane/trajectory_planner/zone_paths.hpp"
+
+namespace {
+using namespace crane;
+using Status = protocol::SupervisorStatus;
+using Feedback = protocol::MoveStatus;
+using Request = protocol::MoveRequest;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+stack::StackConfig lab() { return stack::load_stack_config(CRANE_SOURCE_DIR "/deploy/config/lab_tower_crane.yaml"); }
+
+// The lab crane's jib is 1.2 m; a full trolley stick for 3 s travels 1.5 m. These tests lengthen
+// it to 3 m (planner and supervisor travel), with the same drives, cable and load.
+stack::StackConfig long_jib(stack::StackConfig c) {
+  c.trajectory_planner.trolley_max_position = 2.8;
+  c.supervisor.trolley_max = 3.0;
+  return c;
+}
+
+protocol::SupervisorCommand set_mode(std::uint32_t id, std::uint8_t mode) {
+  protocol::SupervisorCommand c;
+  c.request_id = id;
+  c.command = protocol::SupervisorCommand::COMMAND_SET_OPERATING_MODE;
+  c.operating_mode = mode;
+  return c;
+}
+
+protocol::OperatorSpeed stick(std::uint64_t seq, double trolley, double slew, double hoist = 0.0, bool micro = false) {
+  protocol::OperatorSpeed s;
+  s.header.seq = seq;
+  s.device = protocol::OperatorSpeed::DEVICE_SCRIPT;
+  s.range = micro ? protocol::OperatorSpeed::RANGE_MICRO : protocol::OperatorSpeed::RANGE_NORMAL;
+  s.trolley = trolley;
+  s.slew = slew;
+  s.hoist = hoist;
+  return s;
+}
+
+// Largest swing angle [rad] (either plane) of the plant itself.
+double swing_of(const stack::InProcessStack& s) {
+  const auto& p = s.plant().simulator().state();
+  return std::max(std::abs(p.swing_in_plane), std::abs(p.swing_out_of_plane));
+}
+
+struct StickResult {
+  double residual_swing{0.0};   // [rad] largest swing from 2 s after the reference stops, for 4 s
+  double predicted_distance{0.0};  // [m] or [rad] published rest - measured position at the release
+  double measured_distance{0.0};   // [m] or [rad] final - measured position at the release
+  double max_swing{0.0};
+};
+
+// Cycles to rest (4 s), MANUAL, then a full stick on one axis for 3 s, released; the reference's
+// stop, 2 s, then 4 s of swing measured.
+StickResult scripted_stick(stack::StackConfig config, bool sway_control, int axis) {
+  stack::InProcessOptions options;
+  options.initial_trolley_position = axis == 0 ? 0.25 : 0.9;
+  options.initial_slew_angle = axis == 0 ? 0.0 : -1.5;
+  if (!sway_control) {
+    config.trajectory_planner.manual.shaping = trajectory_planner::SpeedShaping::none;
+    options.controller.anti_swing = anti_swing::AntiSwingLaw::none;
+  }
+  stack::InProcessStack s(config, options);
+  const auto manual = set_mode(1, Status::OPERATION_MANUAL);
+  StickResult r;
+  std::optional<double> rest;
+  double at_release = 0.0;
+  std::optional<std::uint64_t> stopped;
+  const auto measured = [&] { return axis == 0 ? s.next_sensors().trolley_position : s.next_sensors().slew_angle; };
+  for (std::uint64_t k = 0; k < 3000; ++k) {
+    const bool held = k >= 400 && k < 700;
+    const auto speed = stick(k, axis == 0 && held ? 1.0 : 0.0, axis == 1 && held ? 1.0 : 0.0);
+    s.step({}, k >= 400 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &manual : nullptr);
+    if (k == 700) at_release = axis == 0 ? s.sensors().trolley_position : s.sensors().slew_angle;
+    for (const auto& f : s.planner().move_statuses()) {
+      if (k == 700 && f.result == Feedback::RESULT_MANUAL) rest = axis == 0 ? f.rest_trolley_position : f.rest_slew_angle;
+    }
+    r.max_swing = std::max(r.max_swing, swing_of(s));
+    if (k > 700 && !stopped && !s.planner().under_speed_control()) stopped = k;
+    if (stopped && k >= *stopped + 200) r.residual_swing = std::max(r.residual_swing, swing_of(s));
+    if (stopped && k >= *stopped + 600) break;
+  }
+  EXPECT_EQ(s.status().latched_faults, 0U);
+  EXPECT_TRUE(stopped.has_value());
+  EXPECT_TRUE(rest.has_value()) << "no stopping position published at the release";
+  r.predicted_distance = rest.value_or(NAN) - at_release;
+  r.measured_distance = measured() - at_release;
+  return r;
+}
+
+TEST(ManualMode, ScriptedStickStopsWithoutSwingAndWherePredicted) {
+  const auto config = long_jib(lab());
+  for (const int axis : {0, 1}) {
+    const char* name = axis == 0 ? "trolley" : "slew";
+    const auto with = scripted_stick(config, true, axis);
+    const auto without = scripted_stick(config, false, axis);
+    std::printf("%s: full stick 3 s, released: residual swing 2 s after the stop %.3f deg with sway control (max %.1f "
+                "deg on the way), %.3f deg without (ramp only, no anti-swing law; max %.1f deg); stopping distance "
+                "published %.4f, measured %.4f (%.2f %%)\n",
+                name, with.residual_swing * kDeg, with.max_swing * kDeg, without.residual_swing * kDeg,
+                without.max_swing * kDeg, with.predicted_distance, with.measured_distance,
+                100.0 * std::abs(with.measured_distance - with.predicted_distance) / std::abs(with.predicted_distance));
+    EXPECT_LT(with.residual_swing * kDeg, 0.5) << name;
+    EXPECT_GT(without.residual_swing * kDeg, 2.0) << name << ": the figure without sway control";
+    EXPECT_NEAR(with.measured_distance, with.predicted_distance, 0.05 * std::abs(with.predicted_distance)) << name;
+  }
+}
+
+// A goal's fast move stopped half-way (deploy/crane stop): the planner publishes the stopping
+// position before it decelerates, the load comes to rest there without swing.
+TEST(SoftStop, AFastMoveStoppedHalfWayRestsWithoutSwingWherePredicted) {
+  const auto config = lab();
+  stack::InProcessOptions options;
+  stack::InProcessStack s(config, options);
+  Request goal;
+  goal.request_id = 1;
+  goal.profile = Request::PROFILE_TIME_OPTIMAL;
+  goal.axes = Request::AXIS_TROLLEY | Request::AXIS_SLEW;
+  goal.trolley_target = 1.1;
+  goal.slew_target = 1.5;
+  Request stop;
+  stop.request_id = 2;
+  stop.command = Request::COMMAND_STOP;
+  std::optional<std::array<double, 2>> predicted;
+  std::array<double, 2> at_stop{};
+  bool arrived = false, aborted = false;
+  double residual = 0.0;
+  std::optional<std::uint64_t> rest_cycle;
+  for (std::uint64_t k = 0; k < 2500; ++k) {
+    const std::span<const Request> goals = k == 300 ? std::span(&goal, 1) : k == 420 ? std::span(&stop, 1)
+                                                                                       : std::span<const Request>();
+    s.step(goals);
+    if (k == 420) at_stop = {s.sensors().trolley_position, s.sensors().slew_angle};
+    for (const auto& f : s.planner().move_statuses()) {
+      if (f.request_id == 2 && f.result == Feedback::RESULT_STOPPING) {
+        predicted = std::array<double, 2>{f.rest_trolley_position, f.rest_slew_angle};
+      }
+      if (f.request_id == 2 && f.result == Feedback::RESULT_ARRIVED) {
+        arrived = true;
+        rest_cycle = k;
+      }
+      if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED) aborted = f.reason == Feedback::REASON_STOPPED;
+    }
+    if (rest_cycle && k >= *rest_cycle + 200) residual = std::max(residual, swing_of(s));
+    if (rest_cycle && k >= *rest_cycle + 600) break;
+  }
+  ASSERT_TRUE(predicted.has_value());
+  EXPECT_TRUE(arrived);
+  EXPECT_TRUE(aborted) << "the goal is aborted with the reason stopped";
+  const std::array<double, 2> final{s.next_sensors().trolley_position, s.next_sensors().slew_angle};
+  for (int i = 0; i < 2; ++i) {
+    const double p = (*predicted)[i] - at_stop[i], m = final[i] - at_stop[i];
+    std::printf("soft stop half-way (%s): stopping distance predicted %.4f, measured %.4f (%.2f %%)\n",
+                i == 0 ? "trolley, m" : "slew, rad", p, m, 100.0 * std::abs(m - p) / std::abs(p));
+    EXPECT_NEAR(m, p, 0.05 * std::abs(p));
+  }
+  std::printf("soft stop half-way: residual swing 2 s after rest %.3f deg\n", residual * kDeg);
+  EXPECT_LT(residual * kDeg, 0.5);
+  EXPECT_EQ(s.status().latched_faults, 0U);
+}
+
+// The operator's input stops mid-jog (device unplugged, process killed): 200 ms later every axis
+// is released and the load stops softly.
+TEST(ManualMode, DeadManStopsSoftlyWhenTheInputStops) {
+  stack::InProcessStack s(long_jib(lab()), {});
+  const auto manual = set_mode(1, Status::OPERATION_MANUAL);
+  std::optional<std::uint64_t> released;
+  double residual = 0.0;
+  std::optional<std::uint64_t> stopped;
+  for (std::uint64_t k = 0; k < 2000; ++k) {
+    const auto speed = stick(k, 0.6, 0.0);
+    const bool input = k >= 400 && k < 600;  // the last sample at 599
+    s.step({}, input ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &manual : nullptr);
+    // Released: the planner's speed target drops to 0.
+    if (k >= 600 && !released && s.planner().speed_targets()[0] == 0.0) released = k;
+    if (k > 600 && !stopped && !s.planner().under_speed_control()) stopped = k;
+    if (stopped && k >= *stopped + 200) residual = std::max(residual, swing_of(s));
+    if (stopped && k >= *stopped + 600) break;
+  }
+  ASSERT_TRUE(released.has_value());
+  // Released at the first cycle more than 200 ms after the last sample.
+  EXPECT_EQ(*released, 599U + 21U);
+  ASSERT_TRUE(stopped.has_value());
+  std::printf("dead man: input lost at cycle 600, axes released at %llu, residual swing %.3f deg\n",
+              static_cast<unsigned long long>(*released), residual * kDeg);
+  EXPECT_LT(residual * kDeg, 0.5);
+}
+
+TEST(OperatingModes, GoalsAndSpeedsFollowTheModeAndAChangeWhileMovingStopsFirst) {
+  stack::InProcessStack s(long_jib(lab()), {});
+  Request goal;
+  goal.request_id = 1;
+  goal.profile = Request::PROFILE_ZV;
+  goal.axes = Request::AXIS_TROLLEY;
+  goal.trolley_target = 1.0;
+  const auto manual = set_mode(1, Status::OPERATION_MANUAL);
+  const auto automatic = set_mode(2, Status::OPERATION_FULLAUTOMATIC);
+  std::vector<Feedback> feedback;
+  const auto nan_speed = stick(0, NAN, 0.0);
+  const auto too_fast = stick(0, 1.5, 0.0);
+  const auto speed = stick(0, 0.5, 0.0);
+  for (std::uint64_t k = 0; k < 1500; ++k) {
+    std::span<const Request> goals;
+    std::span<const protocol::OperatorSpeed> speeds;
+    const protocol::SupervisorCommand* command = nullptr;
+    if (k == 50) speeds = std::span(&speed, 1);  // FULLAUTOMATIC: counted, not taken
+    if (k == 60) command = &manual;
+    if (k == 100) goals = std::span(&goal, 1);  // MANUAL: refused naming the mode
+    if (k == 110) speeds = std::span(&nan_speed, 1);
+    if (k == 111) speeds = std::span(&too_fast, 1);
+    if (k >= 200 && k < 300) speeds = std::span(&speed, 1);  // moving in MANUAL
+    if (k == 250) command = &automatic;                       // a mode change while moving: soft stop
+    s.step(goals, speeds, command);
+    for (const auto& f : s.planner().move_statuses()) feedback.push_back(f);
+  }
+  // One at cycle 50, and those after the change back to FULLAUTOMATIC (commanded at 250, applied by
+  // the planner from 251 with the status of 250): 251..299.
+  EXPECT_EQ(s.planner().speeds_outside_manual(), 1U + 49U);
+  EXPECT_EQ(s.planner().rejected_speeds(), 2U);
+  bool refused = false;
+  for (const auto& f : feedback) {
+    if (f.request_id == 1 && f.result == Feedback::RESULT_REJECTED) {
+      refused = true;
+      EXPECT_EQ(f.reason, Feedback::REASON_MODE);
+      EXPECT_EQ(f.value, Status::OPERATION_MANUAL);
+    }
+  }
+  EXPECT_TRUE(refused);
+  EXPECT_EQ(s.status().operating_mode, Status::OPERATION_FULLAUTOMATIC);
+  EXPECT_FALSE(s.planner().under_speed_control()) << "stopped and holding after the mode change";
+  EXPECT_LT(swing_of(s) * kDeg, 0.5);
+  EXPECT_EQ(s.status().latched_faults, 0U);
+}
+
+// --- No-go zones -----------------------------------------------------------------------------
+
+std::size_t count_from_env(const char* name, std::size_t fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? static_cast<std::size_t>(std::strtoul(v, nullptr, 10)) : fallback;
+}
+
+// The lab crane (jib at 2.5 m) with three zones: a tall building, a low wall the load can be
+// hoisted over, and a non-convex (L-shaped) yard.
+stack::StackConfig with_zones() {
+  auto c = lab();
+  common::Site site;
+  site.jib_height = 2.5;
+  site.zone_clearance = 0.05;
+  site.zones = {
+      {"building", {{0.5, 0.3}, {0.8, 0.3}, {0.8, 0.6}, {0.5, 0.6}}, 0.0, 10.0, true},
+      {"low wall", {{-0.2, -1.0}, {0.2, -1.0}, {0.2, -0.6}, {-0.2, -0.6}}, 0.0, 0.8, true},
+      {"yard", {{-0.7, 0.5}, {-0.4, 0.5}, {-0.4, 0.7}, {-0.55, 0.7}, {-0.55, 1.0}, {-0.7, 1.0}}, 0.0, 10.0, true},
+  };
+  common::validate(site);
+  c.facts.site = site;
+  c.trajectory_planner.site = site;
+  c.supervisor.site = site;
+  return c;
+}
+
+// The load (the plant's own state, swing included) inside an enabled zone.
+int load_zone(const stack::InProcessStack& s, const common::Site& site, std::uint32_t enabled) {
+  const auto& p = s.plant().simulator().state();
+  const auto load = common::load_position(site, p.trolley_position, p.slew_angle, p.swing_in_plane,
+                                          p.swing_out_of_plane, p.cable_length);
+  return common::intruded_zone(site, enabled, {load[0], load[1]}, load[2], 0.0);
+}
+
+TEST(Zones, SeededRandomGoalsNeverPutTheLoadInAZoneAndEveryReachableGoalIsReached) {
+  const auto config = with_zones();
+  const auto& site = config.facts.site;
+  const std::size_t goals = count_from_env("CRANE_ZONE_GOALS", 1000);
+  std::mt19937 rng(2026);
+  // Targets from 0.3 m out: a stop at the trolley's minimum (0.2 m) with a long cable overshoots
+  // into the supervisor's travel stop (up to 12 cm at L = 1.4 m; a tracking limit of its own,
+  // docs/operation.md), not a zone matter.
+  std::uniform_real_distribution<double> radius(0.3, 1.1), slew(-2.9, 2.9), cable(0.5, 1.9);
+  stack::InProcessOptions options;
+  options.initial_trolley_position = 0.3;
+  stack::InProcessStack s(config, options);
+  std::size_t inside_samples = 0, refused_in_zone = 0, refused_otherwise = 0, reached = 0, accepted = 0;
+  std::size_t no_route = 0;  // refused with the target outside every zone: no route of the planner's set
+  double worst_error = 0.0, settle_worst = 0.0;
+  std::uint64_t k = 0;
+  for (; k < 300; ++k) s.step();
+  for (std::uint32_t id = 1; id <= goals; ++id) {
+    Request goal;
+    goal.request_id = id;
+    goal.profile = (id % 2 == 0) ? Request::PROFILE_TIME_OPTIMAL : Request::PROFILE_ZV;
+    goal.axes = Request::AXIS_TROLLEY | Request::AXIS_SLEW | Request::AXIS_HOIST;
+    goal.trolley_target = radius(rng);
+    goal.slew_target = slew(rng);
+    goal.cable_length_target = cable(rng);
+    // Half the rated slew rate: at (3.55)'s 1.04 rad/s and the jib's full reach the load's
+    // centrifugal pull moves the trolley up to 20 cm off its reference, into the supervisor's
+    // travel stop (a tracking limit of its own, docs/operation.md; not a zone matter).
+    goal.slew_max_velocity = 0.5;
+    goal.slew_max_acceleration = 1.0;
+    bool done = false, ok = false, counted = false;
+    std::optional<std::uint64_t> arrived;
+    const std::uint64_t started = k;
+    for (; !done && k < started + 20000; ++k) {
+      s.step(k == started ? std::span(&goal, 1) : std::span<const Request>());
+      if (load_zone(s, site, s.status().zones_enabled) >= 0) ++inside_samples;
+      for (const auto& f : s.planner().move_statuses()) {
+        if (f.request_id != id) continue;
+        if (f.result == Feedback::RESULT_REJECTED) {
+          done = true;
+          if (f.reason == Feedback::REASON_ZONE) {
+            ++refused_in_zone;
+            // Refused only when the target is in a zone, with the clearance and the swing allowance
+            // of the slowest approach (at most 5 cm here: zone_paths.hpp).
+            auto wider = site;
+            wider.zone_clearance += 0.05;
+            common::MotionReference target;
+            target.trolley.position = goal.trolley_target;
+            target.slew.position = goal.slew_target;
+            target.cable_length.position = goal.cable_length_target;
+            if (trajectory_planner::intruded_zone(wider, 7, target, 9.8) < 0) {
+              ++no_route;
+              std::printf("no route: goal %u to (%.3f m, %.3f rad, %.3f m) from (%.3f m, %.3f rad, %.3f m), zone %g\n",
+                          id, goal.trolley_target, goal.slew_target, goal.cable_length_target,
+                          s.sensors().trolley_position, s.sensors().slew_angle, s.sensors().cable_length, f.value);
+            }
+          } else {
+            ++refused_otherwise;
+            ADD_FAILURE() << "goal " << id << " refused, reason " << int(f.reason);
+          }
+        }
+        if (f.result == Feedback::RESULT_ABORTED) {
+          done = true;
+          ADD_FAILURE() << "goal " << id << " aborted, reason " << int(f.reason);
+        }
+        if ((f.result == Feedback::RESULT_MOVING || f.result == Feedback::RESULT_ARRIVED) && !counted) {
+          ++accepted;
+          counted = true;
+        }
+        if (f.result == Feedback::RESULT_ARRIVED) arrived = k;
+      }
+      // Reached: the trolley's point within 1 cm of the target (the slew's error as an arc) and the
+      // cable within 1 cm, within 10 s of the reference's arrival.
+      if (arrived) {
+        const auto& m = s.next_sensors();
+        const double error = std::max({std::abs(m.trolley_position - goal.trolley_target),
+                                        std::abs(m.slew_angle - goal.slew_target) * m.trolley_position,
+                                        std::abs(m.cable_length - goal.cable_length_target)});
+        if (error < 0.01 || k >= *arrived + 1000) {
+          worst_error = std::max(worst_error, error);
+          settle_worst = std::max(settle_worst, static_cast<double>(k - *arrived) * 0.01);
+          ok = error < 0.01;
+          done = true;
+        }
+      }
+    }
+    if (ok) ++reached;
+    // A stopped move (zone approach) comes to rest before the next goal.
+    for (int c = 0; c < 1000 && s.planner().under_speed_control(); ++c, ++k) s.step();
+    ASSERT_TRUE(done) << "goal " << id << " neither refused nor arrived";
+    ASSERT_EQ(s.status().latched_faults, 0U)
+        << "goal " << id << " to (" << goal.trolley_target << " m, " << goal.slew_target << " rad, "
+        << goal.cable_length_target << " m): fault at x = " << s.sensors().trolley_position
+        << " m, slew = " << s.sensors().slew_angle << " rad, L = " << s.sensors().cable_length;
+  }
+  std::printf("%zu seeded random goals among 3 zones: %zu accepted, %zu reached (within 1 cm, at most %.1f s after the "
+              "reference arrived; worst final error %.1f mm), %zu refused naming a zone (%zu of them with the target outside "
+              "every zone: no route of the planner's set), %zu otherwise; %zu samples with the load in a zone (%.0f s "
+              "simulated)\n",
+              goals, accepted, reached, settle_worst, 1e3 * worst_error, refused_in_zone, no_route, refused_otherwise,
+              inside_samples, static_cast<double>(k) * 0.01);
+  EXPECT_EQ(inside_samples, 0U);
+  // Every accepted goal is reached. The goals refused with the target outside every zone are
+  // printed above: the planner's route set (zone_paths.hpp) is not complete (docs/operation.md).
+  EXPECT_EQ(reached, goals - refused_in_zone);
+  EXPECT_GT(refused_in_zone, 0U);  // the zones do cover some targets
+}
+
+TEST(Zones, SeededRandomManualSessionsNeverPutTheLoadInAZone) {
+  const auto config = with_zones();
+  const auto& site = config.facts.site;
+  const std::size_t sessions = count_from_env("CRANE_ZONE_SESSIONS", 100);
+  std::mt19937 rng(1903);
+  std::uniform_real_distribution<double> axis(-1.0, 1.0);
+  std::uniform_int_distribution<int> hold(50, 200), coin(0, 3);
+  stack::InProcessOptions options;
+  options.initial_trolley_position = 0.3;
+  stack::InProcessStack s(config, options);
+  const auto manual = set_mode(1, Status::OPERATION_MANUAL);
+  std::size_t inside_samples = 0, held_cycles = 0;
+  std::uint64_t k = 0;
+  double max_swing = 0.0;
+  for (; k < 100; ++k) s.step({}, {}, k == 10 ? &manual : nullptr);
+  for (std::size_t session = 0; session < sessions; ++session) {
+    // A session: 5 stick positions held 0.5-2 s each (a quarter of them neutral), then released.
+    for (int segment = 0; segment < 6; ++segment) {
+      const bool neutral = segment == 5 || coin(rng) == 0;
+      const auto speed = stick(0, neutral ? 0.0 : axis(rng), neutral ? 0.0 : axis(rng),
+                               neutral ? 0.0 : 0.5 * axis(rng), coin(rng) == 1);
+      const int cycles = segment == 5 ? 400 : hold(rng);
+      for (int c = 0; c < cycles; ++c, ++k) {
+        auto sample = speed;
+        sample.header.seq = k;
+        s.step({}, std::span(&sample, 1));
+        if (load_zone(s, site, s.status().zones_enabled) >= 0) ++inside_samples;
+        if (s.planner().held_axes() != 0) ++held_cycles;
+        max_swing = std::max(max_swing, swing_of(s));
+      }
+    }
+    ASSERT_EQ(s.status().latched_faults, 0U) << "session " << session;
+  }
+  std::printf("%zu seeded random manual sessions among 3 zones: %zu samples with the load in a zone, %zu cycles with "
+              "an axis held back by a zone or the travel, max swing %.1f deg (%.0f s simulated)\n",
+              sessions, inside_samples, held_cycles, max_swing * kDeg, static_cast<double>(k) * 0.01);
+  EXPECT_EQ(inside_samples, 0U);
+  EXPECT_GT(held_cycles, 0U);         // the sessions did run into the bounds
+  EXPECT_GT(max_swing * kDeg, 1.0);   // and did move the crane
+}
+
+}  // namespace
