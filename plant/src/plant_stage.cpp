@@ -1,6 +1,7 @@
 #include "crane/plant/plant_stage.hpp"
 
 #include "crane/common/validation.hpp"
+#include "crane/config/config_document.hpp"
 #include "crane/config/yaml_section.hpp"
 
 namespace crane::plant {
@@ -28,8 +29,15 @@ void validate(const PlantMismatch& m) {
 
 SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {
   SimulatorParameters p;
+  p.kind = plant_kind_from_string(
+      s.text("kind", {to_string(PlantKind::tower), to_string(PlantKind::gantry), to_string(PlantKind::overhead)}),
+      s.field("kind"));
   p.crane = facts.crane;
   p.sample_period = facts.sample_period;
+  if (p.kind == PlantKind::overhead) {  // elsewhere plant.bridge is an unknown field
+    config::YamlSection bridge = s.child("bridge");
+    p.bridge = config::read_bridge(bridge);
+  }
   p.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
   p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
   p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);

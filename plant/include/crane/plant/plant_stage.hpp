@@ -40,7 +40,8 @@ struct PlantStageParams {
   PlantMismatch mismatch{};
 };
 
-/// Reads the `plant:` block (relative_tolerance, absolute_tolerance [-] in [1e-16, 1e-3],
+/// Reads the `plant:` block (kind: tower | gantry | overhead (PlantKind), with a `bridge:` block
+/// (config::read_bridge) for the overhead crane only; relative_tolerance, absolute_tolerance [-] in [1e-16, 1e-3],
 /// brake_holding_factor [-] in [1, 1000], hoist_max_acceleration [m/s^2] in [1e-3, 100]); the
 /// crane, sample period from facts; the initial state at rest with the crane's cable length. The
 /// gate's params are read from `actuation:` by supervisor::read_actuation_params. Throws

@@ -25,6 +25,9 @@ namespace crane::config {
 
 /// Reads the `crane:` block (every field of common::CraneParameters) and validates it.
 [[nodiscard]] common::CraneParameters read_crane(YamlSection& block);
+/// Reads a bridge block (common::BridgeParameters: drive_mass, drive_gain, friction {the six
+/// volt-equivalents of the crane's frictions}) and validates it.
+[[nodiscard]] common::BridgeParameters read_bridge(YamlSection& block);
 
 class ConfigDocument {
  public:
