@@ -18,6 +18,18 @@ common::AxisFriction scaled(common::AxisFriction f, double factor) {
   return f;
 }
 
+// The stage translates the simulator to the stack's topics, which carry the trolley and one second
+// drive measured as the slew angle: an overhead crane's bridge position has no field there yet.
+const SimulatorParameters& carried_by_topics(const SimulatorParameters& p) {
+  if (p.kind == PlantKind::overhead) {
+    throw common::ConfigError(
+        "plant.kind = overhead is not supported by the stack yet: its topics (SensorSample_, ActuatorCommand_, Reference_, "
+        "MoveRequest_, ...) have no bridge axis; the overhead crane runs in the plant core only "
+        "(plant::CraneSimulator)");
+  }
+  return p;
+}
+
 }  // namespace
 
 void validate(const PlantMismatch& m) {
@@ -60,7 +72,7 @@ SimulatorParameters simulated_truth(const SimulatorParameters& configured, const
 
 PlantStage::PlantStage(const PlantStageParams& params)
     : mismatch_(params.mismatch),
-      simulator_(simulated_truth(params.simulator, params.mismatch)),
+      simulator_(simulated_truth(carried_by_topics(params.simulator), params.mismatch)),
       gate_(params.gate),
       cable_length_reading_factor_(1.0 / params.mismatch.cable_length_factor) {
   measurements_.fill(simulator_.output().measurement);  // at rest before cycle 0

@@ -52,7 +52,8 @@ class PlantStage {
  public:
   static constexpr int kMaxSensorDelay = 16;  // [cycles]
 
-  /// Throws common::ConfigError for invalid params (simulator, gate or mismatch).
+  /// Throws common::ConfigError for invalid params (simulator, gate or mismatch), and for
+  /// plant.kind = overhead (the topics have no bridge axis yet; tower and gantry run).
   explicit PlantStage(const PlantStageParams& params);
 
   /// The sensor sample of the current cycle: header.seq = cycle(), source SOURCE_PLANT; the
