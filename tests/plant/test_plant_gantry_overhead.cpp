@@ -386,6 +386,36 @@ TEST(OverheadCrane, SimulatedWithTheBridgeHeldMatchesTheSimulatedGantry) {
   EXPECT_GT(std::abs(gantry.state().trolley_position), 0.1);  // it moved
 }
 
+// A gantry has no second drive: a voltage on that channel moves nothing (the load at rest stays at
+// rest to the bit, and no friction event happens), while on the overhead crane it drives the bridge.
+TEST(GantryCrane, TheSecondDriveChannelMovesNothing) {
+  SimulatorParameters p = frictionless(PlantKind::gantry, 1.0);
+  CraneSimulator gantry(p);
+  DriveInput input;
+  input.brakes_engaged = false;
+  input.slew_voltage = 10.0;
+  for (int k = 0; k < 100; ++k) ASSERT_EQ(gantry.step(input), common::StepStatus::ok);
+  const PlantState& s = gantry.state();
+  EXPECT_EQ(s.trolley_position, 0.0);
+  EXPECT_EQ(s.swing_in_plane, 0.0);
+  EXPECT_EQ(s.slew_angle, 0.0);
+  EXPECT_EQ(s.swing_out_of_plane, 0.0);
+  EXPECT_EQ(gantry.output().measurement.slew_angle, 0.0);
+  EXPECT_EQ(gantry.friction_event_count(), 0);
+
+  p.kind = PlantKind::overhead;
+  CraneSimulator overhead(p);
+  for (int k = 0; k < 100; ++k) ASSERT_EQ(overhead.step(input), common::StepStatus::ok);
+  // Linear (2.7)-(2.8) per axis with F = M_y K_my V from rest: y(t) = a_r t^2/2 + c (1 - cos(w t))
+  // with a_r = F/(M_y + m) (load rigidly attached) and c w^2 = F/M_y - a_r > 0; since
+  // 0 <= 1 - cos(x) <= x^2/2, y lies between the rigid a_r t^2/2 and the bridge-alone F/M_y t^2/2.
+  const double rigid = 0.5 * p.bridge.drive_mass * p.bridge.drive_gain * 10.0 / (p.bridge.drive_mass + p.crane.load_mass);
+  const double free_load = 0.5 * p.bridge.drive_gain * 10.0;
+  EXPECT_GT(overhead.state().bridge_position, rigid);
+  EXPECT_LT(overhead.state().bridge_position, free_load);
+  EXPECT_EQ(overhead.state().slew_angle, 0.0);
+}
+
 void expect_config_error(const SimulatorParameters& p, const std::string& fragment) {
   try {
     CraneSimulator sim(p);

@@ -78,7 +78,8 @@ struct SimulatorParameters {
 };
 
 struct SimulatorOutput {
-  common::CraneMeasurement measurement;  // quantized sensors of the current state
+  common::CraneMeasurement measurement;  // quantized sensors of the current state (no bridge field yet:
+                                         // an overhead crane's bridge is in CraneSimulator::state() only)
   double applied_trolley_voltage{0.0};   // [V] after the DAC, last sample
   double applied_slew_voltage{0.0};      // [V] after the DAC, last sample
   double applied_hoist_speed{0.0};       // [m/s] rate-limited hoist speed at the end of the last sample
