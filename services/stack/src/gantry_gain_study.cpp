@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 #include "crane/common/validation.hpp"
 #include "crane/gain_scheduling/gain_schedule.hpp"

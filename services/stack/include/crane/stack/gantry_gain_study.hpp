@@ -13,7 +13,8 @@
 // only m_t = m/M enters (2.7)-(2.8)).
 //
 // Time is scaled by the swing period T = 2 pi sqrt(L/g) of the true cable length, as in the figures.
-// Errors: functions throw common::ConfigError (naming the field, value and bound) for invalid cases.
+// Errors: functions throw common::ConfigError (naming the field, value and bound) for invalid cases,
+// std::runtime_error naming the cycle if the plant or the controller rejects a step.
 
 #include <string>
 #include <vector>
@@ -63,7 +64,8 @@ struct GantryStepResult {
   gain_scheduling::GainSchedulingGains gains;  // the gains the controller used (design point)
 };
 
-/// Runs one case (deterministic). Throws common::ConfigError for a field out of its range.
+/// Runs one case (deterministic, allocates its record). Throws common::ConfigError for a field out
+/// of its range, std::runtime_error naming the cycle if a step fails.
 [[nodiscard]] GantryStepResult run_gantry_step(const GantryStepCase& step);
 
 /// The cases of Figure 3.7 (partial feedback, L = 1 m, m_t = 5: adapted vs gains for m_t = 0) and
