@@ -5,15 +5,23 @@
 #include <numbers>
 
 #include "crane/common/validation.hpp"
+#include "crane/plant/gantry_crane_model.hpp"
+#include "crane/plant/overhead_crane_model.hpp"
+#include "crane/plant/tower_crane_model.hpp"
 
 namespace crane::plant {
 
 namespace {
 
-ModelState to_model_state(const PlantState& s) {
+ModelState to_model_state(const PlantState& s, PlantKind kind) {
   ModelState m;
-  m.position << s.trolley_position, s.swing_in_plane, s.slew_angle, s.swing_out_of_plane;
-  m.velocity << s.trolley_velocity, s.swing_in_plane_rate, s.slew_rate, s.swing_out_of_plane_rate;
+  if (kind == PlantKind::overhead) {
+    m.position << s.trolley_position, s.swing_in_plane, s.bridge_position, s.swing_out_of_plane;
+    m.velocity << s.trolley_velocity, s.swing_in_plane_rate, s.bridge_velocity, s.swing_out_of_plane_rate;
+  } else {
+    m.position << s.trolley_position, s.swing_in_plane, s.slew_angle, s.swing_out_of_plane;
+    m.velocity << s.trolley_velocity, s.swing_in_plane_rate, s.slew_rate, s.swing_out_of_plane_rate;
+  }
   return m;
 }
 
@@ -24,13 +32,56 @@ IntegratorSettings integrator_settings(const SimulatorParameters& p) {
   return settings;
 }
 
-double trolley_force_per_volt(const common::CraneParameters& c) { return c.trolley_drive_mass * c.trolley_drive_gain; }
-double slew_torque_per_volt(const common::CraneParameters& c) { return c.jib_inertia * c.slew_drive_gain; }
+// Friction and brake of the second drive axis: the slew's (tower), the bridge's (overhead); a gantry
+// has none, its held slot gets a 1 N static friction that nothing ever loads (so it stays stuck).
+AxisFrictionModel second_axis_friction(const SimulatorParameters& p, const CraneDynamics& model) {
+  const double force_per_volt = model.drive_force_per_volt(DriveAxis::second);
+  switch (p.kind) {
+    case PlantKind::tower:
+      return AxisFrictionModel(p.crane.slew_friction, force_per_volt,
+                               p.brake_holding_factor * force_per_volt * p.crane.dac_range,
+                               "simulator.crane.slew_friction");
+    case PlantKind::overhead:
+      return AxisFrictionModel(p.bridge.friction, force_per_volt,
+                               p.brake_holding_factor * force_per_volt * p.crane.dac_range,
+                               "simulator.bridge.friction");
+    case PlantKind::gantry:
+      break;
+  }
+  return AxisFrictionModel(common::AxisFriction{0.0, 0.0, 0.0, 0.0, 1.0, 1.0}, 1.0, 0.0, "simulator.held_axis");
+}
 
 }  // namespace
 
+const char* to_string(PlantKind kind) noexcept {
+  switch (kind) {
+    case PlantKind::tower: return "tower";
+    case PlantKind::gantry: return "gantry";
+    case PlantKind::overhead: return "overhead";
+  }
+  return "tower";
+}
+
+PlantKind plant_kind_from_string(const std::string& text, const std::string& field) {
+  for (PlantKind kind : {PlantKind::tower, PlantKind::gantry, PlantKind::overhead}) {
+    if (text == to_string(kind)) return kind;
+  }
+  throw common::ConfigError(field + " = \"" + text + "\" is not a crane kind: must be one of tower, gantry, overhead");
+}
+
+std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
+                                                   const common::BridgeParameters& bridge) {
+  switch (kind) {
+    case PlantKind::gantry: return std::make_unique<GantryCraneModel>(crane);
+    case PlantKind::overhead: return std::make_unique<OverheadCraneModel>(crane, bridge);
+    case PlantKind::tower: break;
+  }
+  return std::make_unique<TowerCraneModel>(crane);
+}
+
 const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& p) {
   common::validate(p.crane, "simulator.crane");  // the cable range (the hoist's) included
+  if (p.kind == PlantKind::overhead) common::validate(p.bridge, "simulator.bridge");
   common::require_in_range("simulator.sample_period", p.sample_period, 1e-6, 1.0);
   common::require_greater("simulator.relative_tolerance", p.relative_tolerance, 0.0);
   common::require_in_range("simulator.relative_tolerance", p.relative_tolerance, 0.0, 1e-2);
@@ -43,18 +94,15 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
 
 CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
     : parameters_(validated(parameters)),
-      model_(parameters_.crane),
+      model_(make_crane_dynamics(parameters_.kind, parameters_.crane, parameters_.bridge)),
       sensors_(parameters_.crane),
-      integrator_(model_,
-                  AxisFrictionModel(parameters_.crane.trolley_friction, trolley_force_per_volt(parameters_.crane),
-                                    parameters_.brake_holding_factor * trolley_force_per_volt(parameters_.crane) *
-                                        parameters_.crane.dac_range,
+      integrator_(*model_,
+                  AxisFrictionModel(parameters_.crane.trolley_friction,
+                                    model_->drive_force_per_volt(DriveAxis::trolley),
+                                    parameters_.brake_holding_factor *
+                                        model_->drive_force_per_volt(DriveAxis::trolley) * parameters_.crane.dac_range,
                                     "simulator.crane.trolley_friction"),
-                  AxisFrictionModel(parameters_.crane.slew_friction, slew_torque_per_volt(parameters_.crane),
-                                    parameters_.brake_holding_factor * slew_torque_per_volt(parameters_.crane) *
-                                        parameters_.crane.dac_range,
-                                    "simulator.crane.slew_friction"),
-                  integrator_settings(parameters_)) {
+                  second_axis_friction(parameters_, *model_), integrator_settings(parameters_)) {
   reset(parameters_.initial_state);
 }
 
@@ -73,12 +121,30 @@ void CraneSimulator::validate_state(const PlantState& s) const {
   common::require_in_range(p + "cable_length", s.cable_length, parameters_.crane.min_cable_length,
                            parameters_.crane.max_cable_length);
   common::require_in_range(p + "cable_length_rate", s.cable_length_rate, -limit, limit);
+  common::require_in_range(p + "bridge_position", s.bridge_position, -limit, limit);
+  common::require_in_range(p + "bridge_velocity", s.bridge_velocity, -limit, limit);
+  // Coordinates the crane kind does not have must be 0 (they would be held at their value).
+  const auto require_zero = [&](const char* field, double value) {
+    common::require_in_range(p + field + " (" + to_string(parameters_.kind) + " crane)", value, 0.0, 0.0);
+  };
+  if (parameters_.kind != PlantKind::tower) {
+    require_zero("slew_angle", s.slew_angle);
+    require_zero("slew_rate", s.slew_rate);
+  }
+  if (parameters_.kind != PlantKind::overhead) {
+    require_zero("bridge_position", s.bridge_position);
+    require_zero("bridge_velocity", s.bridge_velocity);
+  }
+  if (parameters_.kind == PlantKind::gantry) {
+    require_zero("swing_out_of_plane", s.swing_out_of_plane);
+    require_zero("swing_out_of_plane_rate", s.swing_out_of_plane_rate);
+  }
 }
 
 void CraneSimulator::reset(const PlantState& state) {
   validate_state(state);
   sample_index_ = 0;
-  integrator_.reset(0.0, to_model_state(state), state.cable_length, state.cable_length_rate);
+  integrator_.reset(0.0, to_model_state(state, parameters_.kind), state.cable_length, state.cable_length_rate);
   refresh_state();
 }
 
@@ -90,11 +156,16 @@ void CraneSimulator::refresh_state() noexcept {
   const ModelState m = integrator_.state();
   state_.trolley_position = m.position[kTrolleyIndex];
   state_.swing_in_plane = m.position[kInPlaneSwingIndex];
-  state_.slew_angle = m.position[kSlewIndex];
   state_.swing_out_of_plane = m.position[kOutOfPlaneSwingIndex];
   state_.trolley_velocity = m.velocity[kTrolleyIndex];
   state_.swing_in_plane_rate = m.velocity[kInPlaneSwingIndex];
-  state_.slew_rate = m.velocity[kSlewIndex];
+  if (parameters_.kind == PlantKind::overhead) {
+    state_.bridge_position = m.position[kBridgeIndex];
+    state_.bridge_velocity = m.velocity[kBridgeIndex];
+  } else {
+    state_.slew_angle = m.position[kSlewIndex];
+    state_.slew_rate = m.velocity[kSlewIndex];
+  }
   state_.swing_out_of_plane_rate = m.velocity[kOutOfPlaneSwingIndex];
   state_.cable_length = integrator_.cable_length();
   state_.cable_length_rate = integrator_.cable_length_rate();
@@ -133,8 +204,8 @@ common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
   const double L_ddot = std::clamp((target_rate - L_dot) / T_s, -a_max, a_max);
 
   SampleInput sample;
-  sample.trolley_drive_force = applied_trolley_voltage_ * model_.trolley_force_per_volt();  // (2.26)
-  sample.slew_drive_torque = applied_slew_voltage_ * model_.slew_torque_per_volt();         // (2.27)
+  sample.trolley_drive_force = applied_trolley_voltage_ * model_->drive_force_per_volt(DriveAxis::trolley);  // (2.26)
+  sample.slew_drive_torque = applied_slew_voltage_ * model_->drive_force_per_volt(DriveAxis::second);     // (2.27)
   sample.cable_length_acceleration = L_ddot;
   sample.brakes_engaged = safe.brakes_engaged;
 
@@ -159,8 +230,8 @@ SimulatorOutput CraneSimulator::output() const noexcept {
 }
 
 double CraneSimulator::total_energy() const noexcept {
-  const ModelState m = to_model_state(state_);
-  return model_.total_energy(m, HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
+  const ModelState m = to_model_state(state_, parameters_.kind);
+  return model_->total_energy(m, HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
 }
 
 }  // namespace crane::plant

@@ -36,9 +36,9 @@ void check(int flag, const char* what) {
 
 }  // namespace
 
-CvodeIntegrator::CvodeIntegrator(const TowerCraneModel& model, const AxisFrictionModel& trolley_friction,
+CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
                                  const AxisFrictionModel& slew_friction, const IntegratorSettings& settings)
-    : model_(model), trolley_friction_(trolley_friction), slew_friction_(slew_friction), settings_(settings) {
+    : model_(model.clone()), trolley_friction_(trolley_friction), slew_friction_(slew_friction), settings_(settings) {
   common::require_greater("integrator.relative_tolerance", settings.relative_tolerance, 0.0);
   common::require_greater("integrator.absolute_tolerance", settings.absolute_tolerance, 0.0);
   common::require_at_least("integrator.max_steps_per_advance", static_cast<double>(settings.max_steps_per_advance),
@@ -55,7 +55,7 @@ CvodeIntegrator::CvodeIntegrator(const TowerCraneModel& model, const AxisFrictio
     throw std::runtime_error("CvodeIntegrator: SUNDIALS allocation failed");
   }
   N_VConst(0.0, y_);
-  NV_Ith_S(y_, kCableLengthIndex) = model_.parameters().cable_length;
+  NV_Ith_S(y_, kCableLengthIndex) = model_->parameters().cable_length;
   linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);
   try {
     if (linear_solver_ == nullptr) throw std::runtime_error("CvodeIntegrator: SUNLinSol_Dense failed");
@@ -73,7 +73,7 @@ CvodeIntegrator::CvodeIntegrator(const TowerCraneModel& model, const AxisFrictio
     throw;
   }
   ModelState rest;
-  reset(0.0, rest, model_.parameters().cable_length, 0.0);
+  reset(0.0, rest, model_->parameters().cable_length, 0.0);
 }
 
 CvodeIntegrator::~CvodeIntegrator() { release(); }
@@ -101,7 +101,7 @@ void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumF
   const HoistMotion hoist{y[kCableLengthIndex], y[kCableLengthRateIndex], input_.cable_length_acceleration};
   CoordinateMatrix mass;
   CoordinateVector bias;
-  model_.compute_dynamics(state, hoist, mass, bias);
+  model_->compute_dynamics(state, hoist, mass, bias);
 
   // Generalized forces (2.15): drives plus the sliding friction of slipping axes.
   CoordinateVector force = CoordinateVector::Zero();

@@ -1,6 +1,7 @@
 #include "crane/plant/plant_stage.hpp"
 
 #include "crane/common/validation.hpp"
+#include "crane/config/config_document.hpp"
 #include "crane/config/yaml_section.hpp"
 
 namespace crane::plant {
@@ -17,6 +18,18 @@ common::AxisFriction scaled(common::AxisFriction f, double factor) {
   return f;
 }
 
+// The stage translates the simulator to the stack's topics, which carry the trolley and one second
+// drive measured as the slew angle: an overhead crane's bridge position has no field there yet.
+const SimulatorParameters& carried_by_topics(const SimulatorParameters& p) {
+  if (p.kind == PlantKind::overhead) {
+    throw common::ConfigError(
+        "plant.kind = overhead is not supported by the stack yet: its topics (SensorSample_, ActuatorCommand_, Reference_, "
+        "MoveRequest_, ...) have no bridge axis; the overhead crane runs in the plant core only "
+        "(plant::CraneSimulator)");
+  }
+  return p;
+}
+
 }  // namespace
 
 void validate(const PlantMismatch& m) {
@@ -28,8 +41,15 @@ void validate(const PlantMismatch& m) {
 
 SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {
   SimulatorParameters p;
+  p.kind = plant_kind_from_string(
+      s.text("kind", {to_string(PlantKind::tower), to_string(PlantKind::gantry), to_string(PlantKind::overhead)}),
+      s.field("kind"));
   p.crane = facts.crane;
   p.sample_period = facts.sample_period;
+  if (p.kind == PlantKind::overhead) {  // elsewhere plant.bridge is an unknown field
+    config::YamlSection bridge = s.child("bridge");
+    p.bridge = config::read_bridge(bridge);
+  }
   p.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
   p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
   p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);
@@ -52,7 +72,7 @@ SimulatorParameters simulated_truth(const SimulatorParameters& configured, const
 
 PlantStage::PlantStage(const PlantStageParams& params)
     : mismatch_(params.mismatch),
-      simulator_(simulated_truth(params.simulator, params.mismatch)),
+      simulator_(simulated_truth(carried_by_topics(params.simulator), params.mismatch)),
       gate_(params.gate),
       cable_length_reading_factor_(1.0 / params.mismatch.cable_length_factor) {
   measurements_.fill(simulator_.output().measurement);  // at rest before cycle 0

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "cable_direction.hpp"
 #include "crane/common/validation.hpp"
 
 namespace crane::plant {
@@ -40,13 +41,13 @@ LoadKinematics load_kinematics(const ModelState& state, const HoistMotion& hoist
   const double L_d = hoist.cable_length_rate;
   const double L_dd = hoist.cable_length_acceleration;
 
-  const double sp = std::sin(phi), cp = std::cos(phi), st = std::sin(theta), ct = std::cos(theta);
-  const Vector3d u(-ct * sp, st, -ct * cp);
-  const Vector3d u_p(-ct * cp, 0.0, ct * sp);       // du/dphi
-  const Vector3d u_t(st * sp, ct, st * cp);         // du/dtheta
-  const Vector3d u_pp(ct * sp, 0.0, ct * cp);       // d2u/dphi2
-  const Vector3d u_pt(st * cp, 0.0, -st * sp);      // d2u/dphi dtheta
-  const Vector3d u_tt = -u;                          // d2u/dtheta2
+  const detail::CableDirection d = detail::cable_direction(phi, theta);
+  const Vector3d& u = d.u;
+  const Vector3d& u_p = d.u_p;    // du/dphi
+  const Vector3d& u_t = d.u_t;    // du/dtheta
+  const Vector3d& u_pp = d.u_pp;  // d2u/dphi2
+  const Vector3d& u_pt = d.u_pt;  // d2u/dphi dtheta
+  const Vector3d& u_tt = d.u_tt;  // d2u/dtheta2
   const Vector3d u_dot = u_p * phi_d + u_t * theta_d;
 
   LoadKinematics k;
@@ -107,14 +108,6 @@ void TowerCraneModel::compute_dynamics(const ModelState& state, const HoistMotio
   bias[kSlewIndex] += 2.0 * M_trolley * x * x_d * gamma_d;
 }
 
-CoordinateVector TowerCraneModel::acceleration(const ModelState& state, const HoistMotion& hoist,
-                                               const CoordinateVector& generalized_force) const noexcept {
-  CoordinateMatrix mass;
-  CoordinateVector bias;
-  compute_dynamics(state, hoist, mass, bias);
-  return mass.partialPivLu().solve(generalized_force - bias);
-}
-
 double TowerCraneModel::kinetic_energy(const ModelState& state, const HoistMotion& hoist) const noexcept {
   const LoadKinematics k = load_kinematics(state, hoist);
   const double x = state.position[kTrolleyIndex];
@@ -130,9 +123,11 @@ double TowerCraneModel::potential_energy(const ModelState& state, double cable_l
          std::cos(state.position[kOutOfPlaneSwingIndex]) * std::cos(state.position[kInPlaneSwingIndex]);
 }
 
-double TowerCraneModel::total_energy(const ModelState& state, const HoistMotion& hoist) const noexcept {
-  return kinetic_energy(state, hoist) + potential_energy(state, hoist.cable_length);
+double TowerCraneModel::drive_force_per_volt(DriveAxis axis) const noexcept {
+  return axis == DriveAxis::trolley ? trolley_force_per_volt() : slew_torque_per_volt();
 }
+
+std::unique_ptr<CraneDynamics> TowerCraneModel::clone() const { return std::make_unique<TowerCraneModel>(*this); }
 
 double TowerCraneModel::slew_momentum(const ModelState& state, const HoistMotion& hoist) const noexcept {
   const LoadKinematics k = load_kinematics(state, hoist);

@@ -13,10 +13,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
 #include "closed_loop_harness.hpp"
+#include "crane/common/validation.hpp"
+#include "crane/stack/stack_config.hpp"
 
 namespace {
 
@@ -254,3 +257,41 @@ TEST(ClosedLoopSensitivity, PrintsTrolleyStictionSlopeAndBand) {
 }
 
 }  // namespace
+
+// The stack on the gantry crane (deploy/config/gantry_crane.yaml, section 3.2.2's K_mx = 1.34 with
+// m_t = 1): every stage object unchanged, the slew laws disabled by the configuration, the plant's
+// GantryCraneModel (2.5)-(2.6) behind the same gate. The trolley maneuvers settle like the tower
+// crane's, and the slew channel stays exactly at rest.
+TEST(ClosedLoopGantry, TrolleyManeuversSettle) {
+  const auto config = crane::stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/gantry_crane.yaml");
+  ASSERT_EQ(config.plant.kind, crane::plant::PlantKind::gantry);
+  ASSERT_FALSE(config.maneuvers.empty());
+  for (const auto& maneuver : config.maneuvers) {
+    crane::stack::InProcessRun run;
+    run.maneuver = maneuver;
+    const crane::stack::InProcessResult result = crane::stack::run_in_process(config, run);
+    const auto& m = result.metrics;
+    std::printf("gantry %s: settle %.2f s (%.2f T), error %.2f mm, max swing %.2f deg, residual %.3f deg\n",
+                maneuver.name.c_str(), m.settle_time, m.settle_time / result.swing_period,
+                1e3 * m.final_position_error, m.max_swing * 180.0 / std::numbers::pi,
+                m.residual_swing * 180.0 / std::numbers::pi);
+    EXPECT_FALSE(std::isnan(m.settle_time)) << maneuver.name;
+    EXPECT_LT(m.final_position_error, 0.005) << maneuver.name;
+    EXPECT_LT(m.residual_swing, 0.5 * std::numbers::pi / 180.0) << maneuver.name;
+    EXPECT_EQ(result.plant_step_failures, 0u);
+    for (const auto& c : result.records) ASSERT_EQ(c.gamma, 0.0) << maneuver.name << " at t = " << c.t;
+  }
+}
+
+TEST(ClosedLoopOverhead, TheStackRefusesItUntilTheTopicsHaveABridge) {
+  const auto config =
+      crane::stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
+  crane::stack::InProcessRun run;
+  run.maneuver = config.maneuvers.front();
+  try {
+    (void)crane::stack::run_in_process(config, run);
+    FAIL() << "expected a ConfigError";
+  } catch (const crane::common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("plant.kind = overhead"), std::string::npos) << e.what();
+  }
+}

@@ -356,3 +356,43 @@ TEST_F(LabConfigText, SharedFactsAreCheckedWhereTheyAreRead) {
   const auto range = error_of(edit_line(text_, "crane:", "max_cable_length:", "max_cable_length: 0.1").text);
   EXPECT_TRUE(contains(range, "crane.max_cable_length = 0.1")) << range;
 }
+
+// The crane kind (plant.kind) and the gantry and overhead configurations (issue 18).
+TEST(GantryConfig, LoadsWithTheValuesOfSection322) {
+  const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/gantry_crane.yaml");
+  EXPECT_EQ(c.plant.kind, crane::plant::PlantKind::gantry);
+  EXPECT_DOUBLE_EQ(c.facts.crane.trolley_drive_gain, 1.34);  // K_mx
+  EXPECT_DOUBLE_EQ(c.facts.crane.cable_length, 1.0);         // L
+  EXPECT_GE(c.facts.crane.mass_ratio(), 0.0);                // m_t within the studied 0..5
+  EXPECT_LE(c.facts.crane.mass_ratio(), 5.0);
+  EXPECT_FALSE(c.anti_swing.anti_swing.slew_enabled);
+  for (const auto& m : c.maneuvers) EXPECT_EQ(m.slew_target, 0.0) << m.name;
+  crane::plant::CraneSimulator plant(c.plant);  // the plant accepts it
+  EXPECT_EQ(plant.model().drive_force_per_volt(crane::plant::DriveAxis::second), 0.0);
+}
+
+TEST(OverheadConfig, LoadsWithItsBridge) {
+  const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
+  EXPECT_EQ(c.plant.kind, crane::plant::PlantKind::overhead);
+  EXPECT_DOUBLE_EQ(c.plant.bridge.drive_mass, 7500.0);
+  EXPECT_DOUBLE_EQ(c.plant.bridge.friction.static_positive, 0.7);
+  crane::plant::CraneSimulator plant(c.plant);
+  EXPECT_DOUBLE_EQ(plant.model().drive_force_per_volt(crane::plant::DriveAxis::second), 7500.0 * 0.04);
+}
+
+TEST_F(LabConfigText, PlantKindIsValidatedLikeTheRest) {
+  auto message = error_of(edit_line(text_, "plant:", "kind:", "kind: gantri").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "plant.kind")) << message;
+  EXPECT_TRUE(contains(message, "gantri")) << message;
+  for (const char* allowed : {"tower", "gantry", "overhead"}) EXPECT_TRUE(contains(message, allowed)) << message;
+
+  message = error_of(edit_line(text_, "plant:", "kind:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field plant.kind")) << message;
+
+  // An overhead crane needs its bridge; a tower crane has none.
+  message = error_of(edit_line(text_, "plant:", "kind:", "kind: overhead").text);
+  EXPECT_TRUE(contains(message, "missing field plant.bridge")) << message;
+  message = error_of(edit_line(text_, "plant:", "kind:", "kind: tower\n  bridge: {drive_mass: 1.0}").text);
+  EXPECT_TRUE(contains(message, "unknown field plant.bridge")) << message;
+}

@@ -11,6 +11,7 @@
 
 #include "crane/common/validation.hpp"
 #include "crane/plant/crane_simulator.hpp"
+#include "crane/plant/tower_crane_model.hpp"
 #include "crane/plant/cvode_integrator.hpp"
 
 namespace crane::plant {

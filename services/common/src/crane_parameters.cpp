@@ -42,4 +42,11 @@ void validate(const CraneParameters& c, const char* prefix) {
   require_greater(p + ".slew_gear_ratio", c.slew_gear_ratio, 0.0);
 }
 
+void validate(const BridgeParameters& b, const char* prefix) {
+  const std::string p(prefix);
+  require_greater(p + ".drive_mass", b.drive_mass, 0.0);
+  require_greater(p + ".drive_gain", b.drive_gain, 0.0);
+  validate(b.friction, (p + ".friction").c_str());
+}
+
 }  // namespace crane::common

@@ -68,6 +68,15 @@ common::Site read_site(YamlSection& s) {
   return site;
 }
 
+common::BridgeParameters read_bridge(YamlSection& s) {
+  common::BridgeParameters b;
+  b.drive_mass = s.number("drive_mass", 1e-3, 1.0e7);
+  b.drive_gain = s.number("drive_gain", 1e-3, 1.0e3);
+  b.friction = read_friction(s.child("friction"));
+  s.finish();  // the ranges above are BridgeParameters' (common::validate checks them again in the plant)
+  return b;
+}
+
 ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
     : root_(std::move(root)), source_name_(std::move(source_name)) {
   facts_ = guarded([&] {

@@ -12,7 +12,12 @@
 //       and the speed in multiples of real time;
 //   crane_sim bench --config FILE [--cases N]
 //       speed figures measured in one run: the demo maneuvers on one core (x real time), and a
-//       sweep of N cases on 1 thread and on every core (the ratio).
+//       sweep of N cases on 1 thread and on every core (the ratio);
+//   crane_sim gantry-gains [--K K]
+//       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
+//       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
+//       settle time in swing periods, residual swing) with adapted and unadapted gains; K is the
+//       forward gain of the full-state law of Figure 3.8 (crane::stack gantry_gain_study.hpp).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -26,6 +31,7 @@
 #include <sstream>
 #include <thread>
 
+#include "crane/stack/gantry_gain_study.hpp"
 #include "crane/stack/in_process_stack.hpp"
 
 namespace {
@@ -344,6 +350,23 @@ int bench(const Selection& s, int cases) {
   return 0;
 }
 
+int gantry_gains(double full_forward_gain) {
+  std::printf("%s\n", stack::format_gain_table(stack::gains_over_cable_length({0.5, 1.0, 2.0, 3.0, 4.0, 5.0}),
+                                               "Figure 3.5: partial-state gains over the cable length, m_t = 0, K_mx = 1.34")
+                          .c_str());
+  std::printf("%s\n", stack::format_gain_table(stack::gains_over_mass_ratio({0.0, 1.0, 2.0, 3.0, 4.0, 5.0}),
+                                               "Figure 3.6: partial-state gains over the load ratio m_t, L = 1 m, K_mx = 1.34")
+                          .c_str());
+  std::vector<stack::GantryStepResult> results;
+  for (const stack::GantryStepCase& c : stack::section_322_cases(full_forward_gain)) {
+    results.push_back(stack::run_gantry_step(c));
+  }
+  std::printf("Figures 3.7 and 3.8: 1 m trolley step on the gantry crane (frictionless, 100 Hz, true state fed back),\n"
+              "full-state law with K = %g V/m; settle: |x - x_r| < 5 mm and |phi| < 0.5 deg for good\n%s",
+              full_forward_gain, stack::format_step_table(results).c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -393,8 +416,14 @@ int main(int argc, char** argv) {
   common_options(bench_cmd);
   int cases = 40;
   bench_cmd->add_option("--cases", cases, "sweep cases of the scaling figure")->check(CLI::Range(1, 100000));
+
+  auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
+  double full_forward_gain = 3.0;
+  gantry_cmd->add_option("--K", full_forward_gain, "forward gain K [V/m] of the full-state law (Figure 3.8), > 0")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
+    if (*gantry_cmd) return gantry_gains(full_forward_gain);
     if (*demo_cmd) return demo(s, out_dir);
     if (*sweep_cmd) {
       if (grid == 0 && random == 0) random = 200;

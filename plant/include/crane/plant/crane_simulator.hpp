@@ -1,36 +1,26 @@
 #pragma once
-// Simulated tower crane: the facade the plant node steps at the sample rate.
+// Simulated crane (tower, gantry or overhead, SimulatorParameters::kind): the facade the plant node
+// steps at the sample rate.
 //
 //   DriveInput (ZOH over one sample_period)
 //     -> DAC (clamp +-dac_range, dac_bits quantization; drives_and_sensors.hpp)
-//     -> drive force F_x = M_drive K_mx V_x, torque T_gamma = J_o K_mgamma V_gamma (2.26)-(2.27)
-//     -> TowerCraneModel (Lagrangian (2.11)-(2.16)) with stick-slip friction (3.1)-(3.3) and brakes
+//     -> drive forces: F_x = M_drive K_mx V_x (2.26), (2.10); second axis: T_gamma = J_o K_mgamma V_gamma
+//        (2.27) on a tower crane, F_y = M_y K_my V_y on an overhead crane's bridge, none on a gantry
+//     -> the crane's model (crane_dynamics.hpp: TowerCraneModel (2.11)-(2.16), GantryCraneModel
+//        (2.5)-(2.6), OverheadCraneModel) with stick-slip friction (3.1)-(3.3) and brakes
 //        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
-// The cable length follows the hoist speed command kinematically: the commanded speed is limited so
-// the hoist can still stop inside [crane.min_cable_length, crane.max_cable_length] at hoist_max_acceleration
-// (accounting for the distance covered during this sample), then rate limited to
-// hoist_max_acceleration (L_ddot is constant over each sample). A discrete overshoot of the length
-// limits of order hoist_max_acceleration * sample_period^2 remains possible.
-//
-// Units: SI throughout ([m], [rad], [s], [V], [m/s]).
-// Errors: the constructor and reset() throw common::ConfigError naming the field, its value and the
-// bound. step() is noexcept and allocation-free; it returns
-//   ok                  sample advanced normally,
-//   rejected_nonfinite  an input was NaN/Inf: 0 V, zero hoist speed and engaged brakes were applied
-//                       for this sample instead,
-//   not_ready           the integrator failed (counted in integrator_failure_count()); the state was
-//                       held at its value before the sample. (common::StepStatus has no better
-//                       fitting value.)
-
+// One composition for every kind: only the model and the second axis's friction differ.
 #include <cstdint>
+#include <memory>
+#include <string>
 
 #include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
 #include "crane/plant/axis_friction.hpp"
 #include "crane/plant/cvode_integrator.hpp"
 #include "crane/plant/drives_and_sensors.hpp"
-#include "crane/plant/tower_crane_model.hpp"
+#include "crane/plant/crane_dynamics.hpp"
 
 namespace crane::plant {
 
@@ -46,18 +36,38 @@ struct PlantState {
   double swing_out_of_plane_rate{0.0};   // [rad/s]
   double cable_length{1.0};              // [m] L
   double cable_length_rate{0.0};         // [m/s]
+  double bridge_position{0.0};           // [m] y, overhead crane only (0 otherwise)
+  double bridge_velocity{0.0};           // [m/s]
 };
+
+/// Which crane the plant simulates (config: plant.kind).
+enum class PlantKind {
+  tower,     // TowerCraneModel: trolley along the jib, slew, hoist, two swings (the lab crane, ch. 4)
+  gantry,    // GantryCraneModel: trolley on a rail, hoist, one swing, (2.5)-(2.6)
+  overhead,  // OverheadCraneModel: bridge and trolley at right angles, hoist, two swings
+};
+/// "tower", "gantry", "overhead".
+[[nodiscard]] const char* to_string(PlantKind kind) noexcept;
+/// Parses `text`; throws common::ConfigError naming `field`, the value and the accepted values.
+[[nodiscard]] PlantKind plant_kind_from_string(const std::string& text, const std::string& field);
+/// The model of `kind` (bridge used by the overhead crane only); throws common::ConfigError for
+/// invalid parameters.
+[[nodiscard]] std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
+                                                                 const common::BridgeParameters& bridge);
 
 /// Commands held for one sample.
 struct DriveInput {
   double trolley_voltage{0.0};  // [V] before the DAC
-  double slew_voltage{0.0};     // [V] before the DAC
+  double slew_voltage{0.0};     // [V] before the DAC: the second drive (slew; the bridge on an
+                                //     overhead crane; ignored on a gantry)
   double hoist_speed{0.0};      // [m/s] commanded dL/dt (positive lowers the load)
   bool brakes_engaged{true};    // both drive brakes
 };
 
 struct SimulatorParameters {
+  PlantKind kind{PlantKind::tower};
   common::CraneParameters crane{};
+  common::BridgeParameters bridge{};   // overhead crane only
   double sample_period{0.01};          // [s] in (0, 1]
   double relative_tolerance{1e-8};     // [-] CVODE rtol in (0, 1e-2]
   double absolute_tolerance{1e-10};    // [SI] CVODE atol in (0, 1e-2]
@@ -68,7 +78,8 @@ struct SimulatorParameters {
 };
 
 struct SimulatorOutput {
-  common::CraneMeasurement measurement;  // quantized sensors of the current state
+  common::CraneMeasurement measurement;  // quantized sensors of the current state (no bridge field yet:
+                                         // an overhead crane's bridge is in CraneSimulator::state() only)
   double applied_trolley_voltage{0.0};   // [V] after the DAC, last sample
   double applied_slew_voltage{0.0};      // [V] after the DAC, last sample
   double applied_hoist_speed{0.0};       // [m/s] rate-limited hoist speed at the end of the last sample
@@ -98,9 +109,10 @@ class CraneSimulator {
   [[nodiscard]] AxisMode axis_mode(FrictionAxis axis) const noexcept { return integrator_.mode(axis); }
 
   [[nodiscard]] const SimulatorParameters& parameters() const noexcept { return parameters_; }
-  [[nodiscard]] const TowerCraneModel& model() const noexcept { return model_; }
+  /// The crane's model (a TowerCraneModel, GantryCraneModel or OverheadCraneModel by kind).
+  [[nodiscard]] const CraneDynamics& model() const noexcept { return *model_; }
   [[nodiscard]] const DrivesAndSensors& drives_and_sensors() const noexcept { return sensors_; }
-  /// Total mechanical energy of the true state [J] (TowerCraneModel::total_energy).
+  /// Total mechanical energy of the true state [J] (CraneDynamics::total_energy).
   [[nodiscard]] double total_energy() const noexcept;
 
  private:
@@ -109,7 +121,7 @@ class CraneSimulator {
   void refresh_state() noexcept;
 
   SimulatorParameters parameters_;
-  TowerCraneModel model_;
+  std::unique_ptr<const CraneDynamics> model_;
   DrivesAndSensors sensors_;
   CvodeIntegrator integrator_;
   PlantState state_{};

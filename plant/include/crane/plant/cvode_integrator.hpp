@@ -1,10 +1,12 @@
 #pragma once
-// Hybrid integrator of the tower crane with stick-slip friction: a RAII wrapper around SUNDIALS 6.4
+// Hybrid integrator of a crane (any CraneDynamics: tower, gantry, overhead) with stick-slip friction: a RAII wrapper around SUNDIALS 6.4
 // CVODE (BDF, dense SUNMatrix + dense SUNLinearSolver, Jacobian by CVODE's difference quotients).
 //
-// State y (10): q = (x, phi, gamma, theta), q_dot, L, L_dot. Model: TowerCraneModel
-// (Lagrangian, (2.11)-(2.16)); friction: AxisFrictionModel ((3.1)-(3.3) as plant truth) on the
-// trolley (x) and slew (gamma) axes; hoist: L_ddot held constant over each advance (zero-order hold).
+// State y (10): q = (x, phi, second axis, theta), q_dot, L, L_dot. Model: a CraneDynamics
+// (crane_dynamics.hpp: TowerCraneModel (2.11)-(2.16), GantryCraneModel (2.5)-(2.6),
+// OverheadCraneModel); friction: AxisFrictionModel ((3.1)-(3.3) as plant truth) on the trolley (x)
+// and the second drive axis (slew gamma, or the overhead crane's bridge y; the gantry's is held);
+// hoist: L_ddot held constant over each advance (zero-order hold).
 //
 // Friction switching is an explicit hybrid automaton per axis, never a smoothed sign() or a tiny
 // fixed step:
@@ -31,12 +33,13 @@
 #include <sundials/sundials_nvector.h>
 
 #include "crane/plant/axis_friction.hpp"
-#include "crane/plant/tower_crane_model.hpp"
+#include "crane/plant/crane_dynamics.hpp"
 
 namespace crane::plant {
 
-/// The two axes with friction and brakes.
-enum class FrictionAxis : int { trolley = 0, slew = 1 };
+/// The two axes with friction and brakes: the trolley and the second axis (slew on a tower crane,
+/// bridge on an overhead crane).
+enum class FrictionAxis : int { trolley = 0, slew = 1, bridge = 1 };
 inline constexpr int kNumFrictionAxes = 2;
 
 enum class AxisMode : int { slipping_positive, slipping_negative, stuck };
@@ -44,7 +47,8 @@ enum class AxisMode : int { slipping_positive, slipping_negative, stuck };
 /// Inputs held constant (zero-order hold) over one advance.
 struct SampleInput {
   double trolley_drive_force{0.0};        // [N] F_x from the drive (friction excluded)
-  double slew_drive_torque{0.0};          // [N m] T_gamma from the drive (friction excluded)
+  double slew_drive_torque{0.0};          // [N m] T_gamma from the drive (friction excluded); the
+                                          // bridge drive force [N] on an overhead crane
   double cable_length_acceleration{0.0};  // [m/s^2] L_ddot
   bool brakes_engaged{false};             // both drive brakes
   bool operator==(const SampleInput&) const = default;
@@ -73,9 +77,9 @@ struct FrictionEvent {
 
 class CvodeIntegrator {
  public:
-  /// Copies the model and frictions. Throws common::ConfigError for invalid settings (field names
+  /// Copies the model (CraneDynamics::clone) and frictions. Throws common::ConfigError for invalid settings (field names
   /// prefixed "integrator."), std::runtime_error if SUNDIALS fails to allocate.
-  CvodeIntegrator(const TowerCraneModel& model, const AxisFrictionModel& trolley_friction,
+  CvodeIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
                   const AxisFrictionModel& slew_friction, const IntegratorSettings& settings);
   ~CvodeIntegrator();
   CvodeIntegrator(const CvodeIntegrator&) = delete;
@@ -120,7 +124,7 @@ class CvodeIntegrator {
   void set_mode(int axis, AxisMode mode) noexcept;
   const AxisFrictionModel& friction(int axis) const noexcept { return axis == 0 ? trolley_friction_ : slew_friction_; }
 
-  TowerCraneModel model_;
+  std::unique_ptr<const CraneDynamics> model_;
   AxisFrictionModel trolley_friction_;
   AxisFrictionModel slew_friction_;
   IntegratorSettings settings_;

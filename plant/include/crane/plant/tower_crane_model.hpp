@@ -41,33 +41,9 @@
 #include <Eigen/Core>
 
 #include "crane/common/crane_parameters.hpp"
+#include "crane/plant/crane_dynamics.hpp"
 
 namespace crane::plant {
-
-/// Index of each generalized coordinate in q.
-enum CoordinateIndex : int {
-  kTrolleyIndex = 0,         // x [m]
-  kInPlaneSwingIndex = 1,    // phi [rad]
-  kSlewIndex = 2,            // gamma [rad]
-  kOutOfPlaneSwingIndex = 3, // theta [rad]
-};
-inline constexpr int kNumCoordinates = 4;
-
-using CoordinateVector = Eigen::Matrix<double, kNumCoordinates, 1>;
-using CoordinateMatrix = Eigen::Matrix<double, kNumCoordinates, kNumCoordinates>;
-
-/// Generalized positions and velocities.
-struct ModelState {
-  CoordinateVector position{CoordinateVector::Zero()};  // q = (x, phi, gamma, theta) [m, rad, rad, rad]
-  CoordinateVector velocity{CoordinateVector::Zero()};  // q_dot [m/s, rad/s, rad/s, rad/s]
-};
-
-/// Prescribed hoist motion at one instant.
-struct HoistMotion {
-  double cable_length{1.0};               // [m] L > 0
-  double cable_length_rate{0.0};          // [m/s] L_dot
-  double cable_length_acceleration{0.0};  // [m/s^2] L_ddot
-};
 
 /// Linearization about rest (q = (x0, 0, gamma0, 0), q_dot = 0, L_dot = L_ddot = 0):
 ///   mass * q_ddot + stiffness * q_deviation = input * (V_x, V_gamma)
@@ -80,25 +56,21 @@ struct LinearizedModel {
   // input columns: trolley voltage [V] -> force M_drive*K_mx [N/V]; slew voltage -> J_o*K_mgamma [N m/V]
 };
 
-class TowerCraneModel {
+class TowerCraneModel final : public CraneDynamics {
  public:
   /// Validates `parameters` (common::validate, plus load_mass >= 0); throws common::ConfigError.
   explicit TowerCraneModel(const common::CraneParameters& parameters);
 
   /// Mass matrix M(q, L) and bias b(q, q_dot, L, L_dot, L_ddot) with M q_ddot + b = Q.
   void compute_dynamics(const ModelState& state, const HoistMotion& hoist, CoordinateMatrix& mass_matrix,
-                        CoordinateVector& bias) const noexcept;
-
-  /// Unconstrained accelerations q_ddot for generalized forces Q = (F_x [N], 0, T_gamma [N m], 0).
-  [[nodiscard]] CoordinateVector acceleration(const ModelState& state, const HoistMotion& hoist,
-                                              const CoordinateVector& generalized_force) const noexcept;
+                        CoordinateVector& bias) const noexcept override;
+  // acceleration() (Q = (F_x [N], 0, T_gamma [N m], 0)) and total_energy() come from CraneDynamics.
+  [[nodiscard]] std::unique_ptr<CraneDynamics> clone() const override;
 
   /// Kinetic energy T [J] (uses L and L_dot; L_ddot is ignored).
-  [[nodiscard]] double kinetic_energy(const ModelState& state, const HoistMotion& hoist) const noexcept;
+  [[nodiscard]] double kinetic_energy(const ModelState& state, const HoistMotion& hoist) const noexcept override;
   /// Potential energy V = -m g L cos(theta) cos(phi) [J] (2.14).
-  [[nodiscard]] double potential_energy(const ModelState& state, double cable_length) const noexcept;
-  /// T + V [J]. Conserved when Q = 0 and L is constant.
-  [[nodiscard]] double total_energy(const ModelState& state, const HoistMotion& hoist) const noexcept;
+  [[nodiscard]] double potential_energy(const ModelState& state, double cable_length) const noexcept override;
 
   /// Generalized momentum of the slew coordinate dT/d(gamma_dot) [kg m^2/s]; conserved when T_gamma = 0
   /// (gamma is cyclic).
@@ -111,7 +83,9 @@ class TowerCraneModel {
   /// `cable_length` [m] (> 0). Allocation-free.
   [[nodiscard]] LinearizedModel linearize_at_rest(double trolley_position, double cable_length) const noexcept;
 
-  [[nodiscard]] const common::CraneParameters& parameters() const noexcept { return parameters_; }
+  [[nodiscard]] const common::CraneParameters& parameters() const noexcept override { return parameters_; }
+  /// trolley: trolley_force_per_volt(); second (the slew): slew_torque_per_volt().
+  [[nodiscard]] double drive_force_per_volt(DriveAxis axis) const noexcept override;
   /// Drive force per volt M_drive*K_mx [N/V].
   [[nodiscard]] double trolley_force_per_volt() const noexcept;
   /// Drive torque per volt J_o*K_mgamma [N m/V].

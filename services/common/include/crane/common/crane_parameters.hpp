@@ -1,5 +1,6 @@
 #pragma once
-// Physical parameters of a tower crane (a gantry crane is the same with the slew locked).
+// Physical parameters of a tower crane (a gantry crane is the same with the slew locked), and the
+// bridge of an overhead crane.
 //
 // Source: H. M. Omar, "Control of Gantry and Tower Cranes", Virginia Tech 2003, section 4.2 and
 // (3.53). Defaults are the dissertation's lab tower crane. All values SI unless the name says
@@ -53,9 +54,20 @@ struct CraneParameters {
   [[nodiscard]] double trolley_inertia_ratio() const { return trolley_mass / jib_inertia; }
 };
 
+/// The bridge of an overhead (bridge) crane: the second horizontal drive axis, at right angles to
+/// the trolley's (plant/include/crane/plant/overhead_crane_model.hpp). The trolley rides on the
+/// bridge girder; the bridge drive moves girder, end trucks and trolley together.
+struct BridgeParameters {
+  double drive_mass{60.0};   // [kg] M_y: mass seen by the bridge drive (girder, end trucks, trolley,
+                             // reflected drive inertia); > 0
+  double drive_gain{2.0};    // [m/s^2/V] K_my: bridge acceleration per volt on mass M_y; > 0
+  AxisFriction friction{};   // volt-equivalents as for the trolley ((3.1)-(3.3) with K_my)
+};
+
 /// Throws crane::common::ConfigError naming the field (prefixed by `prefix`), value and bound
 /// if any parameter is non-finite or out of its physical range.
 void validate(const CraneParameters& parameters, const char* prefix = "crane");
+void validate(const BridgeParameters& bridge, const char* prefix);
 void validate(const AxisFriction& friction, const char* prefix);
 
 }  // namespace crane::common

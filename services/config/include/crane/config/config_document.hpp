@@ -28,6 +28,9 @@ namespace crane::config {
 /// Reads the `site:` block (jib_height, zone_clearance, zones: name, polygon [[x, y], ...], bottom, top,
 /// enabled). Throws common::ConfigError naming the field or the zone (common::validate(Site)).
 [[nodiscard]] common::Site read_site(YamlSection& block);
+/// Reads a bridge block (common::BridgeParameters: drive_mass, drive_gain, friction {the six
+/// volt-equivalents of the crane's frictions}) and validates it.
+[[nodiscard]] common::BridgeParameters read_bridge(YamlSection& block);
 
 class ConfigDocument {
  public:

@@ -1,0 +1,93 @@
+#pragma once
+// The rigid-body model interface the plant integrates: one per crane kind (tower, gantry, overhead),
+// all in the same four-slot coordinate layout so that one integrator (cvode_integrator.hpp), one
+// friction model per drive axis (axis_friction.hpp) and one drives-and-sensors model serve them all.
+//
+// Coordinates q (SI), by slot:
+//   0  x      [m]   trolley position (along the jib, the gantry rail or the bridge girder)
+//   1  phi    [rad] swing in the trolley's plane of motion (tower convention, ERRATA: the load sits at
+//                   x - L cos(theta) sin(phi) along the trolley axis)
+//   2  second drive axis: slew angle gamma [rad] (tower), bridge position y [m] (overhead), held at 0
+//                   (gantry: no second axis)
+//   3  theta  [rad] swing out of that plane
+// The cable length L [m] is a prescribed kinematic input (L, L_dot, L_ddot) from the hoist.
+//
+// Equations of motion in mass-matrix form  M(q, L) q_ddot + b(q, q_dot, L, L_dot, L_ddot) = Q,
+// with generalized forces Q = (F_trolley, 0, F_second_axis, 0) [N, -, N or N m, -]. The rows of the
+// two drive axes are forces [N] (torques [N m] for the slew); the integrator reads the force that
+// holds a stuck axis from them. The swing rows may be scaled freely (each model documents its own).
+//
+// Errors: implementations validate their parameters in their constructors (common::ConfigError);
+// evaluation functions are noexcept, allocation-free, and assume finite inputs with L > 0 and
+// |theta| < pi/2.
+
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "crane/common/crane_parameters.hpp"
+
+namespace crane::plant {
+
+/// Index of each generalized coordinate in q.
+enum CoordinateIndex : int {
+  kTrolleyIndex = 0,          // x [m]
+  kInPlaneSwingIndex = 1,     // phi [rad]
+  kSlewIndex = 2,             // gamma [rad] (tower crane)
+  kBridgeIndex = 2,           // y [m] (overhead crane): the same slot as the slew
+  kOutOfPlaneSwingIndex = 3,  // theta [rad]
+};
+inline constexpr int kNumCoordinates = 4;
+
+using CoordinateVector = Eigen::Matrix<double, kNumCoordinates, 1>;
+using CoordinateMatrix = Eigen::Matrix<double, kNumCoordinates, kNumCoordinates>;
+
+/// Generalized positions and velocities.
+struct ModelState {
+  CoordinateVector position{CoordinateVector::Zero()};  // q [m, rad, rad or m, rad]
+  CoordinateVector velocity{CoordinateVector::Zero()};  // q_dot [m/s, rad/s, rad/s or m/s, rad/s]
+};
+
+/// Prescribed hoist motion at one instant.
+struct HoistMotion {
+  double cable_length{1.0};               // [m] L > 0
+  double cable_length_rate{0.0};          // [m/s] L_dot
+  double cable_length_acceleration{0.0};  // [m/s^2] L_ddot
+};
+
+/// The two drive axes with friction and brakes (slot 0 and slot 2 of q).
+enum class DriveAxis : int { trolley = 0, second = 1 };
+
+class CraneDynamics {
+ public:
+  virtual ~CraneDynamics() = default;
+  /// A copy of the same model (the integrator keeps its own).
+  [[nodiscard]] virtual std::unique_ptr<CraneDynamics> clone() const = 0;
+
+  /// Mass matrix M(q, L) and bias b(q, q_dot, L, L_dot, L_ddot) with M q_ddot + b = Q.
+  virtual void compute_dynamics(const ModelState& state, const HoistMotion& hoist, CoordinateMatrix& mass_matrix,
+                                CoordinateVector& bias) const noexcept = 0;
+  /// Kinetic energy T [J] (uses L and L_dot; L_ddot is ignored).
+  [[nodiscard]] virtual double kinetic_energy(const ModelState& state, const HoistMotion& hoist) const noexcept = 0;
+  /// Potential energy V = -m g L cos(theta) cos(phi) [J].
+  [[nodiscard]] virtual double potential_energy(const ModelState& state, double cable_length) const noexcept = 0;
+  /// Drive force [N] (torque [N m] for the slew) per volt of `axis`; 0 for an axis the crane lacks.
+  [[nodiscard]] virtual double drive_force_per_volt(DriveAxis axis) const noexcept = 0;
+  /// Load, trolley, hoist, drive and sensor parameters shared by every kind.
+  [[nodiscard]] virtual const common::CraneParameters& parameters() const noexcept = 0;
+
+  /// Unconstrained accelerations q_ddot for generalized forces Q (units of the rows).
+  [[nodiscard]] CoordinateVector acceleration(const ModelState& state, const HoistMotion& hoist,
+                                              const CoordinateVector& generalized_force) const noexcept;
+  /// T + V [J]. Conserved when Q = 0 and L is constant.
+  [[nodiscard]] double total_energy(const ModelState& state, const HoistMotion& hoist) const noexcept {
+    return kinetic_energy(state, hoist) + potential_energy(state, hoist.cable_length);
+  }
+
+ protected:
+  CraneDynamics() = default;
+  CraneDynamics(const CraneDynamics&) = default;
+  CraneDynamics& operator=(const CraneDynamics&) = default;
+};
+
+}  // namespace crane::plant
