@@ -10,6 +10,10 @@ writes what repeats them:
                                            visit_fields() (names and values, for echo and records)
   gen_protocol.py IDL --dds OUT.hpp        to_dds() / from_dds() between those structs and the
                                            fastddsgen classes (the DDS transport's types)
+  gen_protocol.py IDL --schema OUT.hpp     crane::protocol::kIdlSchema: the IDL's text as a string
+                                           constant (a Foxglove channel's omgidl schema), its hex
+                                           literals written in decimal (Foxglove's omgidl parser
+                                           reads no hex); the text is otherwise unchanged
   gen_protocol.py IDL --msg-dir DIR        the ROS 2 interface files DIR/<Name>.msg (rosidl's .msg
                                            syntax, constants and the IDL's comments included)
   gen_protocol.py IDL --ros2-package DIR --package-files SRC
@@ -23,6 +27,7 @@ Exit 1 with a message on an IDL construct the parser (idl_structs.py) does not k
 """
 import argparse
 import pathlib
+import re
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
@@ -254,6 +259,19 @@ def ros2_package(structs, constants, idl_name, out_dir, package_files):
                      f"set(CRANE_MSG_FILES\n{listing})\n")
 
 
+def schema(idl_text, idl_name):
+    """The IDL as a C++ string constant, for channels whose schema encoding is omgidl."""
+    text = re.sub(r"\b0[xX]([0-9a-fA-F]+)\b", lambda m: str(int(m.group(1), 16)), idl_text)
+    delimiter = "crane_idl"
+    if ")" + delimiter + '"' in text:
+        raise SystemExit(f"{idl_name}: contains the raw-string delimiter ){delimiter}\"")
+    return (HEADER.format(idl=idl_name) + "#pragma once\n#include <string_view>\n\nnamespace crane::protocol {\n\n"
+            f"/// {idl_name}, every message type of the bus in OMG IDL (schema encoding \"omgidl\"), hex\n"
+            "/// literals in decimal. Root type names are the DDS type names (crane_msgs::msg::dds_::<Name>_).\n"
+            f'inline constexpr std::string_view kIdlSchema = R"{delimiter}({text}){delimiter}";\n\n'
+            "}  // namespace crane::protocol\n")
+
+
 def write_if_changed(target, text):
     target = pathlib.Path(target)
     if not target.exists() or target.read_text() != text:  # unchanged output: no rebuild
@@ -267,6 +285,7 @@ def main():
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--messages", metavar="OUT.hpp")
     what.add_argument("--dds", metavar="OUT.hpp")
+    what.add_argument("--schema", metavar="OUT.hpp")
     what.add_argument("--msg-dir", metavar="DIR")
     what.add_argument("--ros2-package", metavar="DIR")
     parser.add_argument("--package-files", metavar="SRC", help="with --ros2-package: package.xml, "
@@ -280,6 +299,8 @@ def main():
         write_if_changed(args.messages, messages(structs, constants, idl.name))
     elif args.dds:
         write_if_changed(args.dds, dds(structs, idl.name))
+    elif args.schema:
+        write_if_changed(args.schema, schema(idl.read_text(), idl.name))
     elif args.msg_dir:
         for name, text in msg_files(structs, constants, idl.name).items():
             write_if_changed(pathlib.Path(args.msg_dir) / name, text)

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# crane_web seen by an independent Foxglove client (issue 16): the simulated stack (crane_launch
+# --sim, realtime), crane_web, crane_topic record and tests/web/foxglove_client.js (Foxglove's own
+# npm packages) in one private network namespace. The client lists the channels (>= 10), receives
+# rt/crane/hw/sensors for 5 s (100 +- 5 Hz by arrival time), decodes every sample of every channel
+# with the advertised IDL schema, and the decoded values equal crane_topic record's (1e-9).
+#
+#   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
+#
+# NPM_DIR holds the npm packages (installed on the first run, reused offline afterwards). Exit 77
+# (ctest: skipped) when they are not there and the npm registry cannot be reached.
+set -euo pipefail
+BIN=$1 CONFIG=$2 NPM_DIR=$3 OUT=$4
+HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+PACKAGES=(@foxglove/ws-protocol@0.8.0 @foxglove/omgidl-parser@1.1.0 @foxglove/omgidl-serialization@1.0.3 ws@8.18.0
+          @mcap/core@2.2.2)
+
+# 1. The client's packages, outside the namespace (the registry is on the network).
+if [ -z "${CRANE_WEB_TEST_IN_NAMESPACE:-}" ]; then
+  stamp="$NPM_DIR/installed-$(printf '%s\n' "${PACKAGES[@]}" | md5sum | cut -c1-12)"
+  if [ ! -f "$stamp" ]; then
+    command -v npm >/dev/null || { echo "SKIP: npm is not installed (Debian: npm)"; exit 77; }
+    if ! timeout 30 npm view @foxglove/ws-protocol version >/dev/null 2>&1; then
+      echo "SKIP: the npm registry is not reachable and $NPM_DIR has no cached client packages"
+      exit 77
+    fi
+    mkdir -p "$NPM_DIR"
+    [ -f "$NPM_DIR/package.json" ] || echo '{"name":"crane-web-test-client","private":true}' > "$NPM_DIR/package.json"
+    (cd "$NPM_DIR" && timeout 300 npm install --no-audit --no-fund --loglevel=error "${PACKAGES[@]}")
+    touch "$stamp"
+  fi
+  # 2. Everything else in a private network namespace when the system allows one.
+  if unshare --net true 2>/dev/null; then
+    exec unshare --net env CRANE_WEB_TEST_IN_NAMESPACE=1 bash -c \
+      'ip link set lo up && ip link set lo multicast on && exec bash "$0" "$@"' "${BASH_SOURCE[0]}" "$@"
+  fi
+  echo "no private network namespace here: every participant stays on loopback"
+fi
+export NODE_PATH="$NPM_DIR/node_modules"
+
+rm -rf "$OUT" && mkdir -p "$OUT/logs"
+DOMAIN=47
+pids=()
+cleanup() {
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill -TERM "${pids[i]}" 2>/dev/null || true; done
+  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+
+"$BIN/crane_launch" --config "$CONFIG" --sim --domain "$DOMAIN" --log-dir "$OUT/logs" > "$OUT/launch.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 600); do grep -q "all stages matched and alive" "$OUT/launch.log" && break; sleep 0.1; done
+grep -q "all stages matched and alive" "$OUT/launch.log" || { echo "stack not ready:"; cat "$OUT/launch.log"; exit 1; }
+
+"$BIN/crane_web" --port 0 --domain "$DOMAIN" > "$OUT/web.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do grep -q "ws://" "$OUT/web.log" && break; sleep 0.1; done
+URL=$(grep -o "ws://[0-9.]*:[0-9]*" "$OUT/web.log" || true)
+[ -n "$URL" ] || { echo "crane_web did not start:"; cat "$OUT/web.log"; exit 1; }
+echo "crane_web at $URL"
+
+# The recorder starts first and ends after the client, so every decoded sample has its twin.
+"$BIN/crane_topic" record --out "$OUT/run.csv" --duration 9 --domain "$DOMAIN" > "$OUT/record.log" 2>&1 &
+record_pid=$!
+pids+=($record_pid)
+sleep 1
+status=0
+node "$HERE/foxglove_client.js" live "$URL" "$OUT/decoded.jsonl" 5 10 | tee "$OUT/live.json" || status=1
+wait "$record_pid" || { echo "crane_topic record failed:"; cat "$OUT/record.log"; exit 1; }
+node "$HERE/foxglove_client.js" compare "$OUT/decoded.jsonl" "$OUT/run.csv.samples.jsonl" | tee "$OUT/compare.json" || status=1
+rate=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1])).sensor_rate_hz)' "$OUT/live.json")
+echo "[ figure ] rt/crane/hw/sensors through crane_web: $rate Hz over 5 s (required 100 +- 5)"
+node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$rate" || { echo "rate $rate Hz outside 100 +- 5"; status=1; }
+exit $status
