@@ -14,6 +14,12 @@
 //       matches each decoded sample with crane_topic record's sample of the same topic, header.seq
 //       and header.stamp, compares every field (numbers within 1e-9), prints a JSON summary and
 //       exits 1 on a difference or when a decoded rt/crane/hw/sensors sample has no recorded twin.
+//   node foxglove_client.js abuse URL SECONDS
+//       bad input while a well-behaved client takes rt/crane/hw/sensors: malformed JSON, an unknown
+//       channel id, a binary frame, a 200 KiB frame, a handshake without the subprotocol, and a
+//       client subscribed to everything that never reads; checks each answer (error status, close
+//       1009, HTTP 400), that the good client still gets 100 +- 5 Hz, and that /metrics counted it
+//       all (refusals, dropped samples, samples received, rates, supervisor mode, plant cycles).
 "use strict";
 const fs = require("fs");
 const WebSocket = require("ws");
@@ -188,9 +194,142 @@ function compare(decodedPath, recordedPath) {
   process.exit(ok ? 0 : 1);
 }
 
+// ---- bad input and /metrics ----------------------------------------------------------------
+
+// GET http://HOST:PORT/metrics -> Map "name{labels}" -> value (Prometheus text format).
+function scrape(url) {
+  const http = require("http");
+  return new Promise((resolve, reject) => {
+    http.get(url.replace(/^ws:/, "http:") + "/metrics", (res) => {
+      let body = "";
+      res.on("data", (d) => (body += d));
+      res.on("end", () => {
+        if (res.statusCode !== 200) return reject(new Error(`/metrics: HTTP ${res.statusCode}`));
+        if (!/text\/plain; version=0\.0\.4/.test(res.headers["content-type"])) {
+          return reject(new Error(`/metrics: content type ${res.headers["content-type"]}`));
+        }
+        const values = new Map();
+        for (const line of body.split("\n")) {
+          if (!line || line.startsWith("#")) continue;
+          const cut = line.lastIndexOf(" ");
+          values.set(line.slice(0, cut), Number(line.slice(cut + 1)));
+        }
+        resolve(values);
+      });
+    }).on("error", reject);
+  });
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// A raw ws client of the protocol; resolves with it once open. statuses/close are recorded.
+function rawClient(url, protocols = [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) {
+  const ws = new WebSocket(url, protocols);
+  const state = { ws, statuses: [], advertised: [], closeCode: null, binaryFrames: 0, refused: null };
+  ws.on("message", (data, isBinary) => {
+    if (isBinary) return void (state.binaryFrames += 1);
+    const m = JSON.parse(data.toString());
+    if (m.op === "status") state.statuses.push(m);
+    if (m.op === "advertise") state.advertised.push(...m.channels);
+  });
+  ws.on("close", (code) => (state.closeCode = code));
+  ws.on("unexpected-response", (req, res) => (state.refused = res.statusCode));
+  ws.on("error", () => {});
+  return new Promise((resolve) => {
+    ws.on("open", () => resolve(state));
+    ws.on("unexpected-response", () => resolve(state));
+  });
+}
+
+async function abuse(url, seconds) {
+  const before = await scrape(url);
+  const problems = [];
+  // A client subscribed to every channel that never reads (stalled_client.py: its receive buffer
+  // is fixed small, so the server's queue for it fills within seconds).
+  const { spawn } = require("child_process");
+  const [host, port] = url.replace(/^ws:\/\//, "").split(":");
+  const stalled = spawn("python3", [require("path").join(__dirname, "stalled_client.py"), host, port, String(seconds + 5)],
+                        { stdio: ["ignore", "pipe", "inherit"] });
+  const stalledChannels = await new Promise((resolve) => stalled.stdout.once("data", (d) => resolve(Number(d))));
+
+  // A well-behaved client on rt/crane/hw/sensors through all of it.
+  const good = await rawClient(url);
+  await sleep(300);
+  const sensors = good.advertised.find((c) => c.topic === SENSORS);
+  good.ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: sensors.id }] }));
+  // The offenders.
+  const malformed = await rawClient(url);
+  malformed.ws.send("{not json");
+  const unknown = await rawClient(url);
+  unknown.ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: 1, channelId: 99999 }] }));
+  const binary = await rawClient(url);
+  binary.ws.send(Buffer.from(Array.from({ length: 200 }, (_, i) => (i * 37 + 11) & 0xff)));
+  const oversized = await rawClient(url);
+  oversized.ws.send("x".repeat(200 * 1024));
+  const wrongProtocol = await rawClient(url, ["not.foxglove"]);
+  const start = good.binaryFrames;
+  const t0 = Date.now();
+  await sleep(seconds * 1000);
+  const goodRate = ((good.binaryFrames - start) * 1000) / (Date.now() - t0);
+  const after = await scrape(url);
+  const delta = (k) => (after.get(k) || 0) - (before.get(k) || 0);
+  const summary = {
+    good_client_sensor_rate_hz: goodRate,
+    malformed_status: malformed.statuses.map((s) => s.message),
+    unknown_channel_status: unknown.statuses.map((s) => s.message),
+    binary_status: binary.statuses.map((s) => s.message),
+    oversized_close_code: oversized.closeCode,
+    wrong_protocol_http_status: wrongProtocol.refused,
+    metrics_delta: {
+      refused_request: delta('crane_web_requests_refused_total{kind="request"}'),
+      refused_binary: delta('crane_web_requests_refused_total{kind="binary"}'),
+      refused_handshake: delta('crane_web_requests_refused_total{kind="handshake"}'),
+      refused_oversized: delta('crane_web_requests_refused_total{kind="oversized"}'),
+      samples_dropped: delta("crane_web_samples_dropped_total"),
+      sensors_received: delta(`crane_topic_samples_received_total{topic="${SENSORS}"}`),
+    },
+    metrics_after: {
+      clients: after.get("crane_web_clients"),
+      sensor_rate_hz: after.get(`crane_topic_rate_hz{topic="${SENSORS}"}`),
+      supervisor_mode: [...after].filter(([k, v]) => k.startsWith("crane_supervisor_mode{") && v === 1).map(([k]) => k),
+      plant_cycles: after.get('crane_process_cycles{process="plant"}'),
+      plant_overruns: after.get('crane_process_overruns{process="plant"}'),
+      plant_latency_p99_us: after.get('crane_process_latency_us{process="plant",quantile="0.99"}'),
+      faults_raised: after.get("crane_supervisor_faults_raised"),
+    },
+  };
+  const expect = (ok, what) => ok || problems.push(what);
+  expect(goodRate >= 95 && goodRate <= 105, `good client got ${goodRate} Hz, not 100 +- 5`);
+  expect(summary.malformed_status.some((m) => m.startsWith("malformed JSON")), "no error status for malformed JSON");
+  expect(summary.unknown_channel_status.some((m) => m.includes("unknown channel id 99999")), "no error for the unknown channel");
+  expect(summary.binary_status.some((m) => m.includes("client publishing")), "no error status for a binary frame");
+  // The server closes with 1009; the client may see the reset first (1006) while its 200 KiB are
+  // still being written: either way that connection is closed, and the metrics name the cause.
+  expect(oversized.closeCode === 1009 || oversized.closeCode === 1006,
+         `oversized frame: close code ${oversized.closeCode}, expected 1009 (or 1006)`);
+  expect(wrongProtocol.refused === 400, `handshake without the subprotocol: HTTP ${wrongProtocol.refused}, expected 400`);
+  const d = summary.metrics_delta;
+  expect(d.refused_request >= 2 && d.refused_binary >= 1 && d.refused_handshake >= 1 && d.refused_oversized >= 1,
+         "refusals not counted");
+  expect(stalledChannels >= 10, `the stalled client subscribed to ${stalledChannels} channels`);
+  expect(d.samples_dropped > 0, "the stalled client's queue dropped nothing");
+  expect(d.sensors_received >= 95 * seconds, `sensors received grew by ${d.sensors_received} only`);
+  const a = summary.metrics_after;
+  expect(a.sensor_rate_hz >= 90 && a.sensor_rate_hz <= 110, `crane_topic_rate_hz of the sensors ${a.sensor_rate_hz}`);
+  expect(a.supervisor_mode.length === 1, "not exactly one supervisor mode at 1");
+  expect(a.plant_cycles > 0, "no plant cycles in the metrics");
+  expect(a.clients >= 4, `crane_web_clients ${a.clients}`);
+  summary.problems = problems;
+  console.log(JSON.stringify(summary, null, 1));
+  for (const c of [good, malformed, unknown, binary]) c.ws.terminate();
+  stalled.kill();
+  process.exit(problems.length === 0 ? 0 : 1);
+}
+
 const [mode, ...args] = process.argv.slice(2);
 if (mode === "live") live(args[0], args[1], Number(args[2]), Number(args[3] || 10));
 else if (mode === "compare") compare(args[0], args[1]);
+else if (mode === "abuse") abuse(args[0], Number(args[1])).catch((e) => { console.error(e); process.exit(1); });
 else {
   console.error("usage: foxglove_client.js live URL OUT.jsonl SECONDS [MIN_CHANNELS] | compare DECODED.jsonl RECORDED.jsonl");
   process.exit(2);

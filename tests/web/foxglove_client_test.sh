@@ -3,7 +3,9 @@
 # --sim, realtime), crane_web, crane_topic record and tests/web/foxglove_client.js (Foxglove's own
 # npm packages) in one private network namespace. The client lists the channels (>= 10), receives
 # rt/crane/hw/sensors for 5 s (100 +- 5 Hz by arrival time), decodes every sample of every channel
-# with the advertised IDL schema, and the decoded values equal crane_topic record's (1e-9).
+# with the advertised IDL schema, and the decoded values equal crane_topic record's (1e-9). Then bad
+# input (malformed JSON, unknown ids, binary and oversized frames, a client that never reads) is
+# answered for that client only, and /metrics counts it.
 #
 #   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
 #
@@ -52,7 +54,7 @@ pids+=($!)
 for _ in $(seq 600); do grep -q "all stages matched and alive" "$OUT/launch.log" && break; sleep 0.1; done
 grep -q "all stages matched and alive" "$OUT/launch.log" || { echo "stack not ready:"; cat "$OUT/launch.log"; exit 1; }
 
-"$BIN/crane_web" --port 0 --domain "$DOMAIN" > "$OUT/web.log" 2>&1 &
+"$BIN/crane_web" --port 0 --queue 64 --domain "$DOMAIN" > "$OUT/web.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do grep -q "ws://" "$OUT/web.log" && break; sleep 0.1; done
 URL=$(grep -o "ws://[0-9.]*:[0-9]*" "$OUT/web.log" || true)
@@ -71,4 +73,7 @@ node "$HERE/foxglove_client.js" compare "$OUT/decoded.jsonl" "$OUT/run.csv.sampl
 rate=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1])).sensor_rate_hz)' "$OUT/live.json")
 echo "[ figure ] rt/crane/hw/sensors through crane_web: $rate Hz over 5 s (required 100 +- 5)"
 node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$rate" || { echo "rate $rate Hz outside 100 +- 5"; status=1; }
+# Bad input and /metrics, while the stack runs (crane_web's queue small, so the stalled client's
+# drops come within seconds).
+node "$HERE/foxglove_client.js" abuse "$URL" 8 | tee "$OUT/abuse.json" || status=1
 exit $status

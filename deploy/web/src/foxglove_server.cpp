@@ -103,6 +103,14 @@ struct FoxgloveServer::Impl {
       return true;
     });
     server.set_open_handler([this](connection_hdl hdl) {
+      // A fixed, small kernel send buffer per client (no autotuning to megabytes): a client that
+      // stops reading fills it and websocketpp's buffer within seconds, and then its own queue
+      // drops the oldest samples instead of the kernel holding many seconds of stale ones.
+      boost::system::error_code option_ec;
+      auto& socket = server.get_con_from_hdl(hdl)->get_socket();
+      socket.set_option(boost::asio::socket_base::send_buffer_size(static_cast<int>(options.socket_buffer_bytes)),
+                        option_ec);
+      socket.set_option(boost::asio::ip::tcp::no_delay(true), option_ec);
       clients.emplace(hdl, Client{ClientSession(channel_ids), SendQueue(options.queue_frames)});
       stats.clients.store(clients.size());
       stats.connections_total.fetch_add(1);
@@ -111,6 +119,11 @@ struct FoxgloveServer::Impl {
       server.send(hdl, advertise, websocketpp::frame::opcode::text, ec);
     });
     const auto remove = [this](connection_hdl hdl) {
+      websocketpp::lib::error_code ec;
+      auto con = server.get_con_from_hdl(hdl, ec);
+      if (!ec && con->get_local_close_code() == websocketpp::close::status::message_too_big) {
+        stats.oversized_closed.fetch_add(1);
+      }
       clients.erase(hdl);
       stats.clients.store(clients.size());
     };

@@ -8,7 +8,8 @@
 // one channel per topic, encoding "cdr", schema encoding "omgidl", schema the IDL
 // (crane::protocol::kIdlSchema, generated from idl/crane_msgs.idl), schema name the DDS type name.
 // Samples with NaN or Inf are rejected where they enter (as every process of the stack does) and
-// counted. Client publishing is off. HTTP on the same port: / (what this is).
+// counted. Client publishing is off. HTTP on the same port: / (what this is) and /metrics (the
+// Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process, the server).
 // Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...), 2 bad usage.
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -16,12 +17,15 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "crane/protocol/dds.hpp"
 #include "crane/protocol/idl_schema.hpp"
 #include "crane/runtime/node_runtime.hpp"
 #include "crane/transport/cdr.hpp"
 #include "crane/web/foxglove_server.hpp"
+#include "crane/web/web_metrics.hpp"
 
 namespace {
 
@@ -67,19 +71,28 @@ int main(int argc, char** argv) {
     runtime::install_stop_handlers(&wakeup);
 
     const auto channels = bus_channels();
+    std::vector<std::string> topic_names;
+    for (const auto& c : channels) topic_names.push_back(c.topic);
+    web::WebMetrics metrics(topic_names);
+    const web::ServerStats* server_stats = nullptr;  // set before the server starts
     web::FoxgloveServer server(server_options, channels, [&](const std::string& path) {
       web::HttpResponse response;
-      if (path == "/") {
+      if (path == "/metrics") {
+        response.status = 200;
+        response.content_type = "text/plain; version=0.0.4; charset=utf-8";
+        response.body = metrics.text(server_stats);
+      } else if (path == "/") {
         response.status = 200;
         response.body = "crane_web: the crane's topics over the Foxglove WebSocket protocol (subprotocol " +
                         std::string(web::kSubprotocol) + ") on this port; " + std::to_string(channels.size()) +
                         " channels, encoding cdr, schema omgidl. Open it in Foxglove or Lichtblick "
-                        "(Foxglove WebSocket, ws://HOST:PORT).\n";
+                        "(Foxglove WebSocket, ws://HOST:PORT). Metrics: /metrics\n";
       } else {
         response.body = "not found: " + path + "\n";
       }
       return response;
     });
+    server_stats = &server.stats();
 
     // One reader per topic (history deep enough that a busy moment never drops a sample here),
     // and its drain: take, reject non-finite, serialize, forward.
@@ -90,11 +103,25 @@ int main(int argc, char** argv) {
       const std::uint32_t id = ++channel_id;
       auto reader = std::shared_ptr(participant->make_recording_reader<T>(&wakeup, 64));
       readers.push_back(reader);
-      drains.push_back([reader, id, &server] {
+      const std::size_t topic_index = id - 1;
+      drains.push_back([reader, id, topic_index, &server, &metrics] {
         typename T::Message m;
         while (reader->take_next(m)) {
           const auto receive_ns = static_cast<std::uint64_t>(runtime::now_nanoseconds());
-          if (!runtime::all_finite(m)) continue;
+          if (!runtime::all_finite(m)) {
+            metrics.nonfinite(topic_index);
+            continue;
+          }
+          metrics.sample(topic_index);
+          if constexpr (std::is_same_v<T, tp::SafetyStatus> || std::is_same_v<T, tp::LoopDiagnostics>) {
+            typename protocol::PlainOf<typename T::Message>::type plain;
+            protocol::from_dds(m, plain);
+            if constexpr (std::is_same_v<T, tp::SafetyStatus>) {
+              metrics.supervisor(plain);
+            } else {
+              metrics.loop(plain);
+            }
+          }
           auto bytes = std::make_shared<std::vector<std::uint8_t>>();
           if (!transport::serialize_cdr<T>(m, *bytes)) continue;
           server.publish(id, receive_ns, std::move(bytes));
@@ -107,9 +134,15 @@ int main(int argc, char** argv) {
                 server_options.bind_address.c_str(), static_cast<unsigned>(server.port()),
                 std::string(web::kSubprotocol).c_str(), channels.size());
     std::fflush(stdout);
+    auto window_start = Clock::now();
     while (!runtime::stop_requested()) {
       for (auto& d : drains) d();
-      wakeup.wait_until(Clock::now() + std::chrono::milliseconds(100));
+      const auto now = Clock::now();
+      if (now - window_start >= std::chrono::seconds(1)) {
+        metrics.update_rates(std::chrono::duration<double>(now - window_start).count());
+        window_start = now;
+      }
+      wakeup.wait_until(now + std::chrono::milliseconds(100));
     }
     server.stop();
     return 0;

@@ -20,7 +20,8 @@ struct ServerOptions {
   std::string bind_address{"127.0.0.1"};       // IPv4 or IPv6 address to listen on (loopback by default)
   std::uint16_t port{8765};                    // TCP port; 0: any free port (see FoxgloveServer::port())
   std::size_t queue_frames{256};               // per-client send queue [frames]
-  std::size_t socket_buffer_bytes{256 * 1024}; // [bytes] handed to a client's socket before queueing
+  std::size_t socket_buffer_bytes{64 * 1024};  // [bytes] a client's kernel send buffer (SO_SNDBUF), and
+                                               // what websocketpp may hold for it before the queue
   std::size_t max_request_bytes{64 * 1024};    // [bytes] largest frame a client may send (else closed, 1009)
   std::string name{"crane_web"};               // serverInfo name
 };
@@ -34,6 +35,7 @@ struct ServerStats {
   std::atomic<std::uint64_t> bad_requests{0};       // refused text requests (malformed, unknown ids, unsupported)
   std::atomic<std::uint64_t> binary_refused{0};     // binary frames from clients (client publishing is off)
   std::atomic<std::uint64_t> handshakes_refused{0}; // WebSocket handshakes without foxglove.websocket.v1
+  std::atomic<std::uint64_t> oversized_closed{0};   // clients closed (1009) for a frame over max_request_bytes
 };
 
 /// An HTTP GET handler: path in, (status, content type, body) out.
