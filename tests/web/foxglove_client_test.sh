@@ -5,7 +5,9 @@
 # rt/crane/hw/sensors for 5 s (100 +- 5 Hz by arrival time), decodes every sample of every channel
 # with the advertised IDL schema, and the decoded values equal crane_topic record's (1e-9). Then bad
 # input (malformed JSON, unknown ids, binary and oversized frames, a client that never reads) is
-# answered for that client only, and /metrics counts it.
+# answered for that client only, and /metrics counts it. The recorder also writes MCAP (--mcap), read
+# by @mcap/core: one channel per topic, 100 Hz x 9 s +- 2 % sensor messages, every message decoded
+# (ros2msg schema, Foxglove's ROS 2 CDR reader) equal to the JSON record.
 #
 #   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
 #
@@ -15,7 +17,7 @@ set -euo pipefail
 BIN=$1 CONFIG=$2 NPM_DIR=$3 OUT=$4
 HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 PACKAGES=(@foxglove/ws-protocol@0.8.0 @foxglove/omgidl-parser@1.1.0 @foxglove/omgidl-serialization@1.0.3 ws@8.18.0
-          @mcap/core@2.2.2)
+          @mcap/core@2.2.2 @foxglove/rosmsg@5.0.5 @foxglove/rosmsg2-serialization@3.1.0)
 
 # 1. The client's packages, outside the namespace (the registry is on the network).
 if [ -z "${CRANE_WEB_TEST_IN_NAMESPACE:-}" ]; then
@@ -62,7 +64,7 @@ URL=$(grep -o "ws://[0-9.]*:[0-9]*" "$OUT/web.log" || true)
 echo "crane_web at $URL"
 
 # The recorder starts first and ends after the client, so every decoded sample has its twin.
-"$BIN/crane_topic" record --out "$OUT/run.csv" --duration 9 --domain "$DOMAIN" > "$OUT/record.log" 2>&1 &
+"$BIN/crane_topic" record --out "$OUT/run.csv" --mcap "$OUT/run.mcap" --duration 9 --domain "$DOMAIN" > "$OUT/record.log" 2>&1 &
 record_pid=$!
 pids+=($record_pid)
 sleep 1
@@ -70,6 +72,8 @@ status=0
 node "$HERE/foxglove_client.js" live "$URL" "$OUT/decoded.jsonl" 5 10 | tee "$OUT/live.json" || status=1
 wait "$record_pid" || { echo "crane_topic record failed:"; cat "$OUT/record.log"; exit 1; }
 node "$HERE/foxglove_client.js" compare "$OUT/decoded.jsonl" "$OUT/run.csv.samples.jsonl" | tee "$OUT/compare.json" || status=1
+# The same recording as MCAP (ros2 profile), read by @mcap/core and decoded by Foxglove's ROS 2 reader.
+node "$HERE/mcap_check.js" "$OUT/run.mcap" "$OUT/run.csv.samples.jsonl" 9 | tee "$OUT/mcap.json" || status=1
 rate=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1])).sensor_rate_hz)' "$OUT/live.json")
 echo "[ figure ] rt/crane/hw/sensors through crane_web: $rate Hz over 5 s (required 100 +- 5)"
 node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$rate" || { echo "rate $rate Hz outside 100 +- 5"; status=1; }

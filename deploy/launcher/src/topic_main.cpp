@@ -8,6 +8,8 @@
 //   crane_topic record --out run.csv [--duration S] [--timeout S]   the audit's CSV (t,u_x,u_gamma,x,gamma,phi,
 //                                                     theta,L, one row per sensor cycle) and every
 //                                                     sample of every topic in run.csv.samples.jsonl
+//   crane_topic record --mcap run.mcap [...]          every sample of every topic in MCAP, ros2 profile
+//                                                     (with --out too: both from the same samples)
 //
 // Common options: --dds fast|cyclone, --domain N, --lan (default: bound to loopback, as the stack).
 // Exit codes: 0 done, 1 nothing received within the time given, 2 bad usage (unknown topic...).
@@ -25,7 +27,10 @@
 #include <thread>
 #include <vector>
 
+#include "crane/launch/mcap_writer.hpp"
+#include "crane/protocol/ros2_schemas.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/transport/cdr.hpp"
 #include "message_json.hpp"
 
 namespace {
@@ -55,6 +60,31 @@ bool with_topic(const std::string& name, F&& f) {
     }
   });
   return found;
+}
+
+/// rt/crane/hw/sensors -> /crane/hw/sensors: the ROS 2 topic name of a DDS topic (rosbag2 records
+/// ROS names; the "rt" prefix is ROS 2's mangling of topics on the wire).
+std::string ros2_topic_name(const std::string& dds_name) {
+  return dds_name.rfind("rt/", 0) == 0 ? dds_name.substr(2) : dds_name;
+}
+
+/// The offered_qos_profiles metadata of a channel in the ros2 profile: rosbag2's YAML of the
+/// writer's QoS (history keep last = 1, reliability reliable = 1 / best effort = 2, durability
+/// transient local = 1 / volatile = 2, liveliness automatic = 1 / manual by topic = 3; durations
+/// as {sec, nsec}, "infinite" as rosbag2 writes it).
+std::string offered_qos_yaml(transport::QosKind kind) {
+  const auto q = transport::qos_profile(kind);
+  const auto duration = [](std::chrono::nanoseconds d) {
+    if (d.count() == 0) return std::string("\n    sec: 2147483647\n    nsec: 4294967295");
+    return "\n    sec: " + std::to_string(d.count() / 1000000000) + "\n    nsec: " + std::to_string(d.count() % 1000000000);
+  };
+  return "- history: 1\n  depth: " + std::to_string(q.history_depth) +
+         "\n  reliability: " + (q.reliability == transport::Reliability::reliable ? "1" : "2") +
+         "\n  durability: " + (q.durability == transport::Durability::transient_local ? "1" : "2") +
+         "\n  deadline:" + duration(q.writer_deadline) + "\n  lifespan:" + duration(std::chrono::nanoseconds{0}) +
+         "\n  liveliness: " + (q.manual_by_topic_liveliness ? "3" : "1") +
+         "\n  liveliness_lease_duration:" + duration(q.liveliness_lease) +
+         "\n  avoid_ros_namespace_conventions: false";
 }
 
 Clock::time_point after(double seconds) {
@@ -171,8 +201,10 @@ int main(int argc, char** argv) {
   hz_cmd->add_flag("--json", as_json, "one JSON object");
   common(hz_cmd);
   auto* record_cmd = app.add_subcommand("record", "the audit's CSV and every sample (JSON lines)");
-  std::string out_path;
-  record_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L)")->required();
+  std::string out_path, mcap_path;
+  auto* out_option = record_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L)");
+  auto* mcap_option = record_cmd->add_option("--mcap", mcap_path,
+                                             "MCAP file: every sample of every topic (ros2 profile, cdr, ros2msg schemas)");
   record_cmd->add_option("--duration", duration, "[s] recording time, from the first sensor sample")
       ->check(CLI::Range(0.1, 86400.0));
   record_cmd->add_option("--timeout", timeout, "[s] give up when no sensor sample arrives this long")
@@ -182,6 +214,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-4, 1.0));
   common(record_cmd);
   CLI11_PARSE(app, argc, argv);
+  if (record_cmd->parsed() && out_option->count() == 0 && mcap_option->count() == 0) {
+    std::fprintf(stderr, "crane_topic record: give --out run.csv, --mcap run.mcap, or both\n");
+    return 2;
+  }
   node.loopback_only = !lan;
   node.shared_memory = !lan;
 
@@ -242,9 +278,15 @@ int main(int argc, char** argv) {
       return status;
     }
 
-    // record: every topic to JSON lines; the sensor stream to the audit's CSV.
-    std::ofstream samples(out_path + ".samples.jsonl");
-    if (!samples) throw std::runtime_error("cannot write " + out_path + ".samples.jsonl");
+    // record: every topic to JSON lines; the sensor stream to the audit's CSV; with --mcap every
+    // sample as its CDR bytes to MCAP.
+    std::ofstream samples;
+    if (!out_path.empty()) {
+      samples.open(out_path + ".samples.jsonl");
+      if (!samples) throw std::runtime_error("cannot write " + out_path + ".samples.jsonl");
+    }
+    std::unique_ptr<launch::McapWriter> mcap;
+    if (!mcap_path.empty()) mcap = std::make_unique<launch::McapWriter>(mcap_path, "ros2", "crane_topic (idl/crane_msgs.idl)");
     std::map<std::uint64_t, tp::msgs::SensorSample_> sensors;
     std::vector<std::function<void()>> drains;
     std::vector<std::shared_ptr<void>> readers;
@@ -252,13 +294,30 @@ int main(int argc, char** argv) {
       with_topic(name, [&]<class T>() {
         auto reader = std::shared_ptr(participant->make_recording_reader<T>(&wakeup, 4096));
         readers.push_back(reader);
-        drains.push_back([reader, &samples, &sensors, name] {
+        std::uint16_t channel = 0;
+        if (mcap) {
+          const auto* schema = protocol::ros2_schema(T::type_name);
+          if (schema == nullptr) throw std::logic_error(std::string("no ROS 2 schema for ") + T::type_name);
+          const auto schema_id = mcap->add_schema(std::string(schema->ros2_type_name), "ros2msg",
+                                                  std::string(schema->msg_definition));
+          channel = mcap->add_channel(schema_id, ros2_topic_name(name), "cdr",
+                                      {{"offered_qos_profiles", offered_qos_yaml(T::qos)}});
+        }
+        drains.push_back([reader, &samples, &sensors, name, &mcap, channel, sequence = std::uint32_t{0}]() mutable {
           typename T::Message m;
+          std::vector<std::uint8_t> bytes;
           while (reader->take_next(m)) {
-            samples << json{{"topic", name}, {"receive_ns", runtime::now_nanoseconds()},
-                            {"sample", launch::message_json(m)}}
-                           .dump()
-                    << '\n';
+            const auto receive_ns = runtime::now_nanoseconds();
+            if (samples.is_open()) {
+              samples << json{{"topic", name}, {"receive_ns", receive_ns}, {"sample", launch::message_json(m)}}.dump()
+                      << '\n';
+            }
+            if (mcap && transport::serialize_cdr<T>(m, bytes)) {
+              const auto& stamp = m.header().stamp();
+              const auto publish_ns = static_cast<std::uint64_t>(stamp.sec()) * 1000000000ULL + stamp.nanosec();
+              mcap->write_message(channel, sequence++, static_cast<std::uint64_t>(receive_ns), publish_ns, bytes.data(),
+                                  bytes.size());
+            }
             if constexpr (std::is_same_v<T, tp::Sensors>) sensors[m.header().seq()] = m;
           }
         });
@@ -278,6 +337,12 @@ int main(int argc, char** argv) {
     }
     if (!started) throw std::runtime_error("no sensor sample arrived within --timeout " + std::to_string(timeout) + " s");
     for (auto& d : drains) d();
+    if (mcap) {
+      mcap->finish();
+      std::fprintf(stderr, "crane_topic: %llu samples -> %s\n", static_cast<unsigned long long>(mcap->message_count()),
+                   mcap_path.c_str());
+      if (out_path.empty()) return mcap->message_count() > 0 ? 0 : 1;
+    }
     // Row k: the sensors of cycle k and the voltage applied during cycle k, which sample k+1 reports.
     std::ofstream csv(out_path);
     if (!csv) throw std::runtime_error("cannot write " + out_path);
