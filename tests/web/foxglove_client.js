@@ -14,6 +14,8 @@
 //       matches each decoded sample with crane_topic record's sample of the same topic, header.seq
 //       and header.stamp, compares every field (numbers within 1e-9), prints a JSON summary and
 //       exits 1 on a difference or when a decoded rt/crane/hw/sensors sample has no recorded twin.
+//   node foxglove_client.js load URL CLIENTS SECONDS
+//       CLIENTS connections subscribed to every channel for SECONDS (deploy/bench_web.sh).
 //   node foxglove_client.js abuse URL SECONDS
 //       bad input while a well-behaved client takes rt/crane/hw/sensors: malformed JSON, an unknown
 //       channel id, a binary frame, a 200 KiB frame, a handshake without the subprotocol, and a
@@ -326,9 +328,34 @@ async function abuse(url, seconds) {
   process.exit(problems.length === 0 ? 0 : 1);
 }
 
+// ---- load: N clients subscribed to every channel ---------------------------------------------
+
+// Opens `clients` connections, each subscribed to every advertised channel, reads for `seconds`,
+// prints {clients, seconds, frames per client (min, max), bytes} and exits 0 (deploy/bench_web.sh).
+async function load(url, clients, seconds) {
+  const all = [];
+  for (let i = 0; i < clients; ++i) {
+    const c = await rawClient(url);
+    for (let k = 0; k < 50 && c.advertised.length === 0; ++k) await sleep(20);
+    c.ws.send(JSON.stringify({ op: "subscribe", subscriptions: c.advertised.map((ch, j) => ({ id: j, channelId: ch.id })) }));
+    c.bytes = 0;
+    c.ws.on("message", (data) => (c.bytes += data.length));
+    all.push(c);
+  }
+  console.error(`load: ${clients} clients subscribed to ${all[0].advertised.length} channels each`);
+  await sleep(seconds * 1000);
+  const frames = all.map((c) => c.binaryFrames);
+  console.log(JSON.stringify({ clients, seconds, frames_per_client_min: Math.min(...frames),
+                               frames_per_client_max: Math.max(...frames),
+                               bytes_total: all.reduce((a, c) => a + c.bytes, 0) }));
+  for (const c of all) c.ws.terminate();
+  process.exit(0);
+}
+
 const [mode, ...args] = process.argv.slice(2);
 if (mode === "live") live(args[0], args[1], Number(args[2]), Number(args[3] || 10));
 else if (mode === "compare") compare(args[0], args[1]);
+else if (mode === "load") load(args[0], Number(args[1]), Number(args[2])).catch((e) => { console.error(e); process.exit(1); });
 else if (mode === "abuse") abuse(args[0], Number(args[1])).catch((e) => { console.error(e); process.exit(1); });
 else {
   console.error("usage: foxglove_client.js live URL OUT.jsonl SECONDS [MIN_CHANNELS] | compare DECODED.jsonl RECORDED.jsonl");
