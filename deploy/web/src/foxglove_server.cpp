@@ -181,8 +181,18 @@ void FoxgloveServer::start() {
   boost::system::error_code ec;
   const auto address = boost::asio::ip::make_address(o.bind_address, ec);
   if (ec) throw std::runtime_error("--bind " + o.bind_address + " is not an IP address: " + ec.message());
+  const boost::asio::ip::tcp::endpoint endpoint(address, o.port);
+  {
+    // websocketpp reports any failure to listen as "Underlying Transport Error": bind once here
+    // to name the reason (address in use, permission denied...).
+    boost::asio::ip::tcp::acceptor probe(s.get_io_service());
+    probe.open(endpoint.protocol(), ec);
+    if (!ec) probe.set_option(boost::asio::socket_base::reuse_address(true), ec);
+    if (!ec) probe.bind(endpoint, ec);
+    if (ec) throw std::runtime_error("cannot listen on " + where + ": " + ec.message());
+  }
   websocketpp::lib::error_code wec;
-  s.listen(boost::asio::ip::tcp::endpoint(address, o.port), wec);
+  s.listen(endpoint, wec);
   if (wec) throw std::runtime_error("cannot listen on " + where + ": " + wec.message());
   s.start_accept(wec);
   if (wec) throw std::runtime_error("cannot accept on " + where + ": " + wec.message());

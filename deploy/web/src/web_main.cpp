@@ -10,7 +10,8 @@
 // Samples with NaN or Inf are rejected where they enter (as every process of the stack does) and
 // counted. Client publishing is off. HTTP on the same port: / (what this is) and /metrics (the
 // Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process, the server).
-// Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...), 2 bad usage.
+// Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
+// CLI11's message and code.
 #include <CLI/CLI.hpp>
 #include <sys/resource.h>
 
@@ -69,8 +70,8 @@ int main(int argc, char** argv) {
                                        "so viewers never take CPU from the control loop")
       ->check(CLI::Range(0, 19));
   CLI11_PARSE(app, argc, argv);
-  // Before any thread exists (DDS's, the I/O thread): they inherit it. deploy/bench_web.sh: with
-  // 20 clients on every channel the stack's p99 grew 1.54x at niceness 0, 1.28x at 19.
+  // Before any thread exists (DDS's, the I/O thread): they inherit it. What it changes for the
+  // stack's latency with 20 clients: deploy/bench_web.sh, docs/operation.md.
   if (nice_value > 0 && setpriority(PRIO_PROCESS, 0, nice_value) != 0) {
     std::fprintf(stderr, "crane_web: --nice %d: %s (running at the default niceness)\n", nice_value, std::strerror(errno));
   }
