@@ -10,29 +10,43 @@
 # (ros2msg schema, Foxglove's ROS 2 CDR reader) equal to the JSON record.
 #
 #   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
+#   foxglove_client_test.sh --install-only NPM_DIR      (deploy/crane test, before its namespace)
 #
 # NPM_DIR holds the npm packages (installed on the first run, reused offline afterwards). Exit 77
 # (ctest: skipped) when they are not there and the npm registry cannot be reached.
 set -euo pipefail
-BIN=$1 CONFIG=$2 NPM_DIR=$3 OUT=$4
 HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 PACKAGES=(@foxglove/ws-protocol@0.8.0 @foxglove/omgidl-parser@1.1.0 @foxglove/omgidl-serialization@1.0.3 ws@8.18.0
           @mcap/core@2.2.2 @foxglove/rosmsg@5.0.5 @foxglove/rosmsg2-serialization@3.1.0)
 
+# The client's packages into NPM_DIR, once (a stamp names the package list); exit 77 when npm or
+# its registry is not there and nothing is cached.
+install_clients() {
+  local npm_dir=$1
+  local stamp
+  stamp="$npm_dir/installed-$(printf '%s\n' "${PACKAGES[@]}" | md5sum | cut -c1-12)"
+  [ -f "$stamp" ] && return 0
+  command -v npm >/dev/null || { echo "SKIP: npm is not installed"; exit 77; }
+  if ! timeout 15 npm view @foxglove/ws-protocol version >/dev/null 2>&1; then
+    echo "SKIP: the npm registry is not reachable and $npm_dir has no cached client packages"
+    exit 77
+  fi
+  mkdir -p "$npm_dir"
+  [ -f "$npm_dir/package.json" ] || echo '{"name":"crane-web-test-client","private":true}' > "$npm_dir/package.json"
+  (cd "$npm_dir" && timeout 300 npm install --no-audit --no-fund --loglevel=error "${PACKAGES[@]}")
+  touch "$stamp"
+}
+
+# deploy/crane test installs them before it enters its private network namespace (no registry there).
+if [ "${1:-}" = "--install-only" ]; then
+  install_clients "$2"
+  exit 0
+fi
+BIN=$1 CONFIG=$2 NPM_DIR=$3 OUT=$4
+
 # 1. The client's packages, outside the namespace (the registry is on the network).
 if [ -z "${CRANE_WEB_TEST_IN_NAMESPACE:-}" ]; then
-  stamp="$NPM_DIR/installed-$(printf '%s\n' "${PACKAGES[@]}" | md5sum | cut -c1-12)"
-  if [ ! -f "$stamp" ]; then
-    command -v npm >/dev/null || { echo "SKIP: npm is not installed (Debian: npm)"; exit 77; }
-    if ! timeout 30 npm view @foxglove/ws-protocol version >/dev/null 2>&1; then
-      echo "SKIP: the npm registry is not reachable and $NPM_DIR has no cached client packages"
-      exit 77
-    fi
-    mkdir -p "$NPM_DIR"
-    [ -f "$NPM_DIR/package.json" ] || echo '{"name":"crane-web-test-client","private":true}' > "$NPM_DIR/package.json"
-    (cd "$NPM_DIR" && timeout 300 npm install --no-audit --no-fund --loglevel=error "${PACKAGES[@]}")
-    touch "$stamp"
-  fi
+  install_clients "$NPM_DIR"
   # 2. Everything else in a private network namespace when the system allows one.
   if unshare --net true 2>/dev/null; then
     exec unshare --net env CRANE_WEB_TEST_IN_NAMESPACE=1 bash -c \
