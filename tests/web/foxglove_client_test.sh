@@ -7,7 +7,8 @@
 # input (malformed JSON, unknown ids, binary and oversized frames, a client that never reads) is
 # answered for that client only, and /metrics counts it. The recorder also writes MCAP (--mcap), read
 # by @mcap/core: one channel per topic, 100 Hz x 9 s +- 2 % sensor messages, every message decoded
-# (ros2msg schema, Foxglove's ROS 2 CDR reader) equal to the JSON record.
+# (ros2msg schema, Foxglove's ROS 2 CDR reader) equal to the JSON record. Last, the operator page in
+# Debian's chromium: what it decoded equals Foxglove's decoder, its views and plots drawn.
 #
 #   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
 #   foxglove_client_test.sh --install-only NPM_DIR      (deploy/crane test, before its namespace)
@@ -17,7 +18,7 @@
 set -euo pipefail
 HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 PACKAGES=(@foxglove/ws-protocol@0.8.0 @foxglove/omgidl-parser@1.1.0 @foxglove/omgidl-serialization@1.0.3 ws@8.18.0
-          @mcap/core@2.2.2 @foxglove/rosmsg@5.0.5 @foxglove/rosmsg2-serialization@3.1.0)
+          @mcap/core@2.2.2 @foxglove/rosmsg@5.0.5 @foxglove/rosmsg2-serialization@3.1.0 puppeteer-core@24.43.1)
 
 # The client's packages into NPM_DIR, once (a stamp names the package list); exit 77 when npm or
 # its registry is not there and nothing is cached.
@@ -94,4 +95,11 @@ node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$
 # Bad input and /metrics, while the stack runs (crane_web's queue small, so the stalled client's
 # drops come within seconds).
 node "$HERE/foxglove_client.js" abuse "$URL" 8 | tee "$OUT/abuse.json" || status=1
+# The operator page in Debian's chromium (headless, puppeteer-core) while the crane moves.
+if [ -x /usr/bin/chromium ]; then
+  "$BIN/crane_move" --domain "$DOMAIN" --trolley 0.9 --slew 60 > "$OUT/move.log" 2>&1 || true
+  node "$HERE/page_check.js" "$URL" "$OUT/operator_page.png" | tee "$OUT/page.json" || status=1
+else
+  echo "operator page not checked: no /usr/bin/chromium (Debian: chromium)"
+fi
 exit $status

@@ -8,8 +8,10 @@
 // one channel per topic, encoding "cdr", schema encoding "omgidl", schema the IDL
 // (crane::protocol::kIdlSchema, generated from idl/crane_msgs.idl), schema name the DDS type name.
 // Samples with NaN or Inf are rejected where they enter (as every process of the stack does) and
-// counted. Client publishing is off. HTTP on the same port: / (what this is) and /metrics (the
-// Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process, the server).
+// counted. Client publishing is off. HTTP on the same port: / the operator page (deploy/web/www:
+// read-only views, plots, mode and faults, over the same protocol), /about (what this is) and
+// /metrics (the Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process,
+// the server).
 // Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
 // CLI11's message and code.
 #include <CLI/CLI.hpp>
@@ -19,7 +21,9 @@
 #include <cstring>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -48,6 +52,14 @@ std::vector<web::Channel> bus_channels() {
   return channels;
 }
 
+/// The text of `path`; empty when it cannot be read.
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return in ? text.str() : std::string();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,6 +77,8 @@ int main(int argc, char** argv) {
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  std::string assets = CRANE_WEB_ASSETS_DIR;
+  app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
   int nice_value = 10;
   app.add_option("--nice", nice_value, "scheduling niceness of the whole server (0-19): below the stack's processes, "
                                        "so viewers never take CPU from the control loop")
@@ -84,6 +98,13 @@ int main(int argc, char** argv) {
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
 
+    // The operator page: its two files, read once (deploy/web/www).
+    const std::string page = file_text(assets + "/index.html");
+    const std::string page_script = file_text(assets + "/crane_view.js");
+    if (page.empty() || page_script.empty()) {
+      std::fprintf(stderr, "crane_web: no operator page in %s (index.html, crane_view.js): / describes the server\n",
+                   assets.c_str());
+    }
     const auto channels = bus_channels();
     std::vector<std::string> topic_names;
     for (const auto& c : channels) topic_names.push_back(c.topic);
@@ -95,7 +116,15 @@ int main(int argc, char** argv) {
         response.status = 200;
         response.content_type = "text/plain; version=0.0.4; charset=utf-8";
         response.body = metrics.text(server_stats);
-      } else if (path == "/") {
+      } else if ((path == "/" || path == "/index.html") && !page.empty()) {
+        response.status = 200;
+        response.content_type = "text/html; charset=utf-8";
+        response.body = page;
+      } else if (path == "/crane_view.js" && !page_script.empty()) {
+        response.status = 200;
+        response.content_type = "text/javascript; charset=utf-8";
+        response.body = page_script;
+      } else if (path == "/" || path == "/about") {
         response.status = 200;
         response.body = "crane_web: the crane's topics over the Foxglove WebSocket protocol (subprotocol " +
                         std::string(web::kSubprotocol) + ") on this port; " + std::to_string(channels.size()) +
