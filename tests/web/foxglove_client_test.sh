@@ -89,6 +89,10 @@ wait "$record_pid" || { echo "crane_topic record failed:"; cat "$OUT/record.log"
 node "$HERE/foxglove_client.js" compare "$OUT/decoded.jsonl" "$OUT/run.csv.samples.jsonl" | tee "$OUT/compare.json" || status=1
 # The same recording as MCAP (ros2 profile), read by @mcap/core and decoded by Foxglove's ROS 2 reader.
 node "$HERE/mcap_check.js" "$OUT/run.mcap" "$OUT/run.csv.samples.jsonl" 9 | tee "$OUT/mcap.json" || status=1
+# The audit's CSV from the MCAP file (crane_topic convert, what deploy/crane audit --data run.mcap
+# reads) is the CSV the recorder wrote, byte for byte.
+"$BIN/crane_topic" convert "$OUT/run.mcap" --out "$OUT/run_from_mcap.csv" || status=1
+cmp "$OUT/run.csv" "$OUT/run_from_mcap.csv" && echo "run.csv and the CSV converted from run.mcap are identical" || status=1
 rate=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1])).sensor_rate_hz)' "$OUT/live.json")
 echo "[ figure ] rt/crane/hw/sensors through crane_web: $rate Hz over 5 s (required 100 +- 5)"
 node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$rate" || { echo "rate $rate Hz outside 100 +- 5"; status=1; }

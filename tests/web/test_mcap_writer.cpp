@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "crane/launch/mcap_reader.hpp"
 #include "crane/launch/mcap_writer.hpp"
 
 namespace {
@@ -59,6 +60,40 @@ TEST(McapWriter, FileHasMagicHeaderSummaryAndFooterWhereTheSpecSays) {
   const std::uint32_t stored = b[footer + 25] | (b[footer + 26] << 8) | (b[footer + 27] << 16) |
                                (static_cast<std::uint32_t>(b[footer + 28]) << 24);
   EXPECT_EQ(stored, crc);
+  std::filesystem::remove(path);
+}
+
+TEST(McapReader, ReadsBackWhatTheWriterWroteAndRefusesATruncatedFile) {
+  const std::string path = (std::filesystem::temp_directory_path() / "crane_test_reader.mcap").string();
+  {
+    crane::launch::McapWriter writer(path, "ros2", "test");
+    const auto schema = writer.add_schema("crane_msgs/msg/X", "ros2msg", "float64 v\n");
+    const auto a = writer.add_channel(schema, "/a", "cdr", {});
+    const auto b = writer.add_channel(schema, "/b", "cdr", {{"k", "v"}});
+    for (std::uint8_t i = 0; i < 5; ++i) {
+      const std::uint8_t payload[3] = {i, static_cast<std::uint8_t>(i + 1), static_cast<std::uint8_t>(i + 2)};
+      writer.write_message(i % 2 == 0 ? a : b, i, 1000U + i, 900U + i, payload, sizeof(payload));
+    }
+  }
+  std::string seen;
+  crane::launch::read_mcap_messages(path, [&](const crane::launch::McapMessageView& m) {
+    seen += m.channel->topic + ":" + std::to_string(m.sequence) + ":" + std::to_string(m.log_time) + ":" +
+            std::to_string(m.publish_time) + ":" + std::to_string(m.size) + ":" + std::to_string(m.data[2]) + ";";
+    EXPECT_EQ(m.channel->schema_name, "crane_msgs/msg/X");
+  });
+  EXPECT_EQ(seen, "/a:0:1000:900:3:2;/b:1:1001:901:3:3;/a:2:1002:902:3:4;/b:3:1003:903:3:5;/a:4:1004:904:3:6;");
+  // Cut inside the data section: refused naming the file.
+  const auto bytes = read_all(path);
+  {
+    std::ofstream cut(path, std::ios::binary | std::ios::trunc);
+    cut.write(reinterpret_cast<const char*>(bytes.data()), 100);
+  }
+  try {
+    crane::launch::read_mcap_messages(path, [](const crane::launch::McapMessageView&) {});
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
   std::filesystem::remove(path);
 }
 

@@ -10,6 +10,7 @@
 //                                                     sample of every topic in run.csv.samples.jsonl
 //   crane_topic record --mcap run.mcap [...]          every sample of every topic in MCAP, ros2 profile
 //                                                     (with --out too: both from the same samples)
+//   crane_topic convert run.mcap --out run.csv        the audit's CSV from such a recording (no DDS)
 //
 // Common options: --dds fast|cyclone, --domain N, --lan (default: bound to loopback, as the stack).
 // Exit codes: 0 done, 1 nothing received within the time given, 2 bad usage (unknown topic...).
@@ -27,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "crane/launch/mcap_reader.hpp"
 #include "crane/launch/mcap_writer.hpp"
 #include "crane/protocol/ros2_schemas.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -85,6 +87,56 @@ std::string offered_qos_yaml(transport::QosKind kind) {
          "\n  liveliness: " + (q.manual_by_topic_liveliness ? "3" : "1") +
          "\n  liveliness_lease_duration:" + duration(q.liveliness_lease) +
          "\n  avoid_ros_namespace_conventions: false";
+}
+
+/// The audit's CSV (t,u_x,u_gamma,x,gamma,phi,theta,L,seq) of the sensor samples by cycle: row k
+/// is the sensors of cycle k and the voltages applied during cycle k, which sample k+1 reports
+/// (cycles without a successor are left out). t from the cycle number (the sensor writer is the
+/// clock; wall stamps jitter, and in lockstep they are not simulated time). Returns the rows
+/// written; throws std::runtime_error when `path` cannot be written.
+std::size_t write_audit_csv(const std::map<std::uint64_t, tp::msgs::SensorSample_>& sensors, const std::string& path,
+                            double sample_period) {
+  std::ofstream csv(path);
+  if (!csv) throw std::runtime_error("cannot write " + path);
+  csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,seq\n";
+  csv.precision(10);
+  std::size_t rows = 0;
+  const std::uint64_t seq0 = sensors.empty() ? 0 : sensors.begin()->first;
+  for (auto it = sensors.begin(); it != sensors.end(); ++it) {
+    const auto next = std::next(it);
+    if (next == sensors.end() || next->first != it->first + 1) continue;
+    const auto& s = it->second;
+    const double t = static_cast<double>(it->first - seq0) * sample_period;
+    csv << t << ',' << next->second.applied_trolley_voltage() << ',' << next->second.applied_slew_voltage() << ','
+        << s.trolley_position() << ',' << s.slew_angle() << ',' << s.swing_in_plane() << ','
+        << s.swing_out_of_plane() << ',' << s.cable_length() << ',' << s.header().seq() << '\n';
+    ++rows;
+  }
+  if (!csv) throw std::runtime_error("cannot write " + path);
+  return rows;
+}
+
+/// crane_topic convert: the audit's CSV from the sensor channel of an MCAP recording.
+int convert(const std::string& mcap_path, const std::string& out_path, double sample_period) {
+  std::map<std::uint64_t, tp::msgs::SensorSample_> sensors;
+  const std::string topic = ros2_topic_name(tp::Sensors::name);
+  std::size_t refused = 0;
+  launch::read_mcap_messages(mcap_path, [&](const launch::McapMessageView& m) {
+    if (m.channel->topic != topic) return;
+    tp::msgs::SensorSample_ s;
+    if (m.channel->message_encoding != "cdr" || !transport::deserialize_cdr<tp::Sensors>(m.data, m.size, s)) {
+      ++refused;
+      return;
+    }
+    sensors[s.header().seq()] = s;
+  });
+  if (refused > 0) {
+    std::fprintf(stderr, "crane_topic: %zu messages of %s could not be decoded (not cdr, or not a SensorSample_)\n",
+                 refused, topic.c_str());
+  }
+  const auto rows = write_audit_csv(sensors, out_path, sample_period);
+  std::fprintf(stderr, "crane_topic: %zu sensor cycles of %s -> %s\n", rows, mcap_path.c_str(), out_path.c_str());
+  return rows > 0 ? 0 : 1;
 }
 
 Clock::time_point after(double seconds) {
@@ -213,7 +265,22 @@ int main(int argc, char** argv) {
   record_cmd->add_option("--sample-period", sample_period, "[s] of the sensor stream (t = cycle number * this)")
       ->check(CLI::Range(1e-4, 1.0));
   common(record_cmd);
+  auto* convert_cmd = app.add_subcommand("convert", "the audit's CSV from an MCAP recording (record --mcap)");
+  std::string convert_in;
+  convert_cmd->add_option("mcap", convert_in, "MCAP file written by crane_topic record --mcap")->required()
+      ->check(CLI::ExistingFile);
+  convert_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L,seq)")->required();
+  convert_cmd->add_option("--sample-period", sample_period, "[s] of the sensor stream (t = cycle number * this)")
+      ->check(CLI::Range(1e-4, 1.0));
   CLI11_PARSE(app, argc, argv);
+  if (convert_cmd->parsed()) {
+    try {
+      return convert(convert_in, out_path, sample_period);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_topic: %s\n", error.what());
+      return 1;
+    }
+  }
   if (record_cmd->parsed() && out_option->count() == 0 && mcap_option->count() == 0) {
     std::fprintf(stderr, "crane_topic record: give --out run.csv, --mcap run.mcap, or both\n");
     return 2;
@@ -343,25 +410,7 @@ int main(int argc, char** argv) {
                    mcap_path.c_str());
       if (out_path.empty()) return mcap->message_count() > 0 ? 0 : 1;
     }
-    // Row k: the sensors of cycle k and the voltage applied during cycle k, which sample k+1 reports.
-    std::ofstream csv(out_path);
-    if (!csv) throw std::runtime_error("cannot write " + out_path);
-    csv << "t,u_x,u_gamma,x,gamma,phi,theta,L,seq\n";
-    csv.precision(10);
-    std::size_t rows = 0;
-    // Time from the cycle number (the sensor writer is the clock; wall stamps jitter, and in
-    // lockstep they are not simulated time).
-    const std::uint64_t seq0 = sensors.empty() ? 0 : sensors.begin()->first;
-    for (auto it = sensors.begin(); it != sensors.end(); ++it) {
-      const auto next = std::next(it);
-      if (next == sensors.end() || next->first != it->first + 1) continue;
-      const auto& s = it->second;
-      const double t = static_cast<double>(it->first - seq0) * sample_period;
-      csv << t << ',' << next->second.applied_trolley_voltage() << ',' << next->second.applied_slew_voltage() << ','
-          << s.trolley_position() << ',' << s.slew_angle() << ',' << s.swing_in_plane() << ','
-          << s.swing_out_of_plane() << ',' << s.cable_length() << ',' << s.header().seq() << '\n';
-      ++rows;
-    }
+    const std::size_t rows = write_audit_csv(sensors, out_path, sample_period);
     std::fprintf(stderr, "crane_topic: %zu sensor cycles -> %s, every sample -> %s.samples.jsonl\n", rows,
                  out_path.c_str(), out_path.c_str());
     return rows > 0 ? 0 : 1;

@@ -9,6 +9,8 @@
 // reader that takes the encapsulation header first (Foxglove's @foxglove/cdr CdrReader, rosbag2's
 // mcap storage) reads them.
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +34,18 @@ template <class Topic>
   }
   bytes.assign(payload.data, payload.data + payload.length);
   return true;
+}
+
+/// The inverse: reads `size` bytes (encapsulation header included) into `message`. Returns false,
+/// `message` unspecified, when the type support refuses them (too short, unknown encapsulation).
+template <class Topic>
+[[nodiscard]] bool deserialize_cdr(const std::uint8_t* data, std::size_t size, typename Topic::Message& message) {
+  typename Topic::FastDdsType type;
+  if (size < 4 || size > type.m_typeSize) return false;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(size));
+  std::copy(data, data + size, payload.data);
+  payload.length = static_cast<std::uint32_t>(size);
+  return type.deserialize(&payload, &message);
 }
 
 }  // namespace crane::transport
