@@ -93,6 +93,15 @@ node "$HERE/mcap_check.js" "$OUT/run.mcap" "$OUT/run.csv.samples.jsonl" 9 | tee 
 # reads) is the CSV the recorder wrote, byte for byte.
 "$BIN/crane_topic" convert "$OUT/run.mcap" --out "$OUT/run_from_mcap.csv" || status=1
 cmp "$OUT/run.csv" "$OUT/run_from_mcap.csv" && echo "run.csv and the CSV converted from run.mcap are identical" || status=1
+# Replayed (3x) into another domain, recorded there: every replayed sample is one of the run's.
+"$BIN/crane_topic" record --out "$OUT/replay.csv" --duration 2 --timeout 20 --domain $((DOMAIN + 1)) > "$OUT/replay_record.log" 2>&1 &
+replay_record=$!
+pids+=($replay_record)
+"$BIN/crane_topic" replay "$OUT/run.mcap" --rate 3 --domain $((DOMAIN + 1)) || status=1
+wait "$replay_record" || { echo "recording the replay failed:"; cat "$OUT/replay_record.log"; status=1; }
+node "$HERE/foxglove_client.js" compare "$OUT/replay.csv.samples.jsonl" "$OUT/run.csv.samples.jsonl" > "$OUT/replay_compare.json" \
+  || { cat "$OUT/replay_compare.json"; status=1; }
+echo "replay: $(grep -c hw/sensors "$OUT/replay.csv.samples.jsonl") sensor samples recorded from the replay, all equal to the run's"
 rate=$(node -e 'console.log(JSON.parse(require("fs").readFileSync(process.argv[1])).sensor_rate_hz)' "$OUT/live.json")
 echo "[ figure ] rt/crane/hw/sensors through crane_web: $rate Hz over 5 s (required 100 +- 5)"
 node -e 'const r=+process.argv[1]; process.exit(r >= 95 && r <= 105 ? 0 : 1)' "$rate" || { echo "rate $rate Hz outside 100 +- 5"; status=1; }

@@ -11,6 +11,8 @@
 //   crane_topic record --mcap run.mcap [...]          every sample of every topic in MCAP, ros2 profile
 //                                                     (with --out too: both from the same samples)
 //   crane_topic convert run.mcap --out run.csv        the audit's CSV from such a recording (no DDS)
+//   crane_topic replay run.mcap --domain N [--rate F]  republishes it (not goals or supervisor
+//                                                     commands), --domain required: not onto a stack
 //
 // Common options: --dds fast|cyclone, --domain N, --lan (default: bound to loopback, as the stack).
 // Exit codes: 0 done, 1 nothing received within the time given, 2 bad usage (unknown topic...).
@@ -26,6 +28,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "crane/launch/mcap_reader.hpp"
@@ -137,6 +140,55 @@ int convert(const std::string& mcap_path, const std::string& out_path, double sa
   const auto rows = write_audit_csv(sensors, out_path, sample_period);
   std::fprintf(stderr, "crane_topic: %zu sensor cycles of %s -> %s\n", rows, mcap_path.c_str(), out_path.c_str());
   return rows > 0 ? 0 : 1;
+}
+
+/// crane_topic replay: republishes an MCAP recording's samples on the bus at `rate` times their
+/// recorded pace (log times), each topic through its own writer. Operator inputs (goals, supervisor
+/// commands) are never replayed. Returns the number of samples written.
+std::size_t replay(transport::Participant& participant, const std::string& mcap_path, double rate) {
+  struct Sample {
+    std::size_t writer;
+    std::uint64_t log_time;
+    std::vector<std::uint8_t> bytes;
+  };
+  std::vector<std::function<bool(const std::vector<std::uint8_t>&)>> writers;
+  std::vector<std::shared_ptr<void>> keep;
+  std::map<std::string, std::size_t> writer_of_topic;
+  tp::for_each_topic([&]<class T>() {
+    if constexpr (std::is_same_v<T, tp::Goal> || std::is_same_v<T, tp::SafetyCommand>) return;
+    auto writer = std::shared_ptr(participant.make_writer<T>());
+    keep.push_back(writer);
+    writer_of_topic[ros2_topic_name(T::name)] = writers.size();
+    writers.push_back([writer](const std::vector<std::uint8_t>& bytes) {
+      typename T::Message m;
+      return transport::deserialize_cdr<T>(bytes.data(), bytes.size(), m) && writer->write(m);
+    });
+  });
+  std::vector<Sample> samples;
+  launch::read_mcap_messages(mcap_path, [&](const launch::McapMessageView& m) {
+    const auto found = writer_of_topic.find(m.channel->topic);
+    if (found == writer_of_topic.end() || m.channel->message_encoding != "cdr") return;
+    samples.push_back({found->second, m.log_time, std::vector<std::uint8_t>(m.data, m.data + m.size)});
+  });
+  if (samples.empty()) throw std::runtime_error(mcap_path + ": no sample of a replayed topic");
+  // Discovery: the readers of another process need a moment to match the new writers.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const auto start = Clock::now();
+  const auto t0 = samples.front().log_time;
+  std::size_t written = 0, refused = 0;
+  for (const auto& s : samples) {
+    if (runtime::stop_requested()) break;
+    const auto due = std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(s.log_time - t0) / rate));
+    std::this_thread::sleep_until(start + due);
+    if (writers[s.writer](s.bytes)) {
+      ++written;
+    } else {
+      ++refused;
+    }
+  }
+  std::fprintf(stderr, "crane_topic: replayed %zu samples of %s at %gx (%zu refused)\n", written, mcap_path.c_str(),
+               rate, refused);
+  return written;
 }
 
 Clock::time_point after(double seconds) {
@@ -272,6 +324,14 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("--out", out_path, "CSV file (t,u_x,u_gamma,x,gamma,phi,theta,L,seq)")->required();
   convert_cmd->add_option("--sample-period", sample_period, "[s] of the sensor stream (t = cycle number * this)")
       ->check(CLI::Range(1e-4, 1.0));
+  auto* replay_cmd = app.add_subcommand("replay", "republish an MCAP recording on the bus (never goals or commands)");
+  std::string replay_in;
+  double replay_rate = 1.0;
+  replay_cmd->add_option("mcap", replay_in, "MCAP file written by crane_topic record --mcap")->required()
+      ->check(CLI::ExistingFile);
+  replay_cmd->add_option("--rate", replay_rate, "pace, times the recorded one")->check(CLI::Range(0.01, 100.0));
+  common(replay_cmd);
+  replay_cmd->get_option("--domain")->required();  // never by default onto domain 0, where a stack runs
   CLI11_PARSE(app, argc, argv);
   if (convert_cmd->parsed()) {
     try {
@@ -294,6 +354,7 @@ int main(int argc, char** argv) {
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
     if (list_cmd->parsed()) return list(*participant, wait, as_json);
+    if (replay_cmd->parsed()) return replay(*participant, replay_in, replay_rate) > 0 ? 0 : 1;
 
     if (echo_cmd->parsed() || hz_cmd->parsed()) {
       int status = 1;
