@@ -198,7 +198,8 @@ function plot(id, series) {
   }
 }
 
-function render() {
+// One frame: the status line, the sample panel, the views and the plots from the samples so far.
+function draw() {
   const s = view.last;
   $("mode").textContent = view.mode || "waiting";
   $("mode").className = view.mode === "ready" || view.mode === "operating" ? "ok" : view.mode ? "bad" : "";
@@ -215,6 +216,11 @@ function render() {
   plot("plot_positions", [{ key: "x", color: "#36c" }, { key: "gamma", color: "#c63" }]);
   plot("plot_swing", [{ key: "phi", color: "#36c" }, { key: "theta", color: "#c63" }]);
   plot("plot_voltages", [{ key: "ux", color: "#36c" }, { key: "ugamma", color: "#c63" }]);
+}
+view.draw = draw; // a test draws a frame synchronously (page_check.js)
+
+function render() {
+  draw();
   requestAnimationFrame(render);
 }
 
