@@ -10,6 +10,13 @@ writes what repeats them:
                                            visit_fields() (names and values, for echo and records)
   gen_protocol.py IDL --dds OUT.hpp        to_dds() / from_dds() between those structs and the
                                            fastddsgen classes (the DDS transport's types)
+  gen_protocol.py IDL --schema OUT.hpp     crane::protocol::kIdlSchema: the IDL's text as a string
+                                           constant (a Foxglove channel's omgidl schema), its hex
+                                           literals written in decimal (Foxglove's omgidl parser
+                                           reads no hex); the text is otherwise unchanged
+  gen_protocol.py IDL --ros2-schemas OUT.hpp   crane::protocol::kRos2Schemas: each message's ROS 2 type
+                                           name and its .msg with its dependencies (MCAP's ros2msg
+                                           schema encoding, for crane_topic record --mcap)
   gen_protocol.py IDL --msg-dir DIR        the ROS 2 interface files DIR/<Name>.msg (rosidl's .msg
                                            syntax, constants and the IDL's comments included)
   gen_protocol.py IDL --ros2-package DIR --package-files SRC
@@ -23,6 +30,7 @@ Exit 1 with a message on an IDL construct the parser (idl_structs.py) does not k
 """
 import argparse
 import pathlib
+import re
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
@@ -200,40 +208,88 @@ def msg_comment(text):
     return f"# {text}" if text else "#"
 
 
-def msg_files(structs, constants, idl_name):
-    """{file name: text} of the ROS 2 .msg files of module crane_msgs::msg::dds_.
+def msg_text(s, structs, constants, idl_name):
+    """The ROS 2 .msg text of struct `s` (rosidl's .msg syntax, rosidl_adapter.parser): the leading
+    # lines are the message's comment, a constant is `TYPE NAME=VALUE`, a field `TYPE name` or
+    `TYPE[N] name`, a type of another package `pkg/Type`; a trailing `# ...` and whole-line comments
+    right above belong to the element below."""
+    modules_of = {x.name: x.modules for x in structs}
+    name = plain(s.name)
+    lines = [msg_comment(line) for line in s.leading]
+    lines += [f"# Generated from {idl_name} ({s.scoped_name}) by idl/tools/gen_protocol.py. Do not edit.", ""]
+    codes = [c for c in constants if c.owner == name]
+    for c in codes:
+        lines += [msg_comment(line) for line in c.leading]
+        comment = f"  # {c.comment}" if c.comment else ""
+        lines.append(f"{ROS_TYPES[c.idl_type]} {c.name}={c.value}{comment}")
+    if codes:
+        lines.append("")
+    for f in s.fields:
+        if f.primitive:
+            ros = ROS_TYPES[f.idl_type]
+        elif modules_of[f.idl_type][0] != "crane_msgs":
+            ros = f"{modules_of[f.idl_type][0]}/{plain(f.idl_type)}"  # builtin_interfaces/Time
+        else:
+            ros = plain(f.idl_type)
+        lines += [msg_comment(line) for line in f.leading]
+        comment = f"  # {f.comment}" if f.comment else ""
+        lines.append(f"{ros}{f'[{f.size}]' if f.size else ''} {f.name}{comment}")
+    return "\n".join(lines) + "\n"
 
-    rosidl's .msg syntax (rosidl_adapter.parser): the leading # lines are the message's comment, a
-    constant is `TYPE NAME=VALUE`, a field `TYPE name` or `TYPE[N] name`, a type of another package
-    `pkg/Type`; a trailing `# ...` and whole-line comments right above belong to the element below.
-    """
-    files = {}
-    modules_of = {s.name: s.modules for s in structs}
+
+def msg_files(structs, constants, idl_name):
+    """{file name: text} of the ROS 2 .msg files of module crane_msgs::msg::dds_."""
+    return {f"{plain(s.name)}.msg": msg_text(s, structs, constants, idl_name)
+            for s in structs if s.modules == ["crane_msgs", "msg", "dds_"]}
+
+
+def ros2_type_name(s):
+    """crane_msgs::msg::dds_::SensorSample_ -> crane_msgs/msg/SensorSample (ROS 2's resource name)."""
+    return f"{s.modules[0]}/msg/{plain(s.name)}"
+
+
+def ros2_schemas(structs, constants, idl_name):
+    """crane::protocol::kRos2Schemas: per message of crane_msgs::msg::dds_, its ROS 2 type name and
+    its schema as MCAP's ros2msg encoding writes it (registry.md, "ros2msg"): the message's .msg
+    text, then each type it uses (depth first, each once) after a line of 80 '=' and a line
+    'MSG: <package>/msg/<Type>'."""
+    by_name = {x.name: x for x in structs}
+    entries = []
     for s in structs:
         if s.modules != ["crane_msgs", "msg", "dds_"]:
             continue
-        name = plain(s.name)
-        lines = [msg_comment(line) for line in s.leading]
-        lines += [f"# Generated from {idl_name} ({s.scoped_name}) by idl/tools/gen_protocol.py. Do not edit.", ""]
-        codes = [c for c in constants if c.owner == name]
-        for c in codes:
-            lines += [msg_comment(line) for line in c.leading]
-            comment = f"  # {c.comment}" if c.comment else ""
-            lines.append(f"{ROS_TYPES[c.idl_type]} {c.name}={c.value}{comment}")
-        if codes:
-            lines.append("")
-        for f in s.fields:
-            if f.primitive:
-                ros = ROS_TYPES[f.idl_type]
-            elif modules_of[f.idl_type][0] != "crane_msgs":
-                ros = f"{modules_of[f.idl_type][0]}/{plain(f.idl_type)}"  # builtin_interfaces/Time
-            else:
-                ros = plain(f.idl_type)
-            lines += [msg_comment(line) for line in f.leading]
-            comment = f"  # {f.comment}" if f.comment else ""
-            lines.append(f"{ros}{f'[{f.size}]' if f.size else ''} {f.name}{comment}")
-        files[f"{name}.msg"] = "\n".join(lines) + "\n"
-    return files
+        order = []
+
+        def visit(t):
+            for f in t.fields:
+                if not f.primitive and f.idl_type not in order:
+                    order.append(f.idl_type)
+                    visit(by_name[f.idl_type])
+
+        visit(s)
+        text = msg_text(s, structs, constants, idl_name)
+        for dep in order:
+            text += "=" * 80 + f"\nMSG: {ros2_type_name(by_name[dep])}\n" + msg_text(by_name[dep], structs, constants, idl_name)
+        if ")crane_msg\"" in text:
+            raise SystemExit(f"{idl_name}: contains the raw-string delimiter )crane_msg\"")
+        entries.append(f'    {{"{s.scoped_name}", "{ros2_type_name(s)}", R"crane_msg({text})crane_msg"}}')
+    return (HEADER.format(idl=idl_name) + "#pragma once\n#include <array>\n#include <string_view>\n\n"
+            "namespace crane::protocol {\n\n"
+            "/// A message's ROS 2 interface: its resource name and its schema in MCAP's ros2msg encoding.\n"
+            "struct Ros2Schema {\n"
+            "  std::string_view dds_type_name;   // crane_msgs::msg::dds_::SensorSample_\n"
+            "  std::string_view ros2_type_name;  // crane_msgs/msg/SensorSample\n"
+            "  std::string_view msg_definition;  // the .msg, then its dependencies, delimited\n"
+            "};\n\n"
+            f"inline constexpr std::array<Ros2Schema, {len(entries)}> kRos2Schemas{{{{\n" + ",\n".join(entries) + "}};\n\n"
+            "/// The schema of DDS type `dds_type_name`, or nullptr when the IDL has no such message.\n"
+            "[[nodiscard]] constexpr const Ros2Schema* ros2_schema(std::string_view dds_type_name) noexcept {\n"
+            "  for (const auto& s : kRos2Schemas) {\n"
+            "    if (s.dds_type_name == dds_type_name) return &s;\n"
+            "  }\n"
+            "  return nullptr;\n"
+            "}\n\n"
+            "}  // namespace crane::protocol\n")
 
 
 def ros2_package(structs, constants, idl_name, out_dir, package_files):
@@ -254,6 +310,19 @@ def ros2_package(structs, constants, idl_name, out_dir, package_files):
                      f"set(CRANE_MSG_FILES\n{listing})\n")
 
 
+def schema(idl_text, idl_name):
+    """The IDL as a C++ string constant, for channels whose schema encoding is omgidl."""
+    text = re.sub(r"\b0[xX]([0-9a-fA-F]+)\b", lambda m: str(int(m.group(1), 16)), idl_text)
+    delimiter = "crane_idl"
+    if ")" + delimiter + '"' in text:
+        raise SystemExit(f"{idl_name}: contains the raw-string delimiter ){delimiter}\"")
+    return (HEADER.format(idl=idl_name) + "#pragma once\n#include <string_view>\n\nnamespace crane::protocol {\n\n"
+            f"/// {idl_name}, every message type of the bus in OMG IDL (schema encoding \"omgidl\"), hex\n"
+            "/// literals in decimal. Root type names are the DDS type names (crane_msgs::msg::dds_::<Name>_).\n"
+            f'inline constexpr std::string_view kIdlSchema = R"{delimiter}({text}){delimiter}";\n\n'
+            "}  // namespace crane::protocol\n")
+
+
 def write_if_changed(target, text):
     target = pathlib.Path(target)
     if not target.exists() or target.read_text() != text:  # unchanged output: no rebuild
@@ -267,6 +336,8 @@ def main():
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--messages", metavar="OUT.hpp")
     what.add_argument("--dds", metavar="OUT.hpp")
+    what.add_argument("--schema", metavar="OUT.hpp")
+    what.add_argument("--ros2-schemas", metavar="OUT.hpp")
     what.add_argument("--msg-dir", metavar="DIR")
     what.add_argument("--ros2-package", metavar="DIR")
     parser.add_argument("--package-files", metavar="SRC", help="with --ros2-package: package.xml, "
@@ -280,6 +351,10 @@ def main():
         write_if_changed(args.messages, messages(structs, constants, idl.name))
     elif args.dds:
         write_if_changed(args.dds, dds(structs, idl.name))
+    elif args.ros2_schemas:
+        write_if_changed(args.ros2_schemas, ros2_schemas(structs, constants, idl.name))
+    elif args.schema:
+        write_if_changed(args.schema, schema(idl.read_text(), idl.name))
     elif args.msg_dir:
         for name, text in msg_files(structs, constants, idl.name).items():
             write_if_changed(pathlib.Path(args.msg_dir) / name, text)

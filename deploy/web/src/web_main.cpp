@@ -1,0 +1,196 @@
+// crane_web: the crane's bus for Foxglove Studio, Lichtblick and any Foxglove WebSocket client.
+//
+//   crane_web [--port 8765] [--bind 127.0.0.1] [--queue 256] [--nice 10] [--dds fast|cyclone] [--domain N] [--lan]
+//
+// A read-only DDS participant (readers only) takes every topic of the bus (the topic table,
+// transport::topics::for_each_topic) and forwards each sample, as the CDR bytes a DDS writer puts
+// on the wire (encapsulation header included), to the WebSocket clients subscribed to its channel:
+// one channel per topic, encoding "cdr", schema encoding "omgidl", schema the IDL
+// (crane::protocol::kIdlSchema, generated from idl/crane_msgs.idl), schema name the DDS type name.
+// Samples with NaN or Inf are rejected where they enter (as every process of the stack does) and
+// counted. Client publishing is off. HTTP on the same port: / the operator page (deploy/web/www:
+// read-only views, plots, mode and faults, over the same protocol), /about (what this is) and
+// /metrics (the Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process,
+// the server).
+// Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
+// CLI11's message and code.
+#include <CLI/CLI.hpp>
+#include <sys/resource.h>
+
+#include <cerrno>
+#include <cstring>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "crane/protocol/dds.hpp"
+#include "crane/protocol/idl_schema.hpp"
+#include "crane/runtime/node_runtime.hpp"
+#include "crane/transport/cdr.hpp"
+#include "crane/web/foxglove_server.hpp"
+#include "crane/web/web_metrics.hpp"
+
+namespace {
+
+using namespace crane;
+namespace tp = transport::topics;
+using Clock = std::chrono::steady_clock;
+
+/// One advertised channel per topic of the bus, ids 1..N in the topic table's order.
+std::vector<web::Channel> bus_channels() {
+  std::vector<web::Channel> channels;
+  tp::for_each_topic([&]<class Topic>() {
+    channels.push_back(web::Channel{static_cast<std::uint32_t>(channels.size() + 1), Topic::name, "cdr",
+                                    Topic::type_name, "omgidl", std::string(protocol::kIdlSchema)});
+  });
+  return channels;
+}
+
+/// The text of `path`; empty when it cannot be read.
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return in ? text.str() : std::string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"crane_web: the crane's topics over the Foxglove WebSocket protocol (read-only)"};
+  runtime::NodeOptions node;
+  web::ServerOptions server_options;
+  bool lan = false;
+  app.add_option("--port", server_options.port, "TCP port (0: any free port, printed at start)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--bind", server_options.bind_address,
+                 "address to listen on (default loopback only; 0.0.0.0: every interface)");
+  app.add_option("--queue", server_options.queue_frames, "per-client send queue [samples]; the oldest is dropped when full")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
+  app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
+  app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  std::string assets = CRANE_WEB_ASSETS_DIR;
+  app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
+  int nice_value = 10;
+  app.add_option("--nice", nice_value, "scheduling niceness of the whole server (0-19): below the stack's processes, "
+                                       "so viewers never take CPU from the control loop")
+      ->check(CLI::Range(0, 19));
+  CLI11_PARSE(app, argc, argv);
+  // Before any thread exists (DDS's, the I/O thread): they inherit it. What it changes for the
+  // stack's latency with 20 clients: deploy/bench_web.sh, docs/operation.md.
+  if (nice_value > 0 && setpriority(PRIO_PROCESS, 0, nice_value) != 0) {
+    std::fprintf(stderr, "crane_web: --nice %d: %s (running at the default niceness)\n", nice_value, std::strerror(errno));
+  }
+  node.loopback_only = !lan;
+  node.shared_memory = !lan;
+
+  try {
+    runtime::configure_logging("warn", "crane_web");
+    auto participant = runtime::make_participant(node, "crane_web");
+    transport::Wakeup wakeup;
+    runtime::install_stop_handlers(&wakeup);
+
+    // The operator page: its two files, read once (deploy/web/www).
+    const std::string page = file_text(assets + "/index.html");
+    const std::string page_script = file_text(assets + "/crane_view.js");
+    if (page.empty() || page_script.empty()) {
+      std::fprintf(stderr, "crane_web: no operator page in %s (index.html, crane_view.js): / describes the server\n",
+                   assets.c_str());
+    }
+    const auto channels = bus_channels();
+    std::vector<std::string> topic_names;
+    for (const auto& c : channels) topic_names.push_back(c.topic);
+    web::WebMetrics metrics(topic_names);
+    const web::ServerStats* server_stats = nullptr;  // set before the server starts
+    web::FoxgloveServer server(server_options, channels, [&](const std::string& path) {
+      web::HttpResponse response;
+      if (path == "/metrics") {
+        response.status = 200;
+        response.content_type = "text/plain; version=0.0.4; charset=utf-8";
+        response.body = metrics.text(server_stats);
+      } else if ((path == "/" || path == "/index.html") && !page.empty()) {
+        response.status = 200;
+        response.content_type = "text/html; charset=utf-8";
+        response.body = page;
+      } else if (path == "/crane_view.js" && !page_script.empty()) {
+        response.status = 200;
+        response.content_type = "text/javascript; charset=utf-8";
+        response.body = page_script;
+      } else if (path == "/" || path == "/about") {
+        response.status = 200;
+        response.body = "crane_web: the crane's topics over the Foxglove WebSocket protocol (subprotocol " +
+                        std::string(web::kSubprotocol) + ") on this port; " + std::to_string(channels.size()) +
+                        " channels, encoding cdr, schema omgidl. Open it in Foxglove or Lichtblick "
+                        "(Foxglove WebSocket, ws://HOST:PORT). Metrics: /metrics\n";
+      } else {
+        response.body = "not found: " + path + "\n";
+      }
+      return response;
+    });
+    server_stats = &server.stats();
+
+    // One reader per topic (history deep enough that a busy moment never drops a sample here),
+    // and its drain: take, reject non-finite, serialize, forward.
+    std::vector<std::function<void()>> drains;
+    std::vector<std::shared_ptr<void>> readers;
+    std::uint32_t channel_id = 0;
+    tp::for_each_topic([&]<class T>() {
+      const std::uint32_t id = ++channel_id;
+      auto reader = std::shared_ptr(participant->make_recording_reader<T>(&wakeup, 64));
+      readers.push_back(reader);
+      const std::size_t topic_index = id - 1;
+      drains.push_back([reader, id, topic_index, &server, &metrics] {
+        typename T::Message m;
+        while (reader->take_next(m)) {
+          const auto receive_ns = static_cast<std::uint64_t>(runtime::now_nanoseconds());
+          if (!runtime::all_finite(m)) {
+            metrics.nonfinite(topic_index);
+            continue;
+          }
+          metrics.sample(topic_index);
+          if constexpr (std::is_same_v<T, tp::SafetyStatus> || std::is_same_v<T, tp::LoopDiagnostics>) {
+            typename protocol::PlainOf<typename T::Message>::type plain;
+            protocol::from_dds(m, plain);
+            if constexpr (std::is_same_v<T, tp::SafetyStatus>) {
+              metrics.supervisor(plain);
+            } else {
+              metrics.loop(plain);
+            }
+          }
+          auto bytes = std::make_shared<std::vector<std::uint8_t>>();
+          if (!transport::serialize_cdr<T>(m, *bytes)) continue;
+          server.publish(id, receive_ns, std::move(bytes));
+        }
+      });
+    });
+
+    server.start();
+    std::printf("crane_web: ws://%s:%u (subprotocol %s), %zu channels; Ctrl-C to stop\n",
+                server_options.bind_address.c_str(), static_cast<unsigned>(server.port()),
+                std::string(web::kSubprotocol).c_str(), channels.size());
+    std::fflush(stdout);
+    auto window_start = Clock::now();
+    while (!runtime::stop_requested()) {
+      for (auto& d : drains) d();
+      const auto now = Clock::now();
+      if (now - window_start >= std::chrono::seconds(1)) {
+        metrics.update_rates(std::chrono::duration<double>(now - window_start).count());
+        window_start = now;
+      }
+      wakeup.wait_until(now + std::chrono::milliseconds(100));
+    }
+    server.stop();
+    return 0;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_web: %s\n", error.what());
+    return 1;
+  }
+}

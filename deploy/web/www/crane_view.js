@@ -1,0 +1,228 @@
+// crane_web's operator page: a Foxglove WebSocket client (foxglove.websocket.v1) that decodes the
+// CDR samples with the OMG IDL schema the server advertises. The field names, the mode and fault
+// names come from that schema (the IDL's constants), not from this file. Read-only.
+"use strict";
+
+// ---- OMG IDL, the subset of idl/crane_msgs.idl: modules, @annotations, const, struct, arrays ----
+function parseIdl(text) {
+  const tokens = text.replace(/\/\*[\s\S]*?\*\//g, " ").replace(/\/\/[^\n]*/g, " ")
+    .match(/::|[A-Za-z_][A-Za-z0-9_]*|-?[0-9][0-9.eE+-]*|[{}();:\[\]=@,<>]/g) || [];
+  let i = 0;
+  const structs = new Map(); // scoped name -> {fields: [{name, type, size}], scope}
+  const constants = new Map(); // scoped module name -> [{name, value}]
+  const next = () => tokens[i++];
+  const skipAnnotation = () => {
+    next(); // name
+    if (tokens[i] === "(") { let depth = 0; do { const t = next(); if (t === "(") depth++; if (t === ")") depth--; } while (depth > 0); }
+  };
+  const scopedName = () => { let n = next(); while (tokens[i] === "::") { next(); n += "::" + next(); } return n; };
+  function definitions(scope) {
+    while (i < tokens.length && tokens[i] !== "}") {
+      const t = next();
+      if (t === "@") skipAnnotation();
+      else if (t === "module") {
+        const name = next(); next(); // {
+        definitions([...scope, name]); next(); if (tokens[i] === ";") next();
+      } else if (t === "const") {
+        next(); const name = next(); next(); // type name =
+        const value = Number(next()); next();
+        const key = scope.join("::");
+        if (!constants.has(key)) constants.set(key, []);
+        constants.get(key).push({ name, value });
+      } else if (t === "struct") {
+        const name = next(); next(); // {
+        const fields = [];
+        while (tokens[i] !== "}") {
+          if (tokens[i] === "@") { next(); skipAnnotation(); continue; }
+          const type = scopedName(); const fname = next(); let size = 0;
+          if (tokens[i] === "[") { next(); size = Number(next()); next(); }
+          next(); // ;
+          fields.push({ name: fname, type, size });
+        }
+        next(); if (tokens[i] === ";") next();
+        structs.set([...scope, name].join("::"), { fields, scope });
+      } else if (t === ";") { /* stray */ }
+      else throw new Error(`IDL: unexpected '${t}'`);
+    }
+  }
+  definitions([]);
+  // A field's type in a scope: the innermost enclosing module that has it (IDL's scoping rule).
+  const resolve = (type, scope) => {
+    for (let n = scope.length; n >= 0; --n) {
+      const candidate = [...scope.slice(0, n), type].join("::");
+      if (structs.has(candidate)) return candidate;
+    }
+    return type;
+  };
+  for (const s of structs.values()) for (const f of s.fields) f.resolved = resolve(f.type, s.scope);
+  return { structs, constants };
+}
+
+// ---- CDR (XCDR1, little or big endian per the encapsulation header), alignment from byte 4 ----
+const PRIMITIVES = {
+  boolean: [1, (v, o, le) => v.getUint8(o) !== 0], octet: [1, (v, o) => v.getUint8(o)], char: [1, (v, o) => v.getUint8(o)],
+  int8: [1, (v, o) => v.getInt8(o)], uint8: [1, (v, o) => v.getUint8(o)],
+  int16: [2, (v, o, le) => v.getInt16(o, le)], uint16: [2, (v, o, le) => v.getUint16(o, le)],
+  int32: [4, (v, o, le) => v.getInt32(o, le)], uint32: [4, (v, o, le) => v.getUint32(o, le)],
+  float: [4, (v, o, le) => v.getFloat32(o, le)], double: [8, (v, o, le) => v.getFloat64(o, le)],
+  int64: [8, (v, o, le) => Number(v.getBigInt64(o, le))], uint64: [8, (v, o, le) => Number(v.getBigUint64(o, le))],
+};
+function decodeCdr(idl, typeName, view) {
+  const le = (view.getUint8(1) & 1) === 1;
+  let offset = 4;
+  const read = (type) => {
+    const p = PRIMITIVES[type];
+    if (p) {
+      offset += (p[0] - ((offset - 4) % p[0])) % p[0];
+      const value = p[1](view, offset, le);
+      offset += p[0];
+      return value;
+    }
+    const s = idl.structs.get(type);
+    if (!s) throw new Error(`CDR: unknown type ${type}`);
+    const out = {};
+    for (const f of s.fields) {
+      out[f.name] = f.size ? Array.from({ length: f.size }, () => read(f.resolved)) : read(f.resolved);
+    }
+    return out;
+  };
+  return read(typeName);
+}
+
+// ---- the page ----
+const view = { connected: false, sensors: 0, last: null, lastPayload: null, actuators: null, status: null, mode: "", faults: [] };
+window.craneView = view; // read by tests/web/page_check.js
+const history = []; // {t, x, gamma, phi, theta, ux, ugamma}
+const channels = new Map(); // subscription id -> {topic, schemaName, idl}
+const idlCache = new Map();
+const $ = (id) => document.getElementById(id);
+
+function codeNames(idl, module, group) {
+  return (idl.constants.get(module) || []).filter((c) => c.name.startsWith(group + "_"))
+    .map((c) => ({ name: c.name.slice(group.length + 1).toLowerCase(), value: c.value }));
+}
+
+function connect() {
+  const ws = new WebSocket(`ws://${location.host}/`, ["foxglove.websocket.v1"]);
+  ws.binaryType = "arraybuffer";
+  ws.onopen = () => { view.connected = true; $("link").textContent = "connected to " + location.host; };
+  ws.onclose = () => { view.connected = false; $("link").textContent = "disconnected; retrying"; setTimeout(connect, 1000); };
+  ws.onmessage = (event) => {
+    if (typeof event.data === "string") {
+      const m = JSON.parse(event.data);
+      if (m.op !== "advertise") return;
+      const wanted = ["rt/crane/hw/sensors", "rt/crane/hw/actuators", "rt/crane/safety/status"];
+      const subscriptions = [];
+      for (const ch of m.channels) {
+        if (!wanted.includes(ch.topic) || ch.schemaEncoding !== "omgidl") continue;
+        if (!idlCache.has(ch.schema)) idlCache.set(ch.schema, parseIdl(ch.schema));
+        const id = subscriptions.length;
+        channels.set(id, { topic: ch.topic, schemaName: ch.schemaName, idl: idlCache.get(ch.schema) });
+        subscriptions.push({ id, channelId: ch.id });
+      }
+      ws.send(JSON.stringify({ op: "subscribe", subscriptions }));
+      return;
+    }
+    const frame = new DataView(event.data);
+    if (frame.getUint8(0) !== 1) return;
+    const ch = channels.get(frame.getUint32(1, true));
+    if (!ch) return;
+    const payload = new DataView(event.data, 13);
+    const sample = decodeCdr(ch.idl, ch.schemaName, payload);
+    if (ch.topic === "rt/crane/hw/sensors") {
+      view.sensors += 1;
+      view.last = sample;
+      view.lastPayload = Array.from(new Uint8Array(event.data, 13));
+      history.push({ t: sample.header.seq * 0.01, x: sample.trolley_position, gamma: sample.slew_angle,
+                     phi: sample.swing_in_plane * 180 / Math.PI, theta: sample.swing_out_of_plane * 180 / Math.PI,
+                     ux: sample.applied_trolley_voltage, ugamma: sample.applied_slew_voltage });
+      if (history.length > 1000) history.shift();
+    } else if (ch.topic === "rt/crane/hw/actuators") {
+      view.actuators = sample;
+    } else {
+      view.status = sample;
+      const module = "crane_msgs::msg::SupervisorStatus_Constants";
+      const mode = codeNames(ch.idl, module, "MODE").find((c) => c.value === sample.mode);
+      view.mode = mode ? mode.name : String(sample.mode);
+      view.faults = codeNames(ch.idl, module, "FAULT").filter((c) => (sample.active_faults & c.value) !== 0).map((c) => c.name);
+      view.warnings = codeNames(ch.idl, module, "WARNING").filter((c) => (sample.warnings & c.value) !== 0).map((c) => c.name);
+    }
+  };
+}
+
+function drawTop() {
+  const c = $("top"), g = c.getContext("2d"), s = view.last;
+  g.clearRect(0, 0, c.width, c.height);
+  const scale = 110, cx = c.width / 2, cy = c.height / 2; // [px/m], the tower at the centre
+  g.strokeStyle = "#bbb"; g.beginPath(); g.arc(cx, cy, 1.2 * scale, 0, 2 * Math.PI); g.stroke();
+  if (!s) return;
+  // Jib frame: x along the jib, y across; load at (x - L cos(theta) sin(phi), L sin(theta)) (2.11).
+  const gam = s.slew_angle, x = s.trolley_position, L = s.cable_length;
+  const lx = x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane), ly = L * Math.sin(s.swing_out_of_plane);
+  const world = (a, b) => [cx + scale * (a * Math.cos(gam) - b * Math.sin(gam)), cy - scale * (a * Math.sin(gam) + b * Math.cos(gam))];
+  g.strokeStyle = "#333"; g.lineWidth = 4; g.beginPath(); g.moveTo(...world(-0.2, 0)); g.lineTo(...world(1.25, 0)); g.stroke();
+  g.lineWidth = 1; g.fillStyle = "#36c"; const [tx, ty] = world(x, 0); g.fillRect(tx - 6, ty - 6, 12, 12);
+  const [px, py] = world(lx, ly); g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, ty); g.lineTo(px, py); g.stroke();
+  g.fillStyle = "#c33"; g.beginPath(); g.arc(px, py, 7, 0, 2 * Math.PI); g.fill();
+}
+
+function drawSide() {
+  const c = $("side"), g = c.getContext("2d"), s = view.last;
+  g.clearRect(0, 0, c.width, c.height);
+  const scale = 140, ox = 30, oy = 40; // [px/m]; the jib at the top
+  g.strokeStyle = "#333"; g.lineWidth = 4; g.beginPath(); g.moveTo(ox, oy); g.lineTo(ox + 1.25 * scale, oy); g.stroke(); g.lineWidth = 1;
+  if (!s) return;
+  const x = s.trolley_position, L = s.cable_length;
+  const lx = x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane), lz = -L * Math.cos(s.swing_out_of_plane) * Math.cos(s.swing_in_plane);
+  const tx = ox + scale * x, px = ox + scale * lx, pz = oy - scale * lz;
+  g.fillStyle = "#36c"; g.fillRect(tx - 6, oy - 6, 12, 12);
+  g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, oy); g.lineTo(px, pz); g.stroke();
+  g.fillStyle = "#c33"; g.beginPath(); g.arc(px, pz, 8, 0, 2 * Math.PI); g.fill();
+}
+
+function plot(id, series) {
+  const c = $(id), g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  if (history.length < 2) return;
+  let lo = Infinity, hi = -Infinity;
+  for (const h of history) for (const s of series) { lo = Math.min(lo, h[s.key]); hi = Math.max(hi, h[s.key]); }
+  if (hi - lo < 1e-6) { hi += 0.5; lo -= 0.5; }
+  const t0 = history[0].t, t1 = history[history.length - 1].t;
+  const X = (t) => 30 + (c.width - 35) * (t - t0) / Math.max(t1 - t0, 1e-6), Y = (v) => c.height - 15 - (c.height - 25) * (v - lo) / (hi - lo);
+  g.fillStyle = "#666"; g.font = "10px sans-serif"; g.fillText(hi.toFixed(2), 0, 12); g.fillText(lo.toFixed(2), 0, c.height - 15);
+  g.fillText(`last ${(t1 - t0).toFixed(0)} s`, c.width - 60, c.height - 2);
+  for (const s of series) {
+    g.strokeStyle = s.color; g.beginPath();
+    history.forEach((h, k) => (k ? g.lineTo(X(h.t), Y(h[s.key])) : g.moveTo(X(h.t), Y(h[s.key]))));
+    g.stroke();
+  }
+}
+
+// One frame: the status line, the sample panel, the views and the plots from the samples so far.
+function draw() {
+  const s = view.last;
+  $("mode").textContent = view.mode || "waiting";
+  $("mode").className = view.mode === "ready" || view.mode === "operating" ? "ok" : view.mode ? "bad" : "";
+  $("faults").textContent = view.faults.length ? view.faults.join(", ") : "none";
+  $("warnings").textContent = view.warnings && view.warnings.length ? view.warnings.join(", ") : "none";
+  if (s) {
+    $("values").textContent = `cycle       ${s.header.seq}\ntrolley     ${s.trolley_position.toFixed(4)} m\n` +
+      `slew        ${(s.slew_angle * 180 / Math.PI).toFixed(2)} deg\ncable       ${s.cable_length.toFixed(3)} m\n` +
+      `swing in    ${(s.swing_in_plane * 180 / Math.PI).toFixed(3)} deg\nswing out   ${(s.swing_out_of_plane * 180 / Math.PI).toFixed(3)} deg\n` +
+      `V trolley   ${s.applied_trolley_voltage.toFixed(3)} V\nV slew      ${s.applied_slew_voltage.toFixed(3)} V\n` +
+      `brakes      ${s.brakes_engaged ? "engaged" : "released"}\nsamples     ${view.sensors}`;
+  }
+  drawTop(); drawSide();
+  plot("plot_positions", [{ key: "x", color: "#36c" }, { key: "gamma", color: "#c63" }]);
+  plot("plot_swing", [{ key: "phi", color: "#36c" }, { key: "theta", color: "#c63" }]);
+  plot("plot_voltages", [{ key: "ux", color: "#36c" }, { key: "ugamma", color: "#c63" }]);
+}
+view.draw = draw; // a test draws a frame synchronously (page_check.js)
+
+function render() {
+  draw();
+  requestAnimationFrame(render);
+}
+
+connect();
+requestAnimationFrame(render);
