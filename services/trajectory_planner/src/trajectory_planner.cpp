@@ -207,6 +207,10 @@ common::MotionReference TrajectoryPlanner::sample_now() const noexcept {
 
 int TrajectoryPlanner::intruded_zone(std::uint32_t zones_enabled, double spacing) const noexcept {
   if (!ready_ || zones_enabled == 0 || params_.site.zones.empty() || !(spacing > 0.0)) return -1;
+  // At most about 120 samples (a long move is checked at a coarser interval); each sample keeps an
+  // extra half of the distance its point travels to the next one, so nothing between two samples
+  // comes closer than the margin.
+  spacing = std::max(spacing, (move_duration_ - time_in_move_) / 120.0);
   const auto sample = [&](double t) {
     const double at = std::min(t, move_duration_);
     const Segment& s = segment_at(at);
@@ -231,7 +235,9 @@ int TrajectoryPlanner::intruded_zone(std::uint32_t zones_enabled, double spacing
                                                static_cast<std::size_t>(std::ceil(period / spacing)) + 1});
     double peak = 0.0;
     for (std::size_t i = 0; i < window; ++i) peak = std::max(peak, recent[(count - 1 - i) % recent.size()]);
-    const int zone = trajectory_planner::intruded_zone(params_.site, zones_enabled, r, params_.gravity, peak, &start);
+    const double travel = std::hypot(r.trolley.velocity, r.trolley.position * r.slew.velocity) * spacing;
+    const int zone = trajectory_planner::intruded_zone(params_.site, zones_enabled, r, params_.gravity, peak, &start,
+                                                       0.5 * travel + 0.5 * std::abs(r.cable_length.velocity) * spacing);
     if (zone >= 0) return zone;
     if (t >= move_duration_) return -1;
   }

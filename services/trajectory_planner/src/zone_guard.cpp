@@ -44,12 +44,12 @@ ZoneDistances zone_distances(const common::Site& site, const common::MotionRefer
 }
 
 int intruded_zone(const common::Site& site, std::uint32_t enabled, const common::MotionReference& r, double gravity,
-                  double acceleration, const ZoneDistances* caps) noexcept {
+                  double acceleration, const ZoneDistances* caps, double extra) noexcept {
   if (enabled == 0 || site.zones.empty()) return -1;
   const double x = r.trolley.position;
   const double a = std::max(horizontal_acceleration(r), acceleration);
   return point_zone(site, enabled, x, r.slew.position, r.cable_length.position, r.cable_length.position,
-                    zone_margin(site, r.cable_length.position, a, gravity), caps);
+                    zone_margin(site, r.cable_length.position, a, gravity) + extra, caps);
 }
 
 double swing_allowance(double cable_length, double horizontal_acceleration, double speed_change,

@@ -148,7 +148,8 @@ class TrajectoryPlanner {
   [[nodiscard]] common::MotionReference sample_now() const noexcept;
 
   /// The zone (index) the move currently planned enters, sampling its reference every `spacing`
-  /// [s] from the current time, or -1 (zone_guard.hpp): each sample with the margin of the largest
+  /// [s] (or every 1/400 of the rest of the move, if that is longer) from the current time, or -1
+  /// (zone_guard.hpp): each sample with the margin of the largest
   /// horizontal acceleration of the swing period before it (the swing it excited is still there).
   [[nodiscard]] int intruded_zone(std::uint32_t zones_enabled, double spacing) const noexcept;
 

@@ -38,8 +38,10 @@ using ZoneDistances = std::array<double, common::Site::kMaxZones>;
 /// larger of the sample's horizontal acceleration and `acceleration` [m/s^2] (a recent peak: the
 /// swing it excited is still there). With `caps`, zone i's margin is at most caps[i]: a move that
 /// starts inside a zone's margin may leave it (no sample closer than its start), not approach it.
+/// `extra` [m] is added to the margin (the half-distance to the next sample of a sampled path).
 [[nodiscard]] int intruded_zone(const common::Site& site, std::uint32_t enabled, const common::MotionReference& sample,
-                                double gravity, double acceleration = 0.0, const ZoneDistances* caps = nullptr) noexcept;
+                                double gravity, double acceleration = 0.0, const ZoneDistances* caps = nullptr,
+                                double extra = 0.0) noexcept;
 
 /// Horizontal swing allowance [m] of a load on a cable of `cable_length` [m] that changes its
 /// horizontal speed by `speed_change` [m/s] at up to `horizontal_acceleration` [m/s^2]: the factor
