@@ -144,3 +144,50 @@ TEST(TrackingStage, ReferenceCorrectionsOfDelay2AreAddedToTheReference) {
 }
 
 }  // namespace
+
+namespace {
+
+// The supervisor's warnings where a hard stop is not yet required (a limit approached too fast, a
+// zone ahead) are answered with the planner's soft stop: the goal is aborted naming the warning and
+// the reference decelerates from where it was, without a jump, to rest.
+TEST(PlannerStage, ASupervisorApproachWarningStopsTheGoalSoftly) {
+  for (const std::uint32_t warning : {protocol::SupervisorStatus::WARNING_SPEED_LIMITED,
+                                      protocol::SupervisorStatus::WARNING_ZONE_APPROACH}) {
+    trajectory_planner::TrajectoryPlannerParams p;
+    trajectory_planner::TrajectoryPlannerStage stage(p, 0.01);
+    protocol::SupervisorStatus status;
+    status.mode = protocol::SupervisorStatus::MODE_OPERATING;
+    status.operating_mode = protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC;
+    protocol::Reference reference, previous;
+    const Request goal = trolley_goal(1, 1.1);
+    std::vector<Feedback> feedback;
+    for (std::uint64_t k = 0; k < 800; ++k) {
+      if (k == 100) status.warnings = warning;  // one cycle of warning, mid-move
+      if (k == 101) status.warnings = 0;
+      const auto estimate = at_rest(k);
+      const trajectory_planner::PlannerCycle cycle{&estimate, k == 0 ? std::span(&goal, 1) : std::span<const Request>(),
+                                                   {}, &status};
+      ASSERT_EQ(stage.step(cycle, reference), common::StepStatus::ok);
+      for (const auto& f : stage.move_statuses()) feedback.push_back(f);
+      if (k > 0) {
+        // Continuous: no jump of the reference at the hand-over (at most a cycle at full speed).
+        EXPECT_LT(std::abs(reference.trolley_position - previous.trolley_position), 0.01) << "cycle " << k;
+      }
+      previous = reference;
+    }
+    bool aborted = false;
+    for (const auto& f : feedback) {
+      if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED) {
+        aborted = true;
+        EXPECT_EQ(f.reason, warning == protocol::SupervisorStatus::WARNING_ZONE_APPROACH ? Feedback::REASON_ZONE
+                                                                                         : Feedback::REASON_LIMIT_APPROACH);
+      }
+    }
+    EXPECT_TRUE(aborted);
+    EXPECT_LT(reference.trolley_position, 1.0) << "stopped short of the goal";
+    EXPECT_EQ(reference.trolley_velocity, 0.0) << "at rest";
+    EXPECT_FALSE(stage.under_speed_control());
+  }
+}
+
+}  // namespace

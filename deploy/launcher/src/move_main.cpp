@@ -291,6 +291,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
                        : f.reason == Feedback::REASON_MODE    ? "the operating mode changed (a soft stop first)"
                        : f.reason == Feedback::REASON_FAULT   ? "the supervisor stopped the crane"
                        : f.reason == Feedback::REASON_ZONE    ? "approaching a no-go zone (a soft stop)"
+                       : f.reason == Feedback::REASON_LIMIT_APPROACH ? "approaching a travel limit too fast (a soft stop)"
                        : f.reason == Feedback::REASON_MANUAL_MOTION ? "the operator's stick took over"
                                                                    : reason_name(f.reason);
         break;

@@ -254,7 +254,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
   const auto& params = planner_.params();
 
   // The supervisor's view: operating mode, zones, faults, zone approach.
-  bool zone_warning = false;
+  bool zone_warning = false, limit_warning = false;
   if (cycle.status != nullptr) {
     const auto& st = *cycle.status;
     const std::uint8_t mode = st.operating_mode;
@@ -269,6 +269,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     supervisor_mode_ = st.mode;
     supervisor_stopped_ = st.mode == Status::MODE_FAULT || st.mode == Status::MODE_EMERGENCY_STOP;
     zone_warning = (st.warnings & Status::WARNING_ZONE_APPROACH) != 0;
+    limit_warning = (st.warnings & Status::WARNING_SPEED_LIMITED) != 0;
   }
   if (supervisor_stopped_) {
     // The brakes hold the crane where it is and the drives are off: the running goal is over. The
@@ -284,8 +285,9 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     hold_on_release_ = false;
     source_ = Source::profile;
     (void)planner_.hold(current);
-  } else if (zone_warning && moving() && stop_id_ == 0) {
-    abort_active(Feedback::REASON_ZONE);
+  } else if ((zone_warning || limit_warning) && moving() && stop_id_ == 0) {
+    // The supervisor's first reaction where a hard stop is not yet required: this soft stop.
+    abort_active(zone_warning ? Feedback::REASON_ZONE : Feedback::REASON_LIMIT_APPROACH);
     soft_stop(0);
   }
 

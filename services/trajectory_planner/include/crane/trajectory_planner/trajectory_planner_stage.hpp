@@ -20,7 +20,8 @@
 //    reference is handed over to the speed reference (speed_reference.hpp) with every speed 0; its
 //    feedback (RESULT_STOPPING, with the predicted stopping position) is written in the cycle the
 //    deceleration starts, before that cycle's reference; RESULT_ARRIVED when at rest. The same stop
-//    answers a change of operating mode while moving and the supervisor's zone-approach warning;
+//    answers a change of operating mode while moving and the supervisor's warnings zone_approach
+//    and speed_limited (a travel or slew limit approached faster than its approach speed);
 //  - operating modes (OPC 40020) come from the supervisor's status: goals are refused in MANUAL and
 //    MAINTENANCE (REASON_MODE, value the mode), operator speeds in FULLAUTOMATIC (counted); in
 //    SEMIAUTOMATIC an operator speed takes over from a running goal (aborted: manual motion);
