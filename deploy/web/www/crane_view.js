@@ -144,6 +144,10 @@ function connect() {
       const module = "crane_msgs::msg::SupervisorStatus_Constants";
       const mode = codeNames(ch.idl, module, "MODE").find((c) => c.value === sample.mode);
       view.mode = mode ? mode.name : String(sample.mode);
+      const operation = codeNames(ch.idl, module, "OPERATION").find((c) => c.value === sample.operating_mode);
+      view.operation = operation ? operation.name : String(sample.operating_mode);
+      view.zones = [];
+      for (let i = 0; i < 32; ++i) if ((sample.zones_enabled >>> i) & 1) view.zones.push(i);
       view.faults = codeNames(ch.idl, module, "FAULT").filter((c) => (sample.active_faults & c.value) !== 0).map((c) => c.name);
       view.warnings = codeNames(ch.idl, module, "WARNING").filter((c) => (sample.warnings & c.value) !== 0).map((c) => c.name);
     }
@@ -203,6 +207,8 @@ function draw() {
   const s = view.last;
   $("mode").textContent = view.mode || "waiting";
   $("mode").className = view.mode === "ready" || view.mode === "operating" ? "ok" : view.mode ? "bad" : "";
+  $("operation").textContent = view.operation || "-";
+  $("zones").textContent = view.zones && view.zones.length ? view.zones.join(", ") : "none";
   $("faults").textContent = view.faults.length ? view.faults.join(", ") : "none";
   $("warnings").textContent = view.warnings && view.warnings.length ? view.warnings.join(", ") : "none";
   if (s) {
