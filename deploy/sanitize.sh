@@ -74,7 +74,8 @@ if [ "$mode" = asan ] || [ "$mode" = all ]; then
   run asan "$ROOT/build-asan" -DCRANE_SANITIZE=ON "$ASAN_TESTS" "${ASAN_TARGETS[@]}" || status=1
 fi
 if [ "$mode" = tsan ] || [ "$mode" = all ]; then
-  export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:exitcode=1:second_deadlock_stack=1}
+  # Suppressions: reports inside the two DDS libraries only, each with its reason in the file.
+  export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:exitcode=1:second_deadlock_stack=1:suppressions=$ROOT/deploy/tsan_suppressions.txt}
   run tsan "$ROOT/build-tsan" -DCRANE_SANITIZE_THREAD=ON "$TSAN_TESTS" "${TSAN_TARGETS[@]}" || status=1
 fi
 command -v fastdds >/dev/null 2>&1 && fastdds shm clean >/dev/null 2>&1 || true
