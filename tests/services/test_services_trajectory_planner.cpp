@@ -201,6 +201,24 @@ TEST(TrajectoryPlanner, TinyLimitsGiveAMoveTooLongToPlan) {
   EXPECT_NEAR(planner.move_duration(), 500.0 + (0.25 / 500.0) / 0.9929, 1e-9);
 }
 
+TEST(TrajectoryPlanner, TimeOptimalGoalWithATinyAccelerationLimitIsRefusedAtOnce) {
+  // Found by the topic-gates fuzzer (tests/fuzz): max_acceleration = 1e-300 m/s^2 made the
+  // swing-free trapezoid family count k = 1, 2, ... towards 1e150 (past 2^53, k += 1 stops changing
+  // k): start_move() never returned. Now the family is computed from k >= sqrt(z/a)/T and dropped
+  // beyond 1e9 periods; the goal is refused (no profile, or longer than kMaxMoveDuration).
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto here = at(0.5, 0.0, 1.0);
+  ASSERT_EQ(planner.hold(here), tp::GoalStatus::accepted);
+  tp::MoveGoal g;
+  g.profile = tp::ProfileKind::time_optimal;
+  g.trolley_target = 0.75;
+  g.trolley_limits.max_acceleration = 1e-300;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::rejected_invalid_limits);
+  // Ordinary limits still plan (the time-optimal cases of (3.54) are checked below).
+  g.trolley_limits.max_acceleration = 0.9929;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::accepted);
+}
+
 TEST(TrajectoryPlanner, BadParamsThrowNamingField) {
   auto expect_throw = [](const tp::TrajectoryPlannerParams& p, const std::string& field) {
     try {
