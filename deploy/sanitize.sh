@@ -69,7 +69,12 @@ run() {
 
 if [ "$mode" = asan ] || [ "$mode" = all ]; then
   # halt_on_error: the first report fails the test; detect_leaks: LeakSanitizer at exit.
-  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=0:exitcode=1}
+  # new_delete_type_mismatch=0: Fast DDS 2.9.1 (Debian's libfastrtps) allocates an 88-byte
+  # StatisticsWriterImpl and deletes it as a 56-byte type in RTPSWriter::~RTPSWriter, whenever a
+  # DataWriter is deleted (transport.CrossVendor.*, 2026-11-22): the whole stack is inside the
+  # library. ASan cannot suppress that check per library, so it is off for every test; the
+  # sanitizer figures in docs/robustness.md say so.
+  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=0:exitcode=1:new_delete_type_mismatch=0}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
   run asan "$ROOT/build-asan" -DCRANE_SANITIZE=ON "$ASAN_TESTS" "${ASAN_TARGETS[@]}" || status=1
 fi
