@@ -162,6 +162,41 @@ TEST(StateEstimator, NonFiniteRejectedAndStateUnchanged) {
   EXPECT_EQ(ea.swing_in_plane_rate, eb.swing_in_plane_rate);
 }
 
+TEST(StateEstimator, AbsurdMagnitudeRejectedBeforeItOverflowsTheRates) {
+  // Found by the topic-gates fuzzer (tests/fuzz): a finite trolley position of -1.47e307 m after a
+  // sample at 0 gave a raw velocity (x_k - x_k-1)/T = -1.47e309 = -Inf, returned as ok. Beyond
+  // kMaxMeasurementMagnitude a sample is refused like a NaN, and the state is unchanged.
+  se::StateEstimator a(se::StateEstimatorParams{});
+  se::StateEstimator b(se::StateEstimatorParams{});
+  CraneStateEstimate ea, eb;
+  const CraneMeasurement rest{0.25, 0.0, 0.0, 0.0, 1.0};
+  ASSERT_EQ(a.step(rest, ea), StepStatus::ok);
+  ASSERT_EQ(b.step(rest, eb), StepStatus::ok);
+  for (const double absurd : {-1.4746701496917433e+307, 2.0 * se::kMaxMeasurementMagnitude}) {
+    for (int channel = 0; channel < 5; ++channel) {
+      CraneMeasurement bad = rest;
+      double* fields[] = {&bad.trolley_position, &bad.slew_angle, &bad.swing_in_plane, &bad.swing_out_of_plane,
+                          &bad.cable_length};
+      *fields[channel] = absurd;
+      EXPECT_EQ(b.step(bad, eb), StepStatus::rejected_nonfinite) << "channel " << channel << " = " << absurd;
+    }
+  }
+  // The bound itself is a measurement (a 1000 km trolley is absurd, but its rates stay finite).
+  CraneMeasurement edge = rest;
+  edge.trolley_position = se::kMaxMeasurementMagnitude;
+  se::StateEstimator c(se::StateEstimatorParams{});
+  CraneStateEstimate ec;
+  ASSERT_EQ(c.step(rest, ec), StepStatus::ok);
+  ASSERT_EQ(c.step(edge, ec), StepStatus::ok);
+  EXPECT_TRUE(std::isfinite(ec.trolley_velocity_raw));
+  EXPECT_TRUE(std::isfinite(ec.trolley_velocity));
+  // b skipped the bad samples entirely: it matches a, which never saw them, bit for bit.
+  ASSERT_EQ(a.step(rest, ea), StepStatus::ok);
+  ASSERT_EQ(b.step(rest, eb), StepStatus::ok);
+  EXPECT_EQ(ea.trolley_position, eb.trolley_position);
+  EXPECT_EQ(ea.trolley_velocity_raw, eb.trolley_velocity_raw);
+}
+
 TEST(StateEstimator, BadParamsThrowNamingField) {
   auto expect_throw = [](const se::StateEstimatorParams& p, const std::string& field) {
     try {

@@ -124,6 +124,33 @@ TEST(TrackingController, NonFiniteRejected) {
   EXPECT_EQ(controller.step(in, out), StepStatus::rejected_nonfinite);
 }
 
+TEST(TrackingController, OverflowOfFiniteInputsGivesTheSafeOutput) {
+  // Found by the topic-gates fuzzer (tests/fuzz): finite inputs every gate lets through, absurd in
+  // size. x = 1e200 m: M_r x^2 = Inf in (3.38), so with the slew error e_y > 0 (V_bar_y > 0) the
+  // feedback term -L (1 + M_r x^2)/(x T^2) V_bar_y is -Inf and the feedforward (1 + M_r x^2) gamma_ddot
+  // is +Inf: V_gamma = NaN, which the clamp passed through as an "ok" voltage before the fix.
+  tr::TrackingParams params;
+  params.acceleration_feedforward = true;
+  ASSERT_GT(params.trolley_inertia_ratio, 0.0);
+  tr::TrackingController controller(params);
+  auto in = base_input();
+  in.estimate.trolley_position = 1e200;
+  in.reference.trolley.position = 1e200;
+  in.estimate.slew_angle = 0.1;  // e_y = -(x/L)(0 - 0.1) > 0
+  in.reference.slew.acceleration = 1.0;
+  tr::TrackingOutput out;
+  out.command.trolley_voltage = 3.0;
+  EXPECT_EQ(controller.step(in, out), StepStatus::rejected_nonfinite);
+  EXPECT_EQ(out.command.trolley_voltage, 0.0);
+  EXPECT_EQ(out.command.slew_voltage, 0.0);
+  EXPECT_EQ(out.slew_tracking_action, 0.0);
+  // The same crane a plausible distance out (x = 1 m) is an ordinary ok step with finite voltages.
+  in.estimate.trolley_position = in.reference.trolley.position = 1.0;
+  ASSERT_EQ(controller.step(in, out), StepStatus::ok);
+  EXPECT_TRUE(std::isfinite(out.command.slew_voltage));
+  EXPECT_NE(out.command.slew_voltage, 0.0);
+}
+
 TEST(TrackingController, BadParamsThrowNamingField) {
   auto expect_throw = [](const tr::TrackingParams& p, const std::string& field) {
     try {

@@ -180,6 +180,45 @@ TEST(TrajectoryPlanner, InvalidGoalsRejectedAndIgnored) {
   EXPECT_EQ(planner.step(-0.01, out), StepStatus::rejected_nonfinite);
 }
 
+TEST(TrajectoryPlanner, TinyLimitsGiveAMoveTooLongToPlan) {
+  // Found by the topic-gates fuzzer (tests/fuzz): a goal with trolley max_velocity = 1.6e-311 m/s
+  // (positive, finite, accepted before) planned a move of Inf duration; its reference carried
+  // move_duration = Inf, which the next node's NaN/Inf gate drops every cycle.
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto here = at(0.5, 0.0, 1.0);
+  ASSERT_EQ(planner.hold(here), tp::GoalStatus::accepted);
+  tp::MoveGoal g;
+  g.trolley_target = 0.75;
+  g.trolley_limits.max_velocity = 1.6296927674613291e-311;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::rejected_invalid_limits);
+  // The bound: trapezoid over d = 0.25 m at v, a = 0.9929 m/s^2 lasts d/v + v/a (3.43):
+  // v = d/700 -> 700.0004 s > kMaxMoveDuration = 600 s (refused); v = d/500 -> 500.0005 s (planned).
+  ASSERT_EQ(tp::kMaxMoveDuration, 600.0);
+  g.trolley_limits.max_velocity = 0.25 / 700.0;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::rejected_invalid_limits);
+  g.trolley_limits.max_velocity = 0.25 / 500.0;
+  ASSERT_EQ(planner.start_move(g, here), tp::GoalStatus::accepted);
+  EXPECT_NEAR(planner.move_duration(), 500.0 + (0.25 / 500.0) / 0.9929, 1e-9);
+}
+
+TEST(TrajectoryPlanner, TimeOptimalGoalWithATinyAccelerationLimitIsRefusedAtOnce) {
+  // Found by the topic-gates fuzzer (tests/fuzz): max_acceleration = 1e-300 m/s^2 made the
+  // swing-free trapezoid family count k = 1, 2, ... towards 1e150 (past 2^53, k += 1 stops changing
+  // k): start_move() never returned. Now the family is computed from k >= sqrt(z/a)/T and dropped
+  // beyond 1e9 periods; the goal is refused (no profile, or longer than kMaxMoveDuration).
+  tp::TrajectoryPlanner planner(tp::TrajectoryPlannerParams{});
+  const auto here = at(0.5, 0.0, 1.0);
+  ASSERT_EQ(planner.hold(here), tp::GoalStatus::accepted);
+  tp::MoveGoal g;
+  g.profile = tp::ProfileKind::time_optimal;
+  g.trolley_target = 0.75;
+  g.trolley_limits.max_acceleration = 1e-300;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::rejected_invalid_limits);
+  // Ordinary limits still plan (the time-optimal cases of (3.54) are checked below).
+  g.trolley_limits.max_acceleration = 0.9929;
+  EXPECT_EQ(planner.start_move(g, here), tp::GoalStatus::accepted);
+}
+
 TEST(TrajectoryPlanner, BadParamsThrowNamingField) {
   auto expect_throw = [](const tp::TrajectoryPlannerParams& p, const std::string& field) {
     try {

@@ -284,3 +284,47 @@ TEST(ZonePaths, ALowZoneIsHoistedOver) {
 }
 
 }  // namespace
+
+// Found by the topic-gates fuzzer (tests/fuzz): a speed reference started at an absurd cable length
+// (3e180 m, from a corrupted estimate) designed a ZVD shaper 3.5e90 s long; rest() then looped over
+// 3.5e92 cycles (the planner's 100 Hz step never returned). A shaper longer than the history
+// (kHistory cycles: 10.24 s at 100 Hz, a ZV half period T_d/2 = pi sqrt(L/g) > 10.23 s for L > 104 m,
+// a ZVD period 2 pi sqrt(L/g) for L > 26 m) is the identity, as documented: the reference is then
+// exactly the unshaped one.
+TEST(SpeedReference, AShaperLongerThanTheHistoryIsTheIdentity) {
+  const ManualParams params;
+  const SpeedBounds bounds{{-100.0, -100.0, 0.2}, {100.0, 100.0, 1e300}, kG};
+  for (const double cable : {30.0, 3.0404018637411493e+180}) {
+    for (const SpeedShaping shaping : {SpeedShaping::zv, SpeedShaping::zvd}) {
+      if (shaping == SpeedShaping::zv && cable == 30.0) continue;  // ZV at 30 m: 5.5 s, within the history
+      SpeedReference shaped, unshaped;
+      common::MotionReference start;
+      start.trolley.position = 0.5;
+      start.cable_length.position = cable;
+      shaped.start(start);
+      unshaped.start(start);
+      const std::array<double, 3> target{0.3, 0.0, 0.0};
+      for (int k = 0; k < 50; ++k) {
+        (void)shaped.step(target, kDt, params, shaping, bounds, {}, 0);
+        (void)unshaped.step(target, kDt, params, SpeedShaping::none, bounds, {}, 0);
+      }
+      EXPECT_EQ(shaped.reference().trolley.velocity, unshaped.reference().trolley.velocity) << cable;
+      EXPECT_EQ(shaped.reference().trolley.position, unshaped.reference().trolley.position) << cable;
+      const auto rest = shaped.rest(kDt, params, shaping, bounds);
+      EXPECT_EQ(rest[0], unshaped.rest(kDt, params, SpeedShaping::none, bounds)[0]) << cable;
+    }
+  }
+  // Within the history the shaper acts: at 1 m, 0.5 s in, the ZV reference (half the command now,
+  // half the command T_d/2 = 1.0 s ago, which was 0) is half the unshaped one.
+  SpeedReference shaped, unshaped;
+  common::MotionReference start;
+  start.trolley.position = 0.5;
+  start.cable_length.position = 1.0;
+  shaped.start(start);
+  unshaped.start(start);
+  for (int k = 0; k < 50; ++k) {
+    (void)shaped.step({0.3, 0.0, 0.0}, kDt, params, SpeedShaping::zv, bounds, {}, 0);
+    (void)unshaped.step({0.3, 0.0, 0.0}, kDt, params, SpeedShaping::none, bounds, {}, 0);
+  }
+  EXPECT_NEAR(shaped.reference().trolley.velocity, 0.5 * unshaped.reference().trolley.velocity, 1e-12);
+}

@@ -13,7 +13,7 @@ constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
 
 class Cursor {
  public:
-  Cursor(const std::vector<std::uint8_t>& bytes, std::size_t begin, std::size_t end, const std::string& where)
+  Cursor(const std::uint8_t* bytes, std::size_t begin, std::size_t end, const std::string& where)
       : bytes_(bytes), at_(begin), end_(end), where_(where) {}
   template <class T>
   T integer() {
@@ -26,7 +26,7 @@ class Cursor {
   std::string string() {
     const auto n = integer<std::uint32_t>();
     need(n);
-    std::string s(reinterpret_cast<const char*>(bytes_.data() + at_), n);
+    std::string s(reinterpret_cast<const char*>(bytes_ + at_), n);
     at_ += n;
     return s;
   }
@@ -41,7 +41,7 @@ class Cursor {
   void need(std::size_t n) const {
     if (n > end_ - at_) throw std::runtime_error(where_ + ": truncated record at byte " + std::to_string(at_));
   }
-  const std::vector<std::uint8_t>& bytes_;
+  const std::uint8_t* bytes_;
   std::size_t at_, end_;
   std::string where_;
 };
@@ -52,12 +52,17 @@ void read_mcap_messages(const std::string& path, const std::function<void(const 
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
   const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
+  read_mcap_messages(bytes.data(), bytes.size(), path, on_message);
+}
+
+void read_mcap_messages(const std::uint8_t* bytes, std::size_t size, const std::string& path,
+                        const std::function<void(const McapMessageView&)>& on_message) {
+  if (size < 8 || std::memcmp(bytes, kMagic, 8) != 0) {
     throw std::runtime_error(path + ": not an MCAP file (no magic 0x89 MCAP0 at byte 0)");
   }
   std::map<std::uint16_t, std::string> schema_names;
   std::map<std::uint16_t, McapChannelInfo> channels;
-  Cursor file(bytes, 8, bytes.size(), path);
+  Cursor file(bytes, 8, size, path);
   while (file.at() < file.end()) {
     const auto start = file.at();
     const auto opcode = file.integer<std::uint8_t>();
@@ -94,7 +99,7 @@ void read_mcap_messages(const std::string& path, const std::function<void(const 
         m.sequence = record.integer<std::uint32_t>();
         m.log_time = record.integer<std::uint64_t>();
         m.publish_time = record.integer<std::uint64_t>();
-        m.data = bytes.data() + record.at();
+        m.data = bytes + record.at();
         m.size = record.end() - record.at();
         on_message(m);
         break;

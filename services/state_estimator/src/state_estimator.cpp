@@ -52,7 +52,9 @@ common::StepStatus StateEstimator::step(const common::CraneMeasurement& measurem
                                         measurement.swing_in_plane, measurement.swing_out_of_plane,
                                         measurement.cable_length};
   for (const double value : inputs) {
-    if (!std::isfinite(value)) return common::StepStatus::rejected_nonfinite;
+    if (!std::isfinite(value) || std::abs(value) > kMaxMeasurementMagnitude) {
+      return common::StepStatus::rejected_nonfinite;
+    }
   }
   if (!initialized_) {
     for (int i = 0; i < kChannelCount; ++i) {

@@ -104,6 +104,17 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
     output.command.slew_voltage = clamp_voltage(V_gamma, p.voltage_limit, output.slew_saturated);
   }
   output.command.hoist_speed = ref.cable_length.velocity;
+  // Finite but absurd inputs (a corrupted estimate: 1e200 m) can overflow the law to Inf - Inf = NaN,
+  // which the voltage clamp passes through: the safe output instead (found by tests/fuzz/topic_gates).
+  const double outputs[] = {output.command.trolley_voltage, output.command.slew_voltage, output.trolley_tracking_action,
+                            output.slew_tracking_action, output.trolley_normalized_action,
+                            output.slew_normalized_action, output.swing_period};
+  for (const double value : outputs) {
+    if (!std::isfinite(value)) {
+      output = TrackingOutput{};
+      return common::StepStatus::rejected_nonfinite;
+    }
+  }
   return common::StepStatus::ok;
 }
 

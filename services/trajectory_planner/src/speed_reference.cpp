@@ -106,7 +106,8 @@ void SpeedReference::start(const common::MotionReference& from) noexcept {
   axes_[2].start(from.cable_length.position, from.cable_length.velocity);
 }
 
-std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const SpeedBounds& bounds) const noexcept {
+std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const SpeedBounds& bounds,
+                                                   double dt) const noexcept {
   std::array<InputShaper, 3> s{};  // identity shapers
   if (shaping == SpeedShaping::none) return s;
   const double cable = axes_[2].position();
@@ -115,7 +116,12 @@ std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const S
   p.kind = shaping == SpeedShaping::zv ? ShaperKind::zv : ShaperKind::zvd;
   p.natural_frequency = std::sqrt(bounds.gravity / cable);
   // A shaper longer than the history cannot be applied; the identity stays (cable beyond ~25 m at 100 Hz).
-  if (s[0].design(p) != ProfileStatus::ok) return std::array<InputShaper, 3>{};
+  // design() does not know the history: its length is checked here. Before this check an absurd cable
+  // (3e180 m from a corrupted estimate: a 3.5e90 s shaper) made rest() loop for ever (tests/fuzz).
+  if (s[0].design(p) != ProfileStatus::ok ||
+      !(s[0].length() < static_cast<double>(SpeedAxis::kHistory - 1) * dt)) {
+    return std::array<InputShaper, 3>{};
+  }
   s[1] = s[0];
   return s;
 }
@@ -147,7 +153,7 @@ bool SpeedReference::keeps_bounds(double dt, const ManualParams& params, const s
 std::uint8_t SpeedReference::step(const std::array<double, 3>& targets, double dt, const ManualParams& params,
                                   SpeedShaping shaping, const SpeedBounds& bounds, const common::Site& site,
                                   std::uint32_t zones_enabled) noexcept {
-  const auto shaper = shapers(shaping, bounds);
+  const auto shaper = shapers(shaping, bounds, dt);
   const SpeedAxisParams* axis_params[3] = {&params.trolley, &params.slew, &params.hoist};
   // Candidates, in order: every target as asked, then with the axes in `released` set to 0.
   static constexpr std::uint8_t kReleased[] = {0, 1, 2, 4, 3, 5, 6, 7};
@@ -174,7 +180,7 @@ std::uint8_t SpeedReference::step(const std::array<double, 3>& targets, double d
 
 std::array<double, 3> SpeedReference::rest(double dt, const ManualParams& params, SpeedShaping shaping,
                                            const SpeedBounds& bounds) const noexcept {
-  const auto shaper = shapers(shaping, bounds);
+  const auto shaper = shapers(shaping, bounds, dt);
   return {axes_[0].rest(dt, params.trolley, shaper[0]), axes_[1].rest(dt, params.slew, shaper[1]),
           axes_[2].rest(dt, params.hoist, shaper[2])};
 }

@@ -177,7 +177,12 @@ Half family_two_dips(double z, double a, double v, double w) {
 Half family_swing_free_trapezoid(double z, double a, double v, double w) {
   Half best;
   const double period = 2.0 * std::numbers::pi / w;
-  double k = std::max(1.0, std::ceil(z / (v * period)));
+  // The smallest whole k >= z/(v T) with z/(a k T) <= k T, i.e. k >= sqrt(z/a)/T: started near that
+  // bound, not counted up from 1 (for a = 1e-300 m/s^2 the count ran to 1e150, and past 2^53 k += 1
+  // no longer changes k: the planner's step never returned; found by tests/fuzz). Two below the
+  // bound, so rounding cannot skip the smallest k. Beyond 1e9 periods: not a candidate.
+  double k = std::max({1.0, std::ceil(z / (v * period)), std::ceil(std::sqrt(z / a) / period) - 2.0});
+  if (!(k <= 1e9)) return best;
   while (z / (a * k * period) > k * period) k += 1.0;
   const double p = z / (a * k * period);
   const double h = 0.5 * (k * period + p);

@@ -182,6 +182,8 @@ GoalStatus TrajectoryPlanner::start_move(const MoveGoal& goal,
     start_time += s.duration;
     from = to;
   }
+  // Positive but tiny limits (1e-311 m/s) plan a move of Inf or absurd duration: refused.
+  if (!(start_time <= kMaxMoveDuration)) return GoalStatus::rejected_invalid_limits;
   segments_ = planned;
   segment_count_ = count;
   move_duration_ = start_time;

@@ -33,4 +33,9 @@ struct McapMessageView {
 /// MCAP, is truncated, holds a Chunk, or a message of an undeclared channel.
 void read_mcap_messages(const std::string& path, const std::function<void(const McapMessageView&)>& on_message);
 
+/// The same on `size` bytes in memory (the file's whole content); `source_name` (the file's path)
+/// starts the messages. The views point into `data`. What the fuzz harness drives (tests/fuzz).
+void read_mcap_messages(const std::uint8_t* data, std::size_t size, const std::string& source_name,
+                        const std::function<void(const McapMessageView&)>& on_message);
+
 }  // namespace crane::launch

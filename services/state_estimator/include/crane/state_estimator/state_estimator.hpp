@@ -21,6 +21,10 @@ struct StateEstimatorParams {
   DifferentiatorKind differentiator{DifferentiatorKind::al_alaoui_second_order};  // (4.10)
 };
 
+/// [m] or [rad]: the largest measurement magnitude step() accepts. Found by tests/fuzz
+/// (topic_gates): a trolley position of -1.5e307 m differentiated to a velocity of -Inf, returned ok.
+inline constexpr double kMaxMeasurementMagnitude = 1e6;
+
 class StateEstimator {
  public:
   /// Throws common::ConfigError naming the field, value and bound if sample_rate is not finite
@@ -30,7 +34,8 @@ class StateEstimator {
   /// One sample. The first accepted sample initializes every filter at rest on that sample
   /// (filtered outputs equal the measurement, rates 0: no start-up transient).
   /// Returns rejected_nonfinite (and leaves the internal state and `estimate` untouched) if any
-  /// measurement field is NaN/Inf; ok otherwise.
+  /// measurement field is NaN/Inf or beyond +-kMaxMeasurementMagnitude (no crane measures that;
+  /// the differentiators would overflow such a value to Inf); ok otherwise (every field finite).
   [[nodiscard]] common::StepStatus step(const common::CraneMeasurement& measurement,
                                         common::CraneStateEstimate& estimate) noexcept;
 

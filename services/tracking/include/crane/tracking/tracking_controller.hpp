@@ -66,7 +66,9 @@ class TrackingController {
   /// or a mass/inertia ratio < 0.
   explicit TrackingController(const TrackingParams& params);
 
-  /// rejected_nonfinite if any used input is NaN/Inf: output set to zero voltages and actions.
+  /// rejected_nonfinite if any used input is NaN/Inf, or if finite inputs so large that the law
+  /// overflows (e.g. a trolley position of 1e200 m: x^2 is Inf, and Inf - Inf a NaN voltage) give a
+  /// non-finite output: output set to zero voltages and actions. ok: every output field is finite.
   [[nodiscard]] common::StepStatus step(const TrackingInput& input, TrackingOutput& output) const noexcept;
 
   [[nodiscard]] const TrackingParams& params() const noexcept { return params_; }

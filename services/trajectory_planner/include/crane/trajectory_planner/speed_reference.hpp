@@ -128,7 +128,8 @@ class SpeedReference {
   [[nodiscard]] common::MotionReference reference() const noexcept;
 
  private:
-  [[nodiscard]] std::array<InputShaper, 3> shapers(SpeedShaping shaping, const SpeedBounds& bounds) const noexcept;
+  [[nodiscard]] std::array<InputShaper, 3> shapers(SpeedShaping shaping, const SpeedBounds& bounds,
+                                                   double dt) const noexcept;
   [[nodiscard]] bool keeps_bounds(double dt, const ManualParams& params, const std::array<InputShaper, 3>& shapers,
                                   const SpeedBounds& bounds, const common::Site& site, std::uint32_t zones_enabled,
                                   const std::array<double, common::Site::kMaxZones>& caps) const noexcept;

@@ -72,6 +72,12 @@ struct Waypoint {
   double cable{1.0};     // [m]
 };
 inline constexpr std::size_t kMaxWaypoints = 8;
+/// [s] the longest move start_move() plans. A goal whose limits make it longer (e.g. a velocity
+/// limit of 1e-9 m/s, or 1e-311: a duration of Inf) is a wrong request, refused as
+/// rejected_invalid_limits: its reference would carry move_duration = Inf (which every node's NaN/Inf
+/// gate drops, stalling the chain), and the no-go zone check samples the whole move every 20 ms
+/// (a 1e9 s move would hold the 100 Hz loop for hours). Found by tests/fuzz (topic_gates).
+inline constexpr double kMaxMoveDuration = 600.0;
 
 /// A move request.
 struct MoveGoal {
@@ -94,7 +100,8 @@ enum class [[nodiscard]] GoalStatus {
   rejected_trolley_out_of_range,  // trolley_target outside [trolley_min_position, trolley_max_position]
   rejected_slew_out_of_range,     // slew_target outside [slew_min_angle, slew_max_angle]
   rejected_cable_out_of_range,    // cable_target outside [cable_min_length, cable_max_length]
-  rejected_invalid_limits,        // a limit is <= 0, or an axis profile could not be planned
+  rejected_invalid_limits,        // a limit is <= 0, an axis profile could not be planned, or the
+                                  // move would last longer than kMaxMoveDuration
   rejected_unknown_profile,       // the goal's profile is not a ProfileKind (e.g. an unknown wire code)
   rejected_waypoint,              // more than kMaxWaypoints, or a waypoint non-finite or out of range
   // Refusals of the planner stage (trajectory_planner_stage.hpp), never of start_move():
