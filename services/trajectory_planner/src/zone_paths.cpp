@@ -24,6 +24,18 @@ const char* zone_route_name(ZoneRoute route) noexcept {
 
 namespace {
 
+// `goal` with its accelerations scaled by `scale` and its velocities by sqrt(scale) (so the
+// centripetal acceleration scales too).
+MoveGoal slowed(const MoveGoal& goal, double scale) noexcept {
+  MoveGoal g = goal;
+  const double slower = std::sqrt(scale);
+  for (AxisLimits* limits : {&g.trolley_limits, &g.slew_limits, &g.cable_limits}) {
+    limits->max_acceleration *= scale;
+    limits->max_velocity *= slower;
+  }
+  return g;
+}
+
 // The last resort: a shortest path over a grid of rest points in (trolley, slew) at one cable
 // length (5 radii x every 15 degrees of the slew range), each edge a rest-to-rest segment of the
 // goal's profile checked against the zones like a whole route; Dijkstra on the segments' durations,
@@ -212,16 +224,8 @@ ZonePlan plan_around_zones(TrajectoryPlanner& scratch, const MoveGoal& goal, con
                                : route == ZoneRoute::side_approach ? 4
                                                                    : 1;
           for (int variant = 0; variant < variants; ++variant) {
-            MoveGoal candidate = goal;
+            MoveGoal candidate = slowed(goal, scale);
             candidate.slew_target = slew;
-            // Accelerations scaled, and velocities by sqrt(scale) (the centripetal acceleration too).
-            const double slower = std::sqrt(scale);
-            candidate.trolley_limits.max_acceleration *= scale;
-            candidate.slew_limits.max_acceleration *= scale;
-            candidate.cable_limits.max_acceleration *= scale;
-            candidate.trolley_limits.max_velocity *= slower;
-            candidate.slew_limits.max_velocity *= slower;
-            candidate.cable_limits.max_velocity *= slower;
             // Not right to the trolley's minimum: the anti-swing law overshoots a stop by several cm.
             const double span = p.trolley_max_position - p.trolley_min_position;
             const double inner = p.trolley_min_position + (0.1 + 0.15 * (variant % 2)) * span;
@@ -291,14 +295,7 @@ ZonePlan plan_around_zones(TrajectoryPlanner& scratch, const MoveGoal& goal, con
       // At the start's height, and at the highest travel height of the routes above.
       for (std::size_t which = 0; which < std::min<std::size_t>(2, lift_count) && !plan.found; ++which) {
         const std::size_t lift = which == 0 ? 0 : lift_count - 1;
-        MoveGoal candidate = goal;
-        const double slower = std::sqrt(scale);
-        candidate.trolley_limits.max_acceleration *= scale;
-        candidate.slew_limits.max_acceleration *= scale;
-        candidate.cable_limits.max_acceleration *= scale;
-        candidate.trolley_limits.max_velocity *= slower;
-        candidate.slew_limits.max_velocity *= slower;
-        candidate.cable_limits.max_velocity *= slower;
+        MoveGoal candidate = slowed(goal, scale);
         const double l = lift > 0 ? lifts[lift] : l0;
         const std::size_t room = kMaxWaypoints - (lift > 0 ? 2 : 0);
         const GridPath path = grid_path(scratch, candidate, Waypoint{x0, g0, l}, Waypoint{x1, goal.slew_target, l},
