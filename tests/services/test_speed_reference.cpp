@@ -189,7 +189,7 @@ TEST(Site, BadZonesAreRefusedNamingTheZone) {
   refused(upside_down, "site.zones[1] (upside down).top = 1 is out of range");
 }
 
-// The load's position of the site equals the tower crane model's (tests/plant checks the model).
+// The load's position of the site, analytic cases of the tower convention (2.11) with ERRATA.
 TEST(Site, LoadPositionFollowsTheTowerConvention) {
   common::Site site;
   site.jib_height = 3.0;

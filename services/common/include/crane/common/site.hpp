@@ -14,8 +14,9 @@
 //
 // The load's position from the crane's coordinates is the tower crane convention of (2.11) with
 // ERRATA.md: r = x e_x + L (-cos(theta) sin(phi), sin(theta), -cos(theta) cos(phi)) in the jib
-// frame, rotated by the slew angle gamma about z (plant::TowerCraneModel::load_position, which
-// tests/services/test_site.cpp checks against this one).
+// frame, rotated by the slew angle gamma about z (the formula of plant::TowerCraneModel::
+// load_position; tests/services/test_speed_reference.cpp checks analytic cases of this one, not the
+// two against each other: the common layer cannot see the plant).
 
 #include <array>
 #include <cstddef>
