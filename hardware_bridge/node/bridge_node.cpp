@@ -348,13 +348,21 @@ int main(int argc, char** argv) {
         wakeup.wait_until(std::min(cycle_deadline, next_republish));
       }
       if (runtime::stop_requested()) break;
+      double late_ms = 0.0;  // [ms] how late this cycle's step ran after its deadline (timer clock)
       if (!applied) {
         if (started) ++counters.overruns;
-        step_without_command(board_clock ? now_s : seconds_since(epoch, Clock::now()));
+        const auto step_time = Clock::now();
+        if (!board_clock) late_ms = std::chrono::duration<double, std::milli>(step_time - cycle_deadline).count();
+        step_without_command(board_clock ? now_s : seconds_since(epoch, step_time));
       }
       if (out.safe_state_reason != logged_reason) {
         if (out.safe_state_reason == hb::SafeStateReason::none) {
           spdlog::info("cycle {}: commands applied, brakes released", seq);
+        } else if (out.safe_state_reason == hb::SafeStateReason::watchdog) {
+          // The gate's rule on this process's clock: a punctual cycle trips on a command at most
+          // watchdog_timeout old; a late wake-up (the OS's) adds its lateness.
+          spdlog::warn("cycle {}: outputs safe (watchdog): last valid command {:.2f} ms old, this cycle {:.2f} ms late",
+                       seq, (in.time - core.last_command_arrival()) * 1e3, late_ms);
         } else {
           spdlog::warn("cycle {}: outputs safe ({})", seq, hb::reason_name(out.safe_state_reason));
         }

@@ -68,6 +68,8 @@ class BridgeCore {
 
   [[nodiscard]] const BridgeCounters& counters() const noexcept { return gate_.counters(); }
   [[nodiscard]] const BridgeParams& params() const noexcept { return params_; }
+  /// [s] arrival time of the last valid command, on the inputs' timeline (0 before the first).
+  [[nodiscard]] double last_command_arrival() const noexcept { return gate_.last_command_arrival(); }
 
  private:
   BridgeParams params_;

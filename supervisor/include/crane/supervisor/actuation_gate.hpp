@@ -140,6 +140,8 @@ class ActuationGate {
   /// For the bridge, which clamps once more to its DAC range.
   void count_clamped() noexcept { ++counters_.clamped_cycles; }
   [[nodiscard]] const ActuationGateParams& params() const noexcept { return params_; }
+  /// [s] arrival time of the last valid command (the watchdog's reference); 0 before the first.
+  [[nodiscard]] double last_command_arrival() const noexcept { return last_command_arrival_; }
 
  private:
   [[nodiscard]] SafeStateReason safe_state_reason(const GateInput& input) const noexcept;
