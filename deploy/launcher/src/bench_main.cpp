@@ -121,12 +121,36 @@ std::vector<double> ping_pong(std::uint32_t domain, int count, const std::string
 }
 
 
+/// Resident set size [kB] of process `pid` (VmRSS of /proc/PID/status); -1 when it is gone.
+long resident_kb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+/// Resident memory of one process over a soak [kB]: at readiness, after the first minute (the
+/// reference: DDS discovery, history buffers and the allocator's pools have settled by then), the
+/// largest seen after that minute, and at the end.
+struct MemoryTrace {
+  long at_start{-1};
+  long after_first_minute{-1};
+  long max_after_first_minute{-1};
+  long at_end{-1};
+};
+
 // crane_bench soak: the live stack (realtime clock, real-time priority where the system allows it,
-// as crane_launch) at rest for `rest_s`, then `moves` moves between two positions, optionally with
-// stress-ng loading both cores at normal priority. Prints faults, moments the stack was not ready,
-// late-stage warnings, overruns and the end-to-end latency. Exit 0 when no fault and no overrun.
-int soak(const std::string& config_path, unsigned domain, double rest_s, int moves, bool stress, int priority,
-         const std::string& dds) {
+// as crane_launch) at rest for `rest_s`, then moves between two positions (`moves` of them, or until
+// `duration_s` has passed since readiness when it is > 0), optionally with stress-ng loading both
+// cores at normal priority (below the stages' SCHED_FIFO). Prints faults, moments the stack was not
+// ready, late-stage warnings, every process's overruns (its rt/crane/diag/loop counters), the
+// end-to-end latency, and every process's resident memory at start, after the first minute and at the
+// end. Exit 0 when no fault, no overrun, every move arrived and (runs of 2 minutes or more) no
+// process grew by more than `memory_bound_kb` after the first minute.
+int soak(const std::string& config_path, unsigned domain, double rest_s, int moves, double duration_s, bool stress,
+         int priority, const std::string& dds, long memory_bound_kb) {
   const fs::path dir = fs::temp_directory_path() / ("crane_soak_" + std::to_string(getpid()));
   fs::create_directories(dir);
   launch::StackOptions stack;
@@ -140,12 +164,15 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
   stack.fault_log_path = (dir / "faults.jsonl").string();
   const std::string rt_failure = priority > 0 ? launch::probe_realtime(priority + 10) : "not asked";
   if (rt_failure.empty()) stack.realtime_priority = priority;
-  std::printf("soak: realtime clock, %s, rest %.0f s, %d moves, %s\n",
+  const std::string move_plan =
+      duration_s > 0.0 ? "moves until " + std::to_string(static_cast<long>(duration_s)) + " s" : std::to_string(moves) + " moves";
+  std::printf("soak: realtime clock, %s, rest %.0f s, %s, %s\n",
               rt_failure.empty() ? ("SCHED_FIFO " + std::to_string(priority) + "+").c_str()
                                  : ("normal priority (" + rt_failure + ")").c_str(),
-              rest_s, moves, stress ? "stress-ng --cpu 2 at normal priority" : "no load");
+              rest_s, move_plan.c_str(), stress ? "stress-ng --cpu 2 at normal priority" : "no load");
   launch::ProcessGroup group;
-  for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
+  std::map<std::string, pid_t> pids;
+  for (const auto& spec : launch::stack_processes(stack)) pids[spec.name] = group.start(spec);
   launch::ProcessGroup load;
   runtime::NodeOptions node;
   node.dds = dds;
@@ -156,6 +183,8 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
   auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
   auto references = participant->make_reader<tp::Reference>(&wakeup);
   auto goal_writer = participant->make_writer<tp::Goal>();
+  auto diagnostics = participant->make_recording_reader<tp::LoopDiagnostics>(&wakeup, 64);
+  std::map<std::uint32_t, tp::msgs::LoopDiagnostics_> last_diagnostics;  // by writer pid
   tp::msgs::SupervisorStatus_ status;
   tp::msgs::Reference_ reference;
   const auto ready_deadline = Clock::now() + std::chrono::seconds(60);
@@ -173,12 +202,31 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
     wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
   if (stress) load.start({"stress-ng", "/usr/bin/stress-ng", {"--cpu", "2", "--quiet"}, (dir / "stress.log").string()});
+  const auto started = Clock::now();
+  std::map<std::string, MemoryTrace> memory;
+  for (const auto& [name, pid] : pids) memory[name].at_start = resident_kb(pid);
+  auto next_memory_sample = started + std::chrono::seconds(60);
+  bool first_minute_taken = false;
+  auto sample_memory = [&] {
+    if (Clock::now() < next_memory_sample) return;
+    for (const auto& [name, pid] : pids) {
+      auto& m = memory[name];
+      const long kb = resident_kb(pid);
+      if (!first_minute_taken) m.after_first_minute = kb;
+      m.max_after_first_minute = std::max(m.max_after_first_minute, kb);
+    }
+    first_minute_taken = true;
+    next_memory_sample += std::chrono::seconds(10);
+  };
   std::uint64_t statuses = 0, not_ready = 0, late = 0;
   std::uint32_t faults = 0;
   std::string died;
   auto watch = [&](double seconds, const std::function<bool()>& done) {
     const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     while (Clock::now() < end && !runtime::stop_requested() && died.empty()) {
+      tp::msgs::LoopDiagnostics_ d;
+      while (diagnostics->take_next(d)) last_diagnostics[d.pid()] = d;
+      sample_memory();
       while (status_reader->take_next(status)) {
         ++statuses;
         if (status.mode() != Status::MODE_READY && status.mode() != Status::MODE_OPERATING) ++not_ready;
@@ -195,7 +243,11 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
   };
   watch(rest_s, nullptr);
   int arrived = 0;
-  for (int i = 0; i < moves && died.empty() && !runtime::stop_requested(); ++i) {
+  int sent = 0;
+  const auto soak_end = started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(duration_s));
+  auto more_moves = [&](int i) { return duration_s > 0.0 ? Clock::now() < soak_end : i < moves; };
+  for (int i = 0; more_moves(i) && died.empty() && !runtime::stop_requested(); ++i) {
+    ++sent;
     tp::msgs::MoveRequest_ goal;
     runtime::stamp_header(goal.header(), 0, runtime::now_stamp());
     const auto id = static_cast<std::uint32_t>(i + 1);
@@ -215,6 +267,8 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
     if (ok) ++arrived;
     watch(5.0, nullptr);  // let the load settle before the next move
   }
+  for (const auto& [name, pid] : pids) memory[name].at_end = resident_kb(pid);
+  const double soaked_s = std::chrono::duration<double>(Clock::now() - started).count();
   load.stop_all();
   group.stop_all();
   json plant = json::parse(std::ifstream(stack.plant_stats_path), nullptr, false);
@@ -222,12 +276,32 @@ int soak(const std::string& config_path, unsigned domain, double rest_s, int mov
   const int overruns = plant.is_object() ? plant.value("overruns", -1) : -1;
   std::printf("statuses %llu, not ready %llu, late-stage warnings %llu, faults raised %u, moves arrived %d of %d%s%s\n",
               static_cast<unsigned long long>(statuses), static_cast<unsigned long long>(not_ready),
-              static_cast<unsigned long long>(late), faults, arrived, moves, died.empty() ? "" : ", died: ",
+              static_cast<unsigned long long>(late), faults, arrived, sent, died.empty() ? "" : ", died: ",
               died.c_str());
+  // Every process's own counters (its last rt/crane/diag/loop sample), by pid.
+  std::printf("%-22s %10s %9s %13s %13s %13s %13s %13s\n", "process", "cycles", "overruns", "latency_p99_us",
+              "rss_start_kB", "rss_1min_kB", "rss_max_kB", "rss_end_kB");
+  bool memory_flat = true;
+  for (const auto& [name, pid] : pids) {
+    const auto d = last_diagnostics.find(static_cast<std::uint32_t>(pid));
+    const auto& m = memory[name];
+    const bool have = d != last_diagnostics.end();
+    std::printf("%-22s %10llu %9llu %13.0f %13ld %13ld %13ld %13ld\n", name.c_str(),
+                have ? static_cast<unsigned long long>(d->second.cycles()) : 0ULL,
+                have ? static_cast<unsigned long long>(d->second.overruns()) : 0ULL,
+                have ? d->second.latency_p99_us() : 0.0, m.at_start, m.after_first_minute, m.max_after_first_minute,
+                m.at_end);
+    if (m.after_first_minute >= 0 && m.max_after_first_minute - m.after_first_minute > memory_bound_kb) {
+      memory_flat = false;
+    }
+  }
+  const bool judged = soaked_s >= 120.0;
+  std::printf("memory after the first minute: %s (bound %ld kB, %.0f s soaked)\n",
+              !judged ? "not judged (under 2 minutes)" : memory_flat ? "flat" : "GREW", memory_bound_kb, soaked_s);
   std::printf("plant: %d overruns, end to end p50 %.0f us, p99 %.0f us, max %.0f us (%d cycles); logs in %s\n", overruns,
               e2e.value("p50_us", 0.0), e2e.value("p99_us", 0.0), e2e.value("max_us", 0.0),
               e2e["samples"].get<int>(), dir.string().c_str());
-  return faults == 0 && overruns == 0 && died.empty() && arrived == moves ? 0 : 1;
+  return faults == 0 && overruns == 0 && died.empty() && arrived == sent && (!judged || memory_flat) ? 0 : 1;
 }
 
 }  // namespace
@@ -270,6 +344,14 @@ int main(int argc, char** argv) {
   soak_cmd->add_option("--config", config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   soak_cmd->add_option("--rest", soak_rest, "[s] at rest first")->check(CLI::Range(0.0, 86400.0));
   soak_cmd->add_option("--moves", soak_moves, "moves between two positions after the rest")->check(CLI::Range(0, 10000));
+  double soak_duration = 0.0;
+  soak_cmd->add_option("--duration", soak_duration,
+                       "[s] the whole soak from readiness: after the rest, moves until then (overrides --moves)")
+      ->check(CLI::Range(0.0, 7.0 * 86400.0));
+  long soak_memory_bound_kb = 1024;
+  soak_cmd->add_option("--memory-bound", soak_memory_bound_kb,
+                       "[kB] largest growth of any process's resident memory after the first minute")
+      ->check(CLI::Range(0L, 1L << 30));
   soak_cmd->add_flag("--stress", soak_stress, "stress-ng loads both cores at normal priority meanwhile");
   soak_cmd->add_option("--realtime-priority", soak_priority, "as crane_launch (0: normal priority)")
       ->check(CLI::Range(0, 89));
@@ -293,7 +375,12 @@ int main(int argc, char** argv) {
   if (soak_cmd->parsed()) {
     try {
       runtime::configure_logging("warn", "bench");
-      return soak(config_path, domain, soak_rest, soak_moves, soak_stress, soak_priority, dds);
+      if (soak_duration > 0.0 && soak_duration <= soak_rest) {
+        throw std::invalid_argument("--duration " + std::to_string(soak_duration) + " s must exceed --rest " +
+                                    std::to_string(soak_rest) + " s");
+      }
+      return soak(config_path, domain, soak_rest, soak_moves, soak_duration, soak_stress, soak_priority, dds,
+                  soak_memory_bound_kb);
     } catch (const std::exception& error) {
       std::fprintf(stderr, "crane_bench soak: %s\n", error.what());
       return 1;
