@@ -13,15 +13,19 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "crane/anti_swing_analysis/characteristic_equation.hpp"
 #include "crane/anti_swing_analysis/damping_map.hpp"
+#include "crane/anti_swing_analysis/filter_delay_sensitivity.hpp"
+#include "crane/anti_swing_analysis/normalized_loop.hpp"
 #include "crane/anti_swing_analysis/delayed_trajectory_anti_swing.hpp"
 #include "crane/anti_swing_analysis/fuzzy_anti_swing.hpp"
 #include "crane/anti_swing_analysis/fuzzy_rule_generation.hpp"
@@ -456,4 +460,128 @@ TEST(DelayedTrajectoryAntiSwing, RejectsNonFiniteAndBadParams) {
   } catch (const crane::common::ConfigError& error) {
     EXPECT_NE(std::string(error.what()).find("delayed_trajectory_anti_swing.normalized_delay"), std::string::npos);
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The estimator's low-pass in the loop (section 5.1's filter-delay question)
+
+namespace {
+
+// The dominant pair's decay per swing period and frequency from the swing of a time-domain run:
+// successive positive peaks after the start-up transient, fitted by least squares of log(peak)
+// against time. Returns the damping ratio -sigma/|s|.
+double damping_from_peaks(const std::vector<asa::NormalizedSample>& samples, double skip) {
+  std::vector<double> times, logs;
+  for (std::size_t k = 1; k + 1 < samples.size(); ++k) {
+    const auto& s = samples[k];
+    if (s.time < skip || s.swing <= 0.0) continue;
+    if (s.swing > samples[k - 1].swing && s.swing >= samples[k + 1].swing) {
+      times.push_back(s.time);
+      logs.push_back(std::log(s.swing));
+    }
+  }
+  if (times.size() < 3) return std::nan("");
+  const double n = static_cast<double>(times.size());
+  double st = 0, sl = 0, stt = 0, stl = 0;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    st += times[i];
+    sl += logs[i];
+    stt += times[i] * times[i];
+    stl += times[i] * logs[i];
+  }
+  const double sigma = (n * stl - st * sl) / (n * stt - st * st);  // [1/period], < 0
+  const double omega = 2.0 * std::numbers::pi * (n - 1.0) / (times.back() - times.front());
+  return -sigma / std::hypot(sigma, omega);
+}
+
+}  // namespace
+
+TEST(FilterDelay, AFastFilterLeavesTheLoopAsItWas) {
+  for (const asa::LawPoint point : {asa::LawPoint{asa::AntiSwingLaw::pd, -30.0, 8.0},
+                                    asa::LawPoint{asa::AntiSwingLaw::delayed_feedback, -90.0, 0.1},
+                                    asa::LawPoint{asa::AntiSwingLaw::delayed_trajectory_correction, -0.26, 0.28}}) {
+    asa::TrackingLoop loop;
+    const double plain = asa::evaluate_damping(point, loop).pade.damping;
+    loop.swing_filter_cutoff = 1e6;
+    EXPECT_NEAR(asa::evaluate_damping(point, loop).pade.damping, plain, 1e-5) << asa::law_name(point.law);
+  }
+}
+
+TEST(FilterDelay, IndependentComputationsOfTheFilteredLoopAgree) {
+  // pd has no delay: the state-space eigenvalues and the companion matrix of the exact sextic
+  // (s^2 + a)(s^2 + K_dx s + K_px) D(s) - s^2 (K_ps + K_ds s) agree. The delay laws: Newton on the
+  // exact equation (filter and e^{-tau s}) reaches the same root from the Pade roots of order 20 and
+  // of order 40, and the Pade pair (3.49) converges to it as the order grows. (The companion matrix
+  // of the expanded Pade polynomial is too ill-conditioned with the filter's extra factor to serve:
+  // its coefficients span 1/(w_c c)^2 more.)
+  for (const double cutoff : {10.0, 25.0, 60.0}) {
+    asa::TrackingLoop loop;
+    loop.swing_filter_cutoff = cutoff;
+    const asa::LawPoint pd{asa::AntiSwingLaw::pd, -30.0, 8.0};
+    const auto state_space = asa::dominant_pair(asa::pade_roots(pd, loop));
+    const auto companion = asa::dominant_pair(asa::pade_roots_companion(pd, loop));
+    ASSERT_TRUE(state_space.found);
+    EXPECT_NEAR(companion.pole.real(), state_space.pole.real(), 1e-9) << cutoff;
+    EXPECT_NEAR(companion.pole.imag(), state_space.pole.imag(), 1e-9) << cutoff;
+    for (const asa::LawPoint point : {asa::LawPoint{asa::AntiSwingLaw::delayed_feedback, -90.0, 0.1},
+                                      asa::LawPoint{asa::AntiSwingLaw::delayed_trajectory_correction, -0.26, 0.28}}) {
+      const auto l20 = asa::evaluate_damping(point, loop, 20);
+      const auto l40 = asa::evaluate_damping(point, loop, 40);
+      ASSERT_TRUE(l20.pade.found && l40.pade.found);
+      EXPECT_NEAR(l20.direct.pole.real(), l40.direct.pole.real(), 1e-9) << asa::law_name(point.law) << " " << cutoff;
+      EXPECT_NEAR(l20.direct.pole.imag(), l40.direct.pole.imag(), 1e-9) << asa::law_name(point.law) << " " << cutoff;
+      EXPECT_LT(std::abs(l40.pade.damping - l40.direct.damping), std::abs(l20.pade.damping - l20.direct.damping))
+          << asa::law_name(point.law) << " " << cutoff;
+    }
+  }
+}
+
+TEST(FilterDelay, TimeDomainDecayMatchesTheDominantPair) {
+  // The normalized loop simulated with the filter on the law's input (semi-implicit Euler, an
+  // independent computation): the decay of the swing peaks, once the faster modes have died out,
+  // gives the damping of the dominant pair the exact equation predicts.
+  for (const double cutoff : {25.0, 30.0, 40.0}) {
+    asa::NormalizedLoopRun run;
+    run.loop.swing_filter_cutoff = cutoff;
+    run.delay_gain = -90.0;
+    run.normalized_delay = 0.1;
+    run.initial_swing = 0.1;
+    run.transfer.distance = 0.0;
+    run.duration = 8.0;
+    run.time_step = 1e-4;
+    const double measured = damping_from_peaks(asa::simulate_delayed_feedback_loop(run), 2.0);
+    const double predicted =
+        asa::evaluate_damping({asa::AntiSwingLaw::delayed_feedback, -90.0, 0.1}, run.loop).direct.damping;
+    std::printf("[ figure   ] delay1 (-90, 0.1), w_c T = %.0f: damping %.4f from the roots, %.4f from the time-domain "
+                "swing peaks\n",
+                cutoff, predicted, measured);
+    EXPECT_NEAR(measured, predicted, 0.02 * std::abs(predicted)) << "w_c T = " << cutoff;
+  }
+}
+
+TEST(FilterDelay, MapOverCutoffAndCableLength) {
+  asa::FilterDelaySpec spec;
+  spec.law = {asa::AntiSwingLaw::delayed_feedback, -90.0, 0.1};
+  spec.cutoffs = {2.0, 5.0, 20.0};
+  spec.cable_lengths = {0.2, 1.0, 2.0};
+  const auto map = asa::compute_filter_delay_map(spec);
+  ASSERT_EQ(map.points.size(), 9U);
+  // Normalized cut-off w_c T: analytic, and what the map's damping depends on alone.
+  const auto& p = map.points[1 * 3 + 1];  // L = 1 m, 5 Hz
+  EXPECT_NEAR(p.normalized_cutoff, 2.0 * std::numbers::pi * 5.0 * 2.0 * std::numbers::pi * std::sqrt(1.0 / 9.8), 1e-12);
+  // The Butterworth's phase delay tends to sqrt(2)/w_c at low frequency.
+  EXPECT_NEAR(asa::butterworth_phase_delay(5.0, 1e-6), std::sqrt(2.0) / (2.0 * std::numbers::pi * 5.0), 1e-9);
+  EXPECT_NEAR(asa::butterworth_phase_delay(5.0, 5.0), (std::numbers::pi / 2.0) / (2.0 * std::numbers::pi * 5.0), 1e-12);
+  // Same w_c T, same damping: L and f_c enter only through it (L 4x = T 2x = f_c / 2).
+  asa::FilterDelaySpec same = spec;
+  same.cutoffs = {10.0};
+  same.cable_lengths = {0.25};
+  const auto a = asa::compute_filter_delay_map(same);
+  same.cutoffs = {5.0};
+  same.cable_lengths = {1.0};
+  const auto b = asa::compute_filter_delay_map(same);
+  EXPECT_NEAR(a.points[0].damping, b.points[0].damping, 1e-9);
+  EXPECT_THROW((void)asa::compute_filter_delay_map(asa::FilterDelaySpec{}), std::invalid_argument);
+  spec.cutoffs = {-1.0};
+  EXPECT_THROW((void)asa::compute_filter_delay_map(spec), std::invalid_argument);
 }

@@ -40,6 +40,20 @@ std::vector<Complex> polynomial_roots(const Poly& p) {
 
 bool has_delay(const LawPoint& point) { return point.law != AntiSwingLaw::pd && point.second > 0.0; }
 
+bool has_filter(const TrackingLoop& loop) { return loop.swing_filter_cutoff > 0.0; }
+
+void check_filter(const TrackingLoop& loop) {
+  if (!(loop.swing_filter_cutoff >= 0.0) || !std::isfinite(loop.swing_filter_cutoff))
+    throw std::invalid_argument("swing_filter_cutoff must be finite and >= 0");
+}
+
+// The filter's denominator over w_c^2, in ascending powers of s: 1 + sqrt(2) s/w_c + s^2/w_c^2.
+Poly filter_denominator(const TrackingLoop& loop) {
+  if (!has_filter(loop)) return {1.0};
+  const double w = loop.swing_filter_cutoff;
+  return {1.0, std::sqrt(2.0) / w, 1.0 / (w * w)};
+}
+
 // Feedback numerator N(s) in "- s^2 N(s) e^{-tau s}" (ascending powers, in s).
 Poly feedback_numerator(const LawPoint& point, const TrackingLoop& loop) {
   switch (point.law) {
@@ -76,14 +90,18 @@ std::vector<Complex> pade_roots(const LawPoint& point, const TrackingLoop& loop,
   if (pade_order < 1) throw std::invalid_argument("pade_order must be >= 1");
   if (point.law != AntiSwingLaw::pd && !(point.second >= 0.0))
     throw std::invalid_argument("tau_del must be >= 0");
+  check_filter(loop);
   // State-space realization whose characteristic polynomial is the Pade form: states
-  // [x_bar, x_bar', phi, phi', z_1..z_l]; the delay is a cascade of l all-pass sections
-  // (1 - c s)/(1 + c s) = -1 + 2/(1 + c s): c z_k' = -z_k + v_{k-1}, v_k = 2 z_k - v_{k-1}, v_0 = phi.
-  // Rows are linear forms in the states; v_k' is tracked too for (3.50), which feeds the
-  // derivative of the delayed swing through K_dx.
+  // [x_bar, x_bar', phi, phi', (p, p'), z_1..z_l]; p is the filtered swing when the loop has a
+  // filter (p'' = w_c^2 (phi - p) - sqrt(2) w_c p'); the delay is a cascade of l all-pass sections
+  // (1 - c s)/(1 + c s) = -1 + 2/(1 + c s): c z_k' = -z_k + v_{k-1}, v_k = 2 z_k - v_{k-1}, v_0 = p
+  // (phi without a filter). Rows are linear forms in the states; v_k' is tracked too for (3.50),
+  // which feeds the derivative of the delayed swing through K_dx.
   const bool delayed = has_delay(point);
+  const bool filtered = has_filter(loop);
   const int l = delayed ? pade_order : 0;
-  const int n = 4 + l;
+  const int f = filtered ? 2 : 0;
+  const int n = 4 + f + l;
   const double a = loop.swing_stiffness;
   const double k_px = loop.proportional_gain;
   const double k_dx = loop.derivative_gain;
@@ -93,12 +111,21 @@ std::vector<Complex> pade_roots(const LawPoint& point, const TrackingLoop& loop,
     row(index) = 1.0;
     return row;
   };
-  Eigen::RowVectorXd delayed_value = unit(2);       // v_0 = phi
-  Eigen::RowVectorXd delayed_derivative = unit(3);  // v_0' = phi'
+  Eigen::RowVectorXd measured_value = unit(2);       // what the law sees: phi, or p when filtered
+  Eigen::RowVectorXd measured_derivative = unit(3);
+  if (filtered) {
+    const double w = loop.swing_filter_cutoff;
+    system(4, 5) = 1.0;
+    system.row(5) = w * w * (unit(2) - unit(4)) - std::sqrt(2.0) * w * unit(5);
+    measured_value = unit(4);
+    measured_derivative = unit(5);
+  }
+  Eigen::RowVectorXd delayed_value = measured_value;            // v_0
+  Eigen::RowVectorXd delayed_derivative = measured_derivative;  // v_0'
   if (delayed) {
     const double c = point.second / (2.0 * pade_order);
     for (int k = 0; k < l; ++k) {
-      const int state = 4 + k;
+      const int state = 4 + f + k;
       const Eigen::RowVectorXd z_rate = (delayed_value - unit(state)) / c;
       system.row(state) = z_rate;
       delayed_value = 2.0 * unit(state) - delayed_value;
@@ -108,7 +135,7 @@ std::vector<Complex> pade_roots(const LawPoint& point, const TrackingLoop& loop,
   Eigen::RowVectorXd acceleration = -k_px * unit(0) - k_dx * unit(1);  // tracking PD (3.40)
   switch (point.law) {
     case AntiSwingLaw::pd:
-      acceleration += point.first * unit(2) + point.second * unit(3);  // (3.45)
+      acceleration += point.first * measured_value + point.second * measured_derivative;  // (3.45)
       break;
     case AntiSwingLaw::delayed_feedback:
       acceleration += point.first * delayed_value;  // (3.47)
@@ -131,25 +158,30 @@ std::vector<Complex> pade_roots_companion(const LawPoint& point, const TrackingL
   if (pade_order < 1) throw std::invalid_argument("pade_order must be >= 1");
   if (point.law != AntiSwingLaw::pd && !(point.second >= 0.0))
     throw std::invalid_argument("tau_del must be >= 0");
+  check_filter(loop);
   const double a = loop.swing_stiffness;
   const double k_px = loop.proportional_gain;
   const double k_dx = loop.derivative_gain;
   const Poly numerator = feedback_numerator(point, loop);
+  const Poly filter = filter_denominator(loop);  // D(s), 1 without a filter
   if (!has_delay(point)) {
-    // (s^2 + a)(s^2 + K_dx s + K_px) - s^2 N(s)
-    const Poly open = multiply(Poly{a, 0.0, 1.0}, Poly{k_px, k_dx, 1.0});
+    // (s^2 + a)(s^2 + K_dx s + K_px) D(s) - s^2 N(s)
+    const Poly open = multiply(multiply(Poly{a, 0.0, 1.0}, Poly{k_px, k_dx, 1.0}), filter);
     return polynomial_roots(add(open, multiply(Poly{0.0, 0.0, -1.0}, numerator)));
   }
   // Pade (3.49), c = tau/(2l), in w = c s, times c^4:
-  //   (w^2 + a c^2)(w^2 + K_dx c w + K_px c^2)(1 + w)^l - w^2 c^2 N(w/c) (1 - w)^l = 0.
+  //   (w^2 + a c^2)(w^2 + K_dx c w + K_px c^2) D(w/c) (1 + w)^l - w^2 c^2 N(w/c) (1 - w)^l = 0.
   const double c = point.second / (2.0 * pade_order);
+  Poly scaled_filter(filter.size());  // D(w/c)
+  for (std::size_t i = 0; i < filter.size(); ++i) scaled_filter[i] = filter[i] / std::pow(c, static_cast<double>(i));
   Poly lead{1.0};
   Poly lag{1.0};
   for (int i = 0; i < pade_order; ++i) {
     lead = multiply(lead, Poly{1.0, 1.0});
     lag = multiply(lag, Poly{1.0, -1.0});
   }
-  const Poly open = multiply(multiply(Poly{a * c * c, 0.0, 1.0}, Poly{k_px * c * c, k_dx * c, 1.0}), lead);
+  const Poly open =
+      multiply(multiply(multiply(Poly{a * c * c, 0.0, 1.0}, Poly{k_px * c * c, k_dx * c, 1.0}), scaled_filter), lead);
   Poly scaled_numerator(numerator.size());  // c^2 N(w/c)
   for (std::size_t i = 0; i < numerator.size(); ++i)
     scaled_numerator[i] = numerator[i] * std::pow(c, 2.0 - static_cast<double>(i));
@@ -184,10 +216,21 @@ CharacteristicValue characteristic_function(const LawPoint& point, const Trackin
       tau = point.second;
       break;
   }
+  // D(s) = 1 + sqrt(2) s/w_c + s^2/w_c^2 (1 without a filter; a negative or NaN cut-off gives NaN).
+  Complex filter{1.0};
+  Complex filter_derivative{0.0};
+  if (loop.swing_filter_cutoff != 0.0) {
+    const double w = loop.swing_filter_cutoff;
+    filter = 1.0 + std::sqrt(2.0) * s / w + s * s / (w * w);
+    filter_derivative = std::sqrt(2.0) / w + 2.0 * s / (w * w);
+    if (!(w > 0.0)) filter = filter_derivative = {std::numeric_limits<double>::quiet_NaN(), 0.0};
+  }
   const Complex delay = std::exp(-tau * s);
+  const Complex open = swing * tracking;
+  const Complex open_derivative = 2.0 * s * tracking + swing * (2.0 * s + k_dx);
   CharacteristicValue result;
-  result.value = swing * tracking - s * s * numerator * delay;
-  result.derivative = 2.0 * s * tracking + swing * (2.0 * s + k_dx) -
+  result.value = open * filter - s * s * numerator * delay;
+  result.derivative = open_derivative * filter + open * filter_derivative -
                       (2.0 * s * numerator + s * s * numerator_derivative - tau * s * s * numerator) * delay;
   return result;
 }

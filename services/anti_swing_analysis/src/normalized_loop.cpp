@@ -35,16 +35,22 @@ NormalizedReference transfer_reference(const TransferProfile& profile, double ta
 std::vector<NormalizedSample> simulate_delayed_feedback_loop(const NormalizedLoopRun& run) {
   if (!(run.time_step > 0.0) || !(run.duration > 0.0) || !(run.normalized_delay >= 0.0))
     throw std::invalid_argument("simulate_delayed_feedback_loop: time_step, duration > 0, delay >= 0");
+  const double cutoff = run.loop.swing_filter_cutoff;
+  if (!(cutoff >= 0.0) || !std::isfinite(cutoff))
+    throw std::invalid_argument("simulate_delayed_feedback_loop: swing_filter_cutoff must be finite and >= 0");
   const auto steps = static_cast<std::size_t>(std::llround(run.duration / run.time_step));
   const auto delay = static_cast<std::size_t>(std::llround(run.normalized_delay / run.time_step));
   std::vector<double> swing_history(steps + 1, run.initial_swing);  // phi at step k
   std::vector<NormalizedSample> samples;
   samples.reserve(steps);
   double position = 0.0, rate = 0.0, swing = run.initial_swing, swing_rate = 0.0;
+  // The estimator's low-pass on the measured swing (TrackingLoop::swing_filter_cutoff), at rest on
+  // phi(0): p'' = w_c^2 (phi - p) - sqrt(2) w_c p'.
+  double filtered = run.initial_swing, filtered_rate = 0.0;
   const double h = run.time_step;
   for (std::size_t k = 0; k < steps; ++k) {
     const double tau = static_cast<double>(k) * h;
-    swing_history[k] = swing;
+    swing_history[k] = cutoff > 0.0 ? filtered : swing;
     const double delayed_swing = k >= delay ? swing_history[k - delay] : run.initial_swing;
     const double action = run.delay_gain * delayed_swing;  // (3.47)
     samples.push_back({tau, swing, swing_rate, action});
@@ -53,6 +59,10 @@ std::vector<NormalizedSample> simulate_delayed_feedback_loop(const NormalizedLoo
     const double acceleration = run.loop.proportional_gain * (reference.position - position) +
                                 run.loop.derivative_gain * (reference.rate - rate) + action;
     const double swing_acceleration = acceleration - run.loop.swing_stiffness * swing;
+    if (cutoff > 0.0) {
+      filtered_rate += h * (cutoff * cutoff * (swing - filtered) - std::sqrt(2.0) * cutoff * filtered_rate);
+      filtered += h * filtered_rate;
+    }
     rate += h * acceleration;
     swing_rate += h * swing_acceleration;
     position += h * rate;

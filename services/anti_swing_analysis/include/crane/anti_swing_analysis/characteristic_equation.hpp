@@ -52,6 +52,15 @@ struct TrackingLoop {
   double proportional_gain{100.0};  // [-] K_px (3.40)-(3.42)
   double derivative_gain{20.0};     // [-] K_dx = 2 sqrt(K_px) (3.42)
   double swing_stiffness{39.47841760435743};  // [-] a = 4 pi^2 (3.33)
+  /// [-] w_c = 2 pi f_c T, the cut-off of the state estimator's second-order Butterworth low-pass
+  /// (section 4.3) in radians per swing period; 0: no filter. The law then sees the filtered swing
+  /// F(s) phi (and its derivative), F(s) = w_c^2 / (s^2 + sqrt(2) w_c s + w_c^2), the continuous
+  /// prototype of the estimator's bilinear design (its pre-warping makes them agree at f_c): every
+  /// function below multiplies the characteristic equation through by s^2/w_c^2 + sqrt(2) s/w_c + 1,
+  ///   (s^2 + a)(s^2 + K_dx s + K_px)(s^2/w_c^2 + sqrt(2) s/w_c + 1) - s^2 N(s) e^{-tau_del s} = 0,
+  /// section 5.1's question (the effect of the filter delay on the delayed-feedback controller).
+  /// Must be >= 0 (functions below throw std::invalid_argument otherwise).
+  double swing_filter_cutoff{0.0};
 };
 
 /// One point of a law's parameter plane. For pd: first = K_ps [-], second = K_ds [-] (multiplies

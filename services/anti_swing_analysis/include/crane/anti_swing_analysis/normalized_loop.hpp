@@ -44,8 +44,10 @@ struct NormalizedSample {
   double action{0.0};      // [-] V_xs = K_del phi(tau - tau_del)
 };
 
-/// Simulates the loop and returns one sample per time step. Throws std::invalid_argument for a
-/// non-positive time step or duration or a negative delay.
+/// Simulates the loop and returns one sample per time step. With loop.swing_filter_cutoff > 0 the
+/// law's delay line takes the filtered swing (the estimator's low-pass, at rest on phi(0)); the
+/// samples' `swing` stays the true phi. Throws std::invalid_argument for a non-positive time step
+/// or duration, a negative delay, or a negative or non-finite swing_filter_cutoff.
 [[nodiscard]] std::vector<NormalizedSample> simulate_delayed_feedback_loop(const NormalizedLoopRun& run);
 
 }  // namespace crane::anti_swing_analysis
