@@ -8,7 +8,10 @@
 # answered for that client only, and /metrics counts it. The recorder also writes MCAP (--mcap), read
 # by @mcap/core: one channel per topic, 100 Hz x 9 s +- 2 % sensor messages, every message decoded
 # (ros2msg schema, Foxglove's ROS 2 CDR reader) equal to the JSON record. Last, the operator page in
-# Debian's chromium: what it decoded equals Foxglove's decoder, its views and plots drawn.
+# Debian's chromium: what it decoded equals Foxglove's decoder, its views and plots drawn; then its
+# controls (operator_check.js): read-only without a login, publishing refused to clients without the
+# operator's session or from another origin, and "move to" pressed by the logged-in operator brings
+# the trolley and slew to the targets.
 #
 #   foxglove_client_test.sh BIN_DIR CONFIG NPM_DIR OUT_DIR
 #   foxglove_client_test.sh --install-only NPM_DIR      (deploy/crane test, before its namespace)
@@ -71,7 +74,9 @@ pids+=($!)
 for _ in $(seq 600); do grep -q "all stages matched and alive" "$OUT/launch.log" && break; sleep 0.1; done
 grep -q "all stages matched and alive" "$OUT/launch.log" || { echo "stack not ready:"; cat "$OUT/launch.log"; exit 1; }
 
-"$BIN/crane_web" --port 0 --queue 64 --domain "$DOMAIN" > "$OUT/web.log" 2>&1 &
+# An operator for the page's controls (its token printed once; the file holds its hash).
+TOKEN=$("$BIN/crane_web" --operators "$OUT/operators" --new-operator alice 2>/dev/null)
+"$BIN/crane_web" --port 0 --queue 64 --domain "$DOMAIN" --operators "$OUT/operators" > "$OUT/web.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do grep -q "ws://" "$OUT/web.log" && break; sleep 0.1; done
 URL=$(grep -o "ws://[0-9.]*:[0-9]*" "$OUT/web.log" || true)
@@ -112,6 +117,10 @@ node "$HERE/foxglove_client.js" abuse "$URL" 8 | tee "$OUT/abuse.json" || status
 if [ -x /usr/bin/chromium ]; then
   "$BIN/crane_move" --domain "$DOMAIN" --trolley 0.9 --slew 60 > "$OUT/move.log" 2>&1 || true
   node "$HERE/page_check.js" "$URL" "$OUT/operator_page.png" | tee "$OUT/page.json" || status=1
+  # The controls: read-only without a login, refused to foreign clients, "move to" for the operator.
+  node "$HERE/operator_check.js" "$URL" "$TOKEN" "$OUT/operator_controls.png" | tee "$OUT/operator.json" || status=1
+  grep -q "operator alice published rt/crane/planner/goal" "$OUT/web.log" \
+    || { echo "crane_web did not log the operator's goal"; status=1; }
 else
   echo "operator page not checked: no /usr/bin/chromium (Debian: chromium)"
 fi

@@ -90,7 +90,9 @@ TEST(FoxgloveProtocol, BadRequestsAreRefusedNamingWhatWasWrongAndChangeNothing) 
             std::string::npos);
   EXPECT_EQ(first(R"({"op":"unsubscribe","subscriptionIds":[42]})"), "unsubscribe: unknown subscription id 42");
   EXPECT_EQ(first(R"({"op":"advertise","channels":[]})"),
-            "advertise: not supported by this server (client publishing is off; no parameters, services or assets)");
+            "advertise: client publishing is off (log in as an operator)");
+  EXPECT_EQ(first(R"({"op":"getParameters","parameterNames":[]})"),
+            "getParameters: not supported by this server (no parameters, services or assets)");
   // Nothing of that changed the session.
   std::uint32_t id = 0;
   ASSERT_TRUE(session.subscription_of(1, id));

@@ -8,12 +8,18 @@ namespace crane::web {
 
 using nlohmann::json;
 
-json server_info_json(const std::string& name, const std::string& session_id) {
-  return json{{"op", "serverInfo"},
-              {"name", name},
-              {"capabilities", json::array()},
-              {"metadata", {{"clientPublish", "off"}}},
-              {"sessionId", session_id}};
+json server_info_json(const std::string& name, const std::string& session_id, const std::string& operator_name) {
+  json info{{"op", "serverInfo"},
+            {"name", name},
+            {"capabilities", json::array()},
+            {"metadata", {{"clientPublish", "off"}}},
+            {"sessionId", session_id}};
+  if (!operator_name.empty()) {
+    info["capabilities"].push_back("clientPublish");
+    info["supportedEncodings"] = json::array({"cdr"});
+    info["metadata"]["clientPublish"] = "operator " + operator_name;
+  }
+  return info;
 }
 
 json advertise_json(const std::vector<Channel>& channels) {
@@ -43,7 +49,8 @@ std::string message_data_frame(std::uint32_t subscription_id, std::uint64_t rece
   return frame;
 }
 
-ClientSession::ClientSession(std::vector<std::uint32_t> channel_ids) : channel_ids_(std::move(channel_ids)) {}
+ClientSession::ClientSession(std::vector<std::uint32_t> channel_ids, std::vector<PublishableTopic> publishable)
+    : channel_ids_(std::move(channel_ids)), publishable_(std::move(publishable)) {}
 
 namespace {
 
@@ -122,7 +129,69 @@ std::vector<std::string> ClientSession::handle_text(std::string_view text) {
     }
     return errors;
   }
-  return {op + ": not supported by this server (client publishing is off; no parameters, services or assets)"};
+  if (op == "advertise" || op == "unadvertise") {
+    if (!may_publish()) return {op + ": client publishing is off (log in as an operator)"};
+    const char* list = op == "advertise" ? "channels" : "channelIds";
+    if (!request.contains(list) || !request[list].is_array()) return {op + ": \"" + list + "\" must be an array"};
+    for (const auto& item : request[list]) {
+      std::uint32_t id = 0;
+      if (op == "unadvertise") {
+        if (!as_uint32(item, id) || advertised_.erase(id) == 0) {
+          errors.push_back("unadvertise: unknown client channel id " + item.dump());
+        }
+        continue;
+      }
+      if (!item.is_object() || !item.contains("id") || !as_uint32(item["id"], id) || !item.contains("topic") ||
+          !item["topic"].is_string() || !item.contains("encoding") || !item["encoding"].is_string()) {
+        errors.push_back("advertise: each channel needs an integer \"id\" in [0, 2^32), a string \"topic\" and "
+                         "\"encoding\", got " + item.dump());
+        continue;
+      }
+      const std::string topic = item["topic"];
+      const auto found = std::find_if(publishable_.begin(), publishable_.end(),
+                                      [&](const PublishableTopic& t) { return t.topic == topic; });
+      if (found == publishable_.end()) {
+        errors.push_back("advertise: topic " + topic + " is not published by operators here");
+        continue;
+      }
+      if (item["encoding"] != "cdr") {
+        errors.push_back("advertise: topic " + topic + " must be encoded \"cdr\", not " + item["encoding"].dump());
+        continue;
+      }
+      if (item.contains("schemaName") && item["schemaName"] != found->schema_name) {
+        errors.push_back("advertise: topic " + topic + " has schema " + found->schema_name + ", not " +
+                         item["schemaName"].dump());
+        continue;
+      }
+      if (advertised_.count(id) != 0) {
+        errors.push_back("advertise: client channel id " + std::to_string(id) + " is already in use");
+        continue;
+      }
+      advertised_[id] = static_cast<std::size_t>(found - publishable_.begin());
+    }
+    return errors;
+  }
+  return {op + ": not supported by this server (no parameters, services or assets)"};
+}
+
+std::string ClientSession::handle_binary(std::string_view frame, ClientMessage& message) const {
+  if (!may_publish()) return "binary frame refused: client publishing is off (log in as an operator)";
+  if (frame.size() <= kClientMessageHeaderBytes) {
+    return "binary frame of " + std::to_string(frame.size()) + " bytes: a Client Message Data frame has " +
+           std::to_string(kClientMessageHeaderBytes) + " header bytes and a payload";
+  }
+  if (static_cast<std::uint8_t>(frame[0]) != kOpClientMessageData) {
+    return "binary opcode " + std::to_string(static_cast<unsigned>(static_cast<std::uint8_t>(frame[0]))) +
+           " refused: only Client Message Data (1)";
+  }
+  std::uint32_t id = 0;
+  for (int i = 0; i < 4; ++i) id |= static_cast<std::uint32_t>(static_cast<std::uint8_t>(frame[1 + i])) << (8 * i);
+  const auto found = advertised_.find(id);
+  if (found == advertised_.end()) return "client channel " + std::to_string(id) + " was not advertised";
+  message.topic_index = found->second;
+  message.data = reinterpret_cast<const std::uint8_t*>(frame.data()) + kClientMessageHeaderBytes;
+  message.size = frame.size() - kClientMessageHeaderBytes;
+  return {};
 }
 
 bool ClientSession::subscription_of(std::uint32_t channel_id, std::uint32_t& subscription_id) const noexcept {

@@ -35,13 +35,17 @@ struct FoxgloveServer::Impl {
   struct Client {
     ClientSession session;
     SendQueue queue;
+    std::string operator_name;  // "" for a read-only client
   };
 
   ServerOptions options;
   std::vector<Channel> channels;
   std::vector<std::uint32_t> channel_ids;
   HttpHandler http;
+  Authenticator authenticate;
+  ClientMessageHandler on_client_message;
   ServerStats& stats;
+  std::string server_session;
   std::string server_info;
   std::string advertise;
   WsServer server;
@@ -49,10 +53,16 @@ struct FoxgloveServer::Impl {
   std::thread io_thread;
   std::atomic<bool> running{false};
 
-  Impl(ServerOptions o, std::vector<Channel> c, HttpHandler h, ServerStats& s)
-      : options(std::move(o)), channels(std::move(c)), http(std::move(h)), stats(s) {
+  Impl(ServerOptions o, std::vector<Channel> c, HttpHandler h, Authenticator a, ClientMessageHandler m, ServerStats& s)
+      : options(std::move(o)),
+        channels(std::move(c)),
+        http(std::move(h)),
+        authenticate(std::move(a)),
+        on_client_message(std::move(m)),
+        stats(s) {
     for (const auto& ch : channels) channel_ids.push_back(ch.id);
-    server_info = server_info_json(options.name, session_id()).dump();
+    server_session = session_id();
+    server_info = server_info_json(options.name, server_session).dump();
     advertise = advertise_json(channels).dump();
   }
 
@@ -111,11 +121,24 @@ struct FoxgloveServer::Impl {
       socket.set_option(boost::asio::socket_base::send_buffer_size(static_cast<int>(options.socket_buffer_bytes)),
                         option_ec);
       socket.set_option(boost::asio::ip::tcp::no_delay(true), option_ec);
-      clients.emplace(hdl, Client{ClientSession(channel_ids), SendQueue(options.queue_frames)});
+      // An operator's handshake (the page's session cookie, same origin) may publish.
+      std::string operator_name;
+      if (!options.publishable.empty() && authenticate && on_client_message) {
+        auto con = server.get_con_from_hdl(hdl);
+        operator_name = authenticate(con->get_request_header("Cookie"), con->get_request_header("Origin"),
+                                     con->get_request_header("Host"));
+      }
+      clients.emplace(hdl, Client{ClientSession(channel_ids, operator_name.empty() ? std::vector<PublishableTopic>{}
+                                                                                    : options.publishable),
+                                  SendQueue(options.queue_frames), operator_name});
       stats.clients.store(clients.size());
+      if (!operator_name.empty()) stats.operator_clients.fetch_add(1);
       stats.connections_total.fetch_add(1);
       websocketpp::lib::error_code ec;
-      server.send(hdl, server_info, websocketpp::frame::opcode::text, ec);
+      server.send(hdl,
+                  operator_name.empty() ? server_info
+                                        : server_info_json(options.name, server_session, operator_name).dump(),
+                  websocketpp::frame::opcode::text, ec);
       server.send(hdl, advertise, websocketpp::frame::opcode::text, ec);
     });
     const auto remove = [this](connection_hdl hdl) {
@@ -124,7 +147,10 @@ struct FoxgloveServer::Impl {
       if (!ec && con->get_local_close_code() == websocketpp::close::status::message_too_big) {
         stats.oversized_closed.fetch_add(1);
       }
-      clients.erase(hdl);
+      const auto found = clients.find(hdl);
+      if (found == clients.end()) return;
+      if (!found->second.operator_name.empty()) stats.operator_clients.fetch_sub(1);
+      clients.erase(found);
       stats.clients.store(clients.size());
     };
     server.set_close_handler(remove);
@@ -133,9 +159,18 @@ struct FoxgloveServer::Impl {
       const auto found = clients.find(hdl);
       if (found == clients.end()) return;
       if (message->get_opcode() != websocketpp::frame::opcode::text) {
-        stats.binary_refused.fetch_add(1);
-        send_status(hdl, StatusLevel::error,
-                    "binary frame refused: client publishing and service calls are off on this server");
+        ClientMessage client_message;
+        std::string error = found->second.session.handle_binary(message->get_payload(), client_message);
+        if (error.empty()) {
+          error = on_client_message(client_message.topic_index, client_message.data, client_message.size,
+                                    found->second.operator_name);
+        }
+        if (!error.empty()) {
+          stats.binary_refused.fetch_add(1);
+          send_status(hdl, StatusLevel::error, error);
+          return;
+        }
+        stats.client_messages.fetch_add(1);
         return;
       }
       const auto errors = found->second.session.handle_text(message->get_payload());
@@ -146,18 +181,27 @@ struct FoxgloveServer::Impl {
     });
     server.set_http_handler([this](connection_hdl hdl) {
       auto con = server.get_con_from_hdl(hdl);
-      std::string path = con->get_resource();
-      path = path.substr(0, path.find('?'));
+      HttpRequest request;
+      request.method = con->get_request().get_method();
+      request.path = con->get_resource();
+      request.path = request.path.substr(0, request.path.find('?'));
+      request.body = con->get_request_body();
+      request.cookie = con->get_request_header("Cookie");
+      request.origin = con->get_request_header("Origin");
+      request.host = con->get_request_header("Host");
       HttpResponse response;
-      if (http) response = http(path);
+      if (http) response = http(request);
       con->set_status(static_cast<websocketpp::http::status_code::value>(response.status));
       con->replace_header("Content-Type", response.content_type);
+      con->replace_header("Cache-Control", "no-store");
+      if (!response.set_cookie.empty()) con->replace_header("Set-Cookie", response.set_cookie);
       con->set_body(response.body);
     });
   }
 };
 
-FoxgloveServer::FoxgloveServer(ServerOptions options, std::vector<Channel> channels, HttpHandler http) {
+FoxgloveServer::FoxgloveServer(ServerOptions options, std::vector<Channel> channels, HttpHandler http,
+                               Authenticator authenticate, ClientMessageHandler on_client_message) {
   if (options.queue_frames == 0) throw std::invalid_argument("web.queue_frames = 0: must be at least 1");
   if (options.socket_buffer_bytes == 0) throw std::invalid_argument("web.socket_buffer_bytes = 0: must be at least 1");
   if (options.max_request_bytes < 1024) {
@@ -168,7 +212,11 @@ FoxgloveServer::FoxgloveServer(ServerOptions options, std::vector<Channel> chann
   for (const auto& c : channels) {
     if (!ids.insert(c.id).second) throw std::invalid_argument("channel id " + std::to_string(c.id) + " repeated");
   }
-  impl_ = std::make_unique<Impl>(std::move(options), std::move(channels), std::move(http), stats_);
+  if (!options.publishable.empty() && (!authenticate || !on_client_message)) {
+    throw std::invalid_argument("web.publishable needs an authenticator and a client message handler");
+  }
+  impl_ = std::make_unique<Impl>(std::move(options), std::move(channels), std::move(http), std::move(authenticate),
+                                 std::move(on_client_message), stats_);
   impl_->setup();
 }
 

@@ -8,15 +8,23 @@
 // one channel per topic, encoding "cdr", schema encoding "omgidl", schema the IDL
 // (crane::protocol::kIdlSchema, generated from idl/crane_msgs.idl), schema name the DDS type name.
 // Samples with NaN or Inf are rejected where they enter (as every process of the stack does) and
-// counted. Client publishing is off. HTTP on the same port: / the operator page (deploy/web/www:
-// read-only views, plots, mode and faults, over the same protocol), /about (what this is) and
+// counted. Client publishing is off unless --operators names an operators file (operator_auth.hpp):
+// then a client whose handshake carries a logged-in operator's session cookie may publish goals
+// (rt/crane/planner/goal) and supervisor commands (rt/crane/safety/command), as CDR; each one is
+// deserialized, checked for NaN/Inf and written to the bus by this process, and logged with the
+// operator's name. HTTP on the same port: / the operator page (deploy/web/www: views, plots, mode
+// and faults over the same protocol, and the controls for a logged-in operator), POST /login (the
+// token as the body: sets the session cookie), POST /logout, GET /whoami, /about (what this is) and
 // /metrics (the Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process,
 // the server).
+//   crane_web --operators FILE --new-operator NAME   appends an operator and prints its token once.
 // Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
 // CLI11's message and code.
 #include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <chrono>
@@ -25,6 +33,8 @@
 #include <functional>
 #include <sstream>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -34,6 +44,7 @@
 #include "crane/runtime/node_runtime.hpp"
 #include "crane/transport/cdr.hpp"
 #include "crane/web/foxglove_server.hpp"
+#include "crane/web/operator_auth.hpp"
 #include "crane/web/web_metrics.hpp"
 
 namespace {
@@ -63,7 +74,7 @@ std::string file_text(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"crane_web: the crane's topics over the Foxglove WebSocket protocol (read-only)"};
+  CLI::App app{"crane_web: the crane's topics over the Foxglove WebSocket protocol (read-only unless --operators)"};
   runtime::NodeOptions node;
   web::ServerOptions server_options;
   bool lan = false;
@@ -79,11 +90,44 @@ int main(int argc, char** argv) {
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
   std::string assets = CRANE_WEB_ASSETS_DIR;
   app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
+  std::string operators_path;
+  app.add_option("--operators", operators_path,
+                 "operators file (NAME SHA256-of-token lines, mode 600): logged-in operators may publish goals and "
+                 "supervisor commands; without it the server is read-only");
+  std::string new_operator;
+  app.add_option("--new-operator", new_operator, "with --operators: add operator NAME, print its token, and exit");
+  double session_hours = 12.0;
+  app.add_option("--session-hours", session_hours, "[h] how long an operator's login lasts")->check(CLI::Range(0.01, 720.0));
   int nice_value = 10;
   app.add_option("--nice", nice_value, "scheduling niceness of the whole server (0-19): below the stack's processes, "
                                        "so viewers never take CPU from the control loop")
       ->check(CLI::Range(0, 19));
   CLI11_PARSE(app, argc, argv);
+  if (!new_operator.empty()) {
+    if (operators_path.empty()) {
+      std::fprintf(stderr, "crane_web: --new-operator needs --operators FILE\n");
+      return 2;
+    }
+    try {
+      const std::string token = web::OperatorAuth::add_operator(operators_path, new_operator);
+      std::printf("%s\n", token.c_str());
+      std::fprintf(stderr, "crane_web: operator %s added to %s; the token above is its only copy\n", new_operator.c_str(),
+                   operators_path.c_str());
+      return 0;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_web: %s\n", error.what());
+      return 2;
+    }
+  }
+  std::unique_ptr<web::OperatorAuth> auth;
+  if (!operators_path.empty()) {
+    try {
+      auth = std::make_unique<web::OperatorAuth>(operators_path, session_hours * 3600.0);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_web: %s\n", error.what());
+      return 2;
+    }
+  }
   // Before any thread exists (DDS's, the I/O thread): they inherit it. What it changes for the
   // stack's latency with 20 clients: deploy/bench_web.sh, docs/operation.md.
   if (nice_value > 0 && setpriority(PRIO_PROCESS, 0, nice_value) != 0) {
@@ -93,7 +137,8 @@ int main(int argc, char** argv) {
   node.shared_memory = !lan;
 
   try {
-    runtime::configure_logging("warn", "crane_web");
+    // With operators, every login and every published command is logged (the audit trail).
+    runtime::configure_logging(auth ? "info" : "warn", "crane_web");
     auto participant = runtime::make_participant(node, "crane_web");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
@@ -110,9 +155,81 @@ int main(int argc, char** argv) {
     for (const auto& c : channels) topic_names.push_back(c.topic);
     web::WebMetrics metrics(topic_names);
     const web::ServerStats* server_stats = nullptr;  // set before the server starts
-    web::FoxgloveServer server(server_options, channels, [&](const std::string& path) {
+    // What operators may publish, and the writers that put it on the bus.
+    auto goal_writer = auth ? participant->make_writer<tp::Goal>() : nullptr;
+    auto command_writer = auth ? participant->make_writer<tp::SafetyCommand>() : nullptr;
+    if (auth) {
+      server_options.publishable = {{tp::Goal::name, tp::Goal::type_name},
+                                    {tp::SafetyCommand::name, tp::SafetyCommand::type_name}};
+    }
+    const auto seconds_now = [] {
+      return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+    };
+    auto authenticate = [&](const std::string& cookie, const std::string& origin, const std::string& host) {
+      if (!auth || !web::same_origin(origin, host)) return std::string();
+      return auth->operator_of(cookie, seconds_now()).value_or(std::string());
+    };
+    auto on_client_message = [&](std::size_t topic_index, const std::uint8_t* data, std::size_t size,
+                                 const std::string& operator_name) -> std::string {
+      const auto forward = [&]<class T>(transport::Writer<T>& writer, const char* topic) -> std::string {
+        typename T::Message m;
+        if (!transport::deserialize_cdr<T>(data, size, m)) {
+          return std::string(topic) + ": " + std::to_string(size) + " bytes are not a CDR " + T::type_name;
+        }
+        if (!runtime::all_finite(m)) return std::string(topic) + ": refused, a field is NaN or Inf";
+        writer.write(m);
+        if constexpr (std::is_same_v<T, tp::Goal>) {
+          spdlog::info("operator {} published {} request {} (command {}, trolley {} m, slew {} rad, cable {} m)",
+                       operator_name, topic, m.request_id(), m.command(), m.trolley_target(), m.slew_target(),
+                       m.cable_length_target());
+        } else {
+          spdlog::info("operator {} published {} request {} (command {})", operator_name, topic, m.request_id(),
+                       m.command());
+        }
+        return {};
+      };
+      if (topic_index == 0) return forward(*goal_writer, tp::Goal::name);
+      if (topic_index == 1) return forward(*command_writer, tp::SafetyCommand::name);
+      return "no such publishable topic";
+    };
+    web::FoxgloveServer server(server_options, channels, [&](const web::HttpRequest& request) {
       web::HttpResponse response;
-      if (path == "/metrics") {
+      const std::string& path = request.path;
+      if (path == "/login" || path == "/logout" || path == "/whoami") {
+        response.content_type = "application/json";
+        if (!auth) {
+          response.status = 403;
+          response.body = R"j({"error": "this server is read-only (started without --operators)"})j";
+        } else if (path == "/whoami") {
+          const auto who = auth->operator_of(request.cookie, seconds_now());
+          response.status = who ? 200 : 401;
+          response.body = who ? nlohmann::json{{"operator", *who}}.dump() : R"j({"operator": null})j";
+        } else if (request.method != "POST" || !web::same_origin(request.origin, request.host)) {
+          response.status = 405;
+          response.body = R"j({"error": "POST from this page only"})j";
+        } else if (path == "/logout") {
+          auth->logout(request.cookie);
+          response.status = 200;
+          response.set_cookie = std::string(web::kSessionCookie) + "=; Max-Age=0; Path=/; HttpOnly; SameSite=Strict";
+          response.body = R"j({"operator": null})j";
+        } else {
+          std::string token = request.body;
+          while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back()))) token.pop_back();
+          const auto session = auth->login(token, seconds_now());
+          const auto who = session ? auth->operator_of(std::string(web::kSessionCookie) + "=" + *session, seconds_now())
+                                   : std::nullopt;
+          response.status = who ? 200 : 403;
+          if (who) {
+            response.set_cookie = std::string(web::kSessionCookie) + "=" + *session +
+                                  "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
+                                  std::to_string(static_cast<long>(session_hours * 3600.0));
+            spdlog::info("operator {} logged in", *who);
+          } else {
+            spdlog::warn("a login with an unknown token was refused");
+          }
+          response.body = who ? nlohmann::json{{"operator", *who}}.dump() : R"j({"error": "unknown token"})j";
+        }
+      } else if (path == "/metrics") {
         response.status = 200;
         response.content_type = "text/plain; version=0.0.4; charset=utf-8";
         response.body = metrics.text(server_stats);
@@ -134,7 +251,7 @@ int main(int argc, char** argv) {
         response.body = "not found: " + path + "\n";
       }
       return response;
-    });
+    }, authenticate, on_client_message);
     server_stats = &server.stats();
 
     // One reader per topic (history deep enough that a busy moment never drops a sample here),

@@ -64,9 +64,15 @@ struct WebMetrics::Impl {
                                  .Help("Samples dropped from full client queues (oldest first)").Register(registry);
   Family<Counter>& refused = BuildCounter().Name("crane_web_requests_refused_total")
                                  .Help("Client input refused: request (malformed, unknown id, unsupported), "
-                                       "binary (client publishing is off), handshake (no foxglove.websocket.v1), "
+                                       "binary (publishing off, channel not advertised, refused for the bus), "
+                                       "handshake (no foxglove.websocket.v1), "
                                        "oversized (frame over the limit: client closed, 1009)")
                                  .Register(registry);
+  Family<Gauge>& operator_clients = BuildGauge().Name("crane_web_operator_clients")
+                                        .Help("Connected clients logged in as an operator (may publish)").Register(registry);
+  Family<Counter>& client_messages = BuildCounter().Name("crane_web_operator_messages_total")
+                                         .Help("Goals and supervisor commands operators published to the bus")
+                                         .Register(registry);
   std::vector<Counter*> received_of, rejected_of;
   std::vector<Gauge*> rate_of;
   std::vector<std::uint64_t> window_counts;
@@ -139,6 +145,8 @@ std::string WebMetrics::text(const ServerStats* server) {
     counter_to(impl_->refused.Add({{"kind", "binary"}}), static_cast<double>(server->binary_refused.load()));
     counter_to(impl_->refused.Add({{"kind", "handshake"}}), static_cast<double>(server->handshakes_refused.load()));
     counter_to(impl_->refused.Add({{"kind", "oversized"}}), static_cast<double>(server->oversized_closed.load()));
+    impl_->operator_clients.Add({}).Set(static_cast<double>(server->operator_clients.load()));
+    counter_to(impl_->client_messages.Add({}), static_cast<double>(server->client_messages.load()));
   }
   return prometheus::TextSerializer().Serialize(impl_->registry.Collect());
 }

@@ -1,6 +1,9 @@
 // crane_web's operator page: a Foxglove WebSocket client (foxglove.websocket.v1) that decodes the
 // CDR samples with the OMG IDL schema the server advertises. The field names, the mode and fault
-// names come from that schema (the IDL's constants), not from this file. Read-only.
+// names and the command codes come from that schema (the IDL's constants), not from this file.
+// Read-only until an operator logs in (POST /login with the token; the server sets a session cookie
+// and announces clientPublish on the next connection): then the controls publish goals and
+// supervisor commands as CDR, encoded with the same schema (Foxglove client publishing).
 "use strict";
 
 // ---- OMG IDL, the subset of idl/crane_msgs.idl: modules, @annotations, const, struct, arrays ----
@@ -89,8 +92,42 @@ function decodeCdr(idl, typeName, view) {
   return read(typeName);
 }
 
+// The inverse of decodeCdr: XCDR1 little endian (encapsulation 0x0001), fields missing from
+// `value` written as 0. Returns the bytes.
+function encodeCdr(idl, typeName, value) {
+  const bytes = [0x00, 0x01, 0x00, 0x00];
+  const scratch = new DataView(new ArrayBuffer(8));
+  const WRITERS = {
+    boolean: (v) => scratch.setUint8(0, v ? 1 : 0), octet: (v) => scratch.setUint8(0, v), char: (v) => scratch.setUint8(0, v),
+    int8: (v) => scratch.setInt8(0, v), uint8: (v) => scratch.setUint8(0, v),
+    int16: (v) => scratch.setInt16(0, v, true), uint16: (v) => scratch.setUint16(0, v, true),
+    int32: (v) => scratch.setInt32(0, v, true), uint32: (v) => scratch.setUint32(0, v, true),
+    float: (v) => scratch.setFloat32(0, v, true), double: (v) => scratch.setFloat64(0, v, true),
+    int64: (v) => scratch.setBigInt64(0, BigInt(Math.trunc(v)), true), uint64: (v) => scratch.setBigUint64(0, BigInt(Math.trunc(v)), true),
+  };
+  const write = (type, v) => {
+    const p = PRIMITIVES[type];
+    if (p) {
+      while ((bytes.length - 4) % p[0] !== 0) bytes.push(0);
+      WRITERS[type](v === undefined ? 0 : v);
+      for (let k = 0; k < p[0]; ++k) bytes.push(scratch.getUint8(k));
+      return;
+    }
+    const s = idl.structs.get(type);
+    if (!s) throw new Error(`CDR: unknown type ${type}`);
+    for (const f of s.fields) {
+      const fv = v ? v[f.name] : undefined;
+      if (f.size) for (let k = 0; k < f.size; ++k) write(f.resolved, fv ? fv[k] : undefined);
+      else write(f.resolved, fv);
+    }
+  };
+  write(typeName, value);
+  return new Uint8Array(bytes);
+}
+
 // ---- the page ----
-const view = { connected: false, sensors: 0, last: null, lastPayload: null, actuators: null, status: null, mode: "", faults: [] };
+const view = { connected: false, sensors: 0, last: null, lastPayload: null, actuators: null, status: null, mode: "", faults: [],
+               operator: "", moveStatus: null, sent: [] };
 window.craneView = view; // read by tests/web/page_check.js
 const history = []; // {t, x, gamma, phi, theta, ux, ugamma}
 const channels = new Map(); // subscription id -> {topic, schemaName, idl}
@@ -102,25 +139,132 @@ function codeNames(idl, module, group) {
     .map((c) => ({ name: c.name.slice(group.length + 1).toLowerCase(), value: c.value }));
 }
 
+// ---- the operator's controls: what an operator's connection may publish ----
+const GOAL = "rt/crane/planner/goal", COMMAND = "rt/crane/safety/command";
+const publishing = new Map(); // topic -> {id, schemaName, idl} of our advertised client channel
+let socket = null;
+let mayPublish = false;
+
+// Request ids only increase (the planner and the supervisor ignore one not above the last they
+// took): tenths of a second since 2025-01-01, as crane_move (deploy/launcher/src/move_main.cpp).
+let lastRequestId = 0;
+function freshRequestId() {
+  lastRequestId = Math.max(lastRequestId + 1, Math.floor(Date.now() / 100) - 17356896000);
+  return lastRequestId;
+}
+function constant(idl, module, name) {
+  const c = (idl.constants.get(module) || []).find((k) => k.name === name);
+  if (!c) throw new Error(`the schema has no ${module}::${name}`);
+  return c.value;
+}
+function header() {
+  const now = Date.now();
+  const stamp = { sec: Math.floor(now / 1000), nanosec: (now % 1000) * 1e6 };
+  return { stamp, seq: 0, origin: stamp };
+}
+function publish(topic, message) {
+  const ch = channelFor(topic);
+  const payload = encodeCdr(ch.idl, ch.schemaName, message);
+  const frame = new Uint8Array(5 + payload.length);
+  const dv = new DataView(frame.buffer);
+  dv.setUint8(0, 1); // Client Message Data
+  dv.setUint32(1, ch.id, true);
+  frame.set(payload, 5);
+  socket.send(frame);
+  view.sent.push({ topic, request_id: message.request_id, command: message.command });
+  return message.request_id;
+}
+function channelFor(topic) {
+  const ch = publishing.get(topic);
+  if (!socket || !ch) throw new Error(`not allowed to publish ${topic} (log in as an operator)`);
+  return ch;
+}
+function supervisorCommand(name) {
+  const ch = channelFor(COMMAND);
+  const code = constant(ch.idl, "crane_msgs::msg::SupervisorCommand_Constants", "COMMAND_" + name);
+  return publish(COMMAND, { header: header(), request_id: freshRequestId(), command: code });
+}
+function moveTo(trolley, slewDeg, cable) {
+  const ch = channelFor(GOAL);
+  const k = (n) => constant(ch.idl, "crane_msgs::msg::MoveRequest_Constants", n);
+  const axes = k("AXIS_TROLLEY") | k("AXIS_SLEW") | (cable > 0 ? k("AXIS_HOIST") : 0);
+  return publish(GOAL, { header: header(), request_id: freshRequestId(), profile: k("PROFILE_TRAPEZOID"), axes,
+                         command: k("COMMAND_MOVE"), trolley_target: trolley, slew_target: slewDeg * Math.PI / 180,
+                         cable_length_target: cable > 0 ? cable : (view.last ? view.last.cable_length : 1.0) });
+}
+function softStop() {
+  const ch = channelFor(GOAL);
+  return publish(GOAL, { header: header(), request_id: freshRequestId(),
+                         command: constant(ch.idl, "crane_msgs::msg::MoveRequest_Constants", "COMMAND_STOP") });
+}
+view.controls = { supervisorCommand, moveTo, softStop }; // also driven by tests/web/page_check.js
+
+async function login() {
+  const response = await fetch("/login", { method: "POST", body: $("token").value, credentials: "same-origin" });
+  const answer = await response.json();
+  $("login_state").textContent = response.ok ? `logged in as ${answer.operator}` : `refused: ${answer.error}`;
+  $("token").value = "";
+  if (response.ok && socket) socket.close(); // reconnect: the new handshake carries the session
+}
+async function logout() {
+  await fetch("/logout", { method: "POST", credentials: "same-origin" });
+  if (socket) socket.close();
+}
+function wireControls() {
+  $("login").onclick = login;
+  $("logout").onclick = logout;
+  const guarded = (f) => () => {
+    try { f(); $("control_error").textContent = ""; } catch (e) { $("control_error").textContent = String(e.message || e); }
+  };
+  $("arm").onclick = guarded(() => supervisorCommand("ARM"));
+  $("disarm").onclick = guarded(() => supervisorCommand("DISARM"));
+  $("reset").onclick = guarded(() => supervisorCommand("RESET"));
+  $("estop").onclick = guarded(() => supervisorCommand("EMERGENCY_STOP"));
+  $("stop").onclick = guarded(softStop);
+  $("move").onclick = guarded(() => {
+    const numbers = ["target_trolley", "target_slew", "target_cable"].map((id) => Number($(id).value));
+    if (numbers.some((v) => !Number.isFinite(v))) throw new Error("move to: every target must be a number");
+    moveTo(...numbers);
+  });
+}
+
 function connect() {
   const ws = new WebSocket(`ws://${location.host}/`, ["foxglove.websocket.v1"]);
+  socket = ws;
   ws.binaryType = "arraybuffer";
   ws.onopen = () => { view.connected = true; $("link").textContent = "connected to " + location.host; };
-  ws.onclose = () => { view.connected = false; $("link").textContent = "disconnected; retrying"; setTimeout(connect, 1000); };
+  ws.onclose = () => {
+    view.connected = false; mayPublish = false; publishing.clear(); view.operator = ""; socket = null;
+    $("link").textContent = "disconnected; retrying"; setTimeout(connect, 1000);
+  };
   ws.onmessage = (event) => {
     if (typeof event.data === "string") {
       const m = JSON.parse(event.data);
+      if (m.op === "serverInfo") {
+        mayPublish = (m.capabilities || []).includes("clientPublish");
+        view.operator = mayPublish ? String((m.metadata || {}).clientPublish || "").replace(/^operator /, "") : "";
+        return;
+      }
+      if (m.op === "status") { if (m.level >= 2) $("control_error").textContent = m.message; return; }
       if (m.op !== "advertise") return;
-      const wanted = ["rt/crane/hw/sensors", "rt/crane/hw/actuators", "rt/crane/safety/status"];
+      const wanted = ["rt/crane/hw/sensors", "rt/crane/hw/actuators", "rt/crane/safety/status", "rt/crane/planner/move_status"];
       const subscriptions = [];
+      const advertise = [];
       for (const ch of m.channels) {
-        if (!wanted.includes(ch.topic) || ch.schemaEncoding !== "omgidl") continue;
+        if (ch.schemaEncoding !== "omgidl") continue;
         if (!idlCache.has(ch.schema)) idlCache.set(ch.schema, parseIdl(ch.schema));
+        if (mayPublish && (ch.topic === GOAL || ch.topic === COMMAND)) {
+          const id = advertise.length + 1;
+          publishing.set(ch.topic, { id, schemaName: ch.schemaName, idl: idlCache.get(ch.schema) });
+          advertise.push({ id, topic: ch.topic, encoding: "cdr", schemaName: ch.schemaName });
+        }
+        if (!wanted.includes(ch.topic)) continue;
         const id = subscriptions.length;
         channels.set(id, { topic: ch.topic, schemaName: ch.schemaName, idl: idlCache.get(ch.schema) });
         subscriptions.push({ id, channelId: ch.id });
       }
       ws.send(JSON.stringify({ op: "subscribe", subscriptions }));
+      if (advertise.length) ws.send(JSON.stringify({ op: "advertise", channels: advertise }));
       return;
     }
     const frame = new DataView(event.data);
@@ -139,6 +283,13 @@ function connect() {
       if (history.length > 1000) history.shift();
     } else if (ch.topic === "rt/crane/hw/actuators") {
       view.actuators = sample;
+    } else if (ch.topic === "rt/crane/planner/move_status") {
+      const module = "crane_msgs::msg::MoveStatus_Constants";
+      const result = codeNames(ch.idl, module, "RESULT").find((c) => c.value === sample.result);
+      const reason = codeNames(ch.idl, module, "REASON").find((c) => c.value === sample.reason);
+      view.moveStatus = { request_id: sample.request_id, result: result ? result.name : String(sample.result),
+                          reason: reason ? reason.name : String(sample.reason), trolley_to_go: sample.trolley_to_go,
+                          value: sample.value, bound_min: sample.bound_min, bound_max: sample.bound_max };
     } else {
       view.status = sample;
       const module = "crane_msgs::msg::SupervisorStatus_Constants";
@@ -218,6 +369,12 @@ function draw() {
       `V trolley   ${s.applied_trolley_voltage.toFixed(3)} V\nV slew      ${s.applied_slew_voltage.toFixed(3)} V\n` +
       `brakes      ${s.brakes_engaged ? "engaged" : "released"}\nsamples     ${view.sensors}`;
   }
+  $("controls").className = mayPublish ? "panel" : "panel readonly";
+  $("operator").textContent = mayPublish ? `operator ${view.operator}` : "read-only (log in to command the crane)";
+  const m = view.moveStatus;
+  $("move_status").textContent = m ? `move ${m.request_id}: ${m.result}${m.reason !== "none" ? " (" + m.reason +
+    (m.result === "rejected" ? `: ${m.value} not in [${m.bound_min}, ${m.bound_max}]` : "") + ")" : ""}` +
+    (m.result === "moving" ? `, trolley ${m.trolley_to_go.toFixed(3)} m to go` : "") : "";
   drawTop(); drawSide();
   plot("plot_positions", [{ key: "x", color: "#36c" }, { key: "gamma", color: "#c63" }]);
   plot("plot_swing", [{ key: "phi", color: "#36c" }, { key: "theta", color: "#c63" }]);
@@ -230,5 +387,6 @@ function render() {
   requestAnimationFrame(render);
 }
 
+wireControls();
 connect();
 requestAnimationFrame(render);

@@ -24,6 +24,8 @@ struct ServerOptions {
                                                // what websocketpp may hold for it before the queue
   std::size_t max_request_bytes{64 * 1024};    // [bytes] largest frame a client may send (else closed, 1009)
   std::string name{"crane_web"};               // serverInfo name
+  // Client publishing: the topics an operator's client may publish (empty: publishing off for all).
+  std::vector<PublishableTopic> publishable{};
 };
 
 /// Counters of the server, read by the metrics (any thread).
@@ -33,24 +35,45 @@ struct ServerStats {
   std::atomic<std::uint64_t> frames_sent{0};        // Message Data frames handed to sockets
   std::atomic<std::uint64_t> frames_dropped{0};     // dropped from full send queues (oldest first)
   std::atomic<std::uint64_t> bad_requests{0};       // refused text requests (malformed, unknown ids, unsupported)
-  std::atomic<std::uint64_t> binary_refused{0};     // binary frames from clients (client publishing is off)
+  std::atomic<std::uint64_t> binary_refused{0};     // binary frames refused (publishing off, not advertised, refused by the bus)
+  std::atomic<std::uint64_t> client_messages{0};    // operators' messages passed to the bus
+  std::atomic<std::uint64_t> operator_clients{0};   // clients connected as an operator now
   std::atomic<std::uint64_t> handshakes_refused{0}; // WebSocket handshakes without foxglove.websocket.v1
   std::atomic<std::uint64_t> oversized_closed{0};   // clients closed (1009) for a frame over max_request_bytes
 };
 
-/// An HTTP GET handler: path in, (status, content type, body) out.
+/// An HTTP request (not a WebSocket handshake) and the handler's answer.
+struct HttpRequest {
+  std::string method;  // "GET", "POST", ...
+  std::string path;    // without the query
+  std::string body;
+  std::string cookie;  // the Cookie header ("" when absent)
+  std::string origin;  // the Origin header ("" when absent)
+  std::string host;    // the Host header
+};
 struct HttpResponse {
   int status{404};
   std::string content_type{"text/plain; charset=utf-8"};
   std::string body;
+  std::string set_cookie;  // a Set-Cookie header value ("" for none)
 };
-using HttpHandler = std::function<HttpResponse(const std::string& path)>;
+using HttpHandler = std::function<HttpResponse(const HttpRequest& request)>;
+/// Who a WebSocket handshake is: the operator's name, or "" (read-only). Called on the I/O thread
+/// with the handshake's Cookie, Origin and Host headers.
+using Authenticator = std::function<std::string(const std::string& cookie, const std::string& origin, const std::string& host)>;
+/// Takes one message an operator's client published (`topic_index` into ServerOptions::publishable,
+/// the CDR payload) and returns "" when it went to the bus, else the reason it was refused. Called
+/// on the I/O thread; must not block.
+using ClientMessageHandler =
+    std::function<std::string(std::size_t topic_index, const std::uint8_t* data, std::size_t size, const std::string& operator_name)>;
 
 class FoxgloveServer {
  public:
   /// `channels`: what every client is offered (ids unique). Throws std::invalid_argument on a bad
   /// option (naming it) or a repeated channel id. Does not open the socket yet.
-  FoxgloveServer(ServerOptions options, std::vector<Channel> channels, HttpHandler http);
+  /// `authenticate` and `on_client_message` are only used when options.publishable is not empty.
+  FoxgloveServer(ServerOptions options, std::vector<Channel> channels, HttpHandler http,
+                 Authenticator authenticate = {}, ClientMessageHandler on_client_message = {});
   ~FoxgloveServer();
   FoxgloveServer(const FoxgloveServer&) = delete;
   FoxgloveServer& operator=(const FoxgloveServer&) = delete;
