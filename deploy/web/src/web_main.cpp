@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
           spdlog::info("operator {} published {} request {} (command {})", operator_name, topic, m.request_id(),
                        m.command());
         }
+        spdlog::default_logger()->flush();  // the audit trail is on disk before the next command
         return {};
       };
       if (topic_index == 0) return forward(*goal_writer, tp::Goal::name);
@@ -227,6 +228,7 @@ int main(int argc, char** argv) {
           } else {
             spdlog::warn("a login with an unknown token was refused");
           }
+          spdlog::default_logger()->flush();
           response.body = who ? nlohmann::json{{"operator", *who}}.dump() : R"j({"error": "unknown token"})j";
         }
       } else if (path == "/metrics") {
