@@ -408,6 +408,7 @@ int main(int argc, char** argv) {
   runtime::NodeOptions node;
   app.add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  runtime::add_security_options(app, node);  // identity: the participant's, "operator"
   app.add_option("--trolley", o.trolley, "[m] trolley target")->check(CLI::Range(-100.0, 100.0));
   app.add_option("--slew", o.slew_deg, "[deg] slew target")->check(CLI::Range(-3600.0, 3600.0));
   app.add_option("--hoist", o.hoist, "[m] cable length target")->check(CLI::Range(0.0, 200.0));
