@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
                                          "zone: enable | disable N");
   app.add_option("--dds", options.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  runtime::add_security_options(app, options);  // identity: the participant's, "operator"
   app.add_option("--timeout", timeout, "[s] longest wait for the supervisor")->check(CLI::Range(0.1, 60.0));
   app.add_flag("--json", json, "status as one JSON object");
   CLI11_PARSE(app, argc, argv);

@@ -35,6 +35,7 @@ else
   done
   NET=(--dds-profile "$OUT/fastdds_lan_unicast.xml")  # each process takes its vendor's file of the pair
 fi
+NET+=(--insecure-lan)  # monitoring without DDS Security, on purpose (tests/security checks it secured)
 inb ip addr show crane_b > "$OUT/address_b.txt"
 grep -q 10.77.0.2 "$OUT/address_b.txt"
 

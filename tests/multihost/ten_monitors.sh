@@ -29,14 +29,14 @@ cleanup() {
 trap cleanup EXIT
 make_veth_pair multicast
 
-"$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
+"$BIN/crane_bench" latency --config "$CONFIG" --lan --insecure-lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/alone.json"
 RX0=$(rx_bytes)
 for i in $(seq 1 10); do
-  inb "${SCHED[@]}" "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
+  inb "${SCHED[@]}" "$BIN/crane_topic" hz rt/crane/hw/sensors --lan --insecure-lan --dds "$MONITOR_DDS" --domain 22 --duration $((DURATION + 15)) --json \
     > "$OUT/monitor_$i.json" 2>&1 &
   MONITORS+=($!)
 done
-"$BIN/crane_bench" latency --config "$CONFIG" --lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/monitored.json"
+"$BIN/crane_bench" latency --config "$CONFIG" --lan --insecure-lan --dds "$STACK_DDS" --domain 22 --duration "$DURATION" --json > "$OUT/monitored.json"
 for p in "${MONITORS[@]}"; do wait "$p" || true; done
 MONITORS=()
 echo "{\"rx_bytes\": $(( $(rx_bytes) - RX0 ))}" > "$OUT/veth.json"

@@ -335,6 +335,8 @@ int main(int argc, char** argv) {
   latency_cmd->add_flag("--lan", lan, "every process on all interfaces (monitors on other machines may join)");
   latency_cmd->add_option("--dds-profile", dds_profile, "network profile of every process (deploy/dds/*.xml)")
       ->check(CLI::ExistingFile);
+  runtime::NodeOptions security;  // --security, --identity (of bench: default operator), --insecure-lan
+  runtime::add_security_options(*latency_cmd, security);
   auto* soak_cmd = app.add_subcommand("soak", "the live stack (realtime) at rest, then moves, optionally under load: "
                                               "faults, readiness, overruns, end-to-end latency");
   double soak_rest = 600.0;
@@ -420,6 +422,11 @@ int main(int argc, char** argv) {
       stack.dds_per_process = launch::parse_dds_mix(dds_mix, known);
     }
     if (!dds_profile.empty()) stack.dds_profile = fs::absolute(dds_profile).string();
+    if (!security.security_directory.empty()) {
+      stack.security_directory = fs::absolute(security.security_directory).string();
+    }
+    stack.insecure_lan = security.insecure_lan;
+    runtime::check_network_security(!lan, stack.dds_profile, stack.security_directory, stack.insecure_lan);
     launch::ProcessGroup group;
     for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
 
@@ -428,6 +435,9 @@ int main(int argc, char** argv) {
     node.domain_id = domain;
     node.loopback_only = !lan;
     node.dds_profile = stack.dds_profile;
+    node.security_directory = stack.security_directory;
+    node.identity = security.identity.empty() ? "operator" : security.identity;  // it writes the goals
+    node.insecure_lan = stack.insecure_lan;
     auto participant = runtime::make_participant(node, "bench");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -52,6 +52,7 @@ struct DemoOptions {
   std::string controller;             // --controller, see main(); "auto" picks per maneuver (time_optimal)
   double plant_cable_length_factor{1.0};
   double plant_load_mass_factor{1.0};
+  std::string security_directory;  // --security: every process and the operator secured (DDS Security)
 };
 
 struct ProcessRecord {
@@ -189,6 +190,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   stack.log_directory = log_dir.string();
   stack.dds = options.dds;
   stack.dds_per_process = options.dds_per_process;
+  stack.security_directory = options.security_directory;
   stack.domain_id = domain_id;
   stack.lockstep = !options.realtime;
   stack.initial_trolley_position = m.initial_trolley_position;
@@ -454,6 +456,9 @@ int main(int argc, char** argv) {
                  "behind it (hardware-in-the-loop), instead of the plant on DDS")
       ->check(CLI::IsMember({"shm"}));
   app.add_option("--domain", options.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--security", options.security_directory,
+                 "DDS Security material (deploy/crane security init): every process with its own identity")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
@@ -512,6 +517,10 @@ int main(int argc, char** argv) {
     }
     runtime::NodeOptions node;
     node.dds = options.dds_per_process.count("operator") != 0 ? options.dds_per_process.at("operator") : options.dds;
+    if (!options.security_directory.empty()) {
+      options.security_directory = fs::absolute(options.security_directory).string();
+    }
+    node.security_directory = options.security_directory;
 
     // Each run gets a fresh DDS domain and a fresh operator participant: nothing of one run's
     // discovery (participants still being removed while the next stack starts) reaches the next.

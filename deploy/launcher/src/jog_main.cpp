@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
   app.add_option("--timeout", timeout, "[s] wait for the planner to listen")->check(CLI::PositiveNumber);
   app.add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  runtime::add_security_options(app, node);  // identity: the participant's, "operator"
   CLI11_PARSE(app, argc, argv);
   if (!script_path.empty() && !device_path.empty()) {
     std::fprintf(stderr, "crane_jog: give --script or --device, not both\n");

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -46,6 +47,12 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_flag("--lan", stack.lan, "every process uses all network interfaces (monitoring from another machine) "
                                    "instead of loopback only");
+  app.add_option("--security", stack.security_directory,
+                 "DDS Security material of every process (deploy/crane security init; default: $CRANE_SECURITY), "
+                 "each with its own identity")
+      ->check(CLI::ExistingDirectory);
+  app.add_flag("--insecure-lan", stack.insecure_lan,
+               "allow --lan or --dds-profile without --security: anyone on that network can read and command the crane");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
   app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
   app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
@@ -81,6 +88,16 @@ int main(int argc, char** argv) {
     node.loopback_only = !stack.lan;
     if (!stack.dds_profile.empty()) stack.dds_profile = std::filesystem::absolute(stack.dds_profile).string();
     node.dds_profile = stack.dds_profile;
+    if (stack.security_directory.empty()) {
+      if (const char* env = std::getenv("CRANE_SECURITY"); env != nullptr) stack.security_directory = env;
+    }
+    if (!stack.security_directory.empty()) {
+      stack.security_directory = std::filesystem::absolute(stack.security_directory).string();
+    }
+    node.security_directory = stack.security_directory;
+    node.insecure_lan = stack.insecure_lan;
+    // Refused here, before any stage starts (each stage would refuse it too).
+    runtime::check_network_security(node.loopback_only, node.dds_profile, node.security_directory, node.insecure_lan);
     if (!lockstep && realtime_priority > 0) {
       // Ask before starting anything: a forked probe tries what every stage will do.
       const std::string failure = launch::probe_realtime(realtime_priority + 10);

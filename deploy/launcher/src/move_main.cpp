@@ -408,6 +408,10 @@ int main(int argc, char** argv) {
   runtime::NodeOptions node;
   app.add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
+  bool lan = false;
+  app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  runtime::add_security_options(app, node);  // identity: the participant's, "operator"
   app.add_option("--trolley", o.trolley, "[m] trolley target")->check(CLI::Range(-100.0, 100.0));
   app.add_option("--slew", o.slew_deg, "[deg] slew target")->check(CLI::Range(-3600.0, 3600.0));
   app.add_option("--hoist", o.hoist, "[m] cable length target")->check(CLI::Range(0.0, 200.0));
@@ -425,6 +429,8 @@ int main(int argc, char** argv) {
   app.add_flag("--stop", o.stop, "a controlled anti-sway stop of whatever moves (deploy/crane stop)");
   app.add_option("--config", o.config, "the stack's configuration: names the no-go zones in messages");
   CLI11_PARSE(app, argc, argv);
+  node.loopback_only = !lan;
+  node.shared_memory = !lan;
   if (o.stop) {
     try {
       runtime::configure_logging("warn", "move");

@@ -85,6 +85,10 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
                             {"--realtime-priority", std::to_string(std::min(o.realtime_priority + offset, 99))});
     }
     if (!o.dds_profile.empty()) spec.arguments.insert(spec.arguments.end(), {"--dds-profile", o.dds_profile});
+    if (!o.security_directory.empty()) {
+      spec.arguments.insert(spec.arguments.end(), {"--security", o.security_directory});
+    }
+    if (o.insecure_lan) spec.arguments.push_back("--insecure-lan");
     if (name == "plant") {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),

@@ -283,6 +283,7 @@ int main(int argc, char** argv) {
     sub->add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
     sub->add_flag("--lan", lan, "use the network (UDP on every interface, no shared memory: as from another "
                                 "machine) instead of loopback only");
+    runtime::add_security_options(*sub, node);
   };
   auto* list_cmd = app.add_subcommand("list", "topics from discovery: types, writers, readers, QoS");
   double wait = 2.0;
@@ -347,6 +348,7 @@ int main(int argc, char** argv) {
   }
   node.loopback_only = !lan;
   node.shared_memory = !lan;
+  if (node.identity.empty()) node.identity = "monitor";  // a read-only tool: the monitor role
 
   try {
     runtime::configure_logging("warn", "crane_topic");

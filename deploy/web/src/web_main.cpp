@@ -88,6 +88,7 @@ int main(int argc, char** argv) {
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  runtime::add_security_options(app, node);
   std::string assets = CRANE_WEB_ASSETS_DIR;
   app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
   std::string operators_path;
@@ -135,6 +136,7 @@ int main(int argc, char** argv) {
   }
   node.loopback_only = !lan;
   node.shared_memory = !lan;
+  if (node.identity.empty()) node.identity = "monitor";  // it only reads topics: the monitor role
 
   try {
     // With operators, every login and every published command is logged (the audit trail).

@@ -257,9 +257,31 @@ void read_builtin(dds_entity_t reader, Visit&& visit) {
   if (n > 0) dds_return_loan(reader, samples.data(), n);
 }
 
+// DDS Security through the participant's QoS properties (Cyclone DDS 0.10, "DDS Security"): its
+// builtin plugins, loaded from where Debian installs them (CRANE_CYCLONE_SECURITY_DIR, found by
+// CMake), files as file:// URIs.
+void apply_security(const SecurityFiles& files, dds_qos_t* qos) {
+  const std::string dir = CRANE_CYCLONE_SECURITY_DIR;
+  const auto plugin = [&](const char* kind, const char* library, const char* function) {
+    const std::string prefix = std::string("dds.sec.") + kind + ".library.";
+    dds_qset_prop(qos, (prefix + "path").c_str(), (dir + "/lib" + library + ".so").c_str());
+    dds_qset_prop(qos, (prefix + "init").c_str(), (std::string("init_") + function).c_str());
+    dds_qset_prop(qos, (prefix + "finalize").c_str(), (std::string("finalize_") + function).c_str());
+  };
+  plugin("auth", "dds_security_auth", "authentication");
+  plugin("access", "dds_security_ac", "access_control");
+  plugin("crypto", "dds_security_crypto", "crypto");
+  dds_qset_prop(qos, "dds.sec.auth.identity_ca", ("file://" + files.identity_ca).c_str());
+  dds_qset_prop(qos, "dds.sec.auth.identity_certificate", ("file://" + files.certificate).c_str());
+  dds_qset_prop(qos, "dds.sec.auth.private_key", ("file://" + files.private_key).c_str());
+  dds_qset_prop(qos, "dds.sec.access.permissions_ca", ("file://" + files.permissions_ca).c_str());
+  dds_qset_prop(qos, "dds.sec.access.governance", ("file://" + files.governance).c_str());
+  dds_qset_prop(qos, "dds.sec.access.permissions", ("file://" + files.permissions).c_str());
+}
+
 class CycloneParticipant final : public ParticipantBackend {
  public:
-  explicit CycloneParticipant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
+  CycloneParticipant(const ParticipantOptions& options, const SecurityFiles* security) : domain_id_(options.domain_id) {
     std::string config;
     if (!options.profile_file.empty()) {
       std::ifstream in(options.profile_file);
@@ -276,11 +298,15 @@ class CycloneParticipant final : public ParticipantBackend {
     DomainRegistry::instance().acquire(domain_id_, config);
     Qos qos;
     dds_qset_entity_name(qos.q, options.name.c_str());
+    if (security != nullptr) apply_security(*security, qos.q);
     participant_ = dds_create_participant(domain_id_, qos.q, nullptr);
     if (participant_ < 0) {
       DomainRegistry::instance().release(domain_id_);
       throw std::runtime_error("cyclone dds: cannot create a participant in domain " + std::to_string(domain_id_) +
-                               ": " + error_text(participant_));
+                               ": " + error_text(participant_) +
+                               (security != nullptr ? " (with the DDS Security files of identity '" + options.identity +
+                                                          "' in " + options.security_directory + ")"
+                                                    : std::string()));
     }
     dds_guid_t guid;
     if (dds_get_guid(participant_, &guid) == DDS_RETCODE_OK) own_prefix_ = hex(guid).substr(0, 36);
@@ -364,8 +390,9 @@ class CycloneParticipant final : public ParticipantBackend {
 
 }  // namespace
 
-std::unique_ptr<ParticipantBackend> make_cyclone_dds_backend(const ParticipantOptions& options) {
-  return std::make_unique<CycloneParticipant>(options);
+std::unique_ptr<ParticipantBackend> make_cyclone_dds_backend(const ParticipantOptions& options,
+                                                             const SecurityFiles* security) {
+  return std::make_unique<CycloneParticipant>(options, security);
 }
 
 }  // namespace crane::transport::detail

@@ -92,7 +92,8 @@ class FastWriter final : public WriterBackend, public dds::DataWriterListener {
   FastWriter(dds::Publisher* publisher, dds::Topic* topic, QosKind kind) : publisher_(publisher) {
     writer_ = publisher->create_datawriter(topic, writer_qos(kind), this, dds::StatusMask::all());
     if (writer_ == nullptr) {
-      throw std::runtime_error(std::string("fast dds: cannot create a writer on ") + topic->get_name());
+      throw std::runtime_error(std::string("fast dds: cannot create a writer on ") + topic->get_name() +
+                               " (with DDS Security: not in this identity's permissions to publish)");
     }
   }
   ~FastWriter() override {
@@ -125,7 +126,8 @@ class FastReader final : public ReaderBackend, public dds::DataReaderListener {
       : subscriber_(subscriber), wakeup_(wakeup) {
     reader_ = subscriber->create_datareader(topic, reader_qos(kind, depth), this, dds::StatusMask::all());
     if (reader_ == nullptr) {
-      throw std::runtime_error(std::string("fast dds: cannot create a reader on ") + topic->get_name());
+      throw std::runtime_error(std::string("fast dds: cannot create a reader on ") + topic->get_name() +
+                               " (with DDS Security: not in this identity's permissions to subscribe)");
     }
   }
   ~FastReader() override {
@@ -258,9 +260,27 @@ class DiscoveryListener final : public dds::DomainParticipantListener {
   std::map<std::string, DiscoveredEndpoint> endpoints_;  // endpoint GUID -> endpoint
 };
 
+// DDS Security through the participant's properties (Fast DDS 2.9, "Security" chapter): the builtin
+// PKI-DH, Access-Permissions and AES-GCM-GMAC plugins, files as file:// URIs.
+void apply_security(const SecurityFiles& files, dds::DomainParticipantQos& qos) {
+  auto& properties = qos.properties().properties();
+  const auto set = [&properties](const std::string& name, const std::string& value) {
+    properties.emplace_back(name, value);
+  };
+  set("dds.sec.auth.plugin", "builtin.PKI-DH");
+  set("dds.sec.auth.builtin.PKI-DH.identity_ca", "file://" + files.identity_ca);
+  set("dds.sec.auth.builtin.PKI-DH.identity_certificate", "file://" + files.certificate);
+  set("dds.sec.auth.builtin.PKI-DH.private_key", "file://" + files.private_key);
+  set("dds.sec.access.plugin", "builtin.Access-Permissions");
+  set("dds.sec.access.builtin.Access-Permissions.permissions_ca", "file://" + files.permissions_ca);
+  set("dds.sec.access.builtin.Access-Permissions.governance", "file://" + files.governance);
+  set("dds.sec.access.builtin.Access-Permissions.permissions", "file://" + files.permissions);
+  set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
 class FastParticipant final : public ParticipantBackend {
  public:
-  explicit FastParticipant(const ParticipantOptions& options) {
+  FastParticipant(const ParticipantOptions& options, const SecurityFiles* security) {
     dds::DomainParticipantQos qos = dds::PARTICIPANT_QOS_DEFAULT;
     qos.name(options.name);
     // Faster detection of vanished participants than the 20 s default; stages are watched by
@@ -307,12 +327,16 @@ class FastParticipant final : public ParticipantBackend {
       group.port = 7400U + 250U * options.domain_id + 1U;  // PB + DG * domain + d2 (RTPS 2.2, 9.6.1.1)
       qos.wire_protocol().default_multicast_locator_list.push_back(group);
     }
+    if (security != nullptr) apply_security(*security, qos);
     // Only the discovery callbacks go to the listener; data and status stay with each endpoint.
     participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
         static_cast<dds::DomainId_t>(options.domain_id), qos, &discovery_, dds::StatusMask::none());
     if (participant_ == nullptr) {
       throw std::runtime_error("fast dds: cannot create a participant in domain " +
-                               std::to_string(options.domain_id));
+                               std::to_string(options.domain_id) +
+                               (security != nullptr ? " with the DDS Security files of identity '" + options.identity +
+                                                          "' in " + options.security_directory + " (refused by Fast DDS)"
+                                                    : std::string()));
     }
     publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
@@ -361,8 +385,9 @@ class FastParticipant final : public ParticipantBackend {
 
 }  // namespace
 
-std::unique_ptr<ParticipantBackend> make_fast_dds_backend(const ParticipantOptions& options) {
-  return std::make_unique<FastParticipant>(options);
+std::unique_ptr<ParticipantBackend> make_fast_dds_backend(const ParticipantOptions& options,
+                                                          const SecurityFiles* security) {
+  return std::make_unique<FastParticipant>(options, security);
 }
 
 }  // namespace crane::transport::detail

@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -59,12 +60,18 @@ bool Wakeup::wait_until(std::chrono::steady_clock::time_point deadline) {
 
 Participant::Participant(const ParticipantOptions& options) : options_(options) {
   options_.profile_file = profile_for_vendor(options.profile_file, options.vendor);
+  std::optional<SecurityFiles> security;
+  if (!options_.security_directory.empty()) {
+    if (options_.identity.empty()) options_.identity = options_.name;
+    security = security_files(options_.security_directory, options_.identity);
+  }
+  const SecurityFiles* files = security ? &*security : nullptr;
   switch (options.vendor) {
     case Vendor::fast_dds:
-      backend_ = detail::make_fast_dds_backend(options_);
+      backend_ = detail::make_fast_dds_backend(options_, files);
       break;
     case Vendor::cyclone_dds:
-      backend_ = detail::make_cyclone_dds_backend(options_);
+      backend_ = detail::make_cyclone_dds_backend(options_, files);
       break;
   }
 }

@@ -42,6 +42,29 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
   app.add_option("--realtime-priority", options.realtime_priority,
                  "SCHED_FIFO priority (1-99) and locked memory, where the system allows it (0: normal priority)")
       ->check(CLI::Range(0, 99));
+  add_security_options(app, options);
+}
+
+void add_security_options(CLI::App& app, NodeOptions& options) {
+  app.add_option("--security", options.security_directory,
+                 "DDS Security material (deploy/crane security init; default: $CRANE_SECURITY): authenticated, "
+                 "access-controlled and encrypted DDS")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--identity", options.identity,
+                 "identity in the --security folder (default: this process's own, or the tool's role)");
+  app.add_flag("--insecure-lan", options.insecure_lan,
+               "allow --lan or a --dds-profile without --security: anyone on that network can read and command "
+               "the crane");
+}
+
+void check_network_security(bool loopback_only, const std::string& dds_profile, const std::string& security_directory,
+                            bool insecure_lan) {
+  if ((loopback_only && dds_profile.empty()) || !security_directory.empty() || insecure_lan) return;
+  throw std::invalid_argument(
+      std::string(dds_profile.empty() ? "--lan" : "--dds-profile " + dds_profile) +
+      " without --security: every participant on that network could read the sensors and write goals and "
+      "supervisor commands, with nothing to authenticate it. Give --security DIR (deploy/crane security init), "
+      "or --insecure-lan to run unprotected on purpose");
 }
 
 std::string enter_realtime(int priority) {
@@ -88,6 +111,15 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
     if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;
   }
   p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
+  p.security_directory = options.security_directory;
+  if (p.security_directory.empty()) {
+    if (const char* env = std::getenv("CRANE_SECURITY"); env != nullptr) p.security_directory = env;
+  }
+  p.identity = options.identity;
+  check_network_security(p.loopback_only, p.profile_file, p.security_directory, options.insecure_lan);
+  if (!p.security_directory.empty()) {
+    spdlog::info("DDS Security: identity '{}' of {}", p.identity.empty() ? name : p.identity, p.security_directory);
+  }
   return std::make_unique<transport::Participant>(p);
 }
 

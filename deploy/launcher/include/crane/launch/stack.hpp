@@ -23,6 +23,8 @@ struct StackOptions {
   unsigned domain_id{0};
   bool lan{false};                    // every process with --lan (all interfaces) instead of loopback only
   std::string dds_profile;            // every process with --dds-profile (deploy/dds/*.xml); empty: none
+  std::string security_directory;     // every process with --security DIR (its own identity in it); empty: none
+  bool insecure_lan{false};           // every process with --insecure-lan (--lan or a profile without security)
   bool lockstep{true};                // plant clock: lockstep (default) or realtime
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]

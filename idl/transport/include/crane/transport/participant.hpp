@@ -24,6 +24,7 @@
 #include <string_view>
 
 #include "crane/transport/qos.hpp"
+#include "crane/transport/security.hpp"
 
 namespace crane::transport {
 
@@ -52,6 +53,10 @@ struct ParticipantOptions {
                                   // replaces loopback_only/shared_memory; empty: none. Fast DDS uses its
                                   // participant profile "crane_participant", Cyclone DDS the whole file.
   Vendor vendor{Vendor::fast_dds};
+  std::string security_directory;  // DDS Security material (security.hpp; deploy/crane security init): every
+                                   // participant authenticated (PKI-DH), its topics limited by signed
+                                   // permissions, RTPS encrypted (AES-GCM); empty: no security
+  std::string identity;            // the identity in security_directory (a folder); empty: `name`
 };
 
 /// Reader-side health, updated from DDS status events.
@@ -130,8 +135,11 @@ class ParticipantBackend {
                                                        std::int32_t history_depth) = 0;
 };
 
-std::unique_ptr<ParticipantBackend> make_fast_dds_backend(const ParticipantOptions& options);
-std::unique_ptr<ParticipantBackend> make_cyclone_dds_backend(const ParticipantOptions& options);
+/// `security`: the checked files (security_files()), or null for a participant without security.
+std::unique_ptr<ParticipantBackend> make_fast_dds_backend(const ParticipantOptions& options,
+                                                          const SecurityFiles* security);
+std::unique_ptr<ParticipantBackend> make_cyclone_dds_backend(const ParticipantOptions& options,
+                                                             const SecurityFiles* security);
 
 template <class Topic>
 TopicDescriptor describe() {
@@ -177,7 +185,10 @@ class Reader {
 };
 
 /// A DDS domain participant of the chosen vendor. Throws std::runtime_error if the vendor cannot
-/// create it (message names the vendor and domain).
+/// create it (message names the vendor and domain); with options.security_directory, first
+/// SecurityError naming the security file that is missing, tampered with or expired (security.hpp).
+/// With security, make_writer/make_reader throw std::runtime_error when the permissions do not
+/// allow the topic (the vendor refuses the endpoint).
 class Participant {
  public:
   explicit Participant(const ParticipantOptions& options);

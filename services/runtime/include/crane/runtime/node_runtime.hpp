@@ -49,10 +49,24 @@ struct NodeOptions {
   std::string dds_profile;   // network profile XML (deploy/dds/); empty: $CRANE_DDS_PROFILE, else none
   std::string log_level{"info"};
   int realtime_priority{0};  // > 0: SCHED_FIFO at this priority and memory locked, where the system allows
+  std::string security_directory;  // DDS Security material (deploy/crane security init); empty: $CRANE_SECURITY,
+                                   // else none (transport/security.hpp)
+  std::string identity;            // identity in it; empty: the participant's name (tools: their role)
+  bool insecure_lan{false};        // the network without security, said explicitly (else refused)
 };
 
-/// Adds --config, --dds, --domain, --lan, --log-level to `app`, bound to `options`.
+/// Adds --config, --dds, --domain, --lan, --log-level, --dds-profile, --realtime-priority and the
+/// security options (add_security_options) to `app`, bound to `options`.
 void add_node_options(CLI::App& app, NodeOptions& options);
+
+/// Adds --security DIR, --identity NAME and --insecure-lan to `app` (every node and tool).
+void add_security_options(CLI::App& app, NodeOptions& options);
+
+/// The rule for the network: a participant that leaves the loopback interface (--lan or a
+/// --dds-profile) needs --security, or --insecure-lan said explicitly. Throws std::invalid_argument
+/// saying why otherwise; nothing on loopback. `security_directory` as resolved ($CRANE_SECURITY).
+void check_network_security(bool loopback_only, const std::string& dds_profile, const std::string& security_directory,
+                            bool insecure_lan);
 
 /// Puts the calling process (and the threads it creates afterwards, DDS's among them) on SCHED_FIFO
 /// at `priority` (1-99) and locks its memory (mlockall), as the systemd units ask. Returns an empty
@@ -67,7 +81,10 @@ void leave_realtime() noexcept;
 
 /// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS); first enters
 /// real time when options.realtime_priority > 0 (a warning in the log when it cannot).
-/// Throws std::invalid_argument on a bad vendor name, std::runtime_error if DDS fails.
+/// With --security (or $CRANE_SECURITY) the participant uses identity options.identity, else `name`.
+/// Throws std::invalid_argument on a bad vendor name or the network without security
+/// (check_network_security), transport::SecurityError naming a bad security file,
+/// std::runtime_error if DDS fails.
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name);
 
 /// Applies --log-level to spdlog's default logger; throws std::invalid_argument on an unknown level.
