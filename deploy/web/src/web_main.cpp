@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
   }
   node.loopback_only = !lan;
   node.shared_memory = !lan;
-  if (node.identity.empty()) node.identity = "monitor";  // it only reads topics: the monitor role
+  // Secured bus: a read-only server is a monitor; one that publishes operators' commands is an operator.
+  if (node.identity.empty()) node.identity = operators_path.empty() ? "monitor" : "operator";
 
   try {
     // With operators, every login and every published command is logged (the audit trail).
