@@ -151,6 +151,8 @@ struct AxisRun {
   double amplitude{0.3};            // [m] reference amplitude
   double period{4.0};               // [s]
   double duration{30.0};            // [s]
+  double hunting{0.0};              // [s] then at rest at x = 0.6 m hunting: every 0.4 s the drive
+                                    // flips sign and the trolley slides 1 mm the other way
 };
 
 struct AxisRunResult {
@@ -201,6 +203,15 @@ AxisRunResult run_axis(const OnlineAdaptationParams& params, const AxisRun& run)
     const auto& c = crane.trolley_friction;
     command += v_ref > 0.0 ? c.coulomb_positive + c.viscous_positive * v_ref : -c.coulomb_negative + c.viscous_negative * v_ref;
     u = std::clamp(std::round(command / dac) * dac, -crane.dac_range, crane.dac_range);
+    if (t >= run.duration - run.hunting) {  // the hunting phase replaces the axis (a limit cycle)
+      const int half = static_cast<int>((t - (run.duration - run.hunting)) / 0.4) % 2 == 0 ? 1 : -1;
+      const double into = std::fmod(t - (run.duration - run.hunting), 0.4);
+      u = 1.6 * half;
+      if (into < 0.05) x += half * 0.02 * t_s;  // 1 mm in 0.05 s
+      v = 0.0;
+      phi = phi_rate = 0.0;
+      continue;
+    }
     for (int s = 0; s < substeps; ++s) {
       const double drive = k * u - m_t * g * phi;  // [m/s^2] (3.31) without friction
       double friction = 0.0;                        // [m/s^2]
@@ -234,6 +245,18 @@ OnlineAdaptationParams adaptation_params() {
   return p;
 }
 
+TEST(OnlineAdaptation, FilterMemoryAndCorrelationOfItsLowPass) {
+  // A moving average of N samples has (sum h)^2 / sum h^2 = N; the Butterworth's figure is printed.
+  const auto params = adaptation_params();
+  const OnlineAdaptation a(params);
+  std::printf("low pass %.1f Hz: memory %d samples (impulse response down to 1 %%, + 2 for the stencil), "
+              "%.2f correlated samples\n", params.filter_cutoff, a.settle_samples(), a.noise_correlation());
+  // Its equivalent noise bandwidth is about 1.11 f_c for a second-order Butterworth: fs / (2 x 1.11 f_c).
+  EXPECT_NEAR(a.noise_correlation(), 100.0 / (2.0 * 1.11 * params.filter_cutoff), 1.0);
+  EXPECT_GT(a.settle_samples(), 10);
+  EXPECT_LT(a.settle_samples(), 60);
+}
+
 TEST(OnlineAdaptation, RecoversMassAndFrictionOfASimulatedTrolley) {
   const auto params = adaptation_params();
   const AxisRunResult r = run_axis(params, AxisRun{});
@@ -254,6 +277,24 @@ TEST(OnlineAdaptation, RecoversMassAndFrictionOfASimulatedTrolley) {
   EXPECT_NEAR(e.trolley_friction.static_positive / cfg.static_positive,
               e.trolley_friction.coulomb_positive / cfg.coulomb_positive, 1e-12);
   EXPECT_FALSE(e.trolley_limit_cycle);
+}
+
+TEST(OnlineAdaptation, ALimitCycleFallsBackToTheConfiguredFriction) {
+  // The trolley is identified (friction x 1.5 released), then hunts at rest for 10 s: the detector
+  // fires and the compensation gets the configured coefficients back.
+  const auto params = adaptation_params();
+  AxisRun run;
+  run.duration = 40.0;
+  run.hunting = 10.0;  // at rest once the 4 s window holds no travel, then 15 reversals
+  const AxisRunResult r = run_axis(params, run);
+  EXPECT_TRUE(r.estimate.trolley_limit_cycle);
+  EXPECT_FALSE(r.estimate.trolley_friction_adapted);
+  EXPECT_EQ(r.estimate.trolley_friction.coulomb_positive, params.crane.trolley_friction.coulomb_positive);
+  EXPECT_EQ(r.estimate.trolley_friction.static_negative, params.crane.trolley_friction.static_negative);
+  EXPECT_GE(r.estimate.trolley_voltage_sign_changes, 10u);
+  // Without the hunting phase the same run adapts (the previous test): the fallback is the detector's.
+  run.hunting = 0.0;
+  EXPECT_TRUE(run_axis(params, run).estimate.trolley_friction_adapted);
 }
 
 TEST(OnlineAdaptation, AnAxisThatNeverSlidesLeavesEverythingConfigured) {

@@ -273,9 +273,9 @@ void OnlineAdaptation::release_axis(const AxisIdentifier& id, const common::Axis
   const std::array<std::array<int, 2>, 2> groups{{{1, 3}, {2, 4}}};
   const std::array<bool, 2> excited{s.positive_excited, s.negative_excited};
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    const auto [vi, ci] = groups[g];
-    if (!excited[g] || !target_ok(vi) || !target_ok(ci)) continue;  // keep what is in use
-    for (int i : {vi, ci}) {
+    if (!excited[g]) continue;  // keep what is in use
+    for (int i : groups[g]) {
+      if (!target_ok(i)) continue;
       const double size = std::max(std::abs(nominal(i)), scale(i));
       double& value = *coefficient[i];
       value += std::clamp(s.estimate(i) - value, -step_limit * size, step_limit * size);

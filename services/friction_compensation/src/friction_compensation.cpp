@@ -84,9 +84,22 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
   }
   output = FrictionCompensationOutput{};
   if (params_.enabled) {
+    // The friction in use: the online estimate when given and sane, the configured otherwise.
+    const auto in_use = [](const AxisCompensationParams& configured, const std::optional<common::AxisFriction>& estimate) {
+      if (!estimate) return configured;
+      const auto& f = *estimate;
+      for (const double c : {f.viscous_positive, f.viscous_negative, f.coulomb_positive, f.coulomb_negative,
+                             f.static_positive, f.static_negative}) {
+        if (!std::isfinite(c) || c < 0.0) return configured;
+      }
+      AxisCompensationParams axis = configured;
+      axis.friction = f;
+      return axis;
+    };
     output.trolley_friction =
-        friction_voltage(params_.trolley, trolley_velocity, input.command.trolley_voltage);
-    output.slew_friction = friction_voltage(params_.slew, slew_velocity, input.command.slew_voltage);
+        friction_voltage(in_use(params_.trolley, input.trolley_friction), trolley_velocity, input.command.trolley_voltage);
+    output.slew_friction =
+        friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
   }
   // (3.5): u = V + F_f/K_m
   output.command.trolley_voltage = clamp_voltage(input.command.trolley_voltage + output.trolley_friction,

@@ -40,11 +40,19 @@ TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts
   p.gain_scheduling.voltage_limit = facts.voltage_limit;
   p.gain_scheduling.slew_enabled = p.tracking.slew_enabled;
   p.gain_scheduling.min_cable_length = facts.crane.min_cable_length;
+  p.trolley_drive_mass = facts.crane.trolley_drive_mass;
+  p.jib_inertia = facts.crane.jib_inertia;
   TrackingStage{p};
   return p;
 }
 
-TrackingStage::TrackingStage(const TrackingStageParams& params) : law_(params.law), tracking_(params.tracking) {
+TrackingStage::TrackingStage(const TrackingStageParams& params)
+    : law_(params.law),
+      tracking_(params.tracking),
+      trolley_drive_mass_(params.trolley_drive_mass),
+      jib_inertia_(params.jib_inertia) {
+  common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
+  common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
   if (law_ != TrackingLaw::tracking) {
     auto p = params.gain_scheduling;
     p.kind = law_ == TrackingLaw::gain_scheduling_full ? gain_scheduling::FeedbackKind::full
@@ -59,10 +67,13 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   TrackingInput in;
   in.estimate = common::to_estimate(estimate);
   in.reference = common::to_reference(reference);
+  if (estimate.payload_confident) {  // the online estimate (crane::adaptation), (2.25)
+    in.load = common::LoadRatios{estimate.payload_mass / trolley_drive_mass_, estimate.payload_mass / jib_inertia_};
+  }
   TrackingOutput result;
   common::StepStatus status = common::StepStatus::ok;
   if (scheduled_) {
-    status = scheduled_->step(in.estimate, in.reference, result.command);
+    status = scheduled_->step(in.estimate, in.reference, result.command, in.load ? &*in.load : nullptr);
   } else {
     in.reference.trolley.position += anti_swing.trolley_reference_correction;
     in.reference.trolley.velocity += anti_swing.trolley_reference_rate_correction;

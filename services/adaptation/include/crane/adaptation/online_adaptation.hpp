@@ -29,11 +29,12 @@
 //   axes identify it; bound = 2 standard deviations; confident while the bound is within
 //   `mass_relative_bound` of the mass and the mass within [min_mass, max_mass]. The consumers
 //   (gain schedule (3.37)-(3.38), tracking) use it only when confident.
-//   friction coefficients in use: per direction, the identified (b, c) once that direction is
-//   excited (AxisIdentifier's check) and each coefficient is within its safe range
-//   [min_friction_factor, max_friction_factor] x configured with a 2-sigma bound within
-//   `friction_relative_bound` of it; they approach it at most `max_friction_rate` x configured per
-//   second (the bounded update rate; the estimate itself is re-solved every `solve_period`).
+//   friction coefficients in use: once a direction is excited (AxisIdentifier's check), each of its
+//   coefficients whose estimate is within its safe range [min_friction_factor, max_friction_factor]
+//   x configured, with a 2-sigma bound within `friction_relative_bound` of it (of its typical size
+//   when larger: the configured value, at least 0.5 V s/m or 0.1 V); a coefficient approaches its
+//   estimate at most `max_friction_rate` x that size per second (the bounded update rate; the
+//   estimate itself is re-solved every `solve_period`). The others stay as they are.
 //   Breakaway (static) friction, which the sliding regression cannot see, is scaled with the Coulomb
 //   coefficient of its direction (fs/c as configured, (4.13)/(4.15)).
 //   Limit cycle (the stiction hazard of section 3.1): LimitCycleDetector on each drive; when it

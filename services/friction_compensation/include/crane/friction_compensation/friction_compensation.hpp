@@ -14,6 +14,7 @@
 // Real-time: step() is noexcept, allocates nothing.
 
 #include <array>
+#include <optional>
 
 #include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
@@ -44,6 +45,11 @@ struct FrictionCompensationParams {
 struct FrictionCompensationInput {
   common::CraneStateEstimate estimate;  // velocities [m/s], [rad/s]
   common::DriveCommand command;         // V from the linear controller [V]; hoist passes through
+  // Friction in use instead of the configured one this cycle (the online re-estimate, released by
+  // crane::adaptation within its safe bounds); empty, or with a non-finite or negative coefficient:
+  // the configured one.
+  std::optional<common::AxisFriction> trolley_friction;
+  std::optional<common::AxisFriction> slew_friction;
 };
 
 struct FrictionCompensationOutput {
