@@ -113,6 +113,9 @@ void print_estimate(const tp::msgs::CraneState_* e) {
   const bool enabled = (e->adaptation() & Estimate::ADAPTATION_ENABLED) != 0;
   if (!enabled) {
     std::printf("payload         %.2f kg (configured; online estimation off)\n", e->payload_mass());
+  } else if (!e->payload_confident() && e->payload_mass_bound() == 0.0) {
+    std::printf("payload         %.2f kg (configured; online estimate: not identified yet, the load needs to move)\n",
+                e->payload_mass());
   } else if (e->payload_confident()) {
     std::printf("payload         %.3f kg +- %.3f kg (online estimate, 2 sigma; in use)\n", e->payload_mass(),
                 e->payload_mass_bound());
