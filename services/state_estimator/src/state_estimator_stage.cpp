@@ -1,9 +1,9 @@
 #include "crane/state_estimator/state_estimator_stage.hpp"
 
+#include <cstdint>
+
 #include "crane/common/protocol_signals.hpp"
 #include "crane/config/yaml_section.hpp"
-
-#include <cstdint>
 
 namespace crane::state_estimator {
 
