@@ -179,6 +179,12 @@ int main(int argc, char** argv) {
   app.add_option("--sensor-delay", mismatch.sensor_delay_cycles,
                  "[cycles] the sensor sample of cycle k reports the encoders of cycle k - this")
       ->check(CLI::Range(0, plant::PlantStage::kMaxSensorDelay));
+  app.add_option("--friction-change-factor", mismatch.friction_change_factor,
+                 "from --friction-change-cycle on, every friction coefficient of both drives is this times what it "
+                 "was (a plant whose friction changes during a run; 1: off)")
+      ->check(CLI::Range(0.1, 10.0));
+  app.add_option("--friction-change-cycle", mismatch.friction_change_cycle,
+                 "[cycles] the first cycle integrated with the changed friction");
   std::string board_uri;
   app.add_option("--board", board_uri,
                  "shm:NAME: sit behind the emulated interface board (the hardware bridge reads and writes it) "
@@ -196,10 +202,11 @@ int main(int argc, char** argv) {
     params.gate = cfg.read("actuation", supervisor::read_actuation_params);
     params.mismatch = mismatch;
     if (mismatch.cable_length_factor != 1.0 || mismatch.load_mass_factor != 1.0 || mismatch.friction_factor != 1.0 ||
-        mismatch.sensor_delay_cycles != 0) {
-      spdlog::warn("plant differs from the configuration: L x {}, m x {}, friction x {}, sensors {} cycles late",
+        mismatch.sensor_delay_cycles != 0 || mismatch.friction_change_factor != 1.0) {
+      spdlog::warn("plant differs from the configuration: L x {}, m x {}, friction x {} (x {} from cycle {}), sensors {} "
+                   "cycles late",
                    mismatch.cable_length_factor, mismatch.load_mass_factor, mismatch.friction_factor,
-                   mismatch.sensor_delay_cycles);
+                   mismatch.friction_change_factor, mismatch.friction_change_cycle, mismatch.sensor_delay_cycles);
     }
     if (!board_uri.empty()) {
       if (board_uri.rfind("shm:", 0) != 0) {

@@ -106,6 +106,18 @@ CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
   reset(parameters_.initial_state);
 }
 
+CraneSimulator::FrictionModels CraneSimulator::friction_models(const common::AxisFriction& trolley_friction,
+                                                               const common::AxisFriction& slew_friction) const {
+  SimulatorParameters p = parameters_;
+  p.crane.trolley_friction = trolley_friction;
+  p.crane.slew_friction = slew_friction;
+  const double force_per_volt = model_->drive_force_per_volt(DriveAxis::trolley);
+  return FrictionModels{AxisFrictionModel(trolley_friction, force_per_volt,
+                                          p.brake_holding_factor * force_per_volt * p.crane.dac_range,
+                                          "simulator.crane.trolley_friction"),
+                        second_axis_friction(p, *model_)};
+}
+
 void CraneSimulator::validate_state(const PlantState& s) const {
   const std::string p = "simulator.initial_state.";
   const double limit = 1e6;

@@ -237,6 +237,18 @@ void CvodeIntegrator::reset(double time, const ModelState& state, double cable_l
   needs_reinit_ = true;
 }
 
+void CvodeIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
+                                   const AxisFrictionModel& slew_friction) noexcept {
+  trolley_friction_ = trolley_friction;
+  slew_friction_ = slew_friction;
+  const double* y = N_VGetArrayPointer(y_);
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (y[kVelocityOffset + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
+  }
+  settle_modes();
+  needs_reinit_ = true;
+}
+
 IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput& input) noexcept {
   if (!std::isfinite(end_time) || !(end_time > time_) || !std::isfinite(input.trolley_drive_force) ||
       !std::isfinite(input.slew_drive_torque) || !std::isfinite(input.cable_length_acceleration)) {

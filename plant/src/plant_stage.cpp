@@ -37,6 +37,7 @@ void validate(const PlantMismatch& m) {
   common::require_in_range("plant.mismatch.load_mass_factor", m.load_mass_factor, 0.0, 10.0);
   common::require_in_range("plant.mismatch.friction_factor", m.friction_factor, 0.0, 10.0);
   common::require_in_range("plant.mismatch.sensor_delay_cycles", m.sensor_delay_cycles, 0, PlantStage::kMaxSensorDelay);
+  common::require_in_range("plant.mismatch.friction_change_factor", m.friction_change_factor, 0.1, 10.0);
 }
 
 SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {
@@ -76,6 +77,11 @@ PlantStage::PlantStage(const PlantStageParams& params)
       gate_(params.gate),
       cable_length_reading_factor_(1.0 / params.mismatch.cable_length_factor) {
   measurements_.fill(simulator_.output().measurement);  // at rest before cycle 0
+  if (mismatch_.friction_change_factor != 1.0) {
+    const auto& crane = simulator_.parameters().crane;
+    changed_friction_ = simulator_.friction_models(scaled(crane.trolley_friction, mismatch_.friction_change_factor),
+                                                   scaled(crane.slew_friction, mismatch_.friction_change_factor));
+  }
 }
 
 void PlantStage::sample(protocol::SensorSample& s) const noexcept {
@@ -110,6 +116,7 @@ common::StepStatus PlantStage::step(const supervisor::GateInput& input) noexcept
   drive.slew_voltage = gate_output_.drive.slew_voltage;
   drive.hoist_speed = gate_output_.drive.hoist_speed;
   drive.brakes_engaged = gate_output_.brakes_engaged;
+  if (changed_friction_ && cycle_ == mismatch_.friction_change_cycle) simulator_.set_friction(*changed_friction_);
   const auto status = simulator_.step(drive);
   ++cycle_;
   remember_measurement();

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -63,7 +64,86 @@ std::string zone_list(std::uint32_t enabled) {
   return text.empty() ? "none" : text;
 }
 
-void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
+using Estimate = protocol::CraneState;  // ADAPTATION_* bits
+
+// The online estimate (state estimator, crane::adaptation): payload, friction in use, limit cycles.
+std::string adaptation_list(std::uint8_t bits, const char* separator, const char* quote) {
+  std::string text;
+  for (const auto& code : Estimate::kCodes) {
+    if (code.group != "ADAPTATION" || (bits & code.value) == 0) continue;
+    if (!text.empty()) text += separator;
+    text += quote + std::string(code.name) + quote;
+  }
+  return text;
+}
+
+std::string friction_text(double b_pos, double b_neg, double c_pos, double c_neg, double s_pos, double s_neg,
+                          const char* viscous_unit) {
+  char text[200];
+  std::snprintf(text, sizeof text, "c+ %.3f c- %.3f V, b+ %.3f b- %.3f %s, breakaway +%.3f -%.3f V", c_pos, c_neg, b_pos,
+                b_neg, viscous_unit, s_pos, s_neg);
+  return text;
+}
+
+std::string estimate_json(const tp::msgs::CraneState_* e) {
+  if (e == nullptr) return ", \"estimate\": null";
+  char text[1200];
+  std::snprintf(text, sizeof text,
+                ", \"estimate\": {\"payload_mass_kg\": %g, \"payload_mass_bound_kg\": %g, \"payload_confident\": %s, "
+                "\"adaptation\": [%s], \"trolley_friction_V\": [%g, %g, %g, %g, %g, %g], "
+                "\"slew_friction_V\": [%g, %g, %g, %g, %g, %g], \"trolley_voltage_sign_changes\": %u, "
+                "\"slew_voltage_sign_changes\": %u, \"seq\": %llu}",
+                e->payload_mass(), e->payload_mass_bound(), e->payload_confident() ? "true" : "false",
+                adaptation_list(e->adaptation(), ", ", "\"").c_str(), e->trolley_friction_viscous_positive(),
+                e->trolley_friction_viscous_negative(), e->trolley_friction_coulomb_positive(),
+                e->trolley_friction_coulomb_negative(), e->trolley_friction_static_positive(),
+                e->trolley_friction_static_negative(), e->slew_friction_viscous_positive(),
+                e->slew_friction_viscous_negative(), e->slew_friction_coulomb_positive(),
+                e->slew_friction_coulomb_negative(), e->slew_friction_static_positive(),
+                e->slew_friction_static_negative(), e->trolley_voltage_sign_changes(), e->slew_voltage_sign_changes(),
+                static_cast<unsigned long long>(e->header().seq()));
+  return text;
+}
+
+void print_estimate(const tp::msgs::CraneState_* e) {
+  if (e == nullptr) {
+    std::printf("payload         no estimate (the state estimator is silent)\n");
+    return;
+  }
+  const bool enabled = (e->adaptation() & Estimate::ADAPTATION_ENABLED) != 0;
+  if (!enabled) {
+    std::printf("payload         %.2f kg (configured; online estimation off)\n", e->payload_mass());
+  } else if (!e->payload_confident() && e->payload_mass_bound() == 0.0) {
+    std::printf("payload         %.2f kg (configured; online estimate: not identified yet, the load needs to move)\n",
+                e->payload_mass());
+  } else if (e->payload_confident()) {
+    std::printf("payload         %.3f kg +- %.3f kg (online estimate, 2 sigma; in use)\n", e->payload_mass(),
+                e->payload_mass_bound());
+  } else {
+    std::printf("payload         %.3f kg +- %.3f kg (online estimate, not yet confident: the configured mass is used)\n",
+                e->payload_mass(), e->payload_mass_bound());
+  }
+  const auto axis = [&](const char* label, std::uint8_t adapted, std::uint8_t cycle, const std::string& text) {
+    const char* source = (e->adaptation() & cycle) ? "configured (limit cycle detected: fallback)"
+                         : (e->adaptation() & adapted) ? "online re-estimate"
+                                                       : "configured";
+    std::printf("%s %s: %s\n", label, source, text.c_str());
+  };
+  axis("trolley friction", Estimate::ADAPTATION_TROLLEY_FRICTION_ADAPTED, Estimate::ADAPTATION_TROLLEY_LIMIT_CYCLE,
+       friction_text(e->trolley_friction_viscous_positive(), e->trolley_friction_viscous_negative(),
+                     e->trolley_friction_coulomb_positive(), e->trolley_friction_coulomb_negative(),
+                     e->trolley_friction_static_positive(), e->trolley_friction_static_negative(), "V s/m"));
+  axis("slew friction   ", Estimate::ADAPTATION_SLEW_FRICTION_ADAPTED, Estimate::ADAPTATION_SLEW_LIMIT_CYCLE,
+       friction_text(e->slew_friction_viscous_positive(), e->slew_friction_viscous_negative(),
+                     e->slew_friction_coulomb_positive(), e->slew_friction_coulomb_negative(),
+                     e->slew_friction_static_positive(), e->slew_friction_static_negative(), "V s/rad"));
+  if (enabled) {
+    std::printf("sign changes    drive voltage at rest: trolley %u, slew %u\n", e->trolley_voltage_sign_changes(),
+                e->slew_voltage_sign_changes());
+  }
+}
+
+void print_status(const tp::msgs::SupervisorStatus_& s, const tp::msgs::CraneState_* estimate, bool json) {
   const auto mode = code_name("MODE", s.mode());
   const auto operating = code_name("OPERATION", s.operating_mode());
   if (json) {
@@ -72,14 +152,14 @@ void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
         "\"latched_faults\": %s, \"fault_count\": %u, \"last_fault\": \"%s\", \"last_fault_seq\": %llu, "
         "\"stages_alive\": %u, \"warnings\": %u, \"trolley_voltage_limit_V\": %g, \"slew_voltage_limit_V\": %g, "
         "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu, "
-        "\"operating_mode\": \"%s\", \"zones_enabled\": %u}\n",
+        "\"operating_mode\": \"%s\", \"zones_enabled\": %u%s}\n",
         mode.c_str(), s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
         quoted_list(s.active_faults()).c_str(), quoted_list(s.latched_faults()).c_str(), s.fault_count(),
         s.last_fault() != 0 ? code_name("FAULT", s.last_fault()).c_str() : "",
         static_cast<unsigned long long>(s.last_fault_seq()),
         s.stages_alive(), s.warnings(), s.trolley_voltage_limit(), s.slew_voltage_limit(), s.trolley_velocity(),
         s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()), operating.c_str(),
-        s.zones_enabled());
+        s.zones_enabled(), estimate_json(estimate).c_str());
     return;
   }
   std::printf("mode            %s\n", mode.c_str());
@@ -100,6 +180,7 @@ void print_status(const tp::msgs::SupervisorStatus_& s, bool json) {
               (s.warnings() & Status::WARNING_SPEED_LIMITED) ? " (approach speed exceeded)" : "");
   std::printf("speeds          trolley %.3f m/s, slew %.3f rad/s\n", s.trolley_velocity(), s.slew_rate());
   std::printf("cycle           %llu\n", static_cast<unsigned long long>(s.header().seq()));
+  print_estimate(estimate);
 }
 
 }  // namespace
@@ -166,12 +247,26 @@ int main(int argc, char** argv) {
     tp::msgs::SupervisorStatus_ status;
 
     if (action == "status") {
-      while (Clock::now() < deadline) {
-        if (status_reader->take_latest(status)) {
-          print_status(status, json);
-          return 0;
+      // The estimate too (payload and friction of the online estimation): waited for at most 0.5 s
+      // after the status (the state estimator may be silent: then printed as missing).
+      auto estimate_reader = participant->make_reader<tp::StateEstimate>(&wakeup);
+      tp::msgs::CraneState_ estimate;
+      bool have_status = false;
+      bool have_estimate = false;
+      auto estimate_deadline = deadline;
+      while (Clock::now() < std::min(deadline, estimate_deadline) && !(have_status && have_estimate)) {
+        if (!have_status && status_reader->take_latest(status)) {
+          have_status = true;
+          estimate_deadline = Clock::now() + std::chrono::milliseconds(500);
         }
-        wakeup.wait_until(std::min(deadline, Clock::now() + std::chrono::milliseconds(20)));
+        have_estimate = estimate_reader->take_latest(estimate) || have_estimate;
+        if (!(have_status && have_estimate)) {
+          wakeup.wait_until(std::min({deadline, estimate_deadline, Clock::now() + std::chrono::milliseconds(20)}));
+        }
+      }
+      if (have_status) {
+        print_status(status, have_estimate ? &estimate : nullptr, json);
+        return 0;
       }
       std::fprintf(stderr, "crane_safety: no supervisor status on domain %u within %.1f s\n", options.domain_id, timeout);
       return 1;

@@ -52,7 +52,7 @@ BENCHMARK(BM_PlantSample)->Iterations(6000);
 
 // The whole control chain of one cycle: estimator, anti-swing, tracking, friction compensation.
 void BM_ControlChainCycle(benchmark::State& state) {
-  state_estimator::StateEstimator estimator(lab().state_estimator);
+  state_estimator::StateEstimator estimator(lab().state_estimator.estimator);
   anti_swing::AntiSwing anti_swing(lab().anti_swing.anti_swing);
   tracking::TrackingController tracking(lab().tracking.tracking);
   friction_compensation::FrictionCompensation compensation(lab().friction_compensation);

@@ -139,7 +139,7 @@ TEST(LabConfig, LoadsAndMatchesTheDissertation) {
   EXPECT_DOUBLE_EQ(c.tracking.tracking.load_inertia_ratio, c.facts.crane.load_inertia_ratio());
   EXPECT_DOUBLE_EQ(c.tracking.tracking.trolley_inertia_ratio, c.facts.crane.trolley_inertia_ratio());
   // 100 Hz: the estimator's sample rate is 1 / sample_period = 1 / 0.01.
-  EXPECT_NEAR(c.state_estimator.sample_rate, 100.0, 1e-9);
+  EXPECT_NEAR(c.state_estimator.estimator.sample_rate, 100.0, 1e-9);
 
   // One source for each shared fact (stack: and crane:), and every stage gets it from there.
   EXPECT_DOUBLE_EQ(c.facts.sample_period, 0.01);
@@ -343,7 +343,7 @@ TEST_F(LabConfigText, AProcessReadsItsOwnBlockOnly) {
   text.erase(start + 1, end - start);
   const auto doc = crane::config::ConfigDocument::parse(text, "test.yaml");
   const auto estimator = doc.read("state_estimator", crane::state_estimator::read_params);
-  EXPECT_NEAR(estimator.sample_rate, 100.0, 1e-9);
+  EXPECT_NEAR(estimator.estimator.sample_rate, 100.0, 1e-9);
   EXPECT_TRUE(contains(error_of(text), "missing field tracking")) << error_of(text);
 }
 
@@ -395,4 +395,21 @@ TEST_F(LabConfigText, PlantKindIsValidatedLikeTheRest) {
   EXPECT_TRUE(contains(message, "missing field plant.bridge")) << message;
   message = error_of(edit_line(text_, "plant:", "kind:", "kind: tower\n  bridge: {drive_mass: 1.0}").text);
   EXPECT_TRUE(contains(message, "unknown field plant.bridge")) << message;
+}
+
+// The online estimation's block (state_estimator.adaptation): every field required and range-checked,
+// the error naming the field, the value and the bound; its cross-field rule (max_mass > min_mass) too.
+TEST_F(LabConfigText, AdaptationFieldsAreValidatedByName) {
+  auto message = error_of(edit_line(text_, "adaptation:", "forgetting_factor:", "forgetting_factor: 1.5").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "state_estimator.adaptation.forgetting_factor = 1.5")) << message;
+  EXPECT_TRUE(contains(message, "[0.9, 1]")) << message;
+  message = error_of(edit_line(text_, "adaptation:", "max_reversals:", "max_reversals: 1").text);
+  EXPECT_TRUE(contains(message, "state_estimator.adaptation.limit_cycle.max_reversals = 1")) << message;
+  message = error_of(edit_line(text_, "adaptation:", "max_mass:", "max_mass: 0").text);
+  EXPECT_TRUE(contains(message, "state_estimator.adaptation.max_mass = 0")) << message;
+  message = error_of(edit_line(text_, "adaptation:", "filter_cutoff:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field state_estimator.adaptation.filter_cutoff")) << message;
+  message = error_of(edit_line(text_, "adaptation:", "enabled:", "enabled: maybe").text);
+  EXPECT_TRUE(contains(message, "state_estimator.adaptation.enabled")) << message;
 }

@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "crane/anti_swing/anti_swing_stage.hpp"
+#include "crane/common/protocol_signals.hpp"
 #include "crane/common/validation.hpp"
+#include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
 #include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 
@@ -141,6 +143,58 @@ TEST(TrackingStage, ReferenceCorrectionsOfDelay2AreAddedToTheReference) {
   EXPECT_DOUBLE_EQ(with_correction.trolley_voltage, moved_reference.trolley_voltage);
   EXPECT_GT(with_correction.trolley_voltage, 0.0);
   EXPECT_EQ(with_correction.header.seq, 4U);
+}
+
+// The online estimate (crane::adaptation) in the tracking stage: a confident payload replaces m_t in
+// (3.37), V_x = (1/K_mx)[(L/T^2) V_bar_x + m_t g phi]; at rest on the reference only the swing term
+// is left, so 3.0 kg instead of the default params' m_t = 0.09 adds (3 kg / M - 0.09) g phi / K_mx
+// = (3/22.222 - 0.09)(9.8)(0.1)/2 V.
+TEST(TrackingStage, AConfidentPayloadEstimateReplacesTheConfiguredMass) {
+  tracking::TrackingStage stage{tracking::TrackingStageParams{}};
+  auto state = at_rest(5, 0.5);
+  state.swing_in_plane = 0.1;
+  protocol::Reference reference;
+  reference.trolley_position = 0.5;
+  reference.cable_length = 1.0;
+  protocol::LinearCommand configured, estimated, not_confident, absurd;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, configured), common::StepStatus::ok);
+  state.payload_mass = 3.0;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, not_confident), common::StepStatus::ok);
+  EXPECT_EQ(not_confident.trolley_voltage, configured.trolley_voltage);  // not confident: configured
+  state.payload_confident = true;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, estimated), common::StepStatus::ok);
+  EXPECT_NEAR(estimated.trolley_voltage - configured.trolley_voltage, (3.0 / 22.222 - 0.09) * 9.8 * 0.1 / 2.0, 1e-12);
+  // Fail safe: a payload the gain schedule cannot use falls back to the configured load.
+  tracking::TrackingStageParams scheduled;
+  scheduled.law = tracking::TrackingLaw::gain_scheduling_partial;
+  tracking::TrackingStage schedule{scheduled};
+  state.payload_mass = 1e308;
+  ASSERT_EQ(schedule.step(state, reference, protocol::AntiSwingCommand{}, absurd), common::StepStatus::ok);
+  EXPECT_TRUE(std::isfinite(absurd.trolley_voltage) && std::isfinite(absurd.slew_voltage));
+}
+
+// The friction compensation stage takes an axis's friction from the estimate only while its
+// ADAPTATION_*_FRICTION_ADAPTED bit is set: sliding at v = 0.1 m/s, F_f/K_m = c+ + b+ v (3.1).
+TEST(FrictionCompensationStage, UsesTheReleasedFrictionOnlyWhileItsBitIsSet) {
+  friction_compensation::FrictionCompensationStage stage{friction_compensation::FrictionCompensationParams{}};
+  auto state = at_rest(6, 0.5);
+  state.trolley_velocity_raw = 0.1;
+  state.trolley_velocity = 0.1;
+  auto released = common::CraneParameters{}.trolley_friction;
+  released.coulomb_positive = 1.35;
+  released.viscous_positive = 2.25;
+  common::set_friction_in_use(released, common::CraneParameters{}.slew_friction, state);
+  protocol::LinearCommand linear;
+  protocol::ActuatorCommand without_bit, with_bit;
+  ASSERT_EQ(stage.step(state, linear, without_bit), common::StepStatus::ok);
+  EXPECT_NEAR(without_bit.trolley_friction_voltage, 0.9 + 1.5 * 0.1, 1e-12);  // (4.12)
+  state.adaptation = protocol::CraneState::ADAPTATION_ENABLED | protocol::CraneState::ADAPTATION_TROLLEY_FRICTION_ADAPTED;
+  ASSERT_EQ(stage.step(state, linear, with_bit), common::StepStatus::ok);
+  EXPECT_NEAR(with_bit.trolley_friction_voltage, 1.35 + 2.25 * 0.1, 1e-12);
+  // A negative coefficient is never used: the configured friction instead.
+  state.trolley_friction_coulomb_positive = -1.0;
+  ASSERT_EQ(stage.step(state, linear, with_bit), common::StepStatus::ok);
+  EXPECT_NEAR(with_bit.trolley_friction_voltage, 0.9 + 1.5 * 0.1, 1e-12);
 }
 
 }  // namespace

@@ -57,6 +57,10 @@ int main(int argc, char** argv) {
   app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
   app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
   app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
+  app.add_option("--plant-load-mass-factor", stack.plant_load_mass_factor,
+                 "--sim: the simulated load mass is this times the configured one (the controllers assume the "
+                 "configuration; the online estimate, state_estimator.adaptation, finds it)")
+      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--log-dir", log_dir, "one <stage>.log per process");
   app.add_option("--ready-timeout", ready_timeout, "[s] longest wait for the stack to become ready");
   int realtime_priority = 70;

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     const auto cfg = crane::config::ConfigDocument::load(config_path);
     anti_swing = cfg.read("anti_swing", crane::anti_swing::read_params);
     tracking = cfg.read("tracking", crane::tracking::read_params);
-    estimator = cfg.read("state_estimator", se::read_params);
+    estimator = cfg.read("state_estimator", se::read_params).estimator;
     facts = cfg.facts();
   } catch (const std::exception& error) {
     std::cerr << "crane_filter_delay_map: " << error.what() << "\n";

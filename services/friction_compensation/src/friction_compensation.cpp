@@ -34,15 +34,30 @@ double clamp_voltage(double value, double limit, bool& saturated) {
 
 }  // namespace
 
+int friction_direction(double velocity, double zero_velocity_band) noexcept {
+  if (velocity > zero_velocity_band) return 1;
+  if (velocity < -zero_velocity_band) return -1;
+  return 0;
+}
+
+std::array<double, 4> friction_regressor(double velocity, int direction) noexcept {
+  const double eta = direction > 0 ? 1.0 : 0.0;
+  const double xi = direction < 0 ? 1.0 : 0.0;
+  return {velocity * eta, velocity * xi, eta, -xi};
+}
+
+std::array<double, 4> sliding_coefficients(const common::AxisFriction& f) noexcept {
+  return {f.viscous_positive, f.viscous_negative, f.coulomb_positive, f.coulomb_negative};
+}
+
 double friction_voltage(const AxisCompensationParams& axis, double velocity,
                         double commanded_voltage) noexcept {
   const auto& f = axis.friction;
-  const double d_s = axis.zero_velocity_band;
-  if (velocity > d_s) {  // eta = 1 (3.3): c+ + b+ v, with the motion
-    return f.coulomb_positive + f.viscous_positive * velocity;
-  }
-  if (velocity < -d_s) {  // xi = 1: -(c- + b- |v|)
-    return -(f.coulomb_negative - f.viscous_negative * velocity);
+  const int direction = friction_direction(velocity, axis.zero_velocity_band);
+  if (direction != 0) {  // eta = 1: c+ + b+ v with the motion; xi = 1: -(c- + b- |v|)   (3.1), (3.3)
+    const auto r = friction_regressor(velocity, direction);
+    const auto c = sliding_coefficients(f);
+    return c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3];
   }
   // Stiction (3.2): F_fs = f_sh + f_s tanh(A V), -> +fs+ (V >> 0), -> -fs- (V << 0).
   const double f_s = 0.5 * (f.static_positive + f.static_negative);
@@ -69,9 +84,22 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
   }
   output = FrictionCompensationOutput{};
   if (params_.enabled) {
+    // The friction in use: the online estimate when given and sane, the configured otherwise.
+    const auto in_use = [](const AxisCompensationParams& configured, const std::optional<common::AxisFriction>& estimate) {
+      if (!estimate) return configured;
+      const auto& f = *estimate;
+      for (const double c : {f.viscous_positive, f.viscous_negative, f.coulomb_positive, f.coulomb_negative,
+                             f.static_positive, f.static_negative}) {
+        if (!std::isfinite(c) || c < 0.0) return configured;
+      }
+      AxisCompensationParams axis = configured;
+      axis.friction = f;
+      return axis;
+    };
     output.trolley_friction =
-        friction_voltage(params_.trolley, trolley_velocity, input.command.trolley_voltage);
-    output.slew_friction = friction_voltage(params_.slew, slew_velocity, input.command.slew_voltage);
+        friction_voltage(in_use(params_.trolley, input.trolley_friction), trolley_velocity, input.command.trolley_voltage);
+    output.slew_friction =
+        friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
   }
   // (3.5): u = V + F_f/K_m
   output.command.trolley_voltage = clamp_voltage(input.command.trolley_voltage + output.trolley_friction,

@@ -43,6 +43,13 @@ common::StepStatus FrictionCompensationStage::step(const protocol::CraneState& e
   in.command.trolley_voltage = linear.trolley_voltage;
   in.command.slew_voltage = linear.slew_voltage;
   in.command.hoist_speed = linear.hoist_speed;
+  // The friction re-estimated online, where the estimator released it (crane::adaptation).
+  if ((estimate.adaptation & protocol::CraneState::ADAPTATION_TROLLEY_FRICTION_ADAPTED) != 0) {
+    in.trolley_friction = common::trolley_friction_in_use(estimate);
+  }
+  if ((estimate.adaptation & protocol::CraneState::ADAPTATION_SLEW_FRICTION_ADAPTED) != 0) {
+    in.slew_friction = common::slew_friction_in_use(estimate);
+  }
   FrictionCompensationOutput result;
   const auto status = compensation_.step(in, result);
   command.trolley_voltage = result.command.trolley_voltage;

@@ -49,7 +49,8 @@ GainSchedulingController::GainSchedulingController(const GainSchedulingParams& p
 
 common::StepStatus GainSchedulingController::step(const common::CraneStateEstimate& estimate,
                                                   const common::MotionReference& reference,
-                                                  common::DriveCommand& command) noexcept {
+                                                  common::DriveCommand& command,
+                                                  const common::LoadRatios* load) noexcept {
   const auto& est = estimate;
   const double used[] = {est.trolley_position, est.trolley_velocity, est.slew_angle, est.slew_rate,
                          est.swing_in_plane, est.swing_in_plane_rate, est.swing_out_of_plane,
@@ -62,13 +63,17 @@ common::StepStatus GainSchedulingController::step(const common::CraneStateEstima
     }
   }
   const auto& p = params_;
+  const bool estimated = load != nullptr && std::isfinite(load->mass_ratio) && load->mass_ratio >= 0.0 &&
+                         std::isfinite(load->load_inertia_ratio) && load->load_inertia_ratio >= 0.0;
+  const double mass_ratio = estimated ? load->mass_ratio : p.mass_ratio;                    // m_t
+  const double load_inertia_ratio = estimated ? load->load_inertia_ratio : p.load_inertia_ratio;  // m_r
   const bool full = p.kind == FeedbackKind::full;
   const double L = std::max(est.cable_length, p.min_cable_length);
   const double limit = p.voltage_limit;
 
   // Trolley: b = K_mx, f = -m_t g, rho = +1 (2.28)-(2.29).
   trolley_gains_ = detail::place_poles(L, p.gravity, p.damping_ratio, p.trolley_drive_gain,
-                                       -p.mass_ratio * p.gravity, 1.0, full,
+                                       -mass_ratio * p.gravity, 1.0, full,
                                        full ? p.trolley_forward_gain : 0.0);
   command.trolley_voltage =
       std::clamp(feedback(trolley_gains_, reference.trolley.position, est.trolley_position,
@@ -82,7 +87,7 @@ common::StepStatus GainSchedulingController::step(const common::CraneStateEstima
     const double x_safe = x < 0.0 ? std::min(x, -p.min_radius) : std::max(x, p.min_radius);
     const double inertia = 1.0 + p.trolley_inertia_ratio * x_safe * x_safe;
     slew_gains_ = detail::place_poles(L, p.gravity, p.damping_ratio, p.slew_drive_gain / inertia,
-                                      p.load_inertia_ratio * p.gravity * x_safe / inertia, -x_safe, full,
+                                      load_inertia_ratio * p.gravity * x_safe / inertia, -x_safe, full,
                                       full ? p.slew_forward_gain : 0.0);
     command.slew_voltage =
         std::clamp(feedback(slew_gains_, reference.slew.position, est.slew_angle, est.slew_rate,

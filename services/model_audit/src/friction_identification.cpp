@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "crane/common/validation.hpp"
+#include "crane/friction_compensation/friction_compensation.hpp"
 #include "crane/model_audit/zero_phase_filter.hpp"
 
 namespace crane::model_audit {
@@ -133,8 +134,6 @@ FrictionIdentificationResult identify_friction(std::span<const double> time, std
   Eigen::VectorXd y(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Row& row = rows[static_cast<std::size_t>(i)];
-    const double eta = row.direction > 0 ? 1.0 : 0.0;
-    const double xi = row.direction < 0 ? 1.0 : 0.0;
     const Eigen::Index offset = km_known ? 0 : 1;
     if (km_known) {
       y(i) = row.acc / *options.motor_constant - row.in;  // (3.14)
@@ -142,10 +141,9 @@ FrictionIdentificationResult identify_friction(std::span<const double> time, std
       y(i) = row.acc;
       phi(i, 0) = row.in;
     }
-    phi(i, offset + 0) = -row.vel * eta;
-    phi(i, offset + 1) = -row.vel * xi;
-    phi(i, offset + 2) = -eta;
-    phi(i, offset + 3) = xi;
+    // (3.13): minus the sliding-friction regressor [v eta, v xi, eta, -xi] the compensation uses.
+    const auto regressor = friction_compensation::friction_regressor(row.vel, row.direction);
+    for (Eigen::Index j = 0; j < 4; ++j) phi(i, offset + j) = -regressor[static_cast<std::size_t>(j)];
   }
 
   // Theta = argmin |Y - Phi Theta| by column-pivoted QR; (Phi^T Phi)^-1 = P R^-1 R^-T P^T.

@@ -122,6 +122,7 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
 std::uint64_t InProcessStack::cycle() const noexcept { return stages_->k; }
 const protocol::SensorSample& InProcessStack::sensors() const noexcept { return stages_->sensors; }
 const protocol::SensorSample& InProcessStack::next_sensors() const noexcept { return stages_->next_sensors; }
+const protocol::CraneState& InProcessStack::estimate() const noexcept { return stages_->estimate; }
 const protocol::Reference& InProcessStack::reference() const noexcept { return stages_->reference; }
 const protocol::LinearCommand& InProcessStack::linear() const noexcept { return stages_->linear; }
 const protocol::ActuatorCommand& InProcessStack::actuators() const noexcept { return stages_->actuators; }

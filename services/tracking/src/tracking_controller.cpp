@@ -76,7 +76,10 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   // With feedforward the reference acceleration enters where the normalized action does (L/T^2 V_bar
   // is an acceleration): the drive then follows the planned profile and the PD corrects what remains.
   const double a_ff = p.acceleration_feedforward ? ref.trolley.acceleration : 0.0;
-  const double V_x = (L / T2 * V_bar_x + a_ff + p.mass_ratio * g * est.swing_in_plane) / p.trolley_drive_gain;
+  const bool estimated = input.load && std::isfinite(input.load->mass_ratio) && input.load->mass_ratio >= 0.0 &&
+                         std::isfinite(input.load->load_inertia_ratio) && input.load->load_inertia_ratio >= 0.0;
+  const double m_t = estimated ? input.load->mass_ratio : p.mass_ratio;
+  const double V_x = (L / T2 * V_bar_x + a_ff + m_t * g * est.swing_in_plane) / p.trolley_drive_gain;
 
   // Slew in y = -(x/L) gamma (3.34), x frozen over the cycle; (3.38) with m_r g x theta.
   const double x = est.trolley_position;
@@ -87,7 +90,7 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   const double V_yp = K_px * e_y + K_dx * e_y_prime;
   const double V_bar_y = V_yp + input.slew_anti_swing_action;
   const double M_r = p.trolley_inertia_ratio;
-  const double m_r = p.load_inertia_ratio;
+  const double m_r = estimated ? input.load->load_inertia_ratio : p.load_inertia_ratio;
   const double gamma_ff = p.acceleration_feedforward ? ref.slew.acceleration : 0.0;
   const double V_gamma =
       (-L * (1.0 + M_r * x_safe * x_safe) / (x_safe * T2) * V_bar_y + (1.0 + M_r * x_safe * x_safe) * gamma_ff -

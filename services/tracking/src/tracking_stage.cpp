@@ -1,6 +1,7 @@
 #include "crane/tracking/tracking_stage.hpp"
 
 #include <array>
+#include <cmath>
 #include <string>
 
 #include "crane/common/protocol_signals.hpp"
@@ -40,11 +41,19 @@ TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts
   p.gain_scheduling.voltage_limit = facts.voltage_limit;
   p.gain_scheduling.slew_enabled = p.tracking.slew_enabled;
   p.gain_scheduling.min_cable_length = facts.crane.min_cable_length;
+  p.trolley_drive_mass = facts.crane.trolley_drive_mass;
+  p.jib_inertia = facts.crane.jib_inertia;
   TrackingStage{p};
   return p;
 }
 
-TrackingStage::TrackingStage(const TrackingStageParams& params) : law_(params.law), tracking_(params.tracking) {
+TrackingStage::TrackingStage(const TrackingStageParams& params)
+    : law_(params.law),
+      tracking_(params.tracking),
+      trolley_drive_mass_(params.trolley_drive_mass),
+      jib_inertia_(params.jib_inertia) {
+  common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
+  common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
   if (law_ != TrackingLaw::tracking) {
     auto p = params.gain_scheduling;
     p.kind = law_ == TrackingLaw::gain_scheduling_full ? gain_scheduling::FeedbackKind::full
@@ -59,18 +68,33 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   TrackingInput in;
   in.estimate = common::to_estimate(estimate);
   in.reference = common::to_reference(reference);
-  TrackingOutput result;
-  common::StepStatus status = common::StepStatus::ok;
-  if (scheduled_) {
-    status = scheduled_->step(in.estimate, in.reference, result.command);
-  } else {
+  if (estimate.payload_confident) {  // the online estimate (crane::adaptation), (2.25)
+    in.load = common::LoadRatios{estimate.payload_mass / trolley_drive_mass_, estimate.payload_mass / jib_inertia_};
+  }
+  if (!scheduled_) {
     in.reference.trolley.position += anti_swing.trolley_reference_correction;
     in.reference.trolley.velocity += anti_swing.trolley_reference_rate_correction;
     in.reference.slew.position += anti_swing.slew_reference_correction;
     in.reference.slew.velocity += anti_swing.slew_reference_rate_correction;
     in.trolley_anti_swing_action = anti_swing.trolley_action;
     in.slew_anti_swing_action = anti_swing.slew_action;
-    status = tracking_.step(in, result);
+  }
+  TrackingOutput result;
+  const auto run = [&]() noexcept {
+    result = TrackingOutput{};
+    return scheduled_ ? scheduled_->step(in.estimate, in.reference, result.command, in.load ? &*in.load : nullptr)
+                      : tracking_.step(in, result);
+  };
+  common::StepStatus status = run();
+  const auto finite = [&] {
+    return std::isfinite(result.command.trolley_voltage) && std::isfinite(result.command.slew_voltage) &&
+           std::isfinite(result.command.hoist_speed);
+  };
+  if (in.load && (status != common::StepStatus::ok || !finite())) {
+    // Fail safe: a load estimate the law cannot use (absurdly large, overflowing the gains) is
+    // dropped for this cycle, and the configured load is used.
+    in.load.reset();
+    status = run();
   }
   command.trolley_voltage = result.command.trolley_voltage;
   command.slew_voltage = result.command.slew_voltage;

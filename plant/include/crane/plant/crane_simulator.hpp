@@ -103,6 +103,20 @@ class CraneSimulator {
   /// [s] = number of samples since construction/reset times sample_period (no accumulation).
   [[nodiscard]] double time() const noexcept;
 
+  /// The friction models of both drives for `crane`'s trolley_friction and slew_friction (the kind's
+  /// second axis as at construction), to hand to set_friction later. Throws common::ConfigError for
+  /// invalid coefficients.
+  struct FrictionModels {
+    AxisFrictionModel trolley;
+    AxisFrictionModel second_axis;
+  };
+  [[nodiscard]] FrictionModels friction_models(const common::AxisFriction& trolley_friction,
+                                               const common::AxisFriction& slew_friction) const;
+  /// Friction from the next step on (a plant whose friction changes during a run). noexcept.
+  void set_friction(const FrictionModels& models) noexcept {
+    integrator_.set_friction(models.trolley, models.second_axis);
+  }
+
   [[nodiscard]] long friction_event_count() const noexcept { return integrator_.friction_event_count(); }
   [[nodiscard]] long integrator_failure_count() const noexcept { return integrator_.solver_failure_count(); }
   [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return integrator_.last_friction_event(); }

@@ -96,6 +96,11 @@ class CvodeIntegrator {
   /// still becomes end_time.
   IntegrationStatus advance_to(double end_time, const SampleInput& input) noexcept;
 
+  /// Replaces the friction of both axes from the next advance on (a plant whose friction changes
+  /// during a run, PlantMismatch::friction_change_factor); an axis at rest is decided again under the
+  /// new breakaway. noexcept, allocation-free.
+  void set_friction(const AxisFrictionModel& trolley_friction, const AxisFrictionModel& slew_friction) noexcept;
+
   [[nodiscard]] double time() const noexcept { return time_; }
   [[nodiscard]] ModelState state() const noexcept;
   [[nodiscard]] double cable_length() const noexcept;       // [m]

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "crane/common/stack_facts.hpp"
 #include "crane/plant/crane_simulator.hpp"
@@ -30,6 +31,12 @@ struct PlantMismatch {
   double load_mass_factor{1.0};     // [-] simulated load mass = factor x configured, in [0, 10]
   double friction_factor{1.0};      // [-] every friction coefficient of both drives x factor, in [0, 10]
   int sensor_delay_cycles{0};       // [cycles] the sample of cycle k reports the encoders of k - d, in [0, 16]
+  // A plant whose friction changes during a run (wear, temperature; the online re-estimation's test):
+  // from cycle friction_change_cycle on, every friction coefficient of both drives is
+  // friction_change_factor times what it was (friction_factor included). 1: off (the default; the
+  // simulation is then bit-identical to a plant without the option).
+  double friction_change_factor{1.0};     // [-] in [0.1, 10]
+  std::uint64_t friction_change_cycle{0};  // [cycles] the first cycle integrated with the changed friction
 };
 /// Throws common::ConfigError naming the field ("plant.mismatch.<name>"), the value and the bound.
 void validate(const PlantMismatch& mismatch);
@@ -80,6 +87,7 @@ class PlantStage {
   double cable_length_reading_factor_{1.0};
   std::uint64_t cycle_{0};
   std::array<common::CraneMeasurement, kMaxSensorDelay + 1> measurements_{};  // ring, by cycle
+  std::optional<CraneSimulator::FrictionModels> changed_friction_;  // applied at friction_change_cycle
 };
 
 /// The simulated crane: `configured` with `mismatch` applied (cable length, load mass, friction).

@@ -45,6 +45,14 @@ struct MotionReference {
   AxisReference cable_length;
 };
 
+/// The load as the controllers' model sees it, (2.25): m_t = m/M [-] and m_r = m/J_o [1/m^2]. The
+/// controllers take one per cycle when the online estimate is confident (crane::adaptation), and use
+/// their configured ratios otherwise.
+struct LoadRatios {
+  double mass_ratio{0.0};          // [-] m_t, finite, >= 0
+  double load_inertia_ratio{0.0};  // [1/m^2] m_r, finite, >= 0
+};
+
 /// Drive commands (after or before friction compensation, depending on where it is used).
 struct DriveCommand {
   double trolley_voltage{0.0};  // [V]

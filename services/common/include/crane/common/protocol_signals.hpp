@@ -3,6 +3,7 @@
 // messages.hpp, generated from the IDL), field for field, SI: what every stage object reads from
 // and writes to its messages. Header-only (target crane::common_protocol).
 
+#include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
 #include "crane/protocol/messages.hpp"
 
@@ -48,6 +49,34 @@ inline void from_estimate(const CraneStateEstimate& e, protocol::CraneState& s) 
   s.cable_length_rate = e.cable_length_rate;
   s.trolley_velocity_raw = e.trolley_velocity_raw;
   s.slew_rate_raw = e.slew_rate_raw;
+}
+
+/// The trolley's friction in use that the estimate carries (CraneState_'s trolley_friction_*), volts.
+[[nodiscard]] inline AxisFriction trolley_friction_in_use(const protocol::CraneState& s) noexcept {
+  return {s.trolley_friction_viscous_positive, s.trolley_friction_viscous_negative,
+          s.trolley_friction_coulomb_positive, s.trolley_friction_coulomb_negative,
+          s.trolley_friction_static_positive,  s.trolley_friction_static_negative};
+}
+
+/// The slew's (CraneState_'s slew_friction_*).
+[[nodiscard]] inline AxisFriction slew_friction_in_use(const protocol::CraneState& s) noexcept {
+  return {s.slew_friction_viscous_positive, s.slew_friction_viscous_negative, s.slew_friction_coulomb_positive,
+          s.slew_friction_coulomb_negative, s.slew_friction_static_positive,  s.slew_friction_static_negative};
+}
+
+inline void set_friction_in_use(const AxisFriction& trolley, const AxisFriction& slew, protocol::CraneState& s) noexcept {
+  s.trolley_friction_viscous_positive = trolley.viscous_positive;
+  s.trolley_friction_viscous_negative = trolley.viscous_negative;
+  s.trolley_friction_coulomb_positive = trolley.coulomb_positive;
+  s.trolley_friction_coulomb_negative = trolley.coulomb_negative;
+  s.trolley_friction_static_positive = trolley.static_positive;
+  s.trolley_friction_static_negative = trolley.static_negative;
+  s.slew_friction_viscous_positive = slew.viscous_positive;
+  s.slew_friction_viscous_negative = slew.viscous_negative;
+  s.slew_friction_coulomb_positive = slew.coulomb_positive;
+  s.slew_friction_coulomb_negative = slew.coulomb_negative;
+  s.slew_friction_static_positive = slew.static_positive;
+  s.slew_friction_static_negative = slew.static_negative;
 }
 
 [[nodiscard]] inline MotionReference to_reference(const protocol::Reference& r) noexcept {

@@ -13,6 +13,9 @@
 //
 // Real-time: step() is noexcept, allocates nothing.
 
+#include <array>
+#include <optional>
+
 #include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
 
@@ -42,6 +45,11 @@ struct FrictionCompensationParams {
 struct FrictionCompensationInput {
   common::CraneStateEstimate estimate;  // velocities [m/s], [rad/s]
   common::DriveCommand command;         // V from the linear controller [V]; hoist passes through
+  // Friction in use instead of the configured one this cycle (the online re-estimate, released by
+  // crane::adaptation within its safe bounds); empty, or with a non-finite or negative coefficient:
+  // the configured one.
+  std::optional<common::AxisFriction> trolley_friction;
+  std::optional<common::AxisFriction> slew_friction;
 };
 
 struct FrictionCompensationOutput {
@@ -51,6 +59,20 @@ struct FrictionCompensationOutput {
   bool trolley_saturated{false};
   bool slew_saturated{false};
 };
+
+/// Which branch of (3.3) a velocity is in: +1 (eta = 1, v > d_s), -1 (xi = 1, v < -d_s), 0 (the
+/// zero-velocity band, where friction is static and not a function of v).
+[[nodiscard]] int friction_direction(double velocity, double zero_velocity_band) noexcept;
+
+/// The sliding-friction regressor of (3.13)-(3.14) at `velocity` [m/s or rad/s] in `direction`
+/// (friction_direction): r = [v eta, v xi, eta, -xi], so that outside the band
+///   F_f/K_m = b+ v eta + b- v xi + c+ eta - c- xi = sliding_coefficients(f) . r        (3.1)
+/// in volts. The one place the regressor is written: the compensation (friction_voltage) and the
+/// online re-estimation (crane::adaptation) both use it. Zero in the band (direction 0).
+[[nodiscard]] std::array<double, 4> friction_regressor(double velocity, int direction) noexcept;
+
+/// (b+, b-, c+, c-) of `friction`, in the order of friction_regressor [V s/m, V s/m, V, V].
+[[nodiscard]] std::array<double, 4> sliding_coefficients(const common::AxisFriction& friction) noexcept;
 
 /// F_f/K_m [V] for one axis at `velocity` [m/s or rad/s] and commanded voltage [V].
 /// Preconditions: finite inputs, validated params.

@@ -3,7 +3,9 @@
 // without DDS, clock or thread. The linear command and the estimate of cycle k -> u = V + F_f/K_m
 // (3.5) with the friction model (3.1)-(3.3) of the configured crane -> ActuatorCommand of cycle k
 // (same seq and origin). Disabled (params.enabled false): u = V, still clamped (the dissertation's
-// runs without compensation, figures 4.19-4.22).
+// runs without compensation, figures 4.19-4.22). An axis whose ADAPTATION_*_FRICTION_ADAPTED bit
+// is set in the estimate is compensated with the estimate's *_friction_* coefficients (the online
+// re-estimate, crane::adaptation), otherwise with the configured crane's.
 
 #include "crane/common/stack_facts.hpp"
 #include "crane/friction_compensation/friction_compensation.hpp"

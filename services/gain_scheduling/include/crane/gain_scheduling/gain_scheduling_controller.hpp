@@ -57,9 +57,11 @@ class GainSchedulingController {
   /// One control cycle. Uses estimate trolley_position/velocity, slew_angle/rate, both swing angles
   /// and rates, cable_length; reference trolley.position, slew.position, cable_length.velocity.
   /// Returns rejected_nonfinite (command zeroed, gains unchanged) if any used value is NaN/Inf.
+  /// `load`: the m_t and m_r the gains are placed for this cycle (the online estimate when it is
+  /// confident); nullptr, or a non-finite or negative ratio: the configured ones.
   [[nodiscard]] common::StepStatus step(const common::CraneStateEstimate& estimate,
-                                        const common::MotionReference& reference,
-                                        common::DriveCommand& command) noexcept;
+                                        const common::MotionReference& reference, common::DriveCommand& command,
+                                        const common::LoadRatios* load = nullptr) noexcept;
 
   /// Gains used by the last successful step() (default-constructed before the first).
   [[nodiscard]] const GainSchedulingGains& trolley_gains() const noexcept { return trolley_gains_; }

@@ -54,6 +54,7 @@ class InProcessStack {
   [[nodiscard]] std::uint64_t cycle() const noexcept;             // cycles stepped
   [[nodiscard]] const protocol::SensorSample& sensors() const noexcept;       // of the last cycle
   [[nodiscard]] const protocol::SensorSample& next_sensors() const noexcept;  // sampled after it
+  [[nodiscard]] const protocol::CraneState& estimate() const noexcept;        // of the last cycle
   [[nodiscard]] const protocol::Reference& reference() const noexcept;
   [[nodiscard]] const protocol::LinearCommand& linear() const noexcept;
   [[nodiscard]] const protocol::ActuatorCommand& actuators() const noexcept;

@@ -44,7 +44,7 @@ struct StackConfig {
   plant::SimulatorParameters plant;               // plant: (the configured crane, at rest)
   supervisor::ActuationGateParams actuation;      // actuation: (plant and hardware bridge)
   supervisor::SupervisorParams supervisor;
-  state_estimator::StateEstimatorParams state_estimator;
+  state_estimator::StateEstimatorStageParams state_estimator;
   trajectory_planner::TrajectoryPlannerParams trajectory_planner;
   anti_swing::AntiSwingStageParams anti_swing;
   tracking::TrackingStageParams tracking;

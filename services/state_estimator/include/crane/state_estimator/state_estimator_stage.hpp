@@ -1,8 +1,11 @@
 #pragma once
 // The state estimator stage: what the state_estimator process computes each cycle, without DDS,
 // clock or thread. Sensor sample of cycle k -> section 4.3 filter and differentiator -> the
-// estimate of cycle k (same seq and origin).
+// estimate of cycle k (same seq and origin), with the online payload mass and friction estimate
+// (crane::adaptation, online_adaptation.hpp) in its payload_* and *_friction_* fields: the
+// configured values while adaptation is off or has not identified them.
 
+#include "crane/adaptation/online_adaptation.hpp"
 #include "crane/common/stack_facts.hpp"
 #include "crane/protocol/messages.hpp"
 #include "crane/state_estimator/state_estimator.hpp"
@@ -13,15 +16,22 @@ class YamlSection;
 
 namespace crane::state_estimator {
 
+struct StateEstimatorStageParams {
+  StateEstimatorParams estimator{};
+  adaptation::OnlineAdaptationParams adaptation{};  // the crane and sample period are the stack's facts
+};
+
 /// Reads the `state_estimator:` block: cutoff_frequency [Hz] in [1e-3, 0.499 fs], differentiator
 /// (backward (4.8) | al_alaoui_first_order (4.9) | al_alaoui_second_order (4.10)); fs is
-/// 1 / facts.sample_period. Throws common::ConfigError naming the field, value and bound.
-[[nodiscard]] StateEstimatorParams read_params(config::YamlSection& block, const common::StackFacts& facts);
+/// 1 / facts.sample_period; and its `adaptation:` block (every field of OnlineAdaptationParams,
+/// limit_cycle: included; ranges in read_adaptation's body and OnlineAdaptation's validate). Throws
+/// common::ConfigError naming the field, value and bound.
+[[nodiscard]] StateEstimatorStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
 
 class StateEstimatorStage {
  public:
   /// Throws common::ConfigError for invalid params (StateEstimator's constructor).
-  explicit StateEstimatorStage(const StateEstimatorParams& params);
+  explicit StateEstimatorStage(const StateEstimatorStageParams& params);
 
   /// One cycle. ok: `estimate` holds the estimate of `sensors`' cycle. rejected_nonfinite (a NaN or
   /// Inf field): `estimate` and the filters are untouched. Never throws, never allocates.
@@ -29,7 +39,9 @@ class StateEstimatorStage {
 
  private:
   StateEstimator estimator_;
+  adaptation::OnlineAdaptation adaptation_;
   common::CraneStateEstimate scratch_{};
+  adaptation::AdaptationEstimate adapted_{};
 };
 
 }  // namespace crane::state_estimator

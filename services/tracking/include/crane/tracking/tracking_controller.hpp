@@ -15,6 +15,8 @@
 //
 // Real-time: step() is noexcept, allocates nothing.
 
+#include <optional>
+
 #include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
 
@@ -46,6 +48,9 @@ struct TrackingInput {
   common::MotionReference reference;
   double trolley_anti_swing_action{0.0};  // [-] V_xs (normalized) from the anti-swing core
   double slew_anti_swing_action{0.0};     // [-] V_ys (normalized)
+  // The load of (3.37)-(3.38) this cycle: the online estimate when it is confident; empty (or not
+  // finite, or negative): the configured mass_ratio and load_inertia_ratio.
+  std::optional<common::LoadRatios> load;
 };
 
 struct TrackingOutput {

@@ -10,6 +10,9 @@
 //   gain_scheduling_full     gain-scheduling state feedback (3.26) on the reference position
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
+// Every law takes the load (m_t, m_r of (3.37)-(3.38) and the gain schedule) from the estimate's
+// payload_mass while payload_confident is set (the online estimate, crane::adaptation), and from the
+// configured crane otherwise.
 
 #include <cstdint>
 #include <optional>
@@ -36,6 +39,8 @@ struct TrackingStageParams {
   TrackingLaw law{TrackingLaw::tracking};
   TrackingParams tracking{};                         // the PD law (model constants from the crane)
   gain_scheduling::GainSchedulingParams gain_scheduling{};  // the gain-scheduling laws (kind follows law)
+  double trolley_drive_mass{22.222};  // [kg] M, > 0: m_t = payload_mass / M when the estimate is confident
+  double jib_inertia{7.143};          // [kg m^2] J_o, > 0: m_r = payload_mass / J_o
 };
 
 /// Reads the `tracking:` block: proportional_gain [-] in [0, 1e4], derivative_gain [-] in [0, 1e3],
@@ -62,6 +67,8 @@ class TrackingStage {
   TrackingLaw law_;
   TrackingController tracking_;
   std::optional<gain_scheduling::GainSchedulingController> scheduled_;
+  double trolley_drive_mass_;  // [kg]
+  double jib_inertia_;         // [kg m^2]
 };
 
 }  // namespace crane::tracking
