@@ -396,3 +396,27 @@ TEST_F(LabConfigText, PlantKindIsValidatedLikeTheRest) {
   message = error_of(edit_line(text_, "plant:", "kind:", "kind: tower\n  bridge: {drive_mass: 1.0}").text);
   EXPECT_TRUE(contains(message, "unknown field plant.bridge")) << message;
 }
+
+TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_FALSE(c.plant.hook.enabled);  // off by default: the dissertation's single pendulum
+  EXPECT_FALSE(c.plant.wind.enabled);
+  auto message = error_of(edit_line(text_, "hook:", "rigging_length:", "rigging_length: 0").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "plant.hook.rigging_length = 0")) << message;
+  EXPECT_TRUE(contains(message, "[0.001, 10]")) << message;
+  message = error_of(edit_line(text_, "wind:", "gust_time_constant:", "gust_time_constant: -2").text);
+  EXPECT_TRUE(contains(message, "plant.wind.gust_time_constant = -2")) << message;
+  message = error_of(edit_line(text_, "wind:", "seed:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field plant.wind.seed")) << message;
+  message = error_of(edit_line(text_, "hook:", "enabled:", "enabled: maybe").text);
+  EXPECT_TRUE(contains(message, "plant.hook.enabled")) << message;
+  // Enabled, they reach the plant's parameters.
+  const auto on = cfg::parse_stack_config(
+      edit_line(edit_line(text_, "hook:", "enabled:", "enabled: true").text, "wind:", "enabled:", "enabled: true").text,
+      "test.yaml");
+  EXPECT_TRUE(on.plant.hook.enabled);
+  EXPECT_DOUBLE_EQ(on.plant.hook.rigging_length, 0.3);
+  EXPECT_TRUE(on.plant.wind.enabled);
+  EXPECT_EQ(on.plant.wind.seed, 1U);
+}
