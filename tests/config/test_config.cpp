@@ -420,3 +420,24 @@ TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {
   EXPECT_TRUE(on.plant.wind.enabled);
   EXPECT_EQ(on.plant.wind.seed, 1U);
 }
+
+TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_EQ(c.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::zvd);
+  EXPECT_EQ(c.trajectory_planner.manual.swing_length_scale, 1.0);  // the single pendulum sqrt(g/L)
+  EXPECT_EQ(c.trajectory_planner.manual.swing_length_offset, 0.0);
+  EXPECT_EQ(c.trajectory_planner.manual.swing_damping_ratio, 0.0);
+  auto message = error_of(edit_line(text_, "manual:", "shaping:", "shaping: zvdd").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.manual.shaping = \"zvdd\"")) << message;
+  EXPECT_TRUE(contains(message, "two_hump_ei")) << message;
+  message = error_of(edit_line(text_, "manual:", "swing_damping_ratio:", "swing_damping_ratio: 0.5").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.manual.swing_damping_ratio = 0.5")) << message;
+  EXPECT_TRUE(contains(message, "[0, 0.3]")) << message;
+  const auto calibrated = cfg::parse_stack_config(
+      edit_line(edit_line(text_, "manual:", "shaping:", "shaping: two_hump_ei").text, "manual:", "swing_length_offset:",
+                "swing_length_offset: 0.25")
+          .text,
+      "test.yaml");
+  EXPECT_EQ(calibrated.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::two_hump_ei);
+  EXPECT_EQ(calibrated.trajectory_planner.manual.swing_length_offset, 0.25);
+}
