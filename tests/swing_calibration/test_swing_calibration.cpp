@@ -358,6 +358,16 @@ TEST(SwingCalibration, ARecordWithoutSwingIsRefusedNamingTheThresholds) {
     EXPECT_NE(std::string(e.what()).find("still.csv: no swing to fit"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("0.003 rad"), std::string::npos) << e.what();
   }
+  CalibrationOptions whole;
+  whole.whole_record = true;
+  try {
+    (void)fit_swing(r, whole);
+    ADD_FAILURE() << "no CalibrationError";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("still.csv: no swing to fit: the record never swings more than 0.003 rad"),
+              std::string::npos)
+        << e.what();
+  }
   CalibrationOptions bad;
   bad.frequency_band = 0.8;
   EXPECT_THROW((void)fit_swing(r, bad), common::ConfigError);

@@ -255,14 +255,16 @@ SwingFit fit_swing(const SwingRecord& record, const CalibrationOptions& options)
   fit.gravity = options.gravity;
   fit.segments = choose_segments(record, signals, options);
   if (fit.segments.empty()) {
+    const std::string swing = "swings more than " + common::format_value(options.min_swing_amplitude) +
+                              " rad with two zero crossings";
     throw CalibrationError(
         record.source + ": no swing to fit: " +
-        (options.whole_record ? std::string("the record")
-                              : "no stretch with the trolley below " + common::format_value(options.still_trolley_speed) +
-                                    " m/s and the slew below " + common::format_value(options.still_slew_rate) +
-                                    " rad/s for " + common::format_value(options.min_segment_periods) + " periods") +
-        " swings more than " + common::format_value(options.min_swing_amplitude) +
-        " rad with two zero crossings (record a move that stops, then lets the load swing; or --whole-record)");
+        (options.whole_record
+             ? "the record never " + swing + " (record a move that lets the load swing)"
+             : "no stretch with the trolley below " + common::format_value(options.still_trolley_speed) +
+                   " m/s and the slew below " + common::format_value(options.still_slew_rate) + " rad/s for " +
+                   common::format_value(options.min_segment_periods) + " periods " + swing +
+                   " (record a move that stops, then lets the load swing; or --whole-record)"));
   }
   // Initial guesses: a = 1, c from the zero-crossing frequencies, small damping.
   double offset_sum = 0.0;
