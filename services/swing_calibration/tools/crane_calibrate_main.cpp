@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   CLI::App app{"crane_calibrate: shaper calibration from a recording (docs/calibration.md)"};
   app.require_subcommand(1);
   auto* swing = app.add_subcommand("swing", "fit the swing frequency and damping against cable length, rank the shapers");
-  std::string data, mapping, out;
+  std::string data, mapping, out, source;
   double cable_length = 0.0;
   sc::CalibrationOptions options;
   swing->add_option("--data", data, "recording: CSV with t,x,gamma,phi,theta,L (crane_demo, crane_sim, crane_topic convert)")
@@ -76,6 +76,8 @@ int main(int argc, char** argv) {
   swing->add_option("--min-periods", options.min_segment_periods, "free-swing segments last at least this many periods")
       ->capture_default_str();
   swing->add_option("--gravity", options.gravity, "[m/s^2]")->capture_default_str();
+  swing->add_option("--source", source, "the recording's name in calibration.yaml (default: --data; deploy/crane "
+                                        "passes the .mcap it converted)");
   swing->add_option("--out", out, "folder for calibration.yaml, report.txt, fit.csv, shapers.csv");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -85,7 +87,7 @@ int main(int argc, char** argv) {
         cable_length > 0.0 ? cable_length : 0.5 * (fit.min_cable_length + fit.max_cable_length);
     const sc::ShaperRecommendation rec = sc::recommend_shaper(fit, design_length, options);
     const std::string report = sc::format_report(fit, rec, options);
-    const std::string yaml = sc::planner_manual_yaml(fit, rec, data);
+    const std::string yaml = sc::planner_manual_yaml(fit, rec, source.empty() ? data : source);
     std::printf("%s\nfor the planner (trajectory_planner.manual in the config):\n%s", report.c_str(), yaml.c_str());
     if (!out.empty()) {
       write_outputs(out, record, fit, rec, report, yaml);
