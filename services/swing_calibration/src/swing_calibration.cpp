@@ -279,6 +279,10 @@ SwingFit fit_swing(const SwingRecord& record, const CalibrationOptions& options)
   }
   double scale = 1.0;
   double offset = offset_sum / static_cast<double>(fit.segments.size());
+  // Ceres starts from a feasible point: an estimate outside the bounds below (zero crossings of a
+  // closed-loop record can count a faster mode) starts from the single pendulum instead.
+  const double lowest_offset = -0.5 * fit.min_cable_length;
+  if (!(offset > lowest_offset && offset < 10.0)) offset = 0.0;
   double zeta = 0.005;
   const double mid_length = 0.5 * (fit.min_cable_length + fit.max_cable_length);
   fit.length_scale_fitted = fit.max_cable_length - fit.min_cable_length > 0.2 * mid_length;
@@ -307,7 +311,7 @@ SwingFit fit_swing(const SwingRecord& record, const CalibrationOptions& options)
   }
   problem.SetParameterLowerBound(&zeta, 0, 0.0);
   problem.SetParameterUpperBound(&zeta, 0, 0.3);
-  problem.SetParameterLowerBound(&offset, 0, -0.5 * fit.min_cable_length);
+  problem.SetParameterLowerBound(&offset, 0, lowest_offset);
   problem.SetParameterUpperBound(&offset, 0, 10.0);
   if (fit.length_scale_fitted) {
     problem.SetParameterLowerBound(&scale, 0, 0.5);
