@@ -13,7 +13,7 @@ namespace crane::plant {
 
 namespace {
 
-ExtendedState to_extended_state(const PlantState& s, PlantKind kind) {
+ExtendedState to_extended_state(const PlantState& s, PlantKind kind, bool rope) {
   ExtendedState e;
   if (kind == PlantKind::overhead) {
     e.position.head<kNumCoordinates>() << s.trolley_position, s.swing_in_plane, s.bridge_position, s.swing_out_of_plane;
@@ -28,6 +28,10 @@ ExtendedState to_extended_state(const PlantState& s, PlantKind kind) {
   e.position[kRiggingOutOfPlaneIndex] = s.rigging_out_of_plane;
   e.velocity[kRiggingInPlaneIndex] = s.rigging_in_plane_rate;
   e.velocity[kRiggingOutOfPlaneIndex] = s.rigging_out_of_plane_rate;
+  if (rope) {  // slot 4 is the stretch (a rope never comes with a hook)
+    e.position[kRopeStretchIndex] = s.rope_stretch;
+    e.velocity[kRopeStretchIndex] = s.rope_stretch_rate;
+  }
   return e;
 }
 
@@ -88,13 +92,14 @@ PlantKind plant_kind_from_string(const std::string& text, const std::string& fie
 }
 
 std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
-                                                   const common::BridgeParameters& bridge, const HookParameters& hook) {
+                                                   const common::BridgeParameters& bridge, const HookParameters& hook,
+                                                   const RopeParameters& rope) {
   switch (kind) {
     case PlantKind::gantry: return std::make_unique<GantryCraneModel>(crane);
     case PlantKind::overhead: return std::make_unique<OverheadCraneModel>(crane, bridge);
     case PlantKind::tower: break;
   }
-  return std::make_unique<TowerCraneModel>(crane, hook);
+  return std::make_unique<TowerCraneModel>(crane, hook, rope);
 }
 
 const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& p) {
@@ -109,6 +114,11 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
   common::require_greater("simulator.hoist_max_acceleration", p.hoist_max_acceleration, 0.0);
   validate(p.hook, "plant.hook.");
   validate(p.wind, "plant.wind.");
+  validate(p.rope, "plant.rope.");
+  if (p.kind != PlantKind::tower && p.rope.enabled) {
+    throw common::ConfigError(std::string("plant.rope.enabled = true needs plant.kind = tower (is ") +
+                              to_string(p.kind) + ")");
+  }
   if (p.kind != PlantKind::tower) {
     if (p.hook.enabled) {
       throw common::ConfigError(std::string("plant.hook.enabled = true needs plant.kind = tower (is ") +
@@ -125,7 +135,8 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
 
 CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
     : parameters_(validated(parameters)),
-      model_(make_crane_dynamics(parameters_.kind, parameters_.crane, parameters_.bridge, parameters_.hook)),
+      model_(make_crane_dynamics(parameters_.kind, parameters_.crane, parameters_.bridge, parameters_.hook,
+                                 parameters_.rope)),
       sensors_(parameters_.crane),
       integrator_(*model_,
                   AxisFrictionModel(parameters_.crane.trolley_friction,
@@ -185,13 +196,21 @@ void CraneSimulator::validate_state(const PlantState& s) const {
     require_zero_without_hook("rigging_out_of_plane", s.rigging_out_of_plane);
     require_zero_without_hook("rigging_out_of_plane_rate", s.rigging_out_of_plane_rate);
   }
+  if (parameters_.rope.enabled) {
+    common::require_in_range(p + "rope_stretch", s.rope_stretch, -0.5 * s.cable_length, s.cable_length);
+    common::require_in_range(p + "rope_stretch_rate", s.rope_stretch_rate, -limit, limit);
+  } else {
+    common::require_in_range(p + "rope_stretch (no plant.rope)", s.rope_stretch, 0.0, 0.0);
+    common::require_in_range(p + "rope_stretch_rate (no plant.rope)", s.rope_stretch_rate, 0.0, 0.0);
+  }
 }
 
 void CraneSimulator::reset(const PlantState& state) {
   validate_state(state);
   sample_index_ = 0;
-  if (parameters_.hook.enabled) {
-    integrator_.reset(0.0, to_extended_state(state, parameters_.kind), state.cable_length, state.cable_length_rate);
+  if (parameters_.hook.enabled || parameters_.rope.enabled) {
+    integrator_.reset(0.0, to_extended_state(state, parameters_.kind, parameters_.rope.enabled), state.cable_length,
+                      state.cable_length_rate);
   } else {
     integrator_.reset(0.0, to_model_state(state, parameters_.kind), state.cable_length, state.cable_length_rate);
   }
@@ -220,6 +239,11 @@ void CraneSimulator::refresh_state() noexcept {
   state_.swing_out_of_plane_rate = m.velocity[kOutOfPlaneSwingIndex];
   state_.cable_length = integrator_.cable_length();
   state_.cable_length_rate = integrator_.cable_length_rate();
+  if (parameters_.rope.enabled) {
+    const ExtendedState e = integrator_.extended_state();
+    state_.rope_stretch = e.position[kRopeStretchIndex];
+    state_.rope_stretch_rate = e.velocity[kRopeStretchIndex];
+  }
   if (parameters_.hook.enabled) {
     const ExtendedState e = integrator_.extended_state();
     state_.rigging_in_plane = e.position[kRiggingInPlaneIndex];
@@ -291,8 +315,8 @@ SimulatorOutput CraneSimulator::output() const noexcept {
 }
 
 double CraneSimulator::total_energy() const noexcept {
-  if (parameters_.hook.enabled) {
-    return model_->extended_total_energy(to_extended_state(state_, parameters_.kind),
+  if (parameters_.hook.enabled || parameters_.rope.enabled) {
+    return model_->extended_total_energy(to_extended_state(state_, parameters_.kind, parameters_.rope.enabled),
                                          HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
   }
   const ModelState m = to_model_state(state_, parameters_.kind);

@@ -97,13 +97,15 @@ void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumF
                                std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
   if (coordinates_ == kMaxCoordinates) {
     evaluate_with<kMaxCoordinates>(y, modes, y_dot, driving_force);
+  } else if (coordinates_ == kNumCoordinates + 1) {
+    evaluate_with<kNumCoordinates + 1>(y, modes, y_dot, driving_force);
   } else {
     evaluate_with<kNumCoordinates>(y, modes, y_dot, driving_force);
   }
 }
 
-// N = 4: the model's compute_dynamics (the single pendulum); N = 6: compute_extended_dynamics (with
-// a hook). The same arithmetic in both.
+// N = 4: the model's compute_dynamics (the single pendulum); N = 6 (a hook) and N = 5 (an elastic
+// rope, the first five of the extended rows): compute_extended_dynamics. The same arithmetic in all.
 template <int N>
 void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes,
                                     double* y_dot, std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
@@ -120,8 +122,14 @@ void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, 
   Vector bias;
   if constexpr (N == kNumCoordinates) {
     model_->compute_dynamics(state, hoist, mass, bias);
-  } else {
+  } else if constexpr (N == kMaxCoordinates) {
     model_->compute_extended_dynamics(state, hoist, mass, bias);
+  } else {
+    ExtendedMatrix full_mass;
+    ExtendedVector full_bias;
+    model_->compute_extended_dynamics(state, hoist, full_mass, full_bias);
+    mass = full_mass.template topLeftCorner<N, N>();
+    bias = full_bias.template head<N>();
   }
 
   // Generalized forces (2.15): drives plus the sliding friction of slipping axes, plus a force on
@@ -129,8 +137,8 @@ void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, 
   Vector force = Vector::Zero();
   if (input_.load_force_x != 0.0 || input_.load_force_y != 0.0) {
     ExtendedState extended;
-    extended.position.head<N>() = state.position;
-    extended.velocity.head<N>() = state.velocity;
+    extended.position.head<N>() = state.position.template head<N>();
+    extended.velocity.head<N>() = state.velocity.template head<N>();
     force += model_->load_force(extended, hoist, input_.load_force_x, input_.load_force_y).template head<N>();
   }
   force[kTrolleyIndex] = input_.trolley_drive_force;

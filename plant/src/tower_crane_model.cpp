@@ -123,6 +123,17 @@ void hook_and_load_kinematics(const ExtendedState& state, const HoistMotion& hoi
   load.column[kRiggingOutOfPlaneIndex] = l * w.u_t;
 }
 
+// The elastic rope (header): the single pendulum's kinematics with the length L + s, its rate
+// L' + s' and, in a_rest, the hoist's L'' only (s'' is the column u).
+LoadKinematics rope_kinematics(const ExtendedState& state, const HoistMotion& hoist) {
+  ModelState m;
+  m.position = state.position.head<kNumCoordinates>();
+  m.velocity = state.velocity.head<kNumCoordinates>();
+  const HoistMotion stretched{hoist.cable_length + state.position[kRopeStretchIndex],
+                              hoist.cable_length_rate + state.velocity[kRopeStretchIndex], hoist.cable_length_acceleration};
+  return load_kinematics(m, stretched);
+}
+
 // Row weights of the double pendulum (header): hook and load mass per row, cable rows divided by
 // m_h + m, rigging rows by m (unit weight of the load's own row when m = 0).
 struct RowWeights {
@@ -144,6 +155,12 @@ ModelState first_four(const ExtendedState& state) {
 
 }  // namespace
 
+void validate(const RopeParameters& rope, const std::string& prefix) {
+  if (!rope.enabled) return;
+  common::require_in_range(prefix + "axial_stiffness", rope.axial_stiffness, 1.0, 1e10);
+  common::require_in_range(prefix + "damping_ratio", rope.damping_ratio, 0.0, 1.0);
+}
+
 void validate(const HookParameters& hook, const std::string& prefix) {
   if (!hook.enabled) return;
   common::require_in_range(prefix + "rigging_length", hook.rigging_length, 0.001, 10.0);
@@ -163,16 +180,58 @@ DoublePendulumFrequencies double_pendulum_frequencies(double cable_length, doubl
   return {std::sqrt(0.5 * gravity * (a - root)), std::sqrt(0.5 * gravity * (a + root))};
 }
 
-TowerCraneModel::TowerCraneModel(const common::CraneParameters& parameters, const HookParameters& hook)
-    : parameters_(parameters), hook_(hook) {
+TowerCraneModel::TowerCraneModel(const common::CraneParameters& parameters, const HookParameters& hook,
+                                 const RopeParameters& rope)
+    : parameters_(parameters), hook_(hook), rope_(rope) {
   common::validate(parameters_, "crane");
   validate(hook_, "plant.hook.");
+  validate(rope_, "plant.rope.");
+  if (rope_.enabled && hook_.enabled) {
+    throw common::ConfigError("plant.rope.enabled = true needs plant.hook.enabled = false (an elastic rope with a hook "
+                              "is not modelled)");
+  }
+  if (rope_.enabled) common::require_greater("plant.rope: crane.load_mass", parameters_.load_mass, 0.0);
 }
 
-int TowerCraneModel::coordinate_count() const noexcept { return hook_.enabled ? kMaxCoordinates : kNumCoordinates; }
+int TowerCraneModel::coordinate_count() const noexcept {
+  if (hook_.enabled) return kMaxCoordinates;
+  return rope_.enabled ? kNumCoordinates + 1 : kNumCoordinates;
+}
+
+double TowerCraneModel::rope_stiffness(double cable_length) const noexcept { return rope_.axial_stiffness / cable_length; }
 
 void TowerCraneModel::compute_extended_dynamics(const ExtendedState& state, const HoistMotion& hoist,
                                                 ExtendedMatrix& mass_matrix, ExtendedVector& bias) const noexcept {
+  if (rope_.enabled) {
+    // The single pendulum's rows over (x, phi, gamma, theta, s), swing and stretch rows per unit
+    // mass, plus the rope's force (k s + c s') / m on the stretch row; slot 5 unused (identity).
+    const double m = parameters_.load_mass;
+    LoadKinematics k = rope_kinematics(state, hoist);
+    Vector3d column[kNumCoordinates + 1];
+    for (int j = 0; j < kNumCoordinates; ++j) column[j] = k.column[j];
+    column[kRopeStretchIndex] = detail::cable_direction(state.position[kInPlaneSwingIndex],
+                                                        state.position[kOutOfPlaneSwingIndex]).u;
+    const Vector3d a_plus_gravity = k.a_rest + Vector3d(0.0, 0.0, parameters_.gravity);
+    mass_matrix.setIdentity();
+    bias.setZero();
+    for (int j = 0; j <= kRopeStretchIndex; ++j) {
+      const double row_scale = (is_swing_row(j) || j == kRopeStretchIndex) ? 1.0 : m;
+      for (int c = 0; c <= kRopeStretchIndex; ++c) mass_matrix(j, c) = row_scale * column[j].dot(column[c]);
+      bias[j] = row_scale * column[j].dot(a_plus_gravity);
+    }
+    const double stiffness = rope_stiffness(hoist.cable_length);
+    const double damping = 2.0 * rope_.damping_ratio * std::sqrt(stiffness * m);
+    bias[kRopeStretchIndex] +=
+        (stiffness * state.position[kRopeStretchIndex] + damping * state.velocity[kRopeStretchIndex]) / m;
+    const double x = state.position[kTrolleyIndex];
+    const double x_d = state.velocity[kTrolleyIndex];
+    const double gamma_d = state.velocity[kSlewIndex];
+    mass_matrix(kTrolleyIndex, kTrolleyIndex) += parameters_.trolley_drive_mass;
+    bias[kTrolleyIndex] -= parameters_.trolley_mass * x * gamma_d * gamma_d;
+    mass_matrix(kSlewIndex, kSlewIndex) += parameters_.trolley_mass * x * x + parameters_.jib_inertia;
+    bias[kSlewIndex] += 2.0 * parameters_.trolley_mass * x * x_d * gamma_d;
+    return;
+  }
   if (!hook_.enabled) {
     CraneDynamics::compute_extended_dynamics(state, hoist, mass_matrix, bias);
     return;
@@ -208,6 +267,15 @@ ExtendedVector TowerCraneModel::load_force(const ExtendedState& state, const Hoi
   const double gamma = state.position[kSlewIndex];
   const double cg = std::cos(gamma), sg = std::sin(gamma);
   const Vector3d force(cg * force_x + sg * force_y, -sg * force_x + cg * force_y, 0.0);
+  if (rope_.enabled) {
+    const LoadKinematics k = rope_kinematics(state, hoist);
+    for (int j = 0; j < kNumCoordinates; ++j) q[j] = (is_swing_row(j) ? 1.0 / m : 1.0) * k.column[j].dot(force);
+    q[kRopeStretchIndex] = detail::cable_direction(state.position[kInPlaneSwingIndex],
+                                                   state.position[kOutOfPlaneSwingIndex])
+                               .u.dot(force) /
+                           m;
+    return q;
+  }
   if (!hook_.enabled) {
     const LoadKinematics k = load_kinematics(first_four(state), hoist);
     for (int j = 0; j < kNumCoordinates; ++j) q[j] = (is_swing_row(j) ? 1.0 / m : 1.0) * k.column[j].dot(force);
@@ -223,6 +291,14 @@ ExtendedVector TowerCraneModel::load_force(const ExtendedState& state, const Hoi
 }
 
 double TowerCraneModel::extended_total_energy(const ExtendedState& state, const HoistMotion& hoist) const noexcept {
+  if (rope_.enabled) {
+    const double s_stretch = state.position[kRopeStretchIndex];
+    const double s_rate = state.velocity[kRopeStretchIndex];
+    const ModelState m = first_four(state);
+    const HoistMotion stretched{hoist.cable_length + s_stretch, hoist.cable_length_rate + s_rate, 0.0};
+    return kinetic_energy(m, stretched) + potential_energy(m, hoist.cable_length + s_stretch) +
+           0.5 * rope_stiffness(hoist.cable_length) * s_stretch * s_stretch;
+  }
   if (!hook_.enabled) return CraneDynamics::extended_total_energy(state, hoist);
   PointKinematics hook, load;
   hook_and_load_kinematics(state, hoist, hook_.rigging_length, hook, load);

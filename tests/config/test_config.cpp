@@ -441,3 +441,18 @@ TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
   EXPECT_EQ(calibrated.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::two_hump_ei);
   EXPECT_EQ(calibrated.trajectory_planner.manual.swing_length_offset, 0.25);
 }
+
+TEST_F(LabConfigText, PlantRopeIsOffAndValidatedLikeTheRest) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_FALSE(c.plant.rope.enabled);  // off by default: an inextensible cable
+  auto message = error_of(edit_line(text_, "rope:", "axial_stiffness:", "axial_stiffness: 0").text);
+  EXPECT_TRUE(contains(message, "plant.rope.axial_stiffness = 0")) << message;
+  EXPECT_TRUE(contains(message, "[1, 1e+10]")) << message;
+  message = error_of(
+      edit_line(edit_line(text_, "rope:", "enabled:", "enabled: true").text, "hook:", "enabled:", "enabled: true").text);
+  EXPECT_TRUE(contains(message, "plant.rope.enabled = true needs plant.hook.enabled = false")) << message;
+  // Enabled, the plant starts at the static stretch m g L / EA.
+  const auto on = cfg::parse_stack_config(edit_line(text_, "rope:", "enabled:", "enabled: true").text, "test.yaml");
+  EXPECT_TRUE(on.plant.rope.enabled);
+  EXPECT_NEAR(on.plant.initial_state.rope_stretch, 2.0 * 9.8 * 1.0 / 2.0e5, 1e-15);
+}

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -292,6 +293,143 @@ TEST(Wind, GustsHaveTheConfiguredMeanSpreadAndCorrelationTime) {
   force.reset();
   EXPECT_EQ(force.force_x(), 1.0);  // gusts start at 0
   EXPECT_EQ(force.force_y(), -0.5);
+}
+
+}  // namespace
+}  // namespace crane::plant
+
+namespace crane::plant {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Elastic rope (RopeParameters): the load on a spring of stiffness k = EA / L along the cable.
+// A soft rope (EA = 2000 N, k = 2000 N/m at 1 m, bounce sqrt(k/m) = 31.6 rad/s) keeps the tests short.
+SimulatorParameters roped(double damping_ratio) {
+  SimulatorParameters p;
+  p.crane.trolley_friction = {};
+  p.crane.slew_friction = {};
+  p.rope = RopeParameters{true, 2000.0, damping_ratio};
+  p.initial_state.trolley_position = 0.6;
+  p.initial_state.cable_length = 1.0;
+  return p;
+}
+
+// Braked, hanging still: the static stretch m g / k holds; 1 mm more bounces at sqrt(k/m).
+TEST(Rope, StaticStretchHoldsAndTheLoadBouncesAtSqrtKOverM) {
+  SimulatorParameters p = roped(0.0);
+  const double m = p.crane.load_mass, g = p.crane.gravity, k = 2000.0 / 1.0;
+  p.initial_state.rope_stretch = m * g / k;
+  CraneSimulator still(p);
+  ASSERT_EQ(still.model().coordinate_count(), 5);
+  double worst = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    ASSERT_EQ(still.step(DriveInput{}), common::StepStatus::ok);
+    worst = std::max(worst, std::abs(still.state().rope_stretch - m * g / k));
+  }
+  EXPECT_LT(worst, 1e-9);
+  p.initial_state.rope_stretch = m * g / k + 0.001;
+  CraneSimulator bouncing(p);
+  std::vector<double> crossings;
+  double previous = bouncing.state().rope_stretch - m * g / k;
+  while (crossings.size() < 21 && bouncing.time() < 5.0) {
+    const double t0 = bouncing.time();
+    ASSERT_EQ(bouncing.step(DriveInput{}), common::StepStatus::ok);
+    const double now = bouncing.state().rope_stretch - m * g / k;
+    if (previous > 0.0 && now <= 0.0) crossings.push_back(t0 + 0.01 * previous / (previous - now));
+    previous = now;
+  }
+  ASSERT_EQ(crossings.size(), 21U);
+  const double period = (crossings.back() - crossings.front()) / 20.0;
+  const double expected = 2.0 * std::numbers::pi / std::sqrt(k / m);
+  std::printf("rope: static stretch held to %.3g m; bounce period %.6f s, 2 pi / sqrt(k/m) = %.6f s\n", worst, period,
+              expected);
+  EXPECT_NEAR(period / expected, 1.0, 2e-3);  // crossings interpolated between 10 ms samples
+}
+
+// Damped bounce: the amplitude falls by exp(-2 pi zeta / sqrt(1 - zeta^2)) per period.
+TEST(Rope, BounceDecaysWithTheConfiguredDampingRatio) {
+  SimulatorParameters p = roped(0.05);
+  const double m = p.crane.load_mass, g = p.crane.gravity, k = 2000.0;
+  p.initial_state.rope_stretch = m * g / k + 0.002;
+  CraneSimulator sim(p);
+  // Peak of |s - s_eq| in the first and the sixth period (0.199 s each).
+  const double period = 2.0 * std::numbers::pi / std::sqrt(k / m);
+  double first = 0.0, sixth = 0.0;
+  while (sim.time() < 6.0 * period) {
+    ASSERT_EQ(sim.step(DriveInput{}), common::StepStatus::ok);
+    const double a = std::abs(sim.state().rope_stretch - m * g / k);
+    if (sim.time() > 0.5 * period && sim.time() <= 1.5 * period) first = std::max(first, a);
+    if (sim.time() > 5.5 * period && sim.time() <= 6.0 * period + 1e-9) sixth = std::max(sixth, a);
+  }
+  const double expected = std::exp(-5.0 * 2.0 * std::numbers::pi * 0.05 / std::sqrt(1.0 - 0.05 * 0.05));
+  std::printf("rope: amplitude ratio over 5 periods %.4f, expected %.4f\n", sixth / first, expected);
+  EXPECT_NEAR(sixth / first, expected, 0.03);  // peaks sampled every 10 ms (period 199 ms)
+}
+
+// No damping, no friction, no input, constant L: T + V + 1/2 k s^2 is conserved while the load
+// swings, the trolley moves and the rope bounces.
+TEST(Rope, FrictionlessFreeMotionKeepsEnergy) {
+  SimulatorParameters p = roped(0.0);
+  p.initial_state.trolley_velocity = 0.2;
+  p.initial_state.swing_in_plane = 0.3;
+  p.initial_state.swing_out_of_plane = 0.2;
+  p.initial_state.slew_rate = 0.5;
+  p.initial_state.rope_stretch = 0.005;
+  CraneSimulator sim(p);
+  const double energy0 = sim.total_energy();
+  DriveInput input;
+  input.brakes_engaged = false;
+  double worst = 0.0, smallest = 1.0, largest = -1.0;
+  for (int i = 0; i < 500; ++i) {  // 5 s
+    ASSERT_EQ(sim.step(input), common::StepStatus::ok);
+    worst = std::max(worst, std::abs(sim.total_energy() - energy0) / std::abs(energy0));
+    smallest = std::min(smallest, sim.state().rope_stretch);
+    largest = std::max(largest, sim.state().rope_stretch);
+  }
+  std::printf("rope: energy %.6g J, worst relative drift %.3g; stretch between %.4f and %.4f m\n", energy0, worst,
+              smallest, largest);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(largest - smallest, 0.005);  // it bounced
+}
+
+// Hoisting: paying out rope softens it (k = EA / L); after lowering from 1.0 m to about 1.5 m and settling, the
+// stretch is m g L / EA at the new length.
+TEST(Rope, HoistingChangesTheStretchWithTheLength) {
+  SimulatorParameters p = roped(0.3);
+  const double m = p.crane.load_mass, g = p.crane.gravity;
+  p.initial_state.rope_stretch = m * g * 1.0 / 2000.0;
+  CraneSimulator sim(p);
+  DriveInput lower;
+  lower.hoist_speed = 0.2;
+  while (sim.state().cable_length < 1.5 - 1e-9 && sim.time() < 5.0) {
+    if (sim.state().cable_length > 1.5 - 0.2 * 0.01) lower.hoist_speed = (1.5 - sim.state().cable_length) / 0.01;
+    ASSERT_EQ(sim.step(lower), common::StepStatus::ok);
+  }
+  DriveInput hold;
+  for (int i = 0; i < 300; ++i) ASSERT_EQ(sim.step(hold), common::StepStatus::ok);
+  const double L = sim.state().cable_length;
+  std::printf("rope: at L = %.4f m the stretch is %.6f m, m g L / EA = %.6f m\n", L, sim.state().rope_stretch,
+              m * g * L / 2000.0);
+  EXPECT_NEAR(sim.state().rope_stretch, m * g * L / 2000.0, 1e-5);
+  EXPECT_GT(L, 1.45);
+}
+
+TEST(Rope, ConfigurationErrorsNameTheField) {
+  SimulatorParameters p = roped(0.0);
+  p.rope.axial_stiffness = 0.5;
+  EXPECT_THROW(CraneSimulator{p}, common::ConfigError);
+  try {
+    SimulatorParameters q = roped(0.0);
+    q.hook.enabled = true;
+    CraneSimulator sim(q);
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("plant.rope.enabled = true needs plant.hook.enabled = false"), std::string::npos)
+        << e.what();
+  }
+  SimulatorParameters off;
+  off.initial_state.rope_stretch = 0.01;
+  EXPECT_THROW(CraneSimulator{off}, common::ConfigError);
 }
 
 }  // namespace

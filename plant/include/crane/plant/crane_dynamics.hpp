@@ -46,6 +46,8 @@ inline constexpr int kNumCoordinates = 4;
 /// Slots of a model with a hook (coordinate_count() == 6).
 inline constexpr int kRiggingInPlaneIndex = 4;      // phi2 [rad]
 inline constexpr int kRiggingOutOfPlaneIndex = 5;   // theta2 [rad]
+/// Slot of a model with an elastic rope and no hook (coordinate_count() == 5).
+inline constexpr int kRopeStretchIndex = 4;         // s [m], the rope's stretch
 inline constexpr int kMaxCoordinates = 6;
 
 using CoordinateVector = Eigen::Matrix<double, kNumCoordinates, 1>;

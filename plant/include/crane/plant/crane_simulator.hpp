@@ -11,7 +11,8 @@
 //        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
 // Options of the tower crane, each off by default (beyond the dissertation): the hook as a double
-// pendulum (HookParameters, tower_crane_model.hpp) and wind on the load (WindParameters, wind.hpp).
+// pendulum (HookParameters, tower_crane_model.hpp), wind on the load (WindParameters, wind.hpp) and
+// an elastic rope (RopeParameters, tower_crane_model.hpp).
 // One composition for every kind: only the model and the second axis's friction differ.
 #include <cstdint>
 #include <memory>
@@ -46,6 +47,8 @@ struct PlantState {
   double rigging_in_plane_rate{0.0};     // [rad/s]
   double rigging_out_of_plane{0.0};      // [rad] theta2
   double rigging_out_of_plane_rate{0.0}; // [rad/s]
+  double rope_stretch{0.0};              // [m] s, the elastic rope's stretch (tower crane with plant.rope only)
+  double rope_stretch_rate{0.0};         // [m/s]
 };
 
 /// Which crane the plant simulates (config: plant.kind).
@@ -62,7 +65,8 @@ enum class PlantKind {
 /// invalid parameters.
 [[nodiscard]] std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
                                                                  const common::BridgeParameters& bridge,
-                                                                 const HookParameters& hook = {});
+                                                                 const HookParameters& hook = {},
+                                                                 const RopeParameters& rope = {});
 
 /// Commands held for one sample.
 struct DriveInput {
@@ -84,6 +88,7 @@ struct SimulatorParameters {
   double hoist_max_acceleration{0.5};  // [m/s^2] > 0
   HookParameters hook{};               // tower crane only: the hook as a double pendulum (off by default)
   WindParameters wind{};               // tower crane only: wind on the load (off by default; needs load_mass > 0)
+  RopeParameters rope{};               // tower crane only, no hook: the rope as a spring (off by default)
   PlantState initial_state{};          // finite; cable_length within the crane's [min_cable_length,
                                        // max_cable_length]; |swing| < pi/2
 };

@@ -49,6 +49,13 @@
 // scaling: the cable rows (phi, theta) are divided by m_h + m, the rigging rows by m (a massless
 // load: the rigging rows of a unit mass, a passive pendulum on the hook).
 //
+// With an elastic rope (RopeParameters::enabled, plant.rope; no hook) the load hangs at
+//   r_load = x e_x + (L + s) u(phi, theta),
+// s [m] the rope's stretch, a fifth coordinate (slot 4): the same d'Alembert form with the column
+// dr/ds = u, plus the rope's force on it, k s + c s', with k = EA / L (EA the rope's axial stiffness
+// [N], L the paid-out length: a longer rope is softer) and c = 2 zeta sqrt(k m). The s row is divided
+// by m like the swing rows. Energy: + 1/2 k s^2.
+//
 // Errors: the constructor validates the parameters and throws common::ConfigError. Evaluation
 // functions are noexcept, allocation-free, and assume finite inputs with L > 0 and
 // |theta| < pi/2 (the mass matrix is singular at theta = +-pi/2: a swing coordinate singularity).
@@ -81,6 +88,15 @@ struct HookParameters {
 /// Throws common::ConfigError naming `prefix` + field, the value and the bound (checked when enabled).
 void validate(const HookParameters& hook, const std::string& prefix);
 
+/// The rope as a spring (config plant.rope). Off by default: an inextensible cable.
+struct RopeParameters {
+  bool enabled{false};
+  double axial_stiffness{2.0e5};  // [N] EA, in [1, 1e10]: k = EA / L [N/m]
+  double damping_ratio{0.02};     // [-] zeta of the load's bounce on the rope, in [0, 1]
+};
+/// Throws common::ConfigError naming `prefix` + field, the value and the bound (checked when enabled).
+void validate(const RopeParameters& rope, const std::string& prefix);
+
 /// Swing frequencies [rad/s] of the double pendulum hanging from a held trolley, linearized about
 /// rest (Singhose, Kim, Kenison 2008, eq. (2)): with R = m/m_h,
 ///   omega^2 = g/2 (1 + R)(1/L + 1/l) -+ g/2 sqrt((1 + R)^2 (1/L + 1/l)^2 - 4 (1 + R)/(L l)).
@@ -96,13 +112,14 @@ struct DoublePendulumFrequencies {
 
 class TowerCraneModel final : public CraneDynamics {
  public:
-  /// Validates `parameters` (common::validate, plus load_mass >= 0) and `hook` (field names
-  /// "plant.hook.*"); throws common::ConfigError.
-  explicit TowerCraneModel(const common::CraneParameters& parameters, const HookParameters& hook = {});
+  /// Validates `parameters` (common::validate, plus load_mass >= 0), `hook` and `rope` (field names
+  /// "plant.hook.*", "plant.rope.*"; a rope needs load_mass > 0 and no hook); throws common::ConfigError.
+  explicit TowerCraneModel(const common::CraneParameters& parameters, const HookParameters& hook = {},
+                           const RopeParameters& rope = {});
 
-  /// 6 with a hook, 4 without.
+  /// 6 with a hook, 5 with an elastic rope, 4 otherwise.
   [[nodiscard]] int coordinate_count() const noexcept override;
-  /// Without a hook: compute_dynamics() embedded. With one: the double pendulum above.
+  /// Without a hook or rope: compute_dynamics() embedded. With one: the models above.
   void compute_extended_dynamics(const ExtendedState& state, const HoistMotion& hoist, ExtendedMatrix& mass_matrix,
                                  ExtendedVector& bias) const noexcept override;
   /// Q_j = (dp_load/dq_j) . F for a horizontal force F = (force_x, force_y, 0) [N] in the inertial
@@ -112,6 +129,9 @@ class TowerCraneModel final : public CraneDynamics {
   /// T + V [J], the hook's energy included.
   [[nodiscard]] double extended_total_energy(const ExtendedState& state, const HoistMotion& hoist) const noexcept override;
   [[nodiscard]] const HookParameters& hook() const noexcept { return hook_; }
+  [[nodiscard]] const RopeParameters& rope() const noexcept { return rope_; }
+  /// k = EA / L [N/m] of the elastic rope at paid-out length `cable_length` [m] (> 0).
+  [[nodiscard]] double rope_stiffness(double cable_length) const noexcept;
 
   /// Mass matrix M(q, L) and bias b(q, q_dot, L, L_dot, L_ddot) with M q_ddot + b = Q.
   void compute_dynamics(const ModelState& state, const HoistMotion& hoist, CoordinateMatrix& mass_matrix,
@@ -146,6 +166,7 @@ class TowerCraneModel final : public CraneDynamics {
  private:
   common::CraneParameters parameters_;
   HookParameters hook_;
+  RopeParameters rope_;
 };
 
 }  // namespace crane::plant
