@@ -13,6 +13,28 @@ namespace crane::plant {
 
 namespace {
 
+ExtendedState to_extended_state(const PlantState& s, PlantKind kind, bool rope) {
+  ExtendedState e;
+  if (kind == PlantKind::overhead) {
+    e.position.head<kNumCoordinates>() << s.trolley_position, s.swing_in_plane, s.bridge_position, s.swing_out_of_plane;
+    e.velocity.head<kNumCoordinates>() << s.trolley_velocity, s.swing_in_plane_rate, s.bridge_velocity,
+        s.swing_out_of_plane_rate;
+  } else {
+    e.position.head<kNumCoordinates>() << s.trolley_position, s.swing_in_plane, s.slew_angle, s.swing_out_of_plane;
+    e.velocity.head<kNumCoordinates>() << s.trolley_velocity, s.swing_in_plane_rate, s.slew_rate,
+        s.swing_out_of_plane_rate;
+  }
+  e.position[kRiggingInPlaneIndex] = s.rigging_in_plane;
+  e.position[kRiggingOutOfPlaneIndex] = s.rigging_out_of_plane;
+  e.velocity[kRiggingInPlaneIndex] = s.rigging_in_plane_rate;
+  e.velocity[kRiggingOutOfPlaneIndex] = s.rigging_out_of_plane_rate;
+  if (rope) {  // slot 4 is the stretch (a rope never comes with a hook)
+    e.position[kRopeStretchIndex] = s.rope_stretch;
+    e.velocity[kRopeStretchIndex] = s.rope_stretch_rate;
+  }
+  return e;
+}
+
 ModelState to_model_state(const PlantState& s, PlantKind kind) {
   ModelState m;
   if (kind == PlantKind::overhead) {
@@ -70,13 +92,14 @@ PlantKind plant_kind_from_string(const std::string& text, const std::string& fie
 }
 
 std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
-                                                   const common::BridgeParameters& bridge) {
+                                                   const common::BridgeParameters& bridge, const HookParameters& hook,
+                                                   const RopeParameters& rope) {
   switch (kind) {
     case PlantKind::gantry: return std::make_unique<GantryCraneModel>(crane);
     case PlantKind::overhead: return std::make_unique<OverheadCraneModel>(crane, bridge);
     case PlantKind::tower: break;
   }
-  return std::make_unique<TowerCraneModel>(crane);
+  return std::make_unique<TowerCraneModel>(crane, hook, rope);
 }
 
 const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& p) {
@@ -89,12 +112,31 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
   common::require_in_range("simulator.absolute_tolerance", p.absolute_tolerance, 0.0, 1e-2);
   common::require_in_range("simulator.brake_holding_factor", p.brake_holding_factor, 0.0, 1e6);
   common::require_greater("simulator.hoist_max_acceleration", p.hoist_max_acceleration, 0.0);
+  validate(p.hook, "plant.hook.");
+  validate(p.wind, "plant.wind.");
+  validate(p.rope, "plant.rope.");
+  if (p.kind != PlantKind::tower && p.rope.enabled) {
+    throw common::ConfigError(std::string("plant.rope.enabled = true needs plant.kind = tower (is ") +
+                              to_string(p.kind) + ")");
+  }
+  if (p.kind != PlantKind::tower) {
+    if (p.hook.enabled) {
+      throw common::ConfigError(std::string("plant.hook.enabled = true needs plant.kind = tower (is ") +
+                                to_string(p.kind) + ")");
+    }
+    if (p.wind.enabled) {
+      throw common::ConfigError(std::string("plant.wind.enabled = true needs plant.kind = tower (is ") +
+                                to_string(p.kind) + ")");
+    }
+  }
+  if (p.wind.enabled) common::require_greater("plant.wind: crane.load_mass", p.crane.load_mass, 0.0);
   return p;
 }
 
 CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
     : parameters_(validated(parameters)),
-      model_(make_crane_dynamics(parameters_.kind, parameters_.crane, parameters_.bridge)),
+      model_(make_crane_dynamics(parameters_.kind, parameters_.crane, parameters_.bridge, parameters_.hook,
+                                 parameters_.rope)),
       sensors_(parameters_.crane),
       integrator_(*model_,
                   AxisFrictionModel(parameters_.crane.trolley_friction,
@@ -102,7 +144,8 @@ CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
                                     parameters_.brake_holding_factor *
                                         model_->drive_force_per_volt(DriveAxis::trolley) * parameters_.crane.dac_range,
                                     "simulator.crane.trolley_friction"),
-                  second_axis_friction(parameters_, *model_), integrator_settings(parameters_)) {
+                  second_axis_friction(parameters_, *model_), integrator_settings(parameters_)),
+      wind_(parameters_.wind, parameters_.sample_period) {
   reset(parameters_.initial_state);
 }
 
@@ -151,12 +194,39 @@ void CraneSimulator::validate_state(const PlantState& s) const {
     require_zero("swing_out_of_plane", s.swing_out_of_plane);
     require_zero("swing_out_of_plane_rate", s.swing_out_of_plane_rate);
   }
+  if (parameters_.hook.enabled) {
+    common::require_in_range(p + "rigging_in_plane", s.rigging_in_plane, -swing_limit, swing_limit);
+    common::require_in_range(p + "rigging_in_plane_rate", s.rigging_in_plane_rate, -limit, limit);
+    common::require_in_range(p + "rigging_out_of_plane", s.rigging_out_of_plane, -swing_limit, swing_limit);
+    common::require_in_range(p + "rigging_out_of_plane_rate", s.rigging_out_of_plane_rate, -limit, limit);
+  } else {
+    const auto require_zero_without_hook = [&](const char* field, double value) {
+      common::require_in_range(p + field + " (no plant.hook)", value, 0.0, 0.0);
+    };
+    require_zero_without_hook("rigging_in_plane", s.rigging_in_plane);
+    require_zero_without_hook("rigging_in_plane_rate", s.rigging_in_plane_rate);
+    require_zero_without_hook("rigging_out_of_plane", s.rigging_out_of_plane);
+    require_zero_without_hook("rigging_out_of_plane_rate", s.rigging_out_of_plane_rate);
+  }
+  if (parameters_.rope.enabled) {
+    common::require_in_range(p + "rope_stretch", s.rope_stretch, -0.5 * s.cable_length, s.cable_length);
+    common::require_in_range(p + "rope_stretch_rate", s.rope_stretch_rate, -limit, limit);
+  } else {
+    common::require_in_range(p + "rope_stretch (no plant.rope)", s.rope_stretch, 0.0, 0.0);
+    common::require_in_range(p + "rope_stretch_rate (no plant.rope)", s.rope_stretch_rate, 0.0, 0.0);
+  }
 }
 
 void CraneSimulator::reset(const PlantState& state) {
   validate_state(state);
   sample_index_ = 0;
-  integrator_.reset(0.0, to_model_state(state, parameters_.kind), state.cable_length, state.cable_length_rate);
+  if (parameters_.hook.enabled || parameters_.rope.enabled) {
+    integrator_.reset(0.0, to_extended_state(state, parameters_.kind, parameters_.rope.enabled), state.cable_length,
+                      state.cable_length_rate);
+  } else {
+    integrator_.reset(0.0, to_model_state(state, parameters_.kind), state.cable_length, state.cable_length_rate);
+  }
+  wind_.reset();
   refresh_state();
 }
 
@@ -181,6 +251,18 @@ void CraneSimulator::refresh_state() noexcept {
   state_.swing_out_of_plane_rate = m.velocity[kOutOfPlaneSwingIndex];
   state_.cable_length = integrator_.cable_length();
   state_.cable_length_rate = integrator_.cable_length_rate();
+  if (parameters_.rope.enabled) {
+    const ExtendedState e = integrator_.extended_state();
+    state_.rope_stretch = e.position[kRopeStretchIndex];
+    state_.rope_stretch_rate = e.velocity[kRopeStretchIndex];
+  }
+  if (parameters_.hook.enabled) {
+    const ExtendedState e = integrator_.extended_state();
+    state_.rigging_in_plane = e.position[kRiggingInPlaneIndex];
+    state_.rigging_out_of_plane = e.position[kRiggingOutOfPlaneIndex];
+    state_.rigging_in_plane_rate = e.velocity[kRiggingInPlaneIndex];
+    state_.rigging_out_of_plane_rate = e.velocity[kRiggingOutOfPlaneIndex];
+  }
 }
 
 common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
@@ -219,11 +301,14 @@ common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
   sample.trolley_drive_force = applied_trolley_voltage_ * model_->drive_force_per_volt(DriveAxis::trolley);  // (2.26)
   sample.slew_drive_torque = applied_slew_voltage_ * model_->drive_force_per_volt(DriveAxis::second);     // (2.27)
   sample.cable_length_acceleration = L_ddot;
+  sample.load_force_x = wind_.force_x();
+  sample.load_force_y = wind_.force_y();
   sample.brakes_engaged = safe.brakes_engaged;
 
   const double end_time = static_cast<double>(sample_index_ + 1) * T_s;
   const IntegrationStatus result = integrator_.advance_to(end_time, sample);
   ++sample_index_;
+  wind_.advance();
   refresh_state();
   applied_hoist_speed_ = state_.cable_length_rate;
   if (result != IntegrationStatus::ok && status == common::StepStatus::ok) status = common::StepStatus::not_ready;
@@ -242,6 +327,10 @@ SimulatorOutput CraneSimulator::output() const noexcept {
 }
 
 double CraneSimulator::total_energy() const noexcept {
+  if (parameters_.hook.enabled || parameters_.rope.enabled) {
+    return model_->extended_total_energy(to_extended_state(state_, parameters_.kind, parameters_.rope.enabled),
+                                         HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
+  }
   const ModelState m = to_model_state(state_, parameters_.kind);
   return model_->total_energy(m, HoistMotion{state_.cable_length, state_.cable_length_rate, 0.0});
 }

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
@@ -15,11 +16,9 @@ namespace crane::plant {
 
 namespace {
 
-// Layout of the CVODE state vector.
+// Layout of the CVODE state vector: positions from 0, velocities from coordinates_ (velocity_offset()),
+// then L and L_dot (cable_length_index(), cable_length_rate_index()).
 constexpr int kPositionOffset = 0;
-constexpr int kVelocityOffset = kNumCoordinates;
-constexpr int kCableLengthIndex = 2 * kNumCoordinates;
-constexpr int kCableLengthRateIndex = 2 * kNumCoordinates + 1;
 
 // Generalized coordinate of each friction axis.
 constexpr std::array<int, kNumFrictionAxes> kAxisCoordinate{kTrolleyIndex, kSlewIndex};
@@ -38,7 +37,10 @@ void check(int flag, const char* what) {
 
 CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
                                  const AxisFrictionModel& slew_friction, const IntegratorSettings& settings)
-    : model_(model.clone()), trolley_friction_(trolley_friction), slew_friction_(slew_friction), settings_(settings) {
+    : model_(model.clone()),
+      coordinates_(model_->coordinate_count()),
+      state_size_(2 * coordinates_ + 2),
+      trolley_friction_(trolley_friction), slew_friction_(slew_friction), settings_(settings) {
   common::require_greater("integrator.relative_tolerance", settings.relative_tolerance, 0.0);
   common::require_greater("integrator.absolute_tolerance", settings.absolute_tolerance, 0.0);
   common::require_at_least("integrator.max_steps_per_advance", static_cast<double>(settings.max_steps_per_advance),
@@ -46,16 +48,16 @@ CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionM
   common::require_at_least("integrator.max_events_per_advance",
                            static_cast<double>(settings.max_events_per_advance), 1.0);
 
-  y_ = N_VNew_Serial(kStateSize, context_);
-  y_saved_ = N_VNew_Serial(kStateSize, context_);
-  jacobian_ = SUNDenseMatrix(kStateSize, kStateSize, context_);
+  y_ = N_VNew_Serial(state_size_, context_);
+  y_saved_ = N_VNew_Serial(state_size_, context_);
+  jacobian_ = SUNDenseMatrix(state_size_, state_size_, context_);
   cvode_memory_ = CVodeCreate(CV_BDF, context_);
   if (y_ == nullptr || y_saved_ == nullptr || jacobian_ == nullptr || cvode_memory_ == nullptr) {
     release();
     throw std::runtime_error("CvodeIntegrator: SUNDIALS allocation failed");
   }
   N_VConst(0.0, y_);
-  NV_Ith_S(y_, kCableLengthIndex) = model_->parameters().cable_length;
+  NV_Ith_S(y_, cable_length_index()) = model_->parameters().cable_length;
   linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);
   try {
     if (linear_solver_ == nullptr) throw std::runtime_error("CvodeIntegrator: SUNLinSol_Dense failed");
@@ -93,18 +95,52 @@ void CvodeIntegrator::release() noexcept {
 
 void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
                                std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
-  ModelState state;
-  for (int j = 0; j < kNumCoordinates; ++j) {
-    state.position[j] = y[kPositionOffset + j];
-    state.velocity[j] = y[kVelocityOffset + j];
+  if (coordinates_ == kMaxCoordinates) {
+    evaluate_with<kMaxCoordinates>(y, modes, y_dot, driving_force);
+  } else if (coordinates_ == kNumCoordinates + 1) {
+    evaluate_with<kNumCoordinates + 1>(y, modes, y_dot, driving_force);
+  } else {
+    evaluate_with<kNumCoordinates>(y, modes, y_dot, driving_force);
   }
-  const HoistMotion hoist{y[kCableLengthIndex], y[kCableLengthRateIndex], input_.cable_length_acceleration};
-  CoordinateMatrix mass;
-  CoordinateVector bias;
-  model_->compute_dynamics(state, hoist, mass, bias);
+}
 
-  // Generalized forces (2.15): drives plus the sliding friction of slipping axes.
-  CoordinateVector force = CoordinateVector::Zero();
+// N = 4: the model's compute_dynamics (the single pendulum); N = 6 (a hook) and N = 5 (an elastic
+// rope, the first five of the extended rows): compute_extended_dynamics. The same arithmetic in all.
+template <int N>
+void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes,
+                                    double* y_dot, std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
+  using Matrix = Eigen::Matrix<double, N, N>;
+  using Vector = Eigen::Matrix<double, N, 1>;
+  const int velocity_offset = N;
+  std::conditional_t<N == kNumCoordinates, ModelState, ExtendedState> state;
+  for (int j = 0; j < N; ++j) {
+    state.position[j] = y[kPositionOffset + j];
+    state.velocity[j] = y[velocity_offset + j];
+  }
+  const HoistMotion hoist{y[2 * N], y[2 * N + 1], input_.cable_length_acceleration};
+  Matrix mass;
+  Vector bias;
+  if constexpr (N == kNumCoordinates) {
+    model_->compute_dynamics(state, hoist, mass, bias);
+  } else if constexpr (N == kMaxCoordinates) {
+    model_->compute_extended_dynamics(state, hoist, mass, bias);
+  } else {
+    ExtendedMatrix full_mass;
+    ExtendedVector full_bias;
+    model_->compute_extended_dynamics(state, hoist, full_mass, full_bias);
+    mass = full_mass.template topLeftCorner<N, N>();
+    bias = full_bias.template head<N>();
+  }
+
+  // Generalized forces (2.15): drives plus the sliding friction of slipping axes, plus a force on
+  // the load (wind) when there is one.
+  Vector force = Vector::Zero();
+  if (input_.load_force_x != 0.0 || input_.load_force_y != 0.0) {
+    ExtendedState extended;
+    extended.position.head<N>() = state.position.template head<N>();
+    extended.velocity.head<N>() = state.velocity.template head<N>();
+    force += model_->load_force(extended, hoist, input_.load_force_x, input_.load_force_y).template head<N>();
+  }
   force[kTrolleyIndex] = input_.trolley_drive_force;
   force[kSlewIndex] = input_.slew_drive_torque;
   for (int a = 0; a < kNumFrictionAxes; ++a) {
@@ -113,12 +149,12 @@ void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumF
     const int direction = modes[a] == AxisMode::slipping_positive ? 1 : -1;
     force[j] += friction(a).sliding_force(state.velocity[j], direction, input_.brakes_engaged);
   }
-  const CoordinateVector rhs = force - bias;
+  const Vector rhs = force - bias;
 
   // Stuck axes: q_dd_j = 0 is imposed by replacing row and column j with the identity (column j
   // multiplies q_dd_j = 0); the friction that holds the axis is the residual of the original row j.
-  CoordinateMatrix constrained = mass;
-  CoordinateVector constrained_rhs = rhs;
+  Matrix constrained = mass;
+  Vector constrained_rhs = rhs;
   for (int a = 0; a < kNumFrictionAxes; ++a) {
     if (modes[a] != AxisMode::stuck) continue;
     const int j = kAxisCoordinate[a];
@@ -127,29 +163,29 @@ void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumF
     constrained(j, j) = 1.0;
     constrained_rhs[j] = 0.0;
   }
-  const CoordinateVector q_dd = constrained.partialPivLu().solve(constrained_rhs);
+  const Vector q_dd = constrained.partialPivLu().solve(constrained_rhs);
   for (int a = 0; a < kNumFrictionAxes; ++a) {
     const int j = kAxisCoordinate[a];
     // Driving force D = everything but the holding friction: friction must supply -D.
     driving_force[a] = modes[a] == AxisMode::stuck ? rhs[j] - mass.row(j).dot(q_dd) : 0.0;
   }
   if (y_dot == nullptr) return;
-  for (int j = 0; j < kNumCoordinates; ++j) {
+  for (int j = 0; j < N; ++j) {
     y_dot[kPositionOffset + j] = state.velocity[j];
-    y_dot[kVelocityOffset + j] = q_dd[j];
+    y_dot[velocity_offset + j] = q_dd[j];
   }
   for (int a = 0; a < kNumFrictionAxes; ++a) {
     if (modes[a] == AxisMode::stuck) y_dot[kPositionOffset + kAxisCoordinate[a]] = 0.0;
   }
-  y_dot[kCableLengthIndex] = hoist.cable_length_rate;
-  y_dot[kCableLengthRateIndex] = hoist.cable_length_acceleration;
+  y_dot[2 * N] = hoist.cable_length_rate;
+  y_dot[2 * N + 1] = hoist.cable_length_acceleration;
 }
 
 int CvodeIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* user_data) {
   const auto* self = static_cast<const CvodeIntegrator*>(user_data);
   std::array<double, kNumFrictionAxes> driving{};
   self->evaluate(N_VGetArrayPointer(y), self->modes_, N_VGetArrayPointer(y_dot), driving);
-  for (int i = 0; i < kStateSize; ++i) {
+  for (int i = 0; i < self->state_size_; ++i) {
     if (!std::isfinite(NV_Ith_S(y_dot, i))) return 1;  // recoverable: CVODE retries with a smaller step
   }
   return 0;
@@ -164,7 +200,7 @@ int CvodeIntegrator::root_functions(double, N_Vector y, double* g, void* user_da
     if (self->modes_[a] == AxisMode::stuck) {
       g[a] = self->friction(a).stick_margin(driving[a], self->input_.brakes_engaged);
     } else {
-      g[a] = values[kVelocityOffset + kAxisCoordinate[a]];
+      g[a] = values[self->velocity_offset() + kAxisCoordinate[a]];
     }
   }
   return 0;
@@ -185,7 +221,7 @@ void CvodeIntegrator::settle_modes() noexcept {
   for (int pass = 0; pass < 2 * kNumFrictionAxes + 1; ++pass) {
     bool changed = false;
     for (int a = 0; a < kNumFrictionAxes; ++a) {
-      const int velocity_index = kVelocityOffset + kAxisCoordinate[a];
+      const int velocity_index = velocity_offset() + kAxisCoordinate[a];
       const AxisMode before = modes_[a];
       if (modes_[a] == AxisMode::stuck) {
         std::array<double, kNumFrictionAxes> driving{};
@@ -218,14 +254,22 @@ void CvodeIntegrator::settle_modes() noexcept {
 
 void CvodeIntegrator::reset(double time, const ModelState& state, double cable_length,
                             double cable_length_rate) noexcept {
+  ExtendedState extended;
+  extended.position.head<kNumCoordinates>() = state.position;
+  extended.velocity.head<kNumCoordinates>() = state.velocity;
+  reset(time, extended, cable_length, cable_length_rate);
+}
+
+void CvodeIntegrator::reset(double time, const ExtendedState& state, double cable_length,
+                            double cable_length_rate) noexcept {
   time_ = time;
   double* y = N_VGetArrayPointer(y_);
-  for (int j = 0; j < kNumCoordinates; ++j) {
+  for (int j = 0; j < coordinates_; ++j) {
     y[kPositionOffset + j] = state.position[j];
-    y[kVelocityOffset + j] = state.velocity[j];
+    y[velocity_offset() + j] = state.velocity[j];
   }
-  y[kCableLengthIndex] = cable_length;
-  y[kCableLengthRateIndex] = cable_length_rate;
+  y[cable_length_index()] = cable_length;
+  y[cable_length_rate_index()] = cable_length_rate;
   modes_ = {AxisMode::slipping_positive, AxisMode::slipping_positive};
   decision_pending_ = {true, true};
   // The initial mode decision is not a friction event.
@@ -243,7 +287,7 @@ void CvodeIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
   slew_friction_ = slew_friction;
   const double* y = N_VGetArrayPointer(y_);
   for (int a = 0; a < kNumFrictionAxes; ++a) {
-    if (y[kVelocityOffset + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
+    if (y[velocity_offset() + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
   }
   settle_modes();
   needs_reinit_ = true;
@@ -251,7 +295,8 @@ void CvodeIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
 
 IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput& input) noexcept {
   if (!std::isfinite(end_time) || !(end_time > time_) || !std::isfinite(input.trolley_drive_force) ||
-      !std::isfinite(input.slew_drive_torque) || !std::isfinite(input.cable_length_acceleration)) {
+      !std::isfinite(input.slew_drive_torque) || !std::isfinite(input.cable_length_acceleration) ||
+      !std::isfinite(input.load_force_x) || !std::isfinite(input.load_force_y)) {
     return IntegrationStatus::invalid_request;
   }
   N_VScale(1.0, y_, y_saved_);
@@ -263,7 +308,7 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
       // direction, and the engaged brake's sliding force would push it from rest).
       const double* y = N_VGetArrayPointer(y_);
       for (int a = 0; a < kNumFrictionAxes; ++a) {
-        if (y[kVelocityOffset + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
+        if (y[velocity_offset() + kAxisCoordinate[a]] == 0.0) decision_pending_[a] = true;
       }
     }
     input_ = input;
@@ -301,7 +346,7 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
           decision_pending_[a] = false;
         } else {
           // Velocity crossed zero: snap it, then stick or reverse (decided in settle_modes).
-          y[kVelocityOffset + kAxisCoordinate[a]] = 0.0;
+          y[velocity_offset() + kAxisCoordinate[a]] = 0.0;
           decision_pending_[a] = true;
         }
       }
@@ -330,12 +375,12 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
   return status;
 }
 
-ModelState CvodeIntegrator::state() const noexcept {
+ExtendedState CvodeIntegrator::extended_state() const noexcept {
   const double* y = N_VGetArrayPointer(y_);
-  ModelState state;
-  for (int j = 0; j < kNumCoordinates; ++j) {
+  ExtendedState state;
+  for (int j = 0; j < coordinates_; ++j) {
     state.position[j] = y[kPositionOffset + j];
-    state.velocity[j] = y[kVelocityOffset + j];
+    state.velocity[j] = y[velocity_offset() + j];
   }
   for (int a = 0; a < kNumFrictionAxes; ++a) {
     if (modes_[a] == AxisMode::stuck) state.velocity[kAxisCoordinate[a]] = 0.0;
@@ -343,9 +388,22 @@ ModelState CvodeIntegrator::state() const noexcept {
   return state;
 }
 
-double CvodeIntegrator::cable_length() const noexcept { return NV_Ith_S(y_, kCableLengthIndex); }
+ModelState CvodeIntegrator::state() const noexcept {
+  const double* y = N_VGetArrayPointer(y_);
+  ModelState state;
+  for (int j = 0; j < kNumCoordinates; ++j) {
+    state.position[j] = y[kPositionOffset + j];
+    state.velocity[j] = y[velocity_offset() + j];
+  }
+  for (int a = 0; a < kNumFrictionAxes; ++a) {
+    if (modes_[a] == AxisMode::stuck) state.velocity[kAxisCoordinate[a]] = 0.0;
+  }
+  return state;
+}
 
-double CvodeIntegrator::cable_length_rate() const noexcept { return NV_Ith_S(y_, kCableLengthRateIndex); }
+double CvodeIntegrator::cable_length() const noexcept { return NV_Ith_S(y_, cable_length_index()); }
+
+double CvodeIntegrator::cable_length_rate() const noexcept { return NV_Ith_S(y_, cable_length_rate_index()); }
 
 double CvodeIntegrator::holding_force(FrictionAxis axis) const noexcept {
   const int a = index(axis);

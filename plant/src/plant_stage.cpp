@@ -1,5 +1,8 @@
 #include "crane/plant/plant_stage.hpp"
 
+#include <cstdint>
+#include <string>
+
 #include "crane/common/validation.hpp"
 #include "crane/config/config_document.hpp"
 #include "crane/config/yaml_section.hpp"
@@ -55,8 +58,40 @@ SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts
   p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
   p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);
   p.hoist_max_acceleration = s.number("hoist_max_acceleration", 1e-3, 100.0);
+  if (p.kind == PlantKind::tower) {  // elsewhere plant.hook, plant.wind and plant.rope are unknown fields
+    config::YamlSection hook = s.child("hook");
+    p.hook.enabled = hook.flag("enabled");
+    p.hook.rigging_length = hook.number("rigging_length", 0.001, 10.0);
+    p.hook.hook_mass = hook.number("hook_mass", 0.001, 1e4);
+    hook.finish();
+    config::YamlSection wind = s.child("wind");
+    p.wind.enabled = wind.flag("enabled");
+    p.wind.mean_force_x = wind.number("mean_force_x", -1e4, 1e4);
+    p.wind.mean_force_y = wind.number("mean_force_y", -1e4, 1e4);
+    p.wind.gust_force_std = wind.number("gust_force_std", 0.0, 1e4);
+    p.wind.gust_time_constant = wind.number("gust_time_constant", 0.01, 1e4);
+    p.wind.seed = static_cast<std::uint64_t>(wind.integer("seed", 0, 2147483647));
+    wind.finish();
+    config::YamlSection rope = s.child("rope");
+    p.rope.enabled = rope.flag("enabled");
+    p.rope.axial_stiffness = rope.number("axial_stiffness", 1.0, 1e10);
+    p.rope.damping_ratio = rope.number("damping_ratio", 0.0, 1.0);
+    rope.finish();
+    if (p.rope.enabled && p.hook.enabled) {
+      throw common::ConfigError(rope.field("enabled") + " = true needs plant.hook.enabled = false (an elastic rope "
+                                "with a hook is not modelled)");
+    }
+    if (p.wind.enabled && !(p.crane.load_mass > 0.0)) {
+      throw common::ConfigError(wind.field("enabled") + " = true needs crane.load_mass > 0 (is " +
+                                std::to_string(p.crane.load_mass) + ")");
+    }
+  }
   s.finish();
   p.initial_state.cable_length = facts.crane.cable_length;
+  // An elastic rope starts at its static stretch m g L / EA (at rest, no bounce).
+  if (p.rope.enabled) {
+    p.initial_state.rope_stretch = p.crane.load_mass * p.crane.gravity * p.crane.cable_length / p.rope.axial_stiffness;
+  }
   return p;
 }
 

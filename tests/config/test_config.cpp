@@ -413,3 +413,63 @@ TEST_F(LabConfigText, AdaptationFieldsAreValidatedByName) {
   message = error_of(edit_line(text_, "adaptation:", "enabled:", "enabled: maybe").text);
   EXPECT_TRUE(contains(message, "state_estimator.adaptation.enabled")) << message;
 }
+
+TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_FALSE(c.plant.hook.enabled);  // off by default: the dissertation's single pendulum
+  EXPECT_FALSE(c.plant.wind.enabled);
+  auto message = error_of(edit_line(text_, "hook:", "rigging_length:", "rigging_length: 0").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "plant.hook.rigging_length = 0")) << message;
+  EXPECT_TRUE(contains(message, "[0.001, 10]")) << message;
+  message = error_of(edit_line(text_, "wind:", "gust_time_constant:", "gust_time_constant: -2").text);
+  EXPECT_TRUE(contains(message, "plant.wind.gust_time_constant = -2")) << message;
+  message = error_of(edit_line(text_, "wind:", "seed:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field plant.wind.seed")) << message;
+  message = error_of(edit_line(text_, "hook:", "enabled:", "enabled: maybe").text);
+  EXPECT_TRUE(contains(message, "plant.hook.enabled")) << message;
+  // Enabled, they reach the plant's parameters.
+  const auto on = cfg::parse_stack_config(
+      edit_line(edit_line(text_, "hook:", "enabled:", "enabled: true").text, "wind:", "enabled:", "enabled: true").text,
+      "test.yaml");
+  EXPECT_TRUE(on.plant.hook.enabled);
+  EXPECT_DOUBLE_EQ(on.plant.hook.rigging_length, 0.3);
+  EXPECT_TRUE(on.plant.wind.enabled);
+  EXPECT_EQ(on.plant.wind.seed, 1U);
+}
+
+TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_EQ(c.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::zvd);
+  EXPECT_EQ(c.trajectory_planner.manual.swing_length_scale, 1.0);  // the single pendulum sqrt(g/L)
+  EXPECT_EQ(c.trajectory_planner.manual.swing_length_offset, 0.0);
+  EXPECT_EQ(c.trajectory_planner.manual.swing_damping_ratio, 0.0);
+  auto message = error_of(edit_line(text_, "manual:", "shaping:", "shaping: zvdd").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.manual.shaping = \"zvdd\"")) << message;
+  EXPECT_TRUE(contains(message, "two_hump_ei")) << message;
+  message = error_of(edit_line(text_, "manual:", "swing_damping_ratio:", "swing_damping_ratio: 0.5").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.manual.swing_damping_ratio = 0.5")) << message;
+  EXPECT_TRUE(contains(message, "[0, 0.3]")) << message;
+  const auto calibrated = cfg::parse_stack_config(
+      edit_line(edit_line(text_, "manual:", "shaping:", "shaping: two_hump_ei").text, "manual:", "swing_length_offset:",
+                "swing_length_offset: 0.25")
+          .text,
+      "test.yaml");
+  EXPECT_EQ(calibrated.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::two_hump_ei);
+  EXPECT_EQ(calibrated.trajectory_planner.manual.swing_length_offset, 0.25);
+}
+
+TEST_F(LabConfigText, PlantRopeIsOffAndValidatedLikeTheRest) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_FALSE(c.plant.rope.enabled);  // off by default: an inextensible cable
+  auto message = error_of(edit_line(text_, "rope:", "axial_stiffness:", "axial_stiffness: 0").text);
+  EXPECT_TRUE(contains(message, "plant.rope.axial_stiffness = 0")) << message;
+  EXPECT_TRUE(contains(message, "[1, 1e+10]")) << message;
+  message = error_of(
+      edit_line(edit_line(text_, "rope:", "enabled:", "enabled: true").text, "hook:", "enabled:", "enabled: true").text);
+  EXPECT_TRUE(contains(message, "plant.rope.enabled = true needs plant.hook.enabled = false")) << message;
+  // Enabled, the plant starts at the static stretch m g L / EA.
+  const auto on = cfg::parse_stack_config(edit_line(text_, "rope:", "enabled:", "enabled: true").text, "test.yaml");
+  EXPECT_TRUE(on.plant.rope.enabled);
+  EXPECT_NEAR(on.plant.initial_state.rope_stretch, 2.0 * 9.8 * 1.0 / 2.0e5, 1e-15);
+}

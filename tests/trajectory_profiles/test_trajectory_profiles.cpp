@@ -217,6 +217,48 @@ TEST(InputShaper, EiHasToleranceAtDesignAndZerosAroundIt) {
   }
 }
 
+TEST(InputShaper, MzvCancelsAtDesignAndLiesBetweenZvAndZvd) {
+  // Undamped MZV: [1 - 1/sqrt(2), sqrt(2) - 1, 1 - 1/sqrt(2)] at [0, 3T/8, 3T/4]: the vectors at 0,
+  // 135 and 270 deg cancel. Its residual at 10 % off (r = 0.9, 1.1) lies between ZV's and ZVD's, and
+  // so does its length (T/2 < 3T/4 < T).
+  const tp::InputShaper mzv(shaper(tp::ShaperKind::mzv));
+  ASSERT_EQ(mzv.impulse_count(), 3u);
+  EXPECT_NEAR(mzv.amplitude(0), 1.0 - 1.0 / std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(mzv.amplitude(1), std::sqrt(2.0) - 1.0, 1e-15);
+  EXPECT_NEAR(mzv.time(2), 0.75 * kPeriod, 1e-15);
+  EXPECT_LT(mzv.residual_vibration(kW), 1e-12);
+  const tp::InputShaper zv(shaper(tp::ShaperKind::zv)), zvd(shaper(tp::ShaperKind::zvd));
+  for (const double r : {0.9, 1.1}) {
+    EXPECT_LT(mzv.residual_vibration(r * kW), zv.residual_vibration(r * kW));
+    EXPECT_GT(mzv.residual_vibration(r * kW), zvd.residual_vibration(r * kW));
+  }
+  for (const double zeta : {0.05, 0.2}) {  // damped: still zero at the design point, sum 1
+    const tp::InputShaper damped(shaper(tp::ShaperKind::mzv, zeta));
+    EXPECT_NEAR(damped.amplitude(0) + damped.amplitude(1) + damped.amplitude(2), 1.0, 1e-15);
+    EXPECT_LT(damped.residual_vibration(kW, zeta), 1e-12) << "zeta " << zeta;
+  }
+}
+
+TEST(InputShaper, TwoHumpEiStaysBelowToleranceOverItsWideBand) {
+  // Undamped two-hump EI (Singhose, Porter, Tuttle, Singer 1997): 4 impulses at 0, T/2, T, 3T/2,
+  // zero at r = 1 (the vectors alternate in sign), two humps of height V around it, <= V over
+  // r in about [0.6, 1.4] for V = 5 %, where EI exceeds V beyond about +-20 %.
+  const double v = 0.05;
+  const tp::InputShaper ei2(shaper(tp::ShaperKind::two_hump_ei, 0.0, v));
+  ASSERT_EQ(ei2.impulse_count(), 4u);
+  EXPECT_NEAR(ei2.length(), 1.5 * kPeriod, 1e-15);
+  EXPECT_NEAR(ei2.amplitude(0) + ei2.amplitude(1) + ei2.amplitude(2) + ei2.amplitude(3), 1.0, 1e-15);
+  EXPECT_LT(ei2.residual_vibration(kW), 1e-12);
+  double worst = 0.0;
+  for (double r = 0.7; r <= 1.3; r += 0.001) worst = std::max(worst, ei2.residual_vibration(r * kW));
+  EXPECT_NEAR(worst, v, 1e-3);  // the humps reach the tolerance
+  const tp::InputShaper ei(shaper(tp::ShaperKind::ei, 0.0, v));
+  EXPECT_GT(ei.residual_vibration(0.7 * kW), 2.0 * v);
+  EXPECT_LE(ei2.residual_vibration(0.7 * kW), v + 1e-3);
+  const tp::InputShaper damped(shaper(tp::ShaperKind::two_hump_ei, 0.1, v));
+  EXPECT_LT(damped.residual_vibration(kW, 0.1), 1e-12);  // the damped weights keep the zero at r = 1
+}
+
 TEST(InputShaper, RejectsInvalidParametersNamingTheField) {
   tp::ShaperParams bad = shaper(tp::ShaperKind::zv);
   bad.natural_frequency = -1.0;

@@ -12,10 +12,12 @@ namespace {
 constexpr double kMaxEiDamping = 0.3;
 constexpr double kMaxEiTolerance = 0.2;
 
+bool is_ei(ShaperKind kind) { return kind == ShaperKind::ei || kind == ShaperKind::two_hump_ei; }
+
 bool valid(const ShaperParams& p) noexcept {
   if (!std::isfinite(p.natural_frequency) || !(p.natural_frequency > 0.0)) return false;
   if (!std::isfinite(p.damping_ratio) || p.damping_ratio < 0.0 || !(p.damping_ratio < 1.0)) return false;
-  if (p.kind == ShaperKind::ei) {
+  if (is_ei(p.kind)) {
     if (p.damping_ratio > kMaxEiDamping) return false;
     if (!std::isfinite(p.vibration_tolerance) || !(p.vibration_tolerance > 0.0) ||
         p.vibration_tolerance > kMaxEiTolerance) {
@@ -27,6 +29,17 @@ bool valid(const ShaperParams& p) noexcept {
 
 }  // namespace
 
+const char* to_string(ShaperKind kind) noexcept {
+  switch (kind) {
+    case ShaperKind::zv: return "zv";
+    case ShaperKind::zvd: return "zvd";
+    case ShaperKind::ei: return "ei";
+    case ShaperKind::mzv: return "mzv";
+    case ShaperKind::two_hump_ei: return "two_hump_ei";
+  }
+  return "zv";
+}
+
 double pendulum_natural_frequency(double cable_length, double gravity) {
   common::require_greater("swing_model.cable_length", cable_length, 0.0);
   common::require_greater("swing_model.gravity", gravity, 0.0);
@@ -36,7 +49,7 @@ double pendulum_natural_frequency(double cable_length, double gravity) {
 InputShaper::InputShaper(const ShaperParams& params) {
   common::require_greater("input_shaper.natural_frequency", params.natural_frequency, 0.0);
   common::require_at_least("input_shaper.damping_ratio", params.damping_ratio, 0.0);
-  if (params.kind == ShaperKind::ei) {
+  if (is_ei(params.kind)) {
     common::require_in_range("input_shaper.damping_ratio", params.damping_ratio, 0.0, kMaxEiDamping);
     common::require_greater("input_shaper.vibration_tolerance", params.vibration_tolerance, 0.0);
     common::require_in_range("input_shaper.vibration_tolerance", params.vibration_tolerance, 0.0,
@@ -94,6 +107,40 @@ ProfileStatus InputShaper::design(const ShaperParams& params) noexcept {
         amplitudes_ = {a1, 1.0 - a1 - a3, a3};
         times_ = {0.0, t2 * damped_period, damped_period};
       }
+      break;
+    }
+    case ShaperKind::mzv: {
+      // Undamped: unit vectors at 0, 135 and 270 deg (t = 0, 3/8 T, 3/4 T) cancel with weights
+      // [1 - 1/sqrt(2), sqrt(2) - 1, 1 - 1/sqrt(2)] (x: a1 - a2/sqrt(2) = 0, y: a2/sqrt(2) - a3 = 0,
+      // sum 1). Damped: each weight times exp(-zeta w t_i) (so the decayed vectors cancel), then
+      // normalized: K^(3/4) and K^(3/2) with K as above.
+      const double a = 1.0 - 1.0 / std::sqrt(2.0);
+      const double b = (std::sqrt(2.0) - 1.0) * std::pow(k, 0.75);
+      const double c = a * std::pow(k, 1.5);
+      const double sum = a + b + c;
+      count_ = 3;
+      amplitudes_ = {a / sum, b / sum, c / sum, 0.0};
+      times_ = {0.0, 0.375 * damped_period, 0.75 * damped_period, 0.0};
+      break;
+    }
+    case ShaperKind::two_hump_ei: {
+      // Singhose, Porter, Tuttle, Singer 1997, undamped two-hump EI: with
+      // X = (V^2 (sqrt(1 - V^2) + 1))^(1/3), A_1 = A_4 = (3 X^2 + 2 X + 3 V^2) / (16 X),
+      // A_2 = A_3 = 1/2 - A_1 at t = 0, T/2, T, 3T/2. Damped: the weights times exp(-zeta w t_i),
+      // normalized (exact at zeta = 0; an approximation of the damped design above it).
+      const double v = params.vibration_tolerance;
+      const double x = std::cbrt(v * v * (std::sqrt(1.0 - v * v) + 1.0));
+      const double a1 = (3.0 * x * x + 2.0 * x + 3.0 * v * v) / (16.0 * x);
+      const double a2 = 0.5 - a1;
+      const std::array<double, 4> base{a1, a2, a2, a1};
+      double sum = 0.0;
+      count_ = 4;
+      for (std::size_t i = 0; i < 4; ++i) {
+        times_[i] = 0.5 * damped_period * static_cast<double>(i);
+        amplitudes_[i] = base[i] * std::pow(k, static_cast<double>(i));
+        sum += amplitudes_[i];
+      }
+      for (double& a : amplitudes_) a /= sum;
       break;
     }
   }

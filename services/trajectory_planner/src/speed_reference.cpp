@@ -98,6 +98,9 @@ void validate(const ManualParams& p) {
   common::require_greater(prefix + "maintenance_speed_fraction", p.maintenance_speed_fraction, 0.0);
   common::require_in_range(prefix + "maintenance_speed_fraction", p.maintenance_speed_fraction, 0.0, 1.0);
   common::require_in_range(prefix + "dead_man_timeout", p.dead_man_timeout, 0.02, 5.0);
+  common::require_in_range(prefix + "swing_length_scale", p.swing_length_scale, 0.1, 10.0);
+  common::require_in_range(prefix + "swing_length_offset", p.swing_length_offset, -1.0, 10.0);
+  common::require_in_range(prefix + "swing_damping_ratio", p.swing_damping_ratio, 0.0, 0.3);
 }
 
 void SpeedReference::start(const common::MotionReference& from) noexcept {
@@ -106,14 +109,45 @@ void SpeedReference::start(const common::MotionReference& from) noexcept {
   axes_[2].start(from.cable_length.position, from.cable_length.velocity);
 }
 
-std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const SpeedBounds& bounds,
-                                                   double dt) const noexcept {
+const char* to_string(SpeedShaping shaping) noexcept {
+  switch (shaping) {
+    case SpeedShaping::none: return "none";
+    case SpeedShaping::zv: return "zv";
+    case SpeedShaping::zvd: return "zvd";
+    case SpeedShaping::ei: return "ei";
+    case SpeedShaping::mzv: return "mzv";
+    case SpeedShaping::two_hump_ei: return "two_hump_ei";
+  }
+  return "none";
+}
+
+SpeedShaping speed_shaping_from_string(const std::string& text, const std::string& field) {
+  std::string names;
+  for (SpeedShaping s : {SpeedShaping::none, SpeedShaping::zv, SpeedShaping::zvd, SpeedShaping::ei, SpeedShaping::mzv,
+                         SpeedShaping::two_hump_ei}) {
+    if (text == to_string(s)) return s;
+    names += names.empty() ? "" : ", ";
+    names += to_string(s);
+  }
+  throw common::ConfigError(field + " = \"" + text + "\" is not a shaping: must be one of " + names);
+}
+
+std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const ManualParams& params,
+                                                   const SpeedBounds& bounds, double dt) const noexcept {
   std::array<InputShaper, 3> s{};  // identity shapers
   if (shaping == SpeedShaping::none) return s;
-  const double cable = axes_[2].position();
+  // The equivalent pendulum length (1 * L + 0 = L exactly for the uncalibrated single pendulum).
+  const double cable = params.swing_length_scale * axes_[2].position() + params.swing_length_offset;
   if (!(cable > 0.0) || !(bounds.gravity > 0.0)) return s;
   ShaperParams p;
-  p.kind = shaping == SpeedShaping::zv ? ShaperKind::zv : ShaperKind::zvd;
+  switch (shaping) {
+    case SpeedShaping::zv: p.kind = ShaperKind::zv; break;
+    case SpeedShaping::ei: p.kind = ShaperKind::ei; break;
+    case SpeedShaping::mzv: p.kind = ShaperKind::mzv; break;
+    case SpeedShaping::two_hump_ei: p.kind = ShaperKind::two_hump_ei; break;
+    default: p.kind = ShaperKind::zvd; break;
+  }
+  p.damping_ratio = params.swing_damping_ratio;
   p.natural_frequency = std::sqrt(bounds.gravity / cable);
   // A shaper longer than the history cannot be applied; the identity stays (cable beyond ~25 m at 100 Hz).
   // design() does not know the history: its length is checked here. Before this check an absurd cable
@@ -153,7 +187,7 @@ bool SpeedReference::keeps_bounds(double dt, const ManualParams& params, const s
 std::uint8_t SpeedReference::step(const std::array<double, 3>& targets, double dt, const ManualParams& params,
                                   SpeedShaping shaping, const SpeedBounds& bounds, const common::Site& site,
                                   std::uint32_t zones_enabled) noexcept {
-  const auto shaper = shapers(shaping, bounds, dt);
+  const auto shaper = shapers(shaping, params, bounds, dt);
   const SpeedAxisParams* axis_params[3] = {&params.trolley, &params.slew, &params.hoist};
   // Candidates, in order: every target as asked, then with the axes in `released` set to 0.
   static constexpr std::uint8_t kReleased[] = {0, 1, 2, 4, 3, 5, 6, 7};
@@ -180,7 +214,7 @@ std::uint8_t SpeedReference::step(const std::array<double, 3>& targets, double d
 
 std::array<double, 3> SpeedReference::rest(double dt, const ManualParams& params, SpeedShaping shaping,
                                            const SpeedBounds& bounds) const noexcept {
-  const auto shaper = shapers(shaping, bounds, dt);
+  const auto shaper = shapers(shaping, params, bounds, dt);
   return {axes_[0].rest(dt, params.trolley, shaper[0]), axes_[1].rest(dt, params.slew, shaper[1]),
           axes_[2].rest(dt, params.hoist, shaper[2])};
 }

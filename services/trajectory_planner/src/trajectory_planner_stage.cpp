@@ -31,8 +31,10 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.manual.micro_speed_fraction = m.number("micro_speed_fraction", 0.0, 1.0);
   p.manual.maintenance_speed_fraction = m.number("maintenance_speed_fraction", 0.0, 1.0);
   p.manual.dead_man_timeout = m.number("dead_man_timeout", 0.02, 5.0);
-  const auto shaping = m.text("shaping", {"none", "zv", "zvd"});
-  p.manual.shaping = shaping == "none" ? SpeedShaping::none : shaping == "zv" ? SpeedShaping::zv : SpeedShaping::zvd;
+  p.manual.shaping = speed_shaping_from_string(m.text("shaping"), m.field("shaping"));
+  p.manual.swing_length_scale = m.number("swing_length_scale", 0.1, 10.0);
+  p.manual.swing_length_offset = m.number("swing_length_offset", -1.0, 10.0);
+  p.manual.swing_damping_ratio = m.number("swing_damping_ratio", 0.0, 0.3);
   m.finish();
   s.finish();
   p.site = facts.site;

@@ -10,6 +10,9 @@
 //        (2.5)-(2.6), OverheadCraneModel) with stick-slip friction (3.1)-(3.3) and brakes
 //        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
+// Options of the tower crane, each off by default (beyond the dissertation): the hook as a double
+// pendulum (HookParameters, tower_crane_model.hpp), wind on the load (WindParameters, wind.hpp) and
+// an elastic rope (RopeParameters, tower_crane_model.hpp).
 // One composition for every kind: only the model and the second axis's friction differ.
 #include <cstdint>
 #include <memory>
@@ -21,6 +24,8 @@
 #include "crane/plant/cvode_integrator.hpp"
 #include "crane/plant/drives_and_sensors.hpp"
 #include "crane/plant/crane_dynamics.hpp"
+#include "crane/plant/tower_crane_model.hpp"
+#include "crane/plant/wind.hpp"
 
 namespace crane::plant {
 
@@ -38,6 +43,12 @@ struct PlantState {
   double cable_length_rate{0.0};         // [m/s]
   double bridge_position{0.0};           // [m] y, overhead crane only (0 otherwise)
   double bridge_velocity{0.0};           // [m/s]
+  double rigging_in_plane{0.0};          // [rad] phi2, the hook-to-load rigging (tower crane with a hook only)
+  double rigging_in_plane_rate{0.0};     // [rad/s]
+  double rigging_out_of_plane{0.0};      // [rad] theta2
+  double rigging_out_of_plane_rate{0.0}; // [rad/s]
+  double rope_stretch{0.0};              // [m] s, the elastic rope's stretch (tower crane with plant.rope only)
+  double rope_stretch_rate{0.0};         // [m/s]
 };
 
 /// Which crane the plant simulates (config: plant.kind).
@@ -53,7 +64,9 @@ enum class PlantKind {
 /// The model of `kind` (bridge used by the overhead crane only); throws common::ConfigError for
 /// invalid parameters.
 [[nodiscard]] std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
-                                                                 const common::BridgeParameters& bridge);
+                                                                 const common::BridgeParameters& bridge,
+                                                                 const HookParameters& hook = {},
+                                                                 const RopeParameters& rope = {});
 
 /// Commands held for one sample.
 struct DriveInput {
@@ -73,6 +86,9 @@ struct SimulatorParameters {
   double absolute_tolerance{1e-10};    // [SI] CVODE atol in (0, 1e-2]
   double brake_holding_factor{20.0};   // [-] brake holding force / drive force at full DAC range, >= 0
   double hoist_max_acceleration{0.5};  // [m/s^2] > 0
+  HookParameters hook{};               // tower crane only: the hook as a double pendulum (off by default)
+  WindParameters wind{};               // tower crane only: wind on the load (off by default; needs load_mass > 0)
+  RopeParameters rope{};               // tower crane only, no hook: the rope as a spring (off by default)
   PlantState initial_state{};          // finite; cable_length within the crane's [min_cable_length,
                                        // max_cable_length]; |swing| < pi/2
 };
@@ -126,6 +142,8 @@ class CraneSimulator {
   /// The crane's model (a TowerCraneModel, GantryCraneModel or OverheadCraneModel by kind).
   [[nodiscard]] const CraneDynamics& model() const noexcept { return *model_; }
   [[nodiscard]] const DrivesAndSensors& drives_and_sensors() const noexcept { return sensors_; }
+  /// The wind force of the current sample [N], inertial frame ((0, 0) without wind).
+  [[nodiscard]] const WindForce& wind() const noexcept { return wind_; }
   /// Total mechanical energy of the true state [J] (CraneDynamics::total_energy).
   [[nodiscard]] double total_energy() const noexcept;
 
@@ -138,6 +156,7 @@ class CraneSimulator {
   std::unique_ptr<const CraneDynamics> model_;
   DrivesAndSensors sensors_;
   CvodeIntegrator integrator_;
+  WindForce wind_;
   PlantState state_{};
   std::int64_t sample_index_{0};
   double applied_trolley_voltage_{0.0};

@@ -2,7 +2,8 @@
 // Hybrid integrator of a crane (any CraneDynamics: tower, gantry, overhead) with stick-slip friction: a RAII wrapper around SUNDIALS 6.4
 // CVODE (BDF, dense SUNMatrix + dense SUNLinearSolver, Jacobian by CVODE's difference quotients).
 //
-// State y (10): q = (x, phi, second axis, theta), q_dot, L, L_dot. Model: a CraneDynamics
+// State y (10, or 14 for a model with a hook): q = (x, phi, second axis, theta[, phi2, theta2]),
+// q_dot, L, L_dot. Model: a CraneDynamics
 // (crane_dynamics.hpp: TowerCraneModel (2.11)-(2.16), GantryCraneModel (2.5)-(2.6),
 // OverheadCraneModel); friction: AxisFrictionModel ((3.1)-(3.3) as plant truth) on the trolley (x)
 // and the second drive axis (slew gamma, or the overhead crane's bridge y; the gantry's is held);
@@ -50,6 +51,8 @@ struct SampleInput {
   double slew_drive_torque{0.0};          // [N m] T_gamma from the drive (friction excluded); the
                                           // bridge drive force [N] on an overhead crane
   double cable_length_acceleration{0.0};  // [m/s^2] L_ddot
+  double load_force_x{0.0};               // [N] horizontal force on the load (wind), inertial x
+  double load_force_y{0.0};               // [N] inertial y (CraneDynamics::load_force)
   bool brakes_engaged{false};             // both drive brakes
   bool operator==(const SampleInput&) const = default;
 };
@@ -90,6 +93,8 @@ class CvodeIntegrator {
   /// Sets time [s], state and hoist (L [m] > 0, L_dot [m/s]); friction modes are decided from the
   /// state (velocity sign, or stick/breakaway at zero velocity) under the current input.
   void reset(double time, const ModelState& state, double cable_length, double cable_length_rate) noexcept;
+  /// The same for a model with more than four coordinates (slots beyond coordinate_count() ignored).
+  void reset(double time, const ExtendedState& state, double cable_length, double cable_length_rate) noexcept;
 
   /// Integrates to exactly `end_time` [s] (> time()) with `input` held constant. noexcept,
   /// allocation-free. On failure the state is restored to its value before the call and time()
@@ -103,6 +108,10 @@ class CvodeIntegrator {
 
   [[nodiscard]] double time() const noexcept { return time_; }
   [[nodiscard]] ModelState state() const noexcept;
+  /// All coordinates (slots beyond coordinate_count() are 0).
+  [[nodiscard]] ExtendedState extended_state() const noexcept;
+  /// The model's coordinate_count(): 4, or 6 with a hook.
+  [[nodiscard]] int coordinate_count() const noexcept { return coordinates_; }
   [[nodiscard]] double cable_length() const noexcept;       // [m]
   [[nodiscard]] double cable_length_rate() const noexcept;  // [m/s]
   [[nodiscard]] AxisMode mode(FrictionAxis axis) const noexcept { return modes_[index(axis)]; }
@@ -115,7 +124,6 @@ class CvodeIntegrator {
   [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return last_event_; }
 
  private:
-  static constexpr int kStateSize = 10;
   static int index(FrictionAxis axis) noexcept { return static_cast<int>(axis); }
   static int right_hand_side(double t, N_Vector y, N_Vector y_dot, void* user_data);
   static int root_functions(double t, N_Vector y, double* g, void* user_data);
@@ -124,12 +132,20 @@ class CvodeIntegrator {
   // of each stuck axis.
   void evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
                 std::array<double, kNumFrictionAxes>& driving_force) const noexcept;
+  template <int N>
+  void evaluate_with(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
+                     std::array<double, kNumFrictionAxes>& driving_force) const noexcept;
+  int velocity_offset() const noexcept { return coordinates_; }
+  int cable_length_index() const noexcept { return 2 * coordinates_; }
+  int cable_length_rate_index() const noexcept { return 2 * coordinates_ + 1; }
   void settle_modes() noexcept;
   void release() noexcept;
   void set_mode(int axis, AxisMode mode) noexcept;
   const AxisFrictionModel& friction(int axis) const noexcept { return axis == 0 ? trolley_friction_ : slew_friction_; }
 
   std::unique_ptr<const CraneDynamics> model_;
+  int coordinates_{kNumCoordinates};  // the model's coordinate_count()
+  int state_size_{2 * kNumCoordinates + 2};
   AxisFrictionModel trolley_friction_;
   AxisFrictionModel slew_friction_;
   IntegratorSettings settings_;

@@ -1,7 +1,10 @@
 #pragma once
 // Input shapers for the load swing: ZV and ZVD (N. C. Singer and W. P. Seering, "Preshaping command
-// inputs to reduce system vibration", 1990) and EI (W. Singhose, W. Seering, N. Singer, "Residual
-// vibration reduction using vector diagrams to generate shaped inputs", 1994).
+// inputs to reduce system vibration", 1990), EI (W. Singhose, W. Seering, N. Singer, "Residual
+// vibration reduction using vector diagrams to generate shaped inputs", 1994), MZV (a three-impulse
+// zero-vibration shaper of length 3/4 T_d, from the same vector diagrams) and the two-hump EI
+// (W. Singhose, L. Porter, T. Tuttle, N. Singer, "Vibration reduction using multi-hump input
+// shapers", J. Dyn. Sys. Meas. Control 119, 1997).
 //
 // The linearized load swing of the tower crane, L phi'' + g phi = x'' (trolley) or
 // L theta'' + g theta = -x gamma'' (slew), is an undamped oscillator of natural frequency
@@ -30,13 +33,19 @@ enum class ShaperKind {
   zv,   // zero vibration: 2 impulses, length T_d/2
   zvd,  // zero vibration and derivative: 3 impulses, length T_d
   ei,   // extra insensitive: 3 impulses, length T_d, residual <= V over about +-20 % (V = 5 %)
+  mzv,  // modified ZV: 3 impulses at 0, 3/8 T_d, 3/4 T_d; zero residual at w, between ZV and ZVD in
+        // robustness and length
+  two_hump_ei,  // two-hump EI: 4 impulses, length 3/2 T_d, residual <= V over about +-40 % (V = 5 %)
 };
+/// "zv", "zvd", "ei", "mzv", "two_hump_ei".
+[[nodiscard]] const char* to_string(ShaperKind kind) noexcept;
 
 struct ShaperParams {
   ShaperKind kind{ShaperKind::zvd};
   double natural_frequency{3.1304951684997055};  // [rad/s] undamped w = sqrt(g/L), > 0
-  double damping_ratio{0.0};          // [-] 0 <= zeta < 1 (EI: zeta <= 0.3, curve fit)
-  double vibration_tolerance{0.05};   // [-] EI only: 0 < V <= 0.2
+  double damping_ratio{0.0};          // [-] 0 <= zeta < 1 (EI: zeta <= 0.3, curve fit; two-hump EI:
+                                      //     zeta <= 0.3, the undamped design with damped amplitudes)
+  double vibration_tolerance{0.05};   // [-] EI and two-hump EI: 0 < V <= 0.2
 };
 
 /// sqrt(gravity / cable_length) [rad/s]. Throws common::ConfigError unless cable_length [m] and
@@ -45,7 +54,7 @@ struct ShaperParams {
 
 class InputShaper {
  public:
-  static constexpr std::size_t kMaxImpulses = 3;
+  static constexpr std::size_t kMaxImpulses = 4;
 
   /// The identity shaper: one impulse of amplitude 1 at t = 0.
   InputShaper() = default;
@@ -72,8 +81,8 @@ class InputShaper {
   [[nodiscard]] double residual_vibration(double frequency, double damping_ratio = 0.0) const noexcept;
 
  private:
-  std::array<double, kMaxImpulses> amplitudes_{1.0, 0.0, 0.0};
-  std::array<double, kMaxImpulses> times_{0.0, 0.0, 0.0};
+  std::array<double, kMaxImpulses> amplitudes_{1.0, 0.0, 0.0, 0.0};
+  std::array<double, kMaxImpulses> times_{0.0, 0.0, 0.0, 0.0};
   std::size_t count_{1};
 };
 

@@ -20,6 +20,7 @@
 // Real time: step(), rest(), start() are noexcept and allocate nothing (fixed history ring).
 
 #include <array>
+#include <string>
 #include <cstddef>
 #include <cstdint>
 
@@ -33,7 +34,14 @@ enum class SpeedShaping {
   none,  // ramp only (maintenance mode)
   zv,
   zvd,
+  ei,           // the InputShaper kinds of the same names (input_shaper.hpp); the last three are what
+  mzv,          // `deploy/crane calibrate swing` may recommend (docs/calibration.md)
+  two_hump_ei,
 };
+/// "none", "zv", "zvd", "ei", "mzv", "two_hump_ei" (the config's names).
+[[nodiscard]] const char* to_string(SpeedShaping shaping) noexcept;
+/// Parses a config name; throws common::ConfigError naming `field`, the value and the names.
+[[nodiscard]] SpeedShaping speed_shaping_from_string(const std::string& text, const std::string& field);
 
 /// One axis's rated motion. Units: [m], [m/s], [m/s^2] for the trolley and the hoist (cable
 /// length), [rad], [rad/s], [rad/s^2] for the slew.
@@ -91,9 +99,16 @@ struct ManualParams {
   double maintenance_speed_fraction{0.25}; // (0, 1]: every speed in MAINTENANCE mode
   double dead_man_timeout{0.2};            // [s] no operator input for longer: every axis released
   SpeedShaping shaping{SpeedShaping::zv};  // sway control in MANUAL and SEMIAUTOMATIC
+  // The swing the shaper is designed for: w = sqrt(g / (swing_length_scale L + swing_length_offset)),
+  // damping swing_damping_ratio. 1, 0, 0 is the single pendulum sqrt(g/L); a calibration
+  // (deploy/crane calibrate swing) fits them from a recording (a hook, rigging, a stiff rope).
+  double swing_length_scale{1.0};   // [-] in [0.1, 10]
+  double swing_length_offset{0.0};  // [m] in [-1, 10]; an equivalent length <= 0 gets no shaping
+  double swing_damping_ratio{0.0};  // [-] in [0, 0.3]
 };
 /// Throws common::ConfigError naming the field ("trajectory_planner.manual.<name>") unless every
-/// speed and acceleration is finite and > 0, both fractions in (0, 1], the timeout in [0.02, 5] s.
+/// speed and acceleration is finite and > 0, both fractions in (0, 1], the timeout in [0.02, 5] s,
+/// the swing model's fields in their ranges above.
 void validate(const ManualParams& params);
 
 /// The bounds the speed reference keeps: each axis's rest position inside its travel (trolley,
@@ -128,8 +143,8 @@ class SpeedReference {
   [[nodiscard]] common::MotionReference reference() const noexcept;
 
  private:
-  [[nodiscard]] std::array<InputShaper, 3> shapers(SpeedShaping shaping, const SpeedBounds& bounds,
-                                                   double dt) const noexcept;
+  [[nodiscard]] std::array<InputShaper, 3> shapers(SpeedShaping shaping, const ManualParams& params,
+                                                   const SpeedBounds& bounds, double dt) const noexcept;
   [[nodiscard]] bool keeps_bounds(double dt, const ManualParams& params, const std::array<InputShaper, 3>& shapers,
                                   const SpeedBounds& bounds, const common::Site& site, std::uint32_t zones_enabled,
                                   const std::array<double, common::Site::kMaxZones>& caps) const noexcept;
