@@ -21,21 +21,11 @@
 
 #include "crane/anti_swing_analysis/damping_map.hpp"
 
+#include "json_and_plot.hpp"
+
 namespace asa = crane::anti_swing_analysis;
-
-namespace {
-
-nlohmann::json number_or_null(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-std::string shell_quote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-}  // namespace
+namespace tools = crane::anti_swing_analysis::tools;
+using tools::number_or_null;
 
 int main(int argc, char** argv) {
   CLI::App app{"Damping map of an anti-swing law (dominant complex pole pair, Pade l = 20)"};
@@ -119,27 +109,5 @@ int main(int argc, char** argv) {
   document["values"] = std::move(values);
   document["stable"] = std::move(stable);
 
-  std::error_code error;
-  std::filesystem::create_directories(out_dir, error);
-  const std::filesystem::path json_path = std::filesystem::path(out_dir) / "damping_map.json";
-  {
-    std::ofstream file(json_path);
-    if (!file) {
-      std::cerr << "crane_damping_map: cannot write " << json_path << "\n";
-      return 1;
-    }
-    file << document.dump(1) << "\n";
-  }
-  std::printf("wrote %s\n", json_path.c_str());
-  if (!plot_script.empty()) {
-    const std::filesystem::path png_path = std::filesystem::path(out_dir) / "damping_map.png";
-    const std::string command = "/usr/bin/python3 " + shell_quote(plot_script) + " " +
-                                shell_quote(json_path.string()) + " " + shell_quote(png_path.string());
-    if (std::system(command.c_str()) != 0) {
-      std::cerr << "crane_damping_map: plot failed: " << command << "\n";
-      return 1;
-    }
-    std::printf("wrote %s\n", png_path.c_str());
-  }
-  return 0;
+  return tools::write_json_and_plot("crane_damping_map", out_dir, "damping_map", document, plot_script);
 }

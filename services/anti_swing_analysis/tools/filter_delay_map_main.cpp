@@ -32,20 +32,14 @@
 #include "crane/state_estimator/state_estimator_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
 
+#include "json_and_plot.hpp"
+
 namespace asa = crane::anti_swing_analysis;
+namespace tools = crane::anti_swing_analysis::tools;
+using tools::number_or_null;
 namespace se = crane::state_estimator;
 
 namespace {
-
-nlohmann::json number_or_null(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-std::string shell_quote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
 
 /// RMS noise gain sqrt(sum h_k^2) of the estimator's cascade (low-pass, then `second` when given)
 /// from its exact difference equations, on a unit impulse.
@@ -217,27 +211,5 @@ int main(int argc, char** argv) {
   std::printf("(damping of the dominant closed-loop pair, exact equation; ! = unstable; in brackets the "
               "filter's delay at the swing frequency)\n");
 
-  std::error_code error;
-  std::filesystem::create_directories(out_dir, error);
-  const std::filesystem::path json_path = std::filesystem::path(out_dir) / "filter_delay_map.json";
-  {
-    std::ofstream file(json_path);
-    if (!file) {
-      std::cerr << "crane_filter_delay_map: cannot write " << json_path << "\n";
-      return 1;
-    }
-    file << document.dump(1) << "\n";
-  }
-  std::printf("wrote %s\n", json_path.c_str());
-  if (!plot_script.empty()) {
-    const std::filesystem::path png_path = std::filesystem::path(out_dir) / "filter_delay_map.png";
-    const std::string command = "/usr/bin/python3 " + shell_quote(plot_script) + " " +
-                                shell_quote(json_path.string()) + " " + shell_quote(png_path.string());
-    if (std::system(command.c_str()) != 0) {
-      std::cerr << "crane_filter_delay_map: plot failed: " << command << "\n";
-      return 1;
-    }
-    std::printf("wrote %s\n", png_path.c_str());
-  }
-  return 0;
+  return tools::write_json_and_plot("crane_filter_delay_map", out_dir, "filter_delay_map", document, plot_script);
 }
