@@ -6,7 +6,10 @@
 # The clients run under SCHED_IDLE (they stand for viewers on other machines), crane_web at normal
 # priority beside the stack. A benchmark, not a ctest. In a private network namespace when possible.
 #
-#   deploy/bench_web.sh [SECONDS=20] [CLIENTS=20]
+#   deploy/bench_web.sh [SECONDS=20] [CLIENTS=20] [PRIORITY=70]
+#
+# PRIORITY: the stages at SCHED_FIFO from it, as crane_launch and the systemd units run them
+# (crane_bench latency --realtime-priority; 0: normal priority).
 #
 # Needs the built tree (deploy/crane build) and the test clients' npm folder
 # (build/npm-test-clients, installed by ctest -R web.FoxgloveClient).
@@ -16,6 +19,7 @@ BUILD_DIR=${CRANE_BUILD_DIR:-"$ROOT/build"}
 BIN=$BUILD_DIR/bin
 DURATION=${1:-20}
 CLIENTS=${2:-20}
+PRIORITY=${3:-70}
 CONFIG=$ROOT/deploy/config/lab_tower_crane.yaml
 export NODE_PATH=$BUILD_DIR/npm-test-clients/node_modules
 [ -d "$NODE_PATH/ws" ] || { echo "no $NODE_PATH/ws: run 'ctest --test-dir $BUILD_DIR -R web.FoxgloveClient' once"; exit 2; }
@@ -34,7 +38,7 @@ cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }
 rss_kb() { awk '/VmRSS/ {print $2}' "/proc/$1/status"; }
 
 echo "alone: crane_bench latency --duration $DURATION" >&2
-"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --json > "$OUT/alone.json"
+"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --realtime-priority "$PRIORITY" --json > "$OUT/alone.json"
 
 ${CRANE_WEB_PREFIX:-} "$BIN/crane_web" --port 0 --domain 30 > "$OUT/web.log" 2>&1 &
 WEB=$!
@@ -44,7 +48,7 @@ URL=$(grep -o "ws://[0-9.]*:[0-9]*" "$OUT/web.log")
 sleep 1
 RSS0=$(rss_kb $WEB)
 echo "crane_web without clients: crane_bench latency --duration $DURATION" >&2
-"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --json > "$OUT/web_idle.json"
+"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --realtime-priority "$PRIORITY" --json > "$OUT/web_idle.json"
 # The clients stand for viewers on other machines: SCHED_IDLE, so that their own work (Node
 # decoding 20 x 800 frames/s) does not count as crane_web's cost on these shared cores.
 chrt --idle 0 node "$ROOT/tests/web/foxglove_client.js" load "$URL" "$CLIENTS" $((DURATION + 12)) > "$OUT/load.json" &
@@ -54,7 +58,7 @@ sleep 3
 echo "loaded: $CLIENTS clients on every channel, crane_bench latency --duration $DURATION" >&2
 T0=$(cpu_ticks $WEB)
 S0=$(date +%s.%N)
-"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --json > "$OUT/loaded.json"
+"$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --realtime-priority "$PRIORITY" --json > "$OUT/loaded.json"
 T1=$(cpu_ticks $WEB)
 S1=$(date +%s.%N)
 RSS1=$(rss_kb $WEB)

@@ -318,6 +318,10 @@ int main(int argc, char** argv) {
   latency_cmd->add_option("--config", config_path, "crane configuration (YAML)")->required()->check(CLI::ExistingFile);
   latency_cmd->add_option("--rate", rate, "[Hz] sample rate of the stack")->check(CLI::Range(10.0, 2000.0));
   latency_cmd->add_option("--duration", duration, "[s] measuring time")->check(CLI::Range(1.0, 3600.0));
+  int latency_priority = 0;
+  latency_cmd->add_option("--realtime-priority", latency_priority,
+                          "the stages at SCHED_FIFO from this priority, as crane_launch (0: normal priority, the default)")
+      ->check(CLI::Range(0, 89));
   latency_cmd->add_option("--domain", domain, "DDS domain (the floor uses domain + 1)")->check(CLI::Range(0, 231));
   latency_cmd->add_flag("--json", as_json, "one JSON object");
   bool lockstep = false;
@@ -414,6 +418,15 @@ int main(int argc, char** argv) {
     stack.domain_id = domain;
     stack.lockstep = lockstep;
     stack.plant_stats_path = (dir / "plant_stats.json").string();
+    if (latency_priority > 0) {
+      const std::string rt_failure = launch::probe_realtime(latency_priority + 10);
+      if (rt_failure.empty()) {
+        stack.realtime_priority = latency_priority;
+      } else {
+        std::fprintf(stderr, "crane_bench latency: --realtime-priority %d: %s (the stack runs at normal priority)\n",
+                     latency_priority, rt_failure.c_str());
+      }
+    }
     stack.lan = lan;
     stack.dds = dds;
     {
