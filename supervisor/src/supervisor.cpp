@@ -119,9 +119,14 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       const double dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
       trolley_velocity_ = (in.trolley_position - previous_trolley_) / dt;
       slew_rate_ = (in.slew_angle - previous_slew_) / dt;
+      // Consecutive samples over the speed limit (kOverspeedSamples in the header).
+      trolley_overspeed_samples_ = std::fabs(trolley_velocity_) > params_.trolley().max_speed ? trolley_overspeed_samples_ + 1 : 0;
+      slew_overspeed_samples_ = std::fabs(slew_rate_) > params_.slew().max_speed ? slew_overspeed_samples_ + 1 : 0;
     } else if (!have_previous_sample_ || in.sensor_seq < previous_sensor_seq_) {
       trolley_velocity_ = 0.0;  // first sample, or the sensor writer restarted
       slew_rate_ = 0.0;
+      trolley_overspeed_samples_ = 0;
+      slew_overspeed_samples_ = 0;
     }
     have_previous_sample_ = true;
     previous_sensor_seq_ = in.sensor_seq;
@@ -140,9 +145,9 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     const AxisVerdict trolley = check_axis(params_.trolley(), in.trolley_position, trolley_velocity_);
     const AxisVerdict slew = check_axis(params_.slew(), in.slew_angle, slew_rate_);
     if (trolley.range_fault) active |= kFaultTrolleyTravel;
-    if (trolley.overspeed) active |= kFaultTrolleyOverspeed;
+    if (trolley.overspeed && trolley_overspeed_samples_ >= kOverspeedSamples) active |= kFaultTrolleyOverspeed;
     if (slew.range_fault) active |= kFaultSlewRange;
-    if (slew.overspeed) active |= kFaultSlewOverspeed;
+    if (slew.overspeed && slew_overspeed_samples_ >= kOverspeedSamples) active |= kFaultSlewOverspeed;
     if (trolley.approaching) warnings |= kWarningTrolleyApproach;
     if (slew.approaching) warnings |= kWarningSlewApproach;
     if (trolley.speed_limited) trolley_limit = params_.approach_voltage_limit;

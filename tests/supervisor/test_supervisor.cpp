@@ -694,7 +694,11 @@ TEST(SupervisorLimits, SlewRangeAndOverspeed) {
   EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
   EXPECT_EQ(out.active_faults, 0U);
   in.sensor_seq = 100002;
-  in.slew_angle += 0.01 * 2.1;  // 2.1 rad/s > 2.0: overspeed
+  in.slew_angle -= 0.01 * 2.1;  // 2.1 rad/s > 2.0 for one sample: not yet an overspeed (kOverspeedSamples)
+  out = step(supervisor, in);
+  EXPECT_FALSE(out.active_faults & sv::kFaultSlewOverspeed);
+  in.sensor_seq = 100003;
+  in.slew_angle -= 0.01 * 2.1;  // and the next: overspeed
   out = step(supervisor, in);
   EXPECT_TRUE(out.active_faults & sv::kFaultSlewOverspeed);
   EXPECT_EQ(out.mode, sv::Mode::fault);
@@ -710,7 +714,23 @@ TEST(SupervisorLimits, TrolleyOverspeed) {
   std::uint64_t seq = 1;
   auto supervisor = ready_supervisor();
   EXPECT_EQ(trolley_at(supervisor, 0.6, 0.99, seq).active_faults, 0U);
-  const auto out = trolley_at(supervisor, 0.6, -1.01, seq);
+  // A 0.6 m/s move read as 1.2 m/s for one sample and 0 for the next (one encoder reading a cycle
+  // late): no fault. Then 1.01 m/s in two consecutive samples: overspeed (kOverspeedSamples).
+  auto in = healthy_input();
+  double x = 0.6;
+  const auto sample = [&](double dx) {
+    in.sensor_seq = seq++;
+    x += dx;
+    in.trolley_position = x;
+    return step(supervisor, in);
+  };
+  seq += 100000;
+  EXPECT_EQ(sample(0.0).active_faults, 0U);
+  EXPECT_EQ(sample(-0.006).active_faults, 0U);
+  EXPECT_EQ(sample(-0.012).active_faults, 0U) << "one sample at 1.2 m/s";
+  EXPECT_EQ(sample(0.0).active_faults, 0U);
+  EXPECT_EQ(sample(-0.0101).active_faults, 0U);
+  const auto out = sample(-0.0101);
   EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed));
   expect_stopped(out);
 }

@@ -126,6 +126,13 @@ struct AxisLimits {
   double max_speed{1.0};          // overspeed limit anywhere
 };
 
+/// Overspeed is a fault when the speed (the difference quotient of consecutive sensor samples) is
+/// over max_speed in this many consecutive samples: a single sample's quotient doubles when one
+/// encoder reading lands a cycle late and the next a cycle early (seen with the emulated board,
+/// whose plant updates its counters once per step on its own timer: 1.28 m/s for one sample, then
+/// 0.09, during a 0.64 m/s move). A real overspeed lasts longer; the trip comes one cycle later.
+inline constexpr int kOverspeedSamples = 2;
+
 struct SupervisorParams {
   double trolley_min{0.05};          // [m] hard travel limit
   double trolley_max{1.30};          // [m] hard travel limit
@@ -269,6 +276,8 @@ class Supervisor {
   double previous_slew_{0.0};
   double trolley_velocity_{0.0};
   double slew_rate_{0.0};
+  int trolley_overspeed_samples_{0};  // consecutive sensor samples over max_speed
+  int slew_overspeed_samples_{0};
   // Voltage rate from successive actuator commands.
   bool have_previous_command_{false};
   std::uint64_t previous_actuator_seq_{0};
