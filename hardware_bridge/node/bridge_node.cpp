@@ -225,6 +225,7 @@ int main(int argc, char** argv) {
         const auto& limits = gate_params;
         if (std::fabs(incoming.trolley_voltage()) > limits.max_drive_voltage ||
             std::fabs(incoming.slew_voltage()) > limits.max_drive_voltage ||
+            std::fabs(incoming.bridge_voltage()) > limits.max_drive_voltage ||
             std::fabs(incoming.hoist_speed()) > limits.hoist_speed_limit) {
           ++rejected_out_of_range;
           continue;
@@ -236,7 +237,7 @@ int main(int argc, char** argv) {
         const std::int64_t arrival_ns = runtime::now_nanoseconds();
         in.time = now_s;
         in.command_received = true;
-        in.command = {incoming.trolley_voltage(), incoming.slew_voltage(), incoming.hoist_speed()};
+        in.command = {incoming.trolley_voltage(), incoming.slew_voltage(), incoming.hoist_speed(), incoming.bridge_voltage()};
         in.command_arrival_time = now_s;
         if (board_clock) {  // applied once the status of this cycle is there (board_step below)
           board_command = true;

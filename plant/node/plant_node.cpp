@@ -156,6 +156,7 @@ int main(int argc, char** argv) {
   bool realtime = false;
   double initial_trolley = 0.25;
   double initial_slew = 0.0;
+  double initial_bridge = 0.0;
   double initial_swing = 0.0;
   std::string stats_path;
   bool lockstep = false;
@@ -163,6 +164,7 @@ int main(int argc, char** argv) {
   app.add_flag("--realtime", realtime, "absolute 10 ms deadlines on the wall clock")->excludes(lockstep_flag);
   app.add_option("--initial-trolley", initial_trolley, "[m] initial trolley position");
   app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle");
+  app.add_option("--initial-bridge", initial_bridge, "[m] initial bridge position (overhead crane)");
   app.add_option("--initial-swing", initial_swing, "[rad] initial in-plane swing");
   app.add_option("--stats-out", stats_path, "write loop statistics (JSON) here on exit");
   plant::PlantMismatch mismatch;
@@ -198,6 +200,7 @@ int main(int argc, char** argv) {
     params.simulator = cfg.read("plant", plant::read_params);
     params.simulator.initial_state.trolley_position = initial_trolley;
     params.simulator.initial_state.slew_angle = initial_slew;
+    params.simulator.initial_state.bridge_position = initial_bridge;
     params.simulator.initial_state.swing_in_plane = initial_swing;
     params.gate = cfg.read("actuation", supervisor::read_actuation_params);
     params.mismatch = mismatch;
@@ -416,7 +419,7 @@ int main(int argc, char** argv) {
         }
         in.time = seconds(Clock::now());
         in.command_received = got;
-        in.command = {command.trolley_voltage, command.slew_voltage, command.hoist_speed};
+        in.command = supervisor::drive_command_of(command);
         step(in);
         const auto& gate = plant.gate_output();
         if (gate.brakes_engaged && Clock::now() >= next_brake_report) {

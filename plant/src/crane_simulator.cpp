@@ -75,22 +75,6 @@ AxisFrictionModel second_axis_friction(const SimulatorParameters& p, const Crane
 
 }  // namespace
 
-const char* to_string(PlantKind kind) noexcept {
-  switch (kind) {
-    case PlantKind::tower: return "tower";
-    case PlantKind::gantry: return "gantry";
-    case PlantKind::overhead: return "overhead";
-  }
-  return "tower";
-}
-
-PlantKind plant_kind_from_string(const std::string& text, const std::string& field) {
-  for (PlantKind kind : {PlantKind::tower, PlantKind::gantry, PlantKind::overhead}) {
-    if (text == to_string(kind)) return kind;
-  }
-  throw common::ConfigError(field + " = \"" + text + "\" is not a crane kind: must be one of tower, gantry, overhead");
-}
-
 std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
                                                    const common::BridgeParameters& bridge, const HookParameters& hook,
                                                    const RopeParameters& rope) {
@@ -269,12 +253,15 @@ common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
   common::StepStatus status = common::StepStatus::ok;
   DriveInput safe = input;
   if (!std::isfinite(input.trolley_voltage) || !std::isfinite(input.slew_voltage) ||
-      !std::isfinite(input.hoist_speed)) {
+      !std::isfinite(input.bridge_voltage) || !std::isfinite(input.hoist_speed)) {
     status = common::StepStatus::rejected_nonfinite;
-    safe = DriveInput{0.0, 0.0, 0.0, true};
+    safe = DriveInput{};  // 0 V, brakes engaged
   }
   applied_trolley_voltage_ = sensors_.applied_voltage(safe.trolley_voltage);
-  applied_slew_voltage_ = sensors_.applied_voltage(safe.slew_voltage);
+  // The second drive: the slew (tower), the bridge (overhead), nothing (gantry: the slot is held).
+  const bool overhead = parameters_.kind == PlantKind::overhead;
+  applied_slew_voltage_ = overhead ? 0.0 : sensors_.applied_voltage(safe.slew_voltage);
+  applied_bridge_voltage_ = overhead ? sensors_.applied_voltage(safe.bridge_voltage) : 0.0;
   brakes_engaged_ = safe.brakes_engaged;
 
   // Hoist: limit the speed v_next reached at the end of this sample so that the hoist can still stop
@@ -299,7 +286,8 @@ common::StepStatus CraneSimulator::step(const DriveInput& input) noexcept {
 
   SampleInput sample;
   sample.trolley_drive_force = applied_trolley_voltage_ * model_->drive_force_per_volt(DriveAxis::trolley);  // (2.26)
-  sample.slew_drive_torque = applied_slew_voltage_ * model_->drive_force_per_volt(DriveAxis::second);     // (2.27)
+  sample.slew_drive_torque = (overhead ? applied_bridge_voltage_ : applied_slew_voltage_) *
+                             model_->drive_force_per_volt(DriveAxis::second);  // (2.27); the bridge's F_y = M_y K_my V_y
   sample.cable_length_acceleration = L_ddot;
   sample.load_force_x = wind_.force_x();
   sample.load_force_y = wind_.force_y();
@@ -321,6 +309,8 @@ SimulatorOutput CraneSimulator::output() const noexcept {
                                      state_.swing_out_of_plane, state_.cable_length);
   out.applied_trolley_voltage = applied_trolley_voltage_;
   out.applied_slew_voltage = applied_slew_voltage_;
+  out.applied_bridge_voltage = applied_bridge_voltage_;
+  if (parameters_.kind == PlantKind::overhead) out.measurement.bridge_position = sensors_.measure_bridge(state_.bridge_position);
   out.applied_hoist_speed = applied_hoist_speed_;
   out.brakes_engaged = brakes_engaged_;
   return out;

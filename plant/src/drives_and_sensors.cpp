@@ -91,4 +91,8 @@ common::CraneMeasurement DrivesAndSensors::measure(double trolley_position, doub
   return m;
 }
 
+double DrivesAndSensors::measure_bridge(double bridge_position) const noexcept {
+  return trolley_encoder_counts_to_position(trolley_position_to_encoder_counts(bridge_position));
+}
+
 }  // namespace crane::plant

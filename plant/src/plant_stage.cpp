@@ -21,18 +21,6 @@ common::AxisFriction scaled(common::AxisFriction f, double factor) {
   return f;
 }
 
-// The stage translates the simulator to the stack's topics, which carry the trolley and one second
-// drive measured as the slew angle: an overhead crane's bridge position has no field there yet.
-const SimulatorParameters& carried_by_topics(const SimulatorParameters& p) {
-  if (p.kind == PlantKind::overhead) {
-    throw common::ConfigError(
-        "plant.kind = overhead is not supported by the stack yet: its topics (SensorSample_, ActuatorCommand_, Reference_, "
-        "MoveRequest_, ...) have no bridge axis; the overhead crane runs in the plant core only "
-        "(plant::CraneSimulator)");
-  }
-  return p;
-}
-
 }  // namespace
 
 void validate(const PlantMismatch& m) {
@@ -45,15 +33,10 @@ void validate(const PlantMismatch& m) {
 
 SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {
   SimulatorParameters p;
-  p.kind = plant_kind_from_string(
-      s.text("kind", {to_string(PlantKind::tower), to_string(PlantKind::gantry), to_string(PlantKind::overhead)}),
-      s.field("kind"));
+  p.kind = facts.crane_kind;
+  p.bridge = facts.bridge;
   p.crane = facts.crane;
   p.sample_period = facts.sample_period;
-  if (p.kind == PlantKind::overhead) {  // elsewhere plant.bridge is an unknown field
-    config::YamlSection bridge = s.child("bridge");
-    p.bridge = config::read_bridge(bridge);
-  }
   p.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
   p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
   p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);
@@ -108,7 +91,7 @@ SimulatorParameters simulated_truth(const SimulatorParameters& configured, const
 
 PlantStage::PlantStage(const PlantStageParams& params)
     : mismatch_(params.mismatch),
-      simulator_(simulated_truth(carried_by_topics(params.simulator), params.mismatch)),
+      simulator_(simulated_truth(params.simulator, params.mismatch)),
       gate_(params.gate),
       cable_length_reading_factor_(1.0 / params.mismatch.cable_length_factor) {
   measurements_.fill(simulator_.output().measurement);  // at rest before cycle 0
@@ -138,6 +121,8 @@ void PlantStage::sample(protocol::SensorSample& s) const noexcept {
   s.brakes_engaged = o.brakes_engaged;
   s.emergency_stop_input = false;
   s.limit_switches = 0;
+  s.bridge_position = m.bridge_position;
+  s.applied_bridge_voltage = o.applied_bridge_voltage;
 }
 
 void PlantStage::remember_measurement() noexcept {
@@ -149,6 +134,7 @@ common::StepStatus PlantStage::step(const supervisor::GateInput& input) noexcept
   DriveInput drive;  // default: 0 V, brakes engaged
   drive.trolley_voltage = gate_output_.drive.trolley_voltage;
   drive.slew_voltage = gate_output_.drive.slew_voltage;
+  drive.bridge_voltage = gate_output_.drive.bridge_voltage;
   drive.hoist_speed = gate_output_.drive.hoist_speed;
   drive.brakes_engaged = gate_output_.brakes_engaged;
   if (changed_friction_ && cycle_ == mismatch_.friction_change_cycle) simulator_.set_friction(*changed_friction_);

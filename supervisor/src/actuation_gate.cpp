@@ -17,7 +17,8 @@ std::string field(const char* prefix, const char* name) { return std::string(pre
 
 bool finite_permit(const SupervisorPermit& status) noexcept {
   return std::isfinite(status.trolley_voltage_limit) && std::isfinite(status.slew_voltage_limit) &&
-         status.trolley_voltage_limit >= 0.0 && status.slew_voltage_limit >= 0.0;
+         std::isfinite(status.bridge_voltage_limit) && status.trolley_voltage_limit >= 0.0 &&
+         status.slew_voltage_limit >= 0.0 && status.bridge_voltage_limit >= 0.0;
 }
 
 bool permits_motion(const SupervisorPermit& status) noexcept { return status.motion_enabled && status.brakes_released; }
@@ -82,11 +83,13 @@ void ActuationGate::step(const GateInput& input, GateOutput& output) noexcept {
   if (input.command_received) {
     const common::DriveCommand& command = input.command;
     if (!std::isfinite(command.trolley_voltage) || !std::isfinite(command.slew_voltage) ||
-        !std::isfinite(command.hoist_speed) || !std::isfinite(input.command_arrival_time)) {
+        !std::isfinite(command.bridge_voltage) || !std::isfinite(command.hoist_speed) ||
+        !std::isfinite(input.command_arrival_time)) {
       output.command_status = CommandStatus::rejected_non_finite;
       ++counters_.rejected_commands.non_finite;
     } else if (std::abs(command.trolley_voltage) > params_.max_drive_voltage ||
                std::abs(command.slew_voltage) > params_.max_drive_voltage ||
+               std::abs(command.bridge_voltage) > params_.max_drive_voltage ||
                std::abs(command.hoist_speed) > params_.hoist_speed_limit) {
       output.command_status = CommandStatus::rejected_out_of_range;
       ++counters_.rejected_commands.out_of_range;
@@ -115,11 +118,14 @@ void ActuationGate::step(const GateInput& input, GateOutput& output) noexcept {
   if (reason == SafeStateReason::none) {
     const double trolley_limit = std::min(input.status.trolley_voltage_limit, params_.max_drive_voltage);
     const double slew_limit = std::min(input.status.slew_voltage_limit, params_.max_drive_voltage);
+    const double bridge_limit = std::min(input.status.bridge_voltage_limit, params_.max_drive_voltage);
     output.drive.trolley_voltage = std::clamp(last_command_.trolley_voltage, -trolley_limit, trolley_limit);
     output.drive.slew_voltage = std::clamp(last_command_.slew_voltage, -slew_limit, slew_limit);
+    output.drive.bridge_voltage = std::clamp(last_command_.bridge_voltage, -bridge_limit, bridge_limit);
     output.drive.hoist_speed = last_command_.hoist_speed;
     output.clamped = output.drive.trolley_voltage != last_command_.trolley_voltage ||
-                     output.drive.slew_voltage != last_command_.slew_voltage;
+                     output.drive.slew_voltage != last_command_.slew_voltage ||
+                     output.drive.bridge_voltage != last_command_.bridge_voltage;
     output.brakes_engaged = false;
     if (output.clamped) ++counters_.clamped_cycles;
   } else {

@@ -78,6 +78,11 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.slew_min", p.slew_min, -100.0, 100.0);
   require_in_range("supervisor.slew_max", p.slew_max, p.slew_min + 1e-3, 100.0);
   validate_axis("slew", "max_rate", p.slew());
+  if (p.bridge_enabled) {
+    require_in_range("supervisor.bridge_min", p.bridge_min, -1000.0, 1000.0);
+    require_in_range("supervisor.bridge_max", p.bridge_max, p.bridge_min + 1e-3, 1000.0);
+    validate_axis("bridge", "max_speed", p.bridge());
+  }
   require_in_range("supervisor.voltage_limit", p.voltage_limit, 0.1, 100.0);
   require_in_range("supervisor.approach_voltage_limit", p.approach_voltage_limit, 0.0, p.voltage_limit);
   require_in_range("supervisor.max_voltage_rate", p.max_voltage_rate, 1.0, 1e6);
@@ -113,7 +118,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   const bool chain_healthy = alive_mask == all_alive;
 
   // Velocities from the sensor stream itself (seq differences), not from the state estimator.
-  const bool finite_sensors = std::isfinite(in.trolley_position) && std::isfinite(in.slew_angle);
+  const bool finite_sensors =
+      std::isfinite(in.trolley_position) && std::isfinite(in.slew_angle) && std::isfinite(in.bridge_position);
   if (in.sensors_valid && finite_sensors) {
     if (have_previous_sample_ && in.sensor_seq > previous_sensor_seq_) {
       const double dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
@@ -122,16 +128,21 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       // Consecutive samples over the speed limit (kOverspeedSamples in the header).
       trolley_overspeed_samples_ = std::fabs(trolley_velocity_) > params_.trolley().max_speed ? trolley_overspeed_samples_ + 1 : 0;
       slew_overspeed_samples_ = std::fabs(slew_rate_) > params_.slew().max_speed ? slew_overspeed_samples_ + 1 : 0;
+      bridge_velocity_ = (in.bridge_position - previous_bridge_) / dt;
+      bridge_overspeed_samples_ = std::fabs(bridge_velocity_) > params_.bridge().max_speed ? bridge_overspeed_samples_ + 1 : 0;
     } else if (!have_previous_sample_ || in.sensor_seq < previous_sensor_seq_) {
       trolley_velocity_ = 0.0;  // first sample, or the sensor writer restarted
       slew_rate_ = 0.0;
       trolley_overspeed_samples_ = 0;
       slew_overspeed_samples_ = 0;
+      bridge_velocity_ = 0.0;
+      bridge_overspeed_samples_ = 0;
     }
     have_previous_sample_ = true;
     previous_sensor_seq_ = in.sensor_seq;
     previous_trolley_ = in.trolley_position;
     previous_slew_ = in.slew_angle;
+    previous_bridge_ = in.bridge_position;
   }
 
   std::uint32_t active = 0;
@@ -141,7 +152,18 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   chain_was_up_ = chain_was_up_ || chain_healthy;
   double trolley_limit = params_.voltage_limit;
   double slew_limit = params_.voltage_limit;
+  double bridge_limit = params_.bridge_enabled ? params_.voltage_limit : 0.0;
   if (in.sensors_valid && finite_sensors) {
+    if (params_.bridge_enabled) {
+      const AxisVerdict bridge = check_axis(params_.bridge(), in.bridge_position, bridge_velocity_);
+      if (bridge.range_fault) active |= kFaultBridgeTravel;
+      if (bridge.overspeed && bridge_overspeed_samples_ >= kOverspeedSamples) active |= kFaultBridgeOverspeed;
+      if (bridge.approaching) warnings |= kWarningBridgeApproach;
+      if (bridge.speed_limited) {
+        bridge_limit = params_.approach_voltage_limit;
+        warnings |= kWarningSpeedLimited;
+      }
+    }
     const AxisVerdict trolley = check_axis(params_.trolley(), in.trolley_position, trolley_velocity_);
     const AxisVerdict slew = check_axis(params_.slew(), in.slew_angle, slew_rate_);
     if (trolley.range_fault) active |= kFaultTrolleyTravel;
@@ -185,20 +207,23 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   }
   if (in.actuators_valid) {
     if (std::fabs(in.trolley_voltage) > params_.voltage_limit + 1e-9 ||
-        std::fabs(in.slew_voltage) > params_.voltage_limit + 1e-9) {
+        std::fabs(in.slew_voltage) > params_.voltage_limit + 1e-9 ||
+        std::fabs(in.bridge_voltage) > params_.voltage_limit + 1e-9) {
       active |= kFaultVoltage;
     }
     if (have_previous_command_ && in.actuator_seq > previous_actuator_seq_) {
       const double dt = static_cast<double>(in.actuator_seq - previous_actuator_seq_) * params_.sample_period;
-      const double rate = std::max(std::fabs(in.trolley_voltage - previous_trolley_voltage_),
-                                   std::fabs(in.slew_voltage - previous_slew_voltage_)) / dt;
+      const double rate = std::max({std::fabs(in.trolley_voltage - previous_trolley_voltage_),
+                                    std::fabs(in.slew_voltage - previous_slew_voltage_),
+                                    std::fabs(in.bridge_voltage - previous_bridge_voltage_)}) / dt;
       if (rate > params_.max_voltage_rate) active |= kFaultVoltageRate;
     }
-    if (std::isfinite(in.trolley_voltage) && std::isfinite(in.slew_voltage)) {
+    if (std::isfinite(in.trolley_voltage) && std::isfinite(in.slew_voltage) && std::isfinite(in.bridge_voltage)) {
       have_previous_command_ = true;
       previous_actuator_seq_ = in.actuator_seq;
       previous_trolley_voltage_ = in.trolley_voltage;
       previous_slew_voltage_ = in.slew_voltage;
+      previous_bridge_voltage_ = in.bridge_voltage;
     }
   }
   if (in.nonfinite_seen) active |= kFaultNonFinite;
@@ -277,6 +302,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   out.slew_voltage_limit = enabled ? slew_limit : 0.0;
   out.trolley_velocity = trolley_velocity_;
   out.slew_rate = slew_rate_;
+  out.bridge_voltage_limit = enabled ? bridge_limit : 0.0;
+  out.bridge_velocity = bridge_velocity_;
   out.operating_mode = operating_mode_;
   out.zones_enabled = zones_enabled_;
   out.command_refused = refused;

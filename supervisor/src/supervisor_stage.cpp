@@ -21,6 +21,15 @@ SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& f
   p.slew_stop_margin = s.number("slew_stop_margin", 0.0, 100.0);
   p.slew_approach_rate = s.number("slew_approach_rate", 0.0, 100.0);
   p.slew_max_rate = s.number("slew_max_rate", 1e-3, 100.0);
+  p.bridge_enabled = facts.crane_kind == common::CraneKind::overhead;
+  if (p.bridge_enabled) {  // elsewhere these are unknown fields
+    p.bridge_min = s.number("bridge_min", -1000.0, 1000.0);
+    p.bridge_max = s.number("bridge_max", -1000.0, 1000.0);
+    p.bridge_approach_margin = s.number("bridge_approach_margin", 0.0, 1000.0);
+    p.bridge_stop_margin = s.number("bridge_stop_margin", 0.0, 1000.0);
+    p.bridge_approach_speed = s.number("bridge_approach_speed", 0.0, 100.0);
+    p.bridge_max_speed = s.number("bridge_max_speed", 1e-3, 100.0);
+  }
   p.approach_voltage_limit = s.number("approach_voltage_limit", 0.0, 100.0);
   p.max_voltage_rate = s.number("max_voltage_rate", 1.0, 1e6);
   p.max_swing = s.number("max_swing", 0.01, 1.5);
@@ -62,6 +71,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.sensor_source = sensors.source;
   in.trolley_position = sensors.trolley_position;
   in.slew_angle = sensors.slew_angle;
+  in.bridge_position = sensors.bridge_position;
   in.swing_in_plane = sensors.swing_in_plane;
   in.swing_out_of_plane = sensors.swing_out_of_plane;
   in.cable_length = sensors.cable_length;
@@ -71,6 +81,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.actuator_seq = actuators.header.seq;
   in.trolley_voltage = actuators.trolley_voltage;
   in.slew_voltage = actuators.slew_voltage;
+  in.bridge_voltage = actuators.bridge_voltage;
   in.sensor_writers = cycle.sensor_writers;
   in.actuator_writers = cycle.actuator_writers;
   in.nonfinite_seen = cycle.nonfinite_seen;
@@ -101,11 +112,13 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   status.nonfinite_rejected = cycle.nonfinite_rejected;
   status.trolley_voltage_limit = out.trolley_voltage_limit;
   status.slew_voltage_limit = out.slew_voltage_limit;
+  status.bridge_voltage_limit = out.bridge_voltage_limit;
   status.warnings = out.warnings;
   status.last_fault = out.last_fault;
   status.last_fault_seq = out.last_fault_seq;
   status.trolley_velocity = out.trolley_velocity;
   status.slew_rate = out.slew_rate;
+  status.bridge_velocity = out.bridge_velocity;
   status.last_request_id = last_request_id_;
   status.last_request_result = last_request_result_;
   status.operating_mode = out.operating_mode;

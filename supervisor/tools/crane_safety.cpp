@@ -152,14 +152,15 @@ void print_status(const tp::msgs::SupervisorStatus_& s, const tp::msgs::CraneSta
         "\"latched_faults\": %s, \"fault_count\": %u, \"last_fault\": \"%s\", \"last_fault_seq\": %llu, "
         "\"stages_alive\": %u, \"warnings\": %u, \"trolley_voltage_limit_V\": %g, \"slew_voltage_limit_V\": %g, "
         "\"trolley_velocity_mps\": %g, \"slew_rate_radps\": %g, \"nonfinite_rejected\": %u, \"seq\": %llu, "
-        "\"operating_mode\": \"%s\", \"zones_enabled\": %u%s}\n",
+        "\"operating_mode\": \"%s\", \"zones_enabled\": %u, \"bridge_voltage_limit_V\": %g, "
+        "\"bridge_velocity_mps\": %g%s}\n",
         mode.c_str(), s.motion_enabled() ? "true" : "false", s.brakes_released() ? "true" : "false",
         quoted_list(s.active_faults()).c_str(), quoted_list(s.latched_faults()).c_str(), s.fault_count(),
         s.last_fault() != 0 ? code_name("FAULT", s.last_fault()).c_str() : "",
         static_cast<unsigned long long>(s.last_fault_seq()),
         s.stages_alive(), s.warnings(), s.trolley_voltage_limit(), s.slew_voltage_limit(), s.trolley_velocity(),
         s.slew_rate(), s.nonfinite_rejected(), static_cast<unsigned long long>(s.header().seq()), operating.c_str(),
-        s.zones_enabled(), estimate_json(estimate).c_str());
+        s.zones_enabled(), s.bridge_voltage_limit(), s.bridge_velocity(), estimate_json(estimate).c_str());
     return;
   }
   std::printf("mode            %s\n", mode.c_str());
@@ -179,6 +180,10 @@ void print_status(const tp::msgs::SupervisorStatus_& s, const tp::msgs::CraneSta
   std::printf("voltage limits  trolley %.2f V, slew %.2f V%s\n", s.trolley_voltage_limit(), s.slew_voltage_limit(),
               (s.warnings() & Status::WARNING_SPEED_LIMITED) ? " (approach speed exceeded)" : "");
   std::printf("speeds          trolley %.3f m/s, slew %.3f rad/s\n", s.trolley_velocity(), s.slew_rate());
+  if (s.bridge_voltage_limit() != 0.0 || s.bridge_velocity() != 0.0) {  // an overhead crane's bridge
+    std::printf("bridge          %.3f m/s, voltage limit %.2f V%s\n", s.bridge_velocity(), s.bridge_voltage_limit(),
+                (s.warnings() & Status::WARNING_BRIDGE_APPROACH) ? " (approaching a runway limit)" : "");
+  }
   std::printf("cycle           %llu\n", static_cast<unsigned long long>(s.header().seq()));
   print_estimate(estimate);
 }

@@ -357,7 +357,7 @@ TEST_F(LabConfigText, SharedFactsAreCheckedWhereTheyAreRead) {
   EXPECT_TRUE(contains(range, "crane.max_cable_length = 0.1")) << range;
 }
 
-// The crane kind (plant.kind) and the gantry and overhead configurations (issue 18).
+// The crane kind (crane.kind, a shared fact) and the gantry and overhead configurations (issue 18).
 TEST(GantryConfig, LoadsWithTheValuesOfSection322) {
   const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/gantry_crane.yaml");
   EXPECT_EQ(c.plant.kind, crane::plant::PlantKind::gantry);
@@ -375,26 +375,32 @@ TEST(OverheadConfig, LoadsWithItsBridge) {
   const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
   EXPECT_EQ(c.plant.kind, crane::plant::PlantKind::overhead);
   EXPECT_DOUBLE_EQ(c.plant.bridge.drive_mass, 7500.0);
-  EXPECT_DOUBLE_EQ(c.plant.bridge.friction.static_positive, 0.7);
+  EXPECT_DOUBLE_EQ(c.plant.bridge.friction.static_positive, 0.6);
+  EXPECT_EQ(c.facts.crane_kind, crane::common::CraneKind::overhead);
+  EXPECT_TRUE(c.supervisor.bridge_enabled);
+  EXPECT_TRUE(c.trajectory_planner.bridge_enabled);
+  EXPECT_TRUE(c.tracking.bridge != nullptr);
+  EXPECT_TRUE(c.friction_compensation.bridge.has_value());
+  EXPECT_TRUE(c.anti_swing.bridge);
   crane::plant::CraneSimulator plant(c.plant);
-  EXPECT_DOUBLE_EQ(plant.model().drive_force_per_volt(crane::plant::DriveAxis::second), 7500.0 * 0.04);
+  EXPECT_DOUBLE_EQ(plant.model().drive_force_per_volt(crane::plant::DriveAxis::second), 7500.0 * 0.15);
 }
 
-TEST_F(LabConfigText, PlantKindIsValidatedLikeTheRest) {
-  auto message = error_of(edit_line(text_, "plant:", "kind:", "kind: gantri").text);
+TEST_F(LabConfigText, CraneKindIsValidatedLikeTheRest) {
+  auto message = error_of(edit_line(text_, "crane:", "kind:", "kind: gantri").text);
   EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
-  EXPECT_TRUE(contains(message, "plant.kind")) << message;
+  EXPECT_TRUE(contains(message, "crane.kind")) << message;
   EXPECT_TRUE(contains(message, "gantri")) << message;
   for (const char* allowed : {"tower", "gantry", "overhead"}) EXPECT_TRUE(contains(message, allowed)) << message;
 
-  message = error_of(edit_line(text_, "plant:", "kind:", std::nullopt).text);
-  EXPECT_TRUE(contains(message, "missing field plant.kind")) << message;
+  message = error_of(edit_line(text_, "crane:", "kind:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field crane.kind")) << message;
 
   // An overhead crane needs its bridge; a tower crane has none.
-  message = error_of(edit_line(text_, "plant:", "kind:", "kind: overhead").text);
-  EXPECT_TRUE(contains(message, "missing field plant.bridge")) << message;
-  message = error_of(edit_line(text_, "plant:", "kind:", "kind: tower\n  bridge: {drive_mass: 1.0}").text);
-  EXPECT_TRUE(contains(message, "unknown field plant.bridge")) << message;
+  message = error_of(edit_line(text_, "crane:", "kind:", "kind: overhead").text);
+  EXPECT_TRUE(contains(message, "missing field crane.bridge")) << message;
+  message = error_of(edit_line(text_, "crane:", "kind:", "kind: tower\n  bridge: {drive_mass: 1.0}").text);
+  EXPECT_TRUE(contains(message, "unknown field crane.bridge")) << message;
 }
 
 // The online estimation's block (state_estimator.adaptation): every field required and range-checked,

@@ -386,14 +386,16 @@ TEST(OverheadCrane, SimulatedWithTheBridgeHeldMatchesTheSimulatedGantry) {
   EXPECT_GT(std::abs(gantry.state().trolley_position), 0.1);  // it moved
 }
 
-// A gantry has no second drive: a voltage on that channel moves nothing (the load at rest stays at
-// rest to the bit, and no friction event happens), while on the overhead crane it drives the bridge.
+// A gantry has no second drive: a voltage on the slew or bridge channel moves nothing (the load at
+// rest stays at rest to the bit, and no friction event happens), while on the overhead crane the
+// bridge channel drives the bridge and the slew channel nothing.
 TEST(GantryCrane, TheSecondDriveChannelMovesNothing) {
   SimulatorParameters p = frictionless(PlantKind::gantry, 1.0);
   CraneSimulator gantry(p);
   DriveInput input;
   input.brakes_engaged = false;
   input.slew_voltage = 10.0;
+  input.bridge_voltage = 10.0;
   for (int k = 0; k < 100; ++k) ASSERT_EQ(gantry.step(input), common::StepStatus::ok);
   const PlantState& s = gantry.state();
   EXPECT_EQ(s.trolley_position, 0.0);
@@ -405,7 +407,16 @@ TEST(GantryCrane, TheSecondDriveChannelMovesNothing) {
 
   p.kind = PlantKind::overhead;
   CraneSimulator overhead(p);
-  for (int k = 0; k < 100; ++k) ASSERT_EQ(overhead.step(input), common::StepStatus::ok);
+  CraneSimulator overhead_slew_only(p);
+  DriveInput slew_only = input;
+  slew_only.bridge_voltage = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_EQ(overhead.step(input), common::StepStatus::ok);
+    ASSERT_EQ(overhead_slew_only.step(slew_only), common::StepStatus::ok);
+  }
+  EXPECT_EQ(overhead_slew_only.state().bridge_position, 0.0);
+  EXPECT_NEAR(overhead.output().applied_bridge_voltage, 10.0, 0.01);  // through the DAC
+  EXPECT_NEAR(overhead.output().measurement.bridge_position, overhead.state().bridge_position, 1e-5);
   // Linear (2.7)-(2.8) per axis with F = M_y K_my V from rest: y(t) = a_r t^2/2 + c (1 - cos(w t))
   // with a_r = F/(M_y + m) (load rigidly attached) and c w^2 = F/M_y - a_r > 0; since
   // 0 <= 1 - cos(x) <= x^2/2, y lies between the rigid a_r t^2/2 and the bridge-alone F/M_y t^2/2.
@@ -427,16 +438,16 @@ void expect_config_error(const SimulatorParameters& p, const std::string& fragme
 
 TEST(PlantKind, ErrorsNameTheFieldAndTheValue) {
   try {
-    (void)plant_kind_from_string("gantri", "plant.kind");
+    (void)crane::common::crane_kind_from_string("gantri", "crane.kind");
     FAIL() << "expected a ConfigError";
   } catch (const common::ConfigError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("plant.kind"), std::string::npos) << what;
+    EXPECT_NE(what.find("crane.kind"), std::string::npos) << what;
     EXPECT_NE(what.find("gantri"), std::string::npos) << what;
     EXPECT_NE(what.find("overhead"), std::string::npos) << what;
   }
   for (PlantKind kind : {PlantKind::tower, PlantKind::gantry, PlantKind::overhead}) {
-    EXPECT_EQ(plant_kind_from_string(to_string(kind), "plant.kind"), kind);
+    EXPECT_EQ(crane::common::crane_kind_from_string(to_string(kind), "crane.kind"), kind);
   }
   SimulatorParameters p = frictionless(PlantKind::gantry, 1.0);
   p.initial_state.slew_angle = 0.3;  // a gantry has no slew

@@ -2,7 +2,9 @@
 // DDS): the planner's goal rules and its feedback (MoveStatus, like a ROS 2 action's), the
 // anti-swing law registry, the tracking stage's (3.50) reference correction.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -10,6 +12,7 @@
 #include "crane/anti_swing/anti_swing_stage.hpp"
 #include "crane/common/protocol_signals.hpp"
 #include "crane/common/validation.hpp"
+#include "crane/config/yaml_section.hpp"
 #include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
 #include "crane/trajectory_planner/trajectory_planner_stage.hpp"
@@ -242,6 +245,162 @@ TEST(PlannerStage, ASupervisorApproachWarningStopsTheGoalSoftly) {
     EXPECT_EQ(reference.trolley_velocity, 0.0) << "at rest";
     EXPECT_FALSE(stage.under_speed_control());
   }
+}
+
+}  // namespace
+
+namespace {
+
+// An overhead crane's bridge through the stages (issue 18). The planner runs the bridge beside the
+// trolley as one move (both start it or neither, arrived when both are), refuses a bridge target
+// outside the runway naming the bound, and refuses AXIS_BRIDGE on a crane without a bridge.
+trajectory_planner::TrajectoryPlannerParams overhead_planner_params() {
+  trajectory_planner::TrajectoryPlannerParams p;  // trolley [0.1, 1.2] m
+  p.bridge_enabled = true;
+  p.bridge_min_position = 1.0;
+  p.bridge_max_position = 9.0;
+  p.manual.bridge = {0.5, 0.5, true};
+  return p;
+}
+
+TEST(PlannerStageBridge, ABridgeGoalMovesTheBridgeAndArrivesWithTheTrolley) {
+  trajectory_planner::TrajectoryPlannerStage stage(overhead_planner_params(), 0.01);
+  Request goal = trolley_goal(1, 0.5);
+  goal.axes |= Request::AXIS_BRIDGE;
+  goal.bridge_target = 6.0;  // 4 m at 0.5 m/s, 0.5 m/s^2: 9 s; the trolley's 0.25 m: about 1 s
+  protocol::Reference reference;
+  std::vector<Feedback> feedback;
+  double peak_bridge_speed = 0.0;
+  for (std::uint64_t k = 0; k < 1200; ++k) {
+    auto estimate = at_rest(k);
+    estimate.bridge_position = k == 0 ? 2.0 : reference.bridge_position;  // follows its reference
+    const std::vector<Request> now = k == 0 ? std::vector<Request>{goal} : std::vector<Request>{};
+    ASSERT_EQ(stage.step(estimate, now, reference), common::StepStatus::ok);
+    peak_bridge_speed = std::max(peak_bridge_speed, std::abs(reference.bridge_velocity));
+    for (const auto& f : stage.move_statuses()) feedback.push_back(f);
+  }
+  EXPECT_DOUBLE_EQ(reference.bridge_position, 6.0);
+  EXPECT_DOUBLE_EQ(reference.trolley_position, 0.5);
+  EXPECT_NEAR(peak_bridge_speed, 0.5, 1e-9);
+  ASSERT_FALSE(feedback.empty());
+  EXPECT_EQ(feedback.back().result, Feedback::RESULT_ARRIVED);
+  EXPECT_NEAR(feedback.back().move_duration, 4.0 / 0.5 + 0.5 / 0.5, 0.02);  // trapezoid: d/v + v/a
+  EXPECT_DOUBLE_EQ(feedback.back().rest_bridge_position, 6.0);
+  // Arrived no earlier than the bridge's reference came to rest.
+  bool moving_after_trolley = false;
+  for (const auto& f : feedback) moving_after_trolley = moving_after_trolley || (f.result == Feedback::RESULT_MOVING && f.time_in_move > 2.0);
+  EXPECT_TRUE(moving_after_trolley);
+}
+
+TEST(PlannerStageBridge, ABridgeTargetOffTheRunwayIsRejectedAndNothingMoves) {
+  trajectory_planner::TrajectoryPlannerStage stage(overhead_planner_params(), 0.01);
+  Request goal = trolley_goal(1, 0.5);
+  goal.axes |= Request::AXIS_BRIDGE;
+  goal.bridge_target = 9.5;
+  const auto feedback = run(stage, 0, 50, {{0, goal}});
+  ASSERT_FALSE(feedback.empty());
+  EXPECT_EQ(feedback.front().result, Feedback::RESULT_REJECTED);
+  EXPECT_EQ(feedback.front().reason, Feedback::REASON_BRIDGE_RANGE);
+  EXPECT_DOUBLE_EQ(feedback.front().value, 9.5);
+  EXPECT_DOUBLE_EQ(feedback.front().bound_min, 1.0);
+  EXPECT_DOUBLE_EQ(feedback.front().bound_max, 9.0);
+  // The trolley part was not started either.
+  protocol::Reference reference;
+  ASSERT_EQ(stage.step(at_rest(51), {}, reference), common::StepStatus::ok);
+  EXPECT_DOUBLE_EQ(reference.trolley_position, 0.25);
+
+  auto tower = lab_planner();
+  const auto refused = run(tower, 0, 5, {{0, goal}});
+  ASSERT_FALSE(refused.empty());
+  EXPECT_EQ(refused.front().reason, Feedback::REASON_BRIDGE_RANGE);
+  EXPECT_EQ(refused.front().bound_min, 0.0);
+  EXPECT_EQ(refused.front().bound_max, 0.0);
+}
+
+// The controller stages on an overhead crane compute the bridge's command with the trolley's law on
+// the bridge's gantry view: the same numbers as a crane whose trolley has the bridge's drive,
+// position, velocity and (sign-flipped) swing.
+TEST(StagesBridge, TheBridgeGetsTheTrolleyLawOfItsGantryView) {
+  common::CraneParameters crane;
+  common::BridgeParameters bridge{50.0, 1.5, {1.0, 1.2, 0.5, 0.6, 0.7, 0.8}};
+  common::StackFacts overhead;
+  overhead.crane = crane;
+  overhead.crane_kind = common::CraneKind::overhead;
+  overhead.bridge = bridge;
+  common::StackFacts gantry;
+  gantry.crane = common::bridge_as_trolley(crane, bridge);
+  gantry.crane_kind = common::CraneKind::gantry;
+
+  protocol::CraneState state = at_rest(7, 0.6);
+  state.bridge_position = 3.0;
+  state.bridge_velocity = 0.2;
+  state.bridge_velocity_raw = 0.21;
+  state.swing_out_of_plane = 0.03;
+  state.swing_out_of_plane_rate = -0.1;
+  state.payload_mass = crane.load_mass;
+  protocol::CraneState view = state;  // what a gantry whose trolley is the bridge would measure
+  view.trolley_position = 3.0;
+  view.trolley_velocity = 0.2;
+  view.trolley_velocity_raw = 0.21;
+  view.swing_in_plane = -0.03;
+  view.swing_in_plane_rate = 0.1;
+  view.swing_out_of_plane = view.swing_out_of_plane_rate = 0.0;
+
+  // Anti-swing (PD, so that one cycle gives an action).
+  anti_swing::AntiSwingStageParams ap;
+  ap.law = anti_swing::AntiSwingLaw::pd;
+  ap.anti_swing.slew_enabled = false;
+  ap.bridge = true;
+  anti_swing::AntiSwingStage overhead_swing(ap);
+  ap.bridge = false;
+  anti_swing::AntiSwingStage gantry_swing(ap);
+  protocol::AntiSwingCommand a_overhead, a_gantry;
+  ASSERT_EQ(overhead_swing.step(state, a_overhead), common::StepStatus::ok);
+  ASSERT_EQ(gantry_swing.step(view, a_gantry), common::StepStatus::ok);
+  EXPECT_NE(a_gantry.trolley_action, 0.0);
+  EXPECT_DOUBLE_EQ(a_overhead.bridge_action, a_gantry.trolley_action);
+
+  // Tracking, from the configuration readers of both facts.
+  tracking::TrackingStageParams tp_overhead, tp_gantry;
+  {
+    const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false}");
+    config::YamlSection s1(yaml, "tracking");
+    tp_overhead = tracking::read_params(s1, overhead);
+    config::YamlSection s2(yaml, "tracking");
+    tp_gantry = tracking::read_params(s2, gantry);
+  }
+  ASSERT_TRUE(tp_overhead.bridge);
+  tracking::TrackingStage t_overhead(tp_overhead), t_gantry(tp_gantry);
+  protocol::Reference ref;
+  ref.header.seq = 7;
+  ref.trolley_position = 0.6;
+  ref.bridge_position = 3.5;
+  ref.bridge_velocity = 0.3;
+  protocol::Reference ref_view = ref;
+  ref_view.trolley_position = 3.5;
+  ref_view.trolley_velocity = 0.3;
+  protocol::AntiSwingCommand swing_view = a_gantry;
+  protocol::LinearCommand l_overhead, l_gantry;
+  ASSERT_EQ(t_overhead.step(state, ref, a_overhead, l_overhead), common::StepStatus::ok);
+  ASSERT_EQ(t_gantry.step(view, ref_view, swing_view, l_gantry), common::StepStatus::ok);
+  EXPECT_NE(l_gantry.trolley_voltage, 0.0);
+  EXPECT_DOUBLE_EQ(l_overhead.bridge_voltage, l_gantry.trolley_voltage);
+  EXPECT_DOUBLE_EQ(l_overhead.bridge_tracking_action, l_gantry.trolley_tracking_action);
+
+  // Friction compensation with the bridge's friction.
+  friction_compensation::FrictionCompensationParams fp;
+  fp.trolley.friction = bridge.friction;
+  friction_compensation::FrictionCompensationStage f_gantry(fp);
+  fp.trolley.friction = crane.trolley_friction;
+  fp.bridge = fp.trolley;
+  fp.bridge->friction = bridge.friction;
+  friction_compensation::FrictionCompensationStage f_overhead(fp);
+  protocol::ActuatorCommand u_overhead, u_gantry;
+  ASSERT_EQ(f_overhead.step(state, l_overhead, u_overhead), common::StepStatus::ok);
+  ASSERT_EQ(f_gantry.step(view, l_gantry, u_gantry), common::StepStatus::ok);
+  EXPECT_NE(u_gantry.trolley_friction_voltage, 0.0);
+  EXPECT_DOUBLE_EQ(u_overhead.bridge_voltage, u_gantry.trolley_voltage);
+  EXPECT_DOUBLE_EQ(u_overhead.bridge_friction_voltage, u_gantry.trolley_friction_voltage);
 }
 
 }  // namespace

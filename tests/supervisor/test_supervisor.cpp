@@ -735,6 +735,88 @@ TEST(SupervisorLimits, TrolleyOverspeed) {
   expect_stopped(out);
 }
 
+// An overhead crane's bridge (bridge_enabled): guarded like the trolley, with its own faults,
+// warning and voltage limit; a tower crane ignores the bridge fields (always 0 there).
+TEST(SupervisorLimits, BridgeTravelOverspeedAndApproach) {
+  sv::SupervisorParams p;
+  p.bridge_enabled = true;
+  p.bridge_min = 1.0;
+  p.bridge_max = 59.0;
+  p.bridge_approach_margin = 2.0;
+  p.bridge_stop_margin = 0.3;
+  p.bridge_approach_speed = 0.15;
+  p.bridge_max_speed = 0.9;
+  sv::Supervisor supervisor(p);
+  auto in = healthy_input();
+  in.bridge_position = 30.0;
+  for (int i = 0; i < 3; ++i) step(supervisor, with_command(in, sv::Command::arm));
+  std::uint64_t seq = 1000;
+  const auto bridge_at = [&](double position, double velocity) {
+    in.sensor_seq = (seq += 100000);
+    in.bridge_position = position - velocity * 0.01;
+    step(supervisor, in);
+    in.sensor_seq = ++seq;
+    in.bridge_position = position;
+    return step(supervisor, in);
+  };
+  auto out = bridge_at(30.0, 0.6);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_NEAR(out.bridge_velocity, 0.6, 1e-9);
+  EXPECT_DOUBLE_EQ(out.bridge_voltage_limit, p.voltage_limit);
+  // 1.5 m from the end stop at 59 m, toward it at 0.6 m/s: allowed 0.15 + 0.75 * (1.5 - 0.3) / 1.7 = 0.68 m/s.
+  out = bridge_at(57.5, 0.6);
+  EXPECT_TRUE(out.warnings & sv::kWarningBridgeApproach);
+  EXPECT_FALSE(out.warnings & sv::kWarningSpeedLimited);
+  out = bridge_at(57.5, 0.7);
+  EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
+  EXPECT_DOUBLE_EQ(out.bridge_voltage_limit, p.approach_voltage_limit);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  EXPECT_EQ(out.active_faults, 0U);
+  // Overspeed: two consecutive samples over 0.9 m/s.
+  in.sensor_seq = ++seq;
+  in.bridge_position += 0.0095;
+  EXPECT_EQ(step(supervisor, in).active_faults, 0U);
+  in.sensor_seq = ++seq;
+  in.bridge_position += 0.0095;  // and the next sample: 0.95 m/s twice
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultBridgeOverspeed));
+  expect_stopped(out);
+  EXPECT_EQ(out.bridge_voltage_limit, 0.0);
+  EXPECT_STREQ(sv::fault_name(sv::kFaultBridgeOverspeed), "bridge_overspeed");
+
+  sv::Supervisor range(p);
+  in = healthy_input();
+  in.bridge_position = 59.1;
+  out = step(range, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultBridgeTravel));
+  EXPECT_STREQ(sv::fault_name(sv::kFaultBridgeTravel), "bridge_travel");
+
+  // Without a bridge (tower, gantry), the field is not looked at and the bridge drive gets 0 V.
+  sv::Supervisor tower{sv::SupervisorParams{}};
+  in = healthy_input();
+  in.bridge_position = 500.0;
+  for (int i = 0; i < 3; ++i) out = step(tower, with_command(in, sv::Command::arm));
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_EQ(out.bridge_voltage_limit, 0.0);
+
+  // A bridge voltage beyond the limit is a voltage fault like the others.
+  sv::Supervisor voltage(p);
+  in = healthy_input();
+  in.bridge_position = 30.0;
+  in.actuators_valid = true;
+  in.bridge_voltage = 10.5;
+  EXPECT_TRUE(step(voltage, in).active_faults & sv::kFaultVoltage);
+
+  p.bridge_max = p.bridge_min;
+  try {
+    sv::validate(p);
+    FAIL() << "expected a ConfigError";
+  } catch (const crane::common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("supervisor.bridge_max"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SupervisorLimits, VoltageRateOfChange) {
   // max_voltage_rate 1500 V/s: 15 V between consecutive cycles.
   auto supervisor = ready_supervisor();

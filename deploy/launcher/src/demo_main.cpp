@@ -195,6 +195,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   stack.lockstep = !options.realtime;
   stack.initial_trolley_position = m.initial_trolley_position;
   stack.initial_slew_angle = m.initial_slew_angle;
+  stack.initial_bridge_position = m.initial_bridge_position;
   stack.friction_compensation = compensation;
   stack.plant_stats_path = (log_dir / "plant_stats.json").string();
   stack.plant_cable_length_factor = options.plant_cable_length_factor;
@@ -403,7 +404,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   }
   {
     std::ofstream csv(csv_path);
-    stack::write_csv(csv, records);
+    stack::write_csv(csv, records, cfg.facts.crane_kind == common::CraneKind::overhead);
   }
   if (result.missing > 0) {
     spdlog::warn("{}: {} of {} cycles missing from the recording (move started at cycle {}, {} sensor samples from "
@@ -636,9 +637,10 @@ int main(int argc, char** argv) {
     std::ofstream(summary_path) << summary.dump(2) << '\n';
 
     // Table (stack::table_row: one place with crane_sim).
-    std::printf("\n%s\n", stack::table_header().c_str());
+    const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
+    std::printf("\n%s\n", stack::table_header(bridge).c_str());
     for (const auto& r : results) {
-      std::printf("%s\n", stack::table_row(r.maneuver, r.friction_compensation, r.metrics, r.swing_period).c_str());
+      std::printf("%s\n", stack::table_row(r.maneuver, r.friction_compensation, r.metrics, r.swing_period, bridge).c_str());
     }
     std::printf("\nloop: %llu cycles, %llu overruns, latency sensor->command p50 %.0f us, p99 %.0f us, max %.0f us (%s)\n",
                 static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(overruns),

@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
   app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
   app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
+  app.add_option("--initial-bridge", stack.initial_bridge_position, "[m] initial bridge position (overhead crane)");
   app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
   app.add_option("--plant-load-mass-factor", stack.plant_load_mass_factor,
                  "--sim: the simulated load mass is this times the configured one (the controllers assume the "

@@ -1,6 +1,6 @@
 // crane_move: send the crane somewhere and follow it, like a ROS 2 action client (deploy/crane move).
 //
-//   crane_move [--trolley M] [--slew DEG] [--hoist M] [--profile NAME] [--trolley-max-velocity V] ...
+//   crane_move [--trolley M] [--slew DEG] [--hoist M] [--bridge M] [--profile NAME] [--trolley-max-velocity V] ...
 //              [--waypoint X,SLEW_DEG,L ...] [--wait] [--json] [--domain N] [--timeout S] [--config F]
 //   crane_move --stop [--json]    a controlled anti-sway stop (deploy/crane stop): prints the stopping
 //                                 position the planner predicts, then where the crane came to rest
@@ -50,6 +50,9 @@ struct MoveOptions {
   std::optional<double> trolley;        // [m]
   std::optional<double> slew_deg;       // [deg]
   std::optional<double> hoist;          // [m] cable length
+  std::optional<double> bridge;         // [m] an overhead crane's bridge
+  double bridge_max_velocity{0.0};      // [m/s] 0: the configured rated bridge speed
+  double bridge_max_acceleration{0.0};  // [m/s^2]
   std::string profile{"trapezoid"};
   double trolley_max_velocity{0.0};     // [m/s] 0: the planner's default
   double trolley_max_acceleration{0.0}; // [m/s^2]
@@ -118,6 +121,11 @@ std::string rejection_message(const Feedback& f, const std::string& config) {
       std::snprintf(b, sizeof(b), "slew target %g deg is outside the slew range [%g, %g] deg", f.value / kDeg,
                     f.bound_min / kDeg, f.bound_max / kDeg);
       return b;
+    case Feedback::REASON_BRIDGE_RANGE:
+      if (f.bound_min == 0.0 && f.bound_max == 0.0) return "this crane has no bridge (crane.kind is not overhead)";
+      std::snprintf(b, sizeof(b), "bridge target %g m is outside the runway travel [%g, %g] m", f.value, f.bound_min,
+                    f.bound_max);
+      return b;
     case Feedback::REASON_CABLE_RANGE:
       std::snprintf(b, sizeof(b), "hoist target %g m is outside the cable range [%g, %g] m", f.value, f.bound_min,
                     f.bound_max);
@@ -143,7 +151,7 @@ protocol::MoveRequest build_request(const MoveOptions& o, std::uint32_t id) {
   }
   if (!known) throw CLI::ValidationError("--profile", "unknown profile '" + o.profile + "'");
   r.axes = static_cast<std::uint8_t>((o.trolley ? Request::AXIS_TROLLEY : 0U) | (o.slew_deg ? Request::AXIS_SLEW : 0U) |
-                                     (o.hoist ? Request::AXIS_HOIST : 0U));
+                                     (o.hoist ? Request::AXIS_HOIST : 0U) | (o.bridge ? Request::AXIS_BRIDGE : 0U));
   r.trolley_target = o.trolley.value_or(0.0);
   r.slew_target = o.slew_deg.value_or(0.0) * kDeg;
   r.cable_length_target = o.hoist.value_or(0.0);
@@ -151,17 +159,26 @@ protocol::MoveRequest build_request(const MoveOptions& o, std::uint32_t id) {
   r.trolley_max_acceleration = o.trolley_max_acceleration;
   r.slew_max_velocity = o.slew_max_velocity_deg * kDeg;
   r.slew_max_acceleration = o.slew_max_acceleration_deg * kDeg;
+  r.bridge_target = o.bridge.value_or(0.0);
+  r.bridge_max_velocity = o.bridge_max_velocity;
+  r.bridge_max_acceleration = o.bridge_max_acceleration;
   if (o.waypoints.size() > r.waypoint_trolley.size()) {
     throw CLI::ValidationError("--waypoint", "at most " + std::to_string(r.waypoint_trolley.size()) + " waypoints");
   }
   r.waypoint_count = static_cast<std::uint8_t>(o.waypoints.size());
   for (std::size_t i = 0; i < o.waypoints.size(); ++i) {
     std::stringstream in(o.waypoints[i]);
-    double x = 0.0, slew = 0.0, length = 0.0;
-    char c1 = 0, c2 = 0;
+    double x = 0.0, slew = 0.0, length = 0.0, y = 0.0;
+    char c1 = 0, c2 = 0, c3 = 0;
     if (!(in >> x >> c1 >> slew >> c2 >> length) || c1 != ',' || c2 != ',') {
-      throw CLI::ValidationError("--waypoint", "'" + o.waypoints[i] + "' is not X,SLEW_DEG,L");
+      throw CLI::ValidationError("--waypoint", "'" + o.waypoints[i] + "' is not X,SLEW_DEG,L[,BRIDGE]");
     }
+    const bool has_bridge = static_cast<bool>(in >> c3 >> y) && c3 == ',';
+    if (has_bridge != o.bridge.has_value()) {
+      throw CLI::ValidationError("--waypoint", "'" + o.waypoints[i] + "': with --bridge each waypoint is X,SLEW_DEG,L,BRIDGE; "
+                                 "without it X,SLEW_DEG,L");
+    }
+    r.waypoint_bridge[i] = y;
     r.waypoint_trolley[i] = x;
     r.waypoint_slew[i] = slew * kDeg;
     r.waypoint_cable_length[i] = length;
@@ -255,6 +272,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
   std::optional<Clock::time_point> settle_deadline;
   const stack::SettleCriteria criteria;
   double trolley_target = request.trolley_target, slew_target = request.slew_target;
+  double bridge_target = request.bridge_target;
   std::string abort_reason;
   while (!runtime::stop_requested()) {
     const auto now = Clock::now();
@@ -343,11 +361,13 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
       // Settled for good: every criterion has held for the residual window since some cycle.
       if (!o.trolley) trolley_target = first_sample->trolley_position;
       if (!o.slew_deg) slew_target = first_sample->slew_angle;
+      if (!o.bridge) bridge_target = first_sample->bridge_position;
       std::uint64_t calm = 0;
       for (auto it = samples.rbegin(); it != samples.rend(); ++it) {
         const auto& s = it->second;
         const bool ok = std::fabs(s.trolley_position - trolley_target) < criteria.trolley_tolerance &&
                         std::fabs(s.slew_angle - slew_target) < criteria.slew_tolerance &&
+                        std::fabs(s.bridge_position - bridge_target) < criteria.trolley_tolerance &&
                         std::fabs(s.swing_in_plane) < criteria.swing_tolerance &&
                         std::fabs(s.swing_out_of_plane) < criteria.swing_tolerance;
         if (!ok) break;
@@ -372,14 +392,15 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
   if (start_seq) samples.erase(samples.begin(), samples.lower_bound(*start_seq));
   for (const auto& [seq, s] : samples) {
     cycles.push_back({static_cast<double>(seq - *start_seq) * o.sample_period, s.trolley_position, s.slew_angle,
-                      s.swing_in_plane, s.swing_out_of_plane, s.applied_trolley_voltage, s.applied_slew_voltage});
+                      s.swing_in_plane, s.swing_out_of_plane, s.applied_trolley_voltage, s.applied_slew_voltage,
+                      s.bridge_position, s.applied_bridge_voltage});
   }
   if (cycles.empty()) {
     std::fprintf(stderr, "crane_move: request %u arrived, but no sensor sample of the move was received\n", id);
     return 3;
   }
-  const auto m = stack::evaluate_maneuver(cycles, trolley_target, slew_target, criteria);
-  const json result{{"result", "arrived"},
+  const auto m = stack::evaluate_maneuver(cycles, trolley_target, slew_target, criteria, bridge_target);
+  json result{{"result", "arrived"},
                     {"request_id", id},
                     {"move_duration_s", last ? last->move_duration : 0.0},
                     {"settle_time_s", std::isfinite(m.settle_time) ? json(m.settle_time) : json(nullptr)},
@@ -388,6 +409,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
                     {"max_swing_rad", m.max_swing},
                     {"residual_swing_rad", m.residual_swing},
                     {"final_cable_length_m", cycles.empty() ? 0.0 : samples.rbegin()->second.cable_length}};
+  if (o.bridge) result["final_bridge_error_m"] = m.final_bridge_error;
   if (o.json) {
     std::printf("%s\n", result.dump().c_str());
   } else {
@@ -396,6 +418,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
     std::printf("arrived: settle %s s, trolley error %.2f mm, slew error %.2f mrad, residual swing %.3f deg (max %.1f deg)\n",
                 settle,
                 m.final_position_error * 1e3, m.final_slew_error * 1e3, m.residual_swing / kDeg, m.max_swing / kDeg);
+    if (o.bridge) std::printf("         bridge error %.2f mm\n", m.final_bridge_error * 1e3);
   }
   return 0;
 }
@@ -415,6 +438,10 @@ int main(int argc, char** argv) {
   app.add_option("--trolley", o.trolley, "[m] trolley target")->check(CLI::Range(-100.0, 100.0));
   app.add_option("--slew", o.slew_deg, "[deg] slew target")->check(CLI::Range(-3600.0, 3600.0));
   app.add_option("--hoist", o.hoist, "[m] cable length target")->check(CLI::Range(0.0, 200.0));
+  app.add_option("--bridge", o.bridge, "[m] bridge target (overhead crane)")->check(CLI::Range(-1000.0, 1000.0));
+  app.add_option("--bridge-max-velocity", o.bridge_max_velocity, "[m/s] (default: the configured rated bridge speed)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--bridge-max-acceleration", o.bridge_max_acceleration, "[m/s^2]")->check(CLI::PositiveNumber);
   app.add_option("--profile", o.profile, "step | trapezoid | zv | zvd | ei | time_optimal (default trapezoid)");
   app.add_option("--trolley-max-velocity", o.trolley_max_velocity, "[m/s] (default: the planner's)")->check(CLI::PositiveNumber);
   app.add_option("--trolley-max-acceleration", o.trolley_max_acceleration, "[m/s^2]")->check(CLI::PositiveNumber);
@@ -440,8 +467,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!o.trolley && !o.slew_deg && !o.hoist && o.waypoints.empty()) {
-    std::fprintf(stderr, "crane_move: give at least one of --trolley, --slew, --hoist\n");
+  if (!o.trolley && !o.slew_deg && !o.hoist && !o.bridge && o.waypoints.empty()) {
+    std::fprintf(stderr, "crane_move: give at least one of --trolley, --slew, --hoist, --bridge\n");
     return 2;
   }
   try {

@@ -92,7 +92,8 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     if (name == "plant") {
       spec.arguments.push_back(o.lockstep ? "--lockstep" : "--realtime");
       spec.arguments.insert(spec.arguments.end(), {"--initial-trolley", number(o.initial_trolley_position),
-                                                   "--initial-slew", number(o.initial_slew_angle)});
+                                                   "--initial-slew", number(o.initial_slew_angle),
+                                                   "--initial-bridge", number(o.initial_bridge_position)});
       if (!bridge && !o.plant_stats_path.empty()) {
         spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
       }

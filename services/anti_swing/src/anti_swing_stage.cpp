@@ -73,40 +73,56 @@ AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFact
   a.gravity = facts.crane.gravity;
   a.min_cable_length = facts.crane.min_cable_length;
   a.max_cable_length = facts.crane.max_cable_length;
+  p.bridge = facts.crane_kind == common::CraneKind::overhead;
   AntiSwingStage{p};  // the law's own invariants, same message format
   return p;
 }
 
-AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params) : law_(params.law), core_(make_core(params)) {}
+AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params) : law_(params.law), core_(make_core(params)) {
+  if (params.bridge) {
+    AntiSwingStageParams bridge = params;
+    bridge.anti_swing.slew_enabled = false;  // the bridge's gantry view has no slew
+    bridge_core_.emplace(make_core(bridge));
+  }
+}
+
+AntiSwingStage::Result AntiSwingStage::run(Core& core, const protocol::CraneState& estimate) noexcept {
+  const auto current = common::to_estimate(estimate);
+  Result r;
+  if (auto* a = std::get_if<AntiSwing>(&core)) {
+    r.status = a->step(current, r.action);
+  } else if (auto* f = std::get_if<anti_swing_analysis::FuzzyAntiSwing>(&core)) {
+    r.status = f->step(current, r.action);
+  } else if (auto* d = std::get_if<anti_swing_analysis::DelayedTrajectoryAntiSwing>(&core)) {
+    r.status = d->step(current, r.correction);
+  }
+  if (r.status != common::StepStatus::ok && r.status != common::StepStatus::rejected_nonfinite) {
+    r.action = {};  // not_ready: every field 0, the safe value
+    r.correction = {};
+  }
+  return r;
+}
 
 common::StepStatus AntiSwingStage::step(const protocol::CraneState& estimate,
                                         protocol::AntiSwingCommand& command) noexcept {
   if (!protocol::all_finite(estimate)) return common::StepStatus::rejected_nonfinite;
-  const auto current = common::to_estimate(estimate);
-  AntiSwingOutput action;
-  anti_swing_analysis::TrajectoryCorrection correction;
-  common::StepStatus status = common::StepStatus::ok;
-  if (auto* a = std::get_if<AntiSwing>(&core_)) {
-    status = a->step(current, action);
-  } else if (auto* f = std::get_if<anti_swing_analysis::FuzzyAntiSwing>(&core_)) {
-    status = f->step(current, action);
-  } else if (auto* d = std::get_if<anti_swing_analysis::DelayedTrajectoryAntiSwing>(&core_)) {
-    status = d->step(current, correction);
-  }
-  if (status == common::StepStatus::rejected_nonfinite) return status;
-  if (status != common::StepStatus::ok) {  // not_ready: every field 0, the safe value
-    action = {};
-    correction = {};
-  }
+  const Result r = run(core_, estimate);
+  if (r.status == common::StepStatus::rejected_nonfinite) return r.status;
   command.controller = static_cast<std::uint8_t>(law_);
-  command.trolley_action = action.trolley_action;
-  command.slew_action = action.slew_action;
-  command.trolley_reference_correction = correction.trolley_position_correction;
-  command.trolley_reference_rate_correction = correction.trolley_velocity_correction;
-  command.slew_reference_correction = correction.slew_angle_correction;
-  command.slew_reference_rate_correction = correction.slew_rate_correction;
+  command.trolley_action = r.action.trolley_action;
+  command.slew_action = r.action.slew_action;
+  command.trolley_reference_correction = r.correction.trolley_position_correction;
+  command.trolley_reference_rate_correction = r.correction.trolley_velocity_correction;
+  command.slew_reference_correction = r.correction.slew_angle_correction;
+  command.slew_reference_rate_correction = r.correction.slew_rate_correction;
+  if (bridge_core_) {
+    const Result b = run(*bridge_core_, common::bridge_view(estimate));
+    command.bridge_action = b.action.trolley_action;
+    command.bridge_reference_correction = b.correction.trolley_position_correction;
+    command.bridge_reference_rate_correction = b.correction.trolley_velocity_correction;
+  }
   common::same_cycle(estimate.header, command.header);
-  return status;
+  return r.status;
 }
 
 }  // namespace crane::anti_swing

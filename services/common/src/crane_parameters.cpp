@@ -49,4 +49,28 @@ void validate(const BridgeParameters& b, const char* prefix) {
   validate(b.friction, (p + ".friction").c_str());
 }
 
+const char* to_string(CraneKind kind) noexcept {
+  switch (kind) {
+    case CraneKind::tower: return "tower";
+    case CraneKind::gantry: return "gantry";
+    case CraneKind::overhead: return "overhead";
+  }
+  return "unknown";
+}
+
+CraneKind crane_kind_from_string(const std::string& text, const std::string& field) {
+  for (const CraneKind kind : {CraneKind::tower, CraneKind::gantry, CraneKind::overhead}) {
+    if (text == to_string(kind)) return kind;
+  }
+  throw ConfigError(field + " = \"" + text + "\" is not a crane kind: must be one of tower, gantry, overhead");
+}
+
+CraneParameters bridge_as_trolley(const CraneParameters& crane, const BridgeParameters& bridge) noexcept {
+  CraneParameters c = crane;
+  c.trolley_drive_mass = bridge.drive_mass;
+  c.trolley_drive_gain = bridge.drive_gain;
+  c.trolley_friction = bridge.friction;
+  return c;
+}
+
 }  // namespace crane::common

@@ -83,6 +83,13 @@ ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
     YamlSection document(root_, "");
     common::StackFacts facts;
     YamlSection crane = document.child("crane");
+    facts.crane_kind = common::crane_kind_from_string(crane.text("kind", {"tower", "gantry", "overhead"}),
+                                                      crane.field("kind"));
+    if (facts.crane_kind == common::CraneKind::overhead) {  // elsewhere crane.bridge is an unknown field
+      YamlSection bridge = crane.child("bridge");
+      facts.bridge = read_bridge(bridge);
+      common::validate(facts.bridge, "crane.bridge");
+    }
     facts.crane = read_crane(crane);
     YamlSection stack = document.child("stack");
     facts.sample_period = stack.number("sample_period", 1e-4, 0.1);

@@ -26,6 +26,9 @@ FrictionCompensationParams read_params(config::YamlSection& s, const common::Sta
   // The compensator's friction model is the configured crane's, (4.12)-(4.16).
   p.trolley = read_axis(s.child("trolley"), facts.crane.trolley_friction);
   p.slew = read_axis(s.child("slew"), facts.crane.slew_friction);
+  if (facts.crane_kind == common::CraneKind::overhead) {  // elsewhere friction_compensation.bridge is unknown
+    p.bridge = read_axis(s.child("bridge"), facts.bridge.friction);
+  }
   s.finish();
   p.voltage_limit = facts.voltage_limit;
   FrictionCompensation{p};
@@ -33,7 +36,14 @@ FrictionCompensationParams read_params(config::YamlSection& s, const common::Sta
 }
 
 FrictionCompensationStage::FrictionCompensationStage(const FrictionCompensationParams& params)
-    : compensation_(params) {}
+    : compensation_(params) {
+  if (params.bridge) {
+    FrictionCompensationParams bridge = params;
+    bridge.trolley = *params.bridge;
+    bridge.bridge.reset();
+    bridge_.emplace(bridge);
+  }
+}
 
 common::StepStatus FrictionCompensationStage::step(const protocol::CraneState& estimate,
                                                    const protocol::LinearCommand& linear,
@@ -51,12 +61,22 @@ common::StepStatus FrictionCompensationStage::step(const protocol::CraneState& e
     in.slew_friction = common::slew_friction_in_use(estimate);
   }
   FrictionCompensationOutput result;
-  const auto status = compensation_.step(in, result);
+  auto status = compensation_.step(in, result);
   command.trolley_voltage = result.command.trolley_voltage;
   command.slew_voltage = result.command.slew_voltage;
   command.hoist_speed = result.command.hoist_speed;
   command.trolley_friction_voltage = result.trolley_friction;
   command.slew_friction_voltage = result.slew_friction;
+  if (bridge_) {
+    FrictionCompensationInput b;
+    b.estimate = common::to_estimate(common::bridge_view(estimate));
+    b.command.trolley_voltage = linear.bridge_voltage;
+    FrictionCompensationOutput bridge;
+    const auto bridge_status = bridge_->step(b, bridge);
+    command.bridge_voltage = bridge.command.trolley_voltage;
+    command.bridge_friction_voltage = bridge.trolley_friction;
+    if (status == common::StepStatus::ok) status = bridge_status;
+  }
   common::same_cycle(linear.header, command.header);
   return status;
 }

@@ -19,6 +19,7 @@ plant::PlantStageParams plant_params(const StackConfig& cfg, const InProcessOpti
   p.simulator = cfg.plant;
   p.simulator.initial_state.trolley_position = o.initial_trolley_position;
   p.simulator.initial_state.slew_angle = o.initial_slew_angle;
+  p.simulator.initial_state.bridge_position = o.initial_bridge_position;
   p.gate = cfg.actuation;
   p.mismatch = o.mismatch;
   return p;
@@ -141,6 +142,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   options.mismatch = run.mismatch;
   options.initial_trolley_position = m.initial_trolley_position;
   options.initial_slew_angle = m.initial_slew_angle;
+  options.initial_bridge_position = m.initial_bridge_position;
   InProcessStack stack(cfg, options);
 
   const protocol::MoveRequest goal = move_request(m, cfg.facts, run.request_id, run.profile, run.start_cycle);

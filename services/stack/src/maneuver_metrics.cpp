@@ -8,7 +8,7 @@
 namespace crane::stack {
 
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
-                                  double slew_target, const SettleCriteria& criteria) {
+                                  double slew_target, const SettleCriteria& criteria, double bridge_target) {
   if (cycles.empty()) throw std::invalid_argument("evaluate_maneuver: the recording has no cycles");
   ManeuverMetrics m;
   const double end_time = cycles.back().time;
@@ -17,10 +17,12 @@ ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, doub
     const auto& c = cycles[i];
     const double swing = std::max(std::fabs(c.swing_in_plane), std::fabs(c.swing_out_of_plane));
     m.max_swing = std::max(m.max_swing, swing);
-    m.max_voltage = std::max({m.max_voltage, std::fabs(c.trolley_voltage), std::fabs(c.slew_voltage)});
+    m.max_voltage =
+        std::max({m.max_voltage, std::fabs(c.trolley_voltage), std::fabs(c.slew_voltage), std::fabs(c.bridge_voltage)});
     if (c.time >= end_time - criteria.residual_window) m.residual_swing = std::max(m.residual_swing, swing);
     const bool settled = std::fabs(c.trolley_position - trolley_target) < criteria.trolley_tolerance &&
                          std::fabs(c.slew_angle - slew_target) < criteria.slew_tolerance &&
+                         std::fabs(c.bridge_position - bridge_target) < criteria.trolley_tolerance &&
                          std::fabs(c.swing_in_plane) < criteria.swing_tolerance &&
                          std::fabs(c.swing_out_of_plane) < criteria.swing_tolerance;
     if (!settled) last_violation = static_cast<std::ptrdiff_t>(i);
@@ -30,6 +32,7 @@ ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, doub
                                              : std::numeric_limits<double>::quiet_NaN();
   m.final_position_error = std::fabs(cycles.back().trolley_position - trolley_target);
   m.final_slew_error = std::fabs(cycles.back().slew_angle - slew_target);
+  m.final_bridge_error = std::fabs(cycles.back().bridge_position - bridge_target);
   return m;
 }
 

@@ -2,6 +2,7 @@
 
 #include "crane/common/validation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -60,6 +61,12 @@ protocol::MoveRequest move_request(const ManeuverConfig& m, const common::StackF
   goal.trolley_max_acceleration = m.trolley_max_acceleration;
   goal.slew_max_velocity = m.slew_max_velocity;
   goal.slew_max_acceleration = m.slew_max_acceleration;
+  if (facts.crane_kind == common::CraneKind::overhead) {
+    goal.axes |= Request::AXIS_BRIDGE;
+    goal.bridge_target = m.bridge_target;
+    goal.bridge_max_velocity = m.bridge_max_velocity;
+    goal.bridge_max_acceleration = m.bridge_max_acceleration;
+  }
   return goal;
 }
 
@@ -89,26 +96,37 @@ CycleRecord record_of(double t, const protocol::SensorSample& s, const protocol:
   c.u_x_cmd = a != nullptr ? a->trolley_voltage : nan;
   c.u_gamma_cmd = a != nullptr ? a->slew_voltage : nan;
   c.brakes = next.brakes_engaged;
+  c.y = s.bridge_position;
+  c.u_y = next.applied_bridge_voltage;
+  c.y_ref = r != nullptr ? r->bridge_position : nan;
+  c.V_y = l != nullptr ? l->bridge_voltage : nan;
+  c.friction_y = a != nullptr ? a->bridge_friction_voltage : nan;
+  c.u_y_cmd = a != nullptr ? a->bridge_voltage : nan;
   return c;
 }
 
-void write_csv(std::ostream& out, const std::vector<CycleRecord>& records) {
+void write_csv(std::ostream& out, const std::vector<CycleRecord>& records, bool bridge) {
   out << "t,u_x,u_gamma,x,gamma,phi,theta,L,x_ref,gamma_ref,V_x,V_gamma,friction_x,friction_gamma,"
-         "u_x_cmd,u_gamma_cmd,brakes\n";
+         "u_x_cmd,u_gamma_cmd,brakes"
+      << (bridge ? ",y,u_y,y_ref,V_y,friction_y,u_y_cmd\n" : "\n");
   out.precision(9);
   for (const auto& c : records) {
     out << c.t << ',' << c.u_x << ',' << c.u_gamma << ',' << c.x << ',' << c.gamma << ',' << c.phi << ',' << c.theta
         << ',' << c.L << ',' << c.x_ref << ',' << c.gamma_ref << ',' << c.V_x << ',' << c.V_gamma << ','
         << c.friction_x << ',' << c.friction_gamma << ',' << c.u_x_cmd << ',' << c.u_gamma_cmd << ','
-        << (c.brakes ? 1 : 0) << '\n';
+        << (c.brakes ? 1 : 0);
+    if (bridge) {
+      out << ',' << c.y << ',' << c.u_y << ',' << c.y_ref << ',' << c.V_y << ',' << c.friction_y << ',' << c.u_y_cmd;
+    }
+    out << '\n';
   }
 }
 
 ManeuverMetrics evaluate(const std::vector<CycleRecord>& records, const ManeuverConfig& m) {
   std::vector<RecordedCycle> cycles;
   cycles.reserve(records.size());
-  for (const auto& r : records) cycles.push_back({r.t, r.x, r.gamma, r.phi, r.theta, r.u_x, r.u_gamma});
-  return evaluate_maneuver(cycles, m.trolley_target, m.slew_target);
+  for (const auto& r : records) cycles.push_back({r.t, r.x, r.gamma, r.phi, r.theta, r.u_x, r.u_gamma, r.y, r.u_y});
+  return evaluate_maneuver(cycles, m.trolley_target, m.slew_target, SettleCriteria{}, m.bridge_target);
 }
 
 std::string format_number(double v, int precision) {
@@ -118,21 +136,23 @@ std::string format_number(double v, int precision) {
   return b;
 }
 
-std::string table_header() {
+std::string table_header(bool bridge) {
   char b[256];
   std::snprintf(b, sizeof(b), "%-13s %-9s %9s %7s %10s %11s %10s %12s %8s", "maneuver", "friction", "settle_s",
                 "settle_T", "pos_err_mm", "slew_err_mrad", "max_swing_deg", "resid_swing_deg", "max_V");
-  return b;
+  return bridge ? std::string(b) + " bridge_err_mm" : std::string(b);
 }
 
 std::string table_row(const std::string& maneuver, bool friction_compensation, const ManeuverMetrics& m,
-                      double period) {
+                      double period, bool bridge) {
   char b[256];
   std::snprintf(b, sizeof(b), "%-13s %-9s %9s %7s %10s %11s %10s %12s %8s", maneuver.c_str(),
                 friction_compensation ? "comp_on" : "comp_off", format_number(m.settle_time, 2).c_str(),
                 format_number(m.settle_time / period, 2).c_str(), format_number(m.final_position_error * 1e3, 2).c_str(),
                 format_number(m.final_slew_error * 1e3, 2).c_str(), format_number(m.max_swing * 180 / std::numbers::pi, 2).c_str(),
                 format_number(m.residual_swing * 180 / std::numbers::pi, 3).c_str(), format_number(m.max_voltage, 2).c_str());
+  if (bridge) return std::string(b) + " " + std::string(13 - std::min<std::size_t>(13, format_number(m.final_bridge_error * 1e3, 2).size()), ' ') +
+                     format_number(m.final_bridge_error * 1e3, 2);
   return b;
 }
 

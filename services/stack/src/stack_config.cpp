@@ -10,7 +10,7 @@ namespace {
 
 using common::ConfigError;
 
-ManeuverConfig read_maneuver(config::YamlSection& s) {
+ManeuverConfig read_maneuver(config::YamlSection& s, bool bridge) {
   constexpr double kDeg = std::numbers::pi / 180.0;
   ManeuverConfig m;
   m.name = s.text("name");
@@ -25,6 +25,12 @@ ManeuverConfig read_maneuver(config::YamlSection& s) {
   m.cable_length_target = s.number("cable_length_target", 0.05, 200.0);
   m.slew_max_acceleration = s.number("slew_max_acceleration", 1e-4, 100.0);
   m.duration = s.number("duration", 0.5, 3600.0);
+  if (bridge) {
+    m.initial_bridge_position = s.number("initial_bridge_position", -1000.0, 1000.0);
+    m.bridge_target = s.number("bridge_target", -1000.0, 1000.0);
+    m.bridge_max_velocity = s.number("bridge_max_velocity", 1e-4, 100.0);
+    m.bridge_max_acceleration = s.number("bridge_max_acceleration", 1e-4, 100.0);
+  }
   s.finish();
   return m;
 }
@@ -45,9 +51,10 @@ StackConfig read(const config::ConfigDocument& doc) {
   c.hardware_bridge = doc.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
     return hardware_bridge::read_params(block, facts, c.actuation);
   });
-  c.maneuvers = doc.read_root([](config::YamlSection& root, const common::StackFacts&) {
+  c.maneuvers = doc.read_root([](config::YamlSection& root, const common::StackFacts& facts) {
     std::vector<ManeuverConfig> maneuvers;
-    for (auto& item : root.list("maneuvers")) maneuvers.push_back(read_maneuver(item));
+    const bool bridge = facts.crane_kind == common::CraneKind::overhead;
+    for (auto& item : root.list("maneuvers")) maneuvers.push_back(read_maneuver(item, bridge));
     return maneuvers;
   });
   return c;

@@ -114,16 +114,18 @@ int demo(const Selection& s, const std::string& out_dir) {
   const auto cfg = stack::load_stack_config(s.config_path);
   double wall = 0.0;
   const auto runs = run_demo(cfg, s, wall);
+  const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   if (!out_dir.empty()) {
     fs::create_directories(out_dir);
     for (const auto& r : runs) {
       std::ofstream csv(fs::path(out_dir) / (r.maneuver.name + (r.compensation ? "_fc_on" : "_fc_off") + ".csv"));
-      stack::write_csv(csv, r.result.records);
+      stack::write_csv(csv, r.result.records, bridge);
     }
   }
-  std::printf("\n%s\n", stack::table_header().c_str());
+  std::printf("\n%s\n", stack::table_header(bridge).c_str());
   for (const auto& r : runs) {
-    std::printf("%s\n", stack::table_row(r.maneuver.name, r.compensation, r.result.metrics, r.result.swing_period).c_str());
+    std::printf("%s\n",
+                stack::table_row(r.maneuver.name, r.compensation, r.result.metrics, r.result.swing_period, bridge).c_str());
   }
   const double simulated = simulated_seconds(cfg, runs);
   std::printf("\nspeed: %.1f s simulated in %.3f s on one core (%.0fx real time), controller %s, %zu runs\n", simulated,

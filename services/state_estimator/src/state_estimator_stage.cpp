@@ -51,13 +51,16 @@ StateEstimatorStageParams read_params(config::YamlSection& s, const common::Stac
                      : kind == "al_alaoui_first_order" ? DifferentiatorKind::al_alaoui_first_order
                                                        : DifferentiatorKind::al_alaoui_second_order;
   stage.adaptation = read_adaptation(s.child("adaptation"), facts);
+  stage.bridge = facts.crane_kind == common::CraneKind::overhead;
   s.finish();
   StateEstimator{p};  // its own invariants, same message format
   return stage;
 }
 
 StateEstimatorStage::StateEstimatorStage(const StateEstimatorStageParams& params)
-    : estimator_(params.estimator), adaptation_(params.adaptation) {}
+    : estimator_(params.estimator), adaptation_(params.adaptation) {
+  if (params.bridge) bridge_estimator_.emplace(params.estimator);
+}
 
 common::StepStatus StateEstimatorStage::step(const protocol::SensorSample& sensors,
                                              protocol::CraneState& estimate) noexcept {
@@ -65,6 +68,15 @@ common::StepStatus StateEstimatorStage::step(const protocol::SensorSample& senso
   const auto status = estimator_.step(common::to_measurement(sensors), scratch_);
   if (status != common::StepStatus::ok) return status;
   common::from_estimate(scratch_, estimate);
+  if (bridge_estimator_) {
+    common::CraneMeasurement bridge = common::to_measurement(sensors);
+    bridge.trolley_position = sensors.bridge_position;
+    if (bridge_estimator_->step(bridge, bridge_scratch_) == common::StepStatus::ok) {
+      estimate.bridge_position = bridge_scratch_.trolley_position;
+      estimate.bridge_velocity = bridge_scratch_.trolley_velocity;
+      estimate.bridge_velocity_raw = bridge_scratch_.trolley_velocity_raw;
+    }
+  }
   adaptation::AdaptationInput in;
   in.trolley_position = sensors.trolley_position;
   in.slew_angle = sensors.slew_angle;

@@ -25,24 +25,46 @@ TrackingLaw law_from_name(std::string_view name, std::string_view field) {
   throw common::ConfigError(std::string(field) + " = '" + std::string(name) + "' is not one of: " + choices);
 }
 
-TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
+namespace {
+
+// The stage's params for `crane` (the crane's own, or the bridge seen as a trolley).
+TrackingStageParams params_for(const common::CraneParameters& crane, const TrackingParams& gains,
+                               const common::StackFacts& facts) {
   TrackingStageParams p;
   // The controller's model is the configured crane (section 3.3: (3.37)-(3.38) need K_m, m_t, m_r,
   // M_r and g).
-  p.tracking = tracking_params_from(facts.crane);
-  p.tracking.proportional_gain = s.number("proportional_gain", 0.0, 1.0e4);
-  p.tracking.derivative_gain = s.number("derivative_gain", 0.0, 1.0e3);
-  p.tracking.min_radius = s.number("min_radius", 1e-3, 100.0);
-  p.tracking.slew_enabled = s.flag("slew_enabled");
-  s.finish();
-  p.tracking.min_cable_length = facts.crane.min_cable_length;
+  p.tracking = tracking_params_from(crane);
+  p.tracking.proportional_gain = gains.proportional_gain;
+  p.tracking.derivative_gain = gains.derivative_gain;
+  p.tracking.min_radius = gains.min_radius;
+  p.tracking.slew_enabled = gains.slew_enabled;
+  p.tracking.min_cable_length = crane.min_cable_length;
   p.tracking.voltage_limit = facts.voltage_limit;
-  p.gain_scheduling = gain_scheduling::gain_scheduling_params_from(facts.crane);
+  p.gain_scheduling = gain_scheduling::gain_scheduling_params_from(crane);
   p.gain_scheduling.voltage_limit = facts.voltage_limit;
   p.gain_scheduling.slew_enabled = p.tracking.slew_enabled;
-  p.gain_scheduling.min_cable_length = facts.crane.min_cable_length;
-  p.trolley_drive_mass = facts.crane.trolley_drive_mass;
-  p.jib_inertia = facts.crane.jib_inertia;
+  p.gain_scheduling.min_cable_length = crane.min_cable_length;
+  p.trolley_drive_mass = crane.trolley_drive_mass;
+  p.jib_inertia = crane.jib_inertia;
+  return p;
+}
+
+}  // namespace
+
+TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
+  TrackingParams gains;
+  gains.proportional_gain = s.number("proportional_gain", 0.0, 1.0e4);
+  gains.derivative_gain = s.number("derivative_gain", 0.0, 1.0e3);
+  gains.min_radius = s.number("min_radius", 1e-3, 100.0);
+  gains.slew_enabled = s.flag("slew_enabled");
+  s.finish();
+  TrackingStageParams p = params_for(facts.crane, gains, facts);
+  if (facts.crane_kind == common::CraneKind::overhead) {
+    TrackingParams bridge_gains = gains;
+    bridge_gains.slew_enabled = false;
+    p.bridge = std::make_shared<const TrackingStageParams>(
+        params_for(common::bridge_as_trolley(facts.crane, facts.bridge), bridge_gains, facts));
+  }
   TrackingStage{p};
   return p;
 }
@@ -59,6 +81,12 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
     p.kind = law_ == TrackingLaw::gain_scheduling_full ? gain_scheduling::FeedbackKind::full
                                                         : gain_scheduling::FeedbackKind::partial;
     scheduled_.emplace(p);
+  }
+  if (params.bridge) {
+    TrackingStageParams bridge = *params.bridge;
+    bridge.law = law_;
+    bridge.bridge.reset();
+    bridge_ = std::make_unique<TrackingStage>(bridge);
   }
 }
 
@@ -101,6 +129,14 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   command.hoist_speed = result.command.hoist_speed;
   command.trolley_tracking_action = result.trolley_tracking_action;
   command.slew_tracking_action = result.slew_tracking_action;
+  if (bridge_) {
+    protocol::LinearCommand bridge;
+    const auto bridge_status = bridge_->step(common::bridge_view(estimate), common::bridge_view(reference),
+                                             common::bridge_view(anti_swing), bridge);
+    command.bridge_voltage = bridge.trolley_voltage;
+    command.bridge_tracking_action = bridge.trolley_tracking_action;
+    if (status == common::StepStatus::ok) status = bridge_status;
+  }
   common::same_cycle(estimate.header, command.header);
   return status;
 }

@@ -88,7 +88,7 @@ namespace crane::trajectory_planner {
 void validate(const ManualParams& p) {
   const std::string prefix = "trajectory_planner.manual.";
   const std::pair<const char*, const SpeedAxisParams*> axes[] = {
-      {"trolley", &p.trolley}, {"slew", &p.slew}, {"hoist", &p.hoist}};
+      {"trolley", &p.trolley}, {"slew", &p.slew}, {"hoist", &p.hoist}, {"bridge", &p.bridge}};
   for (const auto& [name, axis] : axes) {
     common::require_greater(prefix + name + "_speed", axis->rated_speed, 0.0);
     common::require_greater(prefix + name + "_acceleration", axis->acceleration, 0.0);

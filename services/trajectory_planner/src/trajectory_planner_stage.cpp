@@ -20,6 +20,10 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.trolley_max_position = s.number("trolley_max_position", p.trolley_min_position, 100.0);
   p.slew_min_angle = s.number("slew_min_angle", -20.0 * kPi, 20.0 * kPi);
   p.slew_max_angle = s.number("slew_max_angle", p.slew_min_angle, 20.0 * kPi);
+  if (facts.crane_kind == common::CraneKind::overhead) {
+    p.bridge_min_position = s.number("bridge_min_position", -1000.0, 1000.0);
+    p.bridge_max_position = s.number("bridge_max_position", p.bridge_min_position, 1000.0);
+  }
   auto m = s.child("manual");
   const auto axis = [&](const char* name, bool swings) {
     return SpeedAxisParams{m.number(std::string(name) + "_speed", 0.0, 100.0),
@@ -28,6 +32,10 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.manual.trolley = axis("trolley", true);
   p.manual.slew = axis("slew", true);
   p.manual.hoist = axis("hoist", false);
+  p.bridge_enabled = facts.crane_kind == common::CraneKind::overhead;
+  if (p.bridge_enabled) {  // elsewhere these are unknown fields
+    p.manual.bridge = axis("bridge", true);
+  }
   p.manual.micro_speed_fraction = m.number("micro_speed_fraction", 0.0, 1.0);
   p.manual.maintenance_speed_fraction = m.number("maintenance_speed_fraction", 0.0, 1.0);
   p.manual.dead_man_timeout = m.number("dead_man_timeout", 0.02, 5.0);
@@ -38,6 +46,10 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   m.finish();
   s.finish();
   p.site = facts.site;
+  if (p.bridge_enabled && !p.site.zones.empty()) {
+    throw common::ConfigError("site.zones: no-go zones are planned around for a slewing crane only (crane.kind = "
+                              "overhead has " + std::to_string(p.site.zones.size()) + " zones)");
+  }
   p.cable_min_length = facts.crane.min_cable_length;
   p.cable_max_length = facts.crane.max_cable_length;
   p.gravity = facts.crane.gravity;
@@ -60,12 +72,16 @@ const char* goal_status_name(GoalStatus s) noexcept {
     case GoalStatus::rejected_operating_mode: return "rejected: goals are not taken in this operating mode";
     case GoalStatus::rejected_supervisor_stop: return "rejected: the supervisor has stopped the crane (fault or emergency stop)";
     case GoalStatus::rejected_manual_motion: return "rejected: operator speed control is moving the crane";
+    case GoalStatus::rejected_bridge_out_of_range: return "rejected: bridge target outside its travel (or no bridge)";
   }
   return "unknown";
 }
 
-MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current) noexcept {
+MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current, const ManualParams& rated) noexcept {
   MoveGoal g;
+  g.trolley_limits = {rated.trolley.rated_speed, rated.trolley.acceleration};
+  g.slew_limits = {rated.slew.rated_speed, rated.slew.acceleration};
+  g.cable_limits = {rated.hoist.rated_speed, rated.hoist.acceleration};
   g.request_id = r.request_id;
   switch (r.profile) {
     case Request::PROFILE_STEP: g.profile = ProfileKind::step; break;
@@ -136,6 +152,11 @@ void describe_rejection(GoalStatus status, const MoveGoal& goal, const Trajector
     case GoalStatus::rejected_operating_mode: f.reason = S::REASON_MODE; return;
     case GoalStatus::rejected_supervisor_stop: f.reason = S::REASON_FAULT; return;
     case GoalStatus::rejected_manual_motion: f.reason = S::REASON_MANUAL_MOTION; return;
+    case GoalStatus::rejected_bridge_out_of_range:  // value: the caller's (the bridge target)
+      f.reason = S::REASON_BRIDGE_RANGE;
+      f.bound_min = params.bridge_min_position;
+      f.bound_max = params.bridge_max_position;
+      return;
   }
 }
 
@@ -143,6 +164,7 @@ TrajectoryPlannerStage::TrajectoryPlannerStage(const TrajectoryPlannerParams& pa
     : planner_(params), scratch_(params), sample_period_(sample_period) {
   common::require_greater("stack.sample_period", sample_period, 0.0);
   zones_enabled_ = params.site.enabled_at_start();
+  if (params.bridge_enabled) bridge_.emplace(params.bridge_view());
 }
 
 void TrajectoryPlannerStage::record(const GoalOutcome& outcome) noexcept {
@@ -166,6 +188,10 @@ protocol::MoveStatus* TrajectoryPlannerStage::report(std::uint32_t request_id, s
   s.rest_trolley_position = active_goal_.trolley_target;
   s.rest_slew_angle = active_goal_.slew_target;
   s.rest_cable_length = active_goal_.cable_target;
+  if (bridge_) {
+    s.bridge_to_go = bridge_->target - bridge_->reference(source_ == Source::speed).position;
+    s.rest_bridge_position = bridge_->target;
+  }
   return &s;
 }
 
@@ -179,6 +205,11 @@ void TrajectoryPlannerStage::report_rest(protocol::MoveStatus& s) const noexcept
   s.trolley_to_go = rest[0] - now.trolley.position;
   s.slew_to_go = rest[1] - now.slew.position;
   s.cable_to_go = rest[2] - now.cable_length.position;
+  if (bridge_) {
+    const auto& b = bridge_->params;
+    s.rest_bridge_position = bridge_->speed.rest(sample_period_, b.manual, b.manual.shaping, b.speed_bounds())[0];
+    s.bridge_to_go = s.rest_bridge_position - bridge_->speed.reference().trolley.position;
+  }
 }
 
 void TrajectoryPlannerStage::abort_active(std::uint8_t reason) noexcept {
@@ -187,12 +218,14 @@ void TrajectoryPlannerStage::abort_active(std::uint8_t reason) noexcept {
 }
 
 bool TrajectoryPlannerStage::moving() const noexcept {
-  return source_ == Source::speed ? !speed_.at_rest() : output_.phase == MovePhase::moving;
+  return source_ == Source::speed ? !speed_.at_rest() || (bridge_ && !bridge_->speed.at_rest())
+                                  : output_.phase == MovePhase::moving;
 }
 
 void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id) noexcept {
   if (source_ == Source::profile) {
     speed_.start(planner_.sample_now());
+    if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
     source_ = Source::speed;
   }
   stop_id_ = stop_id;
@@ -205,9 +238,10 @@ void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id) noexcept {
 void TrajectoryPlannerStage::take_speeds(std::span<const protocol::OperatorSpeed> speeds, std::uint64_t seq) noexcept {
   using Speed = protocol::OperatorSpeed;
   for (const auto& sample : speeds) {
-    const double values[] = {sample.trolley, sample.slew, sample.hoist};
+    const double values[] = {sample.trolley, sample.slew, sample.hoist, sample.bridge};
     bool valid = sample.range == Speed::RANGE_NORMAL || sample.range == Speed::RANGE_MICRO;
     for (const double v : values) valid = valid && std::isfinite(v) && std::abs(v) <= 1.0;
+    valid = valid && (bridge_ || sample.bridge == 0.0);  // a bridge speed for a crane without a bridge
     if (!valid) {
       ++rejected_speeds_;
       continue;
@@ -217,24 +251,26 @@ void TrajectoryPlannerStage::take_speeds(std::span<const protocol::OperatorSpeed
       continue;
     }
     operator_speed_ = {sample.trolley, sample.slew, sample.hoist};
+    if (bridge_) bridge_->operator_speed = sample.bridge;
     operator_micro_ = sample.range == Speed::RANGE_MICRO;
     operator_seq_ = seq;
     have_operator_input_ = true;
   }
 }
 
-std::array<double, 3> TrajectoryPlannerStage::targets_of(std::uint64_t seq) const noexcept {
+std::array<double, 4> TrajectoryPlannerStage::targets_of(std::uint64_t seq) const noexcept {
   const auto& m = planner_.params().manual;
   const bool silent = !have_operator_input_ ||
                       static_cast<double>(seq - operator_seq_) * sample_period_ > m.dead_man_timeout + 1e-9;
   if (silent || require_neutral_ || stop_id_ != 0 || supervisor_stopped_ ||
       operating_mode_ == protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC) {
-    return {0.0, 0.0, 0.0};
+    return {0.0, 0.0, 0.0, 0.0};
   }
   double fraction = operator_micro_ ? m.micro_speed_fraction : 1.0;
   if (operating_mode_ == protocol::SupervisorStatus::OPERATION_MAINTENANCE) fraction *= m.maintenance_speed_fraction;
   return {operator_speed_[0] * fraction * m.trolley.rated_speed, operator_speed_[1] * fraction * m.slew.rated_speed,
-          operator_speed_[2] * fraction * m.hoist.rated_speed};
+          operator_speed_[2] * fraction * m.hoist.rated_speed,
+          bridge_ ? bridge_->operator_speed * fraction * m.bridge.rated_speed : 0.0};
 }
 
 common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, protocol::Reference& reference) noexcept {
@@ -249,9 +285,20 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
   cycle_estimate_ = &estimate;
   const std::uint64_t seq = estimate.header.seq;
   const auto current = common::to_estimate(estimate);
+  // The bridge's planner holds and moves the bridge as its trolley, at the crane's slew 0 and cable.
+  const auto bridge_state = [&](double position) {
+    common::CraneStateEstimate b = current;
+    b.trolley_position = position;
+    b.slew_angle = 0.0;
+    return b;
+  };
+  const auto hold_bridge = [&](double position) {
+    if (bridge_) (void)bridge_->planner.hold(bridge_state(position));
+  };
   if (!holding_) {
     holding_ = planner_.hold(current) == GoalStatus::accepted;
     if (!holding_) return common::StepStatus::not_ready;
+    hold_bridge(estimate.bridge_position);
   }
   const auto& params = planner_.params();
 
@@ -287,6 +334,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     hold_on_release_ = false;
     source_ = Source::profile;
     (void)planner_.hold(current);
+    hold_bridge(estimate.bridge_position);
   } else if ((zone_warning || limit_warning) && moving() && stop_id_ == 0) {
     // The supervisor's first reaction where a hard stop is not yet required: this soft stop.
     abort_active(zone_warning ? Feedback::REASON_ZONE : Feedback::REASON_LIMIT_APPROACH);
@@ -295,7 +343,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
 
   // Start `r` now: the planner takes it or refuses it (the running move then continues).
   const auto start = [&](const Request& r) {
-    MoveGoal goal = to_goal(r, current);
+    MoveGoal goal = to_goal(r, current, params.manual);
     // Refuses with the reason; `value` the mode or zone it names.
     const auto reject = [&](GoalStatus status, double value) {
       if (auto* f = report(r.request_id, Feedback::RESULT_REJECTED)) {
@@ -309,7 +357,9 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     if (operating_mode_ == Status::OPERATION_MANUAL || operating_mode_ == Status::OPERATION_MAINTENANCE) {
       return reject(GoalStatus::rejected_operating_mode, operating_mode_);
     }
-    if (source_ == Source::speed && !speed_.at_rest()) return reject(GoalStatus::rejected_manual_motion, 0.0);
+    if (source_ == Source::speed && (!speed_.at_rest() || (bridge_ && !bridge_->speed.at_rest()))) {
+      return reject(GoalStatus::rejected_manual_motion, 0.0);
+    }
     // The move starts from where the reference rests (the speed reference, or the estimate).
     common::CraneStateEstimate from = current;
     if (source_ == Source::speed) {
@@ -327,8 +377,40 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       if (!plan.found) return reject(GoalStatus::rejected_zone, plan.zone);
       goal = plan.goal;
     }
+    // The bridge first, on its own planner's copy: both axes start the goal, or neither.
+    MoveGoal bridge_goal;
+    if (bridge_) {
+      bridge_goal = goal;  // profile, cable target and limits, waypoints' cable lengths
+      const bool named = (r.axes & Request::AXIS_BRIDGE) != 0;
+      const double bridge_from = source_ == Source::speed ? bridge_->speed.reference().trolley.position
+                                                          : estimate.bridge_position;
+      bridge_goal.trolley_target = named ? r.bridge_target : bridge_from;
+      bridge_goal.trolley_limits = {r.bridge_max_velocity > 0.0 ? r.bridge_max_velocity : params.manual.bridge.rated_speed,
+                                    r.bridge_max_acceleration > 0.0 ? r.bridge_max_acceleration
+                                                                    : params.manual.bridge.acceleration};
+      bridge_goal.slew_target = 0.0;
+      for (std::size_t i = 0; i < std::min<std::size_t>(goal.waypoint_count, kMaxWaypoints); ++i) {
+        bridge_goal.waypoints[i].trolley = named ? r.waypoint_bridge[i] : bridge_from;
+        bridge_goal.waypoints[i].slew = 0.0;
+      }
+      common::CraneStateEstimate bridge_start = from;
+      bridge_start.trolley_position = bridge_from;
+      bridge_start.slew_angle = 0.0;
+      bridge_->trial = bridge_->planner;
+      GoalStatus b = bridge_->trial.start_move(bridge_goal, bridge_start);
+      if (b == GoalStatus::rejected_trolley_out_of_range || b == GoalStatus::rejected_waypoint) {
+        b = GoalStatus::rejected_bridge_out_of_range;
+      }
+      if (b != GoalStatus::accepted) return reject(b, bridge_goal.trolley_target);  // value: bridge_out_of_range's
+    } else if ((r.axes & Request::AXIS_BRIDGE) != 0) {
+      return reject(GoalStatus::rejected_bridge_out_of_range, r.bridge_target);
+    }
     const GoalStatus status = planner_.start_move(goal, from);
     if (status != GoalStatus::accepted) return reject(status, 0.0);
+    if (bridge_) {
+      bridge_->planner = bridge_->trial;
+      bridge_->target = bridge_goal.trolley_target;
+    }
     if (active_ && active_goal_.request_id != goal.request_id) abort_active(Feedback::REASON_REPLACED);
     source_ = Source::profile;
     stop_id_ = 0;
@@ -372,7 +454,8 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
           f->rest_trolley_position = output_.reference.trolley.position;
           f->rest_slew_angle = output_.reference.slew.position;
           f->rest_cable_length = output_.reference.cable_length.position;
-          f->trolley_to_go = f->slew_to_go = f->cable_to_go = 0.0;
+          f->trolley_to_go = f->slew_to_go = f->cable_to_go = f->bridge_to_go = 0.0;
+          if (bridge_) f->rest_bridge_position = bridge_->reference(source_ == Source::speed).position;
         }
         continue;
       }
@@ -397,9 +480,11 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
 
   // Operator speeds: taken in the manual modes; in SEMIAUTOMATIC they take over from a goal.
   take_speeds(cycle.speeds, seq);
-  const auto targets = targets_of(seq);
+  const auto all_targets = targets_of(seq);
+  const std::array<double, 3> targets{all_targets[0], all_targets[1], all_targets[2]};
   targets_ = targets;
-  const bool commanding = targets[0] != 0.0 || targets[1] != 0.0 || targets[2] != 0.0;
+  if (bridge_) bridge_->speed_target = all_targets[3];
+  const bool commanding = targets[0] != 0.0 || targets[1] != 0.0 || targets[2] != 0.0 || all_targets[3] != 0.0;
   if (require_neutral_ && have_operator_input_ && operator_speed_ == std::array<double, 3>{} &&
       (source_ == Source::profile || speed_.at_rest())) {
     require_neutral_ = false;
@@ -408,12 +493,22 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     if (active_ && output_.phase == MovePhase::moving) abort_active(Feedback::REASON_MANUAL_MOTION);
     active_ = false;
     speed_.start(planner_.sample_now());
+    if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
     source_ = Source::speed;
   }
 
   if (source_ == Source::profile) {
     const auto status = planner_.step(sample_period_, output_);
     if (status != common::StepStatus::ok) return status;
+    if (bridge_) {
+      // One move: moving while either axis moves, its duration the longer one's.
+      (void)bridge_->planner.step(sample_period_, bridge_->output);
+      if (bridge_->output.phase == MovePhase::moving && output_.phase == MovePhase::arrived) {
+        output_.phase = MovePhase::moving;
+      }
+      output_.move_duration = std::max(output_.move_duration, bridge_->output.move_duration);
+      output_.time_in_move = std::max(output_.time_in_move, bridge_->output.time_in_move);
+    }
     if (active_) {
       const auto id = static_cast<std::uint32_t>(active_goal_.request_id);
       if (output_.phase == MovePhase::arrived && output_.request_id == active_goal_.request_id) {
@@ -429,15 +524,23 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
                                                                                         : params.manual.shaping;
     held_axes_ = speed_.step(targets, sample_period_, params.manual, shaping, params.speed_bounds(), params.site,
                              zones_enabled_);
+    bool at_rest = speed_.at_rest();
+    if (bridge_) {
+      const auto& b = bridge_->params;
+      const std::uint8_t held = bridge_->speed.step({bridge_->speed_target, 0.0, 0.0}, sample_period_, b.manual, shaping,
+                                                    b.speed_bounds(), b.site, 0);
+      if ((held & protocol::MoveRequest::AXIS_TROLLEY) != 0) held_axes_ |= protocol::MoveRequest::AXIS_BRIDGE;
+      at_rest = at_rest && bridge_->speed.at_rest();
+    }
     output_.reference = speed_.reference();
     output_.request_id = stop_id_;
-    output_.phase = speed_.at_rest() ? MovePhase::arrived : MovePhase::moving;
+    output_.phase = at_rest ? MovePhase::arrived : MovePhase::moving;
     const bool released = was_commanding_ && !commanding;
     if (stop_id_ == 0 && (released || (!speed_.at_rest() && ++cycles_since_manual_report_ >= kProgressCycles))) {
       if (auto* s = report(0, Feedback::RESULT_MANUAL)) report_rest(*s);
       cycles_since_manual_report_ = 0;
     }
-    if (speed_.at_rest()) {
+    if (at_rest) {
       // At rest: back to holding the rest position (goals start from it).
       if (stop_id_ != 0) {
         if (auto* s = report(stop_id_, Feedback::RESULT_ARRIVED)) report_rest(*s);
@@ -449,11 +552,18 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       rest.slew_angle = r.slew.position;
       rest.cable_length = r.cable_length.position;
       (void)planner_.hold(rest);
+      if (bridge_) hold_bridge(bridge_->speed.reference().trolley.position);
       source_ = Source::profile;
     }
   }
   was_commanding_ = commanding;
   common::from_reference(output_.reference, reference);
+  if (bridge_) {
+    const common::AxisReference b = bridge_->reference(source_ == Source::speed);
+    reference.bridge_position = b.position;
+    reference.bridge_velocity = b.velocity;
+    reference.bridge_acceleration = b.acceleration;
+  }
   reference.request_id = static_cast<std::uint32_t>(output_.request_id);
   reference.phase = static_cast<std::uint8_t>(output_.phase);
   reference.time_in_move = output_.time_in_move;

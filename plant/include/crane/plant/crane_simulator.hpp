@@ -51,16 +51,8 @@ struct PlantState {
   double rope_stretch_rate{0.0};         // [m/s]
 };
 
-/// Which crane the plant simulates (config: plant.kind).
-enum class PlantKind {
-  tower,     // TowerCraneModel: trolley along the jib, slew, hoist, two swings (the lab crane, ch. 4)
-  gantry,    // GantryCraneModel: trolley on a rail, hoist, one swing, (2.5)-(2.6)
-  overhead,  // OverheadCraneModel: bridge and trolley at right angles, hoist, two swings
-};
-/// "tower", "gantry", "overhead".
-[[nodiscard]] const char* to_string(PlantKind kind) noexcept;
-/// Parses `text`; throws common::ConfigError naming `field`, the value and the accepted values.
-[[nodiscard]] PlantKind plant_kind_from_string(const std::string& text, const std::string& field);
+/// Which crane the plant simulates: the config's crane.kind (common::CraneKind, a shared fact).
+using PlantKind = common::CraneKind;
 /// The model of `kind` (bridge used by the overhead crane only); throws common::ConfigError for
 /// invalid parameters.
 [[nodiscard]] std::unique_ptr<CraneDynamics> make_crane_dynamics(PlantKind kind, const common::CraneParameters& crane,
@@ -71,10 +63,10 @@ enum class PlantKind {
 /// Commands held for one sample.
 struct DriveInput {
   double trolley_voltage{0.0};  // [V] before the DAC
-  double slew_voltage{0.0};     // [V] before the DAC: the second drive (slew; the bridge on an
-                                //     overhead crane; ignored on a gantry)
+  double slew_voltage{0.0};     // [V] before the DAC: the slew drive (ignored on a gantry or overhead crane)
   double hoist_speed{0.0};      // [m/s] commanded dL/dt (positive lowers the load)
   bool brakes_engaged{true};    // both drive brakes
+  double bridge_voltage{0.0};   // [V] before the DAC: the bridge drive (overhead crane only; ignored elsewhere)
 };
 
 struct SimulatorParameters {
@@ -94,10 +86,11 @@ struct SimulatorParameters {
 };
 
 struct SimulatorOutput {
-  common::CraneMeasurement measurement;  // quantized sensors of the current state (no bridge field yet:
-                                         // an overhead crane's bridge is in CraneSimulator::state() only)
+  common::CraneMeasurement measurement;  // quantized sensors of the current state (bridge_position: overhead
+                                         // crane, through the trolley's encoder model; 0 elsewhere)
   double applied_trolley_voltage{0.0};   // [V] after the DAC, last sample
   double applied_slew_voltage{0.0};      // [V] after the DAC, last sample
+  double applied_bridge_voltage{0.0};    // [V] after the DAC, last sample (overhead crane)
   double applied_hoist_speed{0.0};       // [m/s] rate-limited hoist speed at the end of the last sample
   bool brakes_engaged{true};             // last sample
 };
@@ -161,6 +154,7 @@ class CraneSimulator {
   std::int64_t sample_index_{0};
   double applied_trolley_voltage_{0.0};
   double applied_slew_voltage_{0.0};
+  double applied_bridge_voltage_{0.0};
   double applied_hoist_speed_{0.0};
   bool brakes_engaged_{true};
 };

@@ -56,6 +56,9 @@ class DrivesAndSensors {
   [[nodiscard]] std::int64_t swing_angle_to_encoder_counts(double swing_angle) const noexcept;
   [[nodiscard]] double swing_encoder_counts_to_angle(std::int64_t encoder_counts) const noexcept;  // [rad]
 
+  /// An overhead crane's bridge position [m], quantized by an encoder like the trolley's (same lines
+  /// and travel per motor radian, crane.motor_encoder_lines and crane.leadscrew_pitch).
+  [[nodiscard]] double measure_bridge(double bridge_position) const noexcept;
   /// Quantized measurement of the true positions [m, rad, rad, rad], cable length [m] passed through.
   [[nodiscard]] common::CraneMeasurement measure(double trolley_position, double slew_angle, double swing_in_plane,
                                                  double swing_out_of_plane, double cable_length) const noexcept;

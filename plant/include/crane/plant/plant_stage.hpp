@@ -47,10 +47,9 @@ struct PlantStageParams {
   PlantMismatch mismatch{};
 };
 
-/// Reads the `plant:` block (kind: tower | gantry | overhead (PlantKind), with a `bridge:` block
-/// (config::read_bridge) for the overhead crane only; relative_tolerance, absolute_tolerance [-] in [1e-16, 1e-3],
+/// Reads the `plant:` block (relative_tolerance, absolute_tolerance [-] in [1e-16, 1e-3],
 /// brake_holding_factor [-] in [1, 1000], hoist_max_acceleration [m/s^2] in [1e-3, 100]); the
-/// crane, sample period from facts; the initial state at rest with the crane's cable length. The
+/// crane, its kind (crane.kind) and bridge (crane.bridge), sample period from facts; the initial state at rest with the crane's cable length. The
 /// gate's params are read from `actuation:` by supervisor::read_actuation_params. Throws
 /// common::ConfigError naming the field.
 [[nodiscard]] SimulatorParameters read_params(config::YamlSection& block, const common::StackFacts& facts);
@@ -59,8 +58,7 @@ class PlantStage {
  public:
   static constexpr int kMaxSensorDelay = 16;  // [cycles]
 
-  /// Throws common::ConfigError for invalid params (simulator, gate or mismatch), and for
-  /// plant.kind = overhead (the topics have no bridge axis yet; tower and gantry run).
+  /// Throws common::ConfigError for invalid params (simulator, gate or mismatch).
   explicit PlantStage(const PlantStageParams& params);
 
   /// The sensor sample of the current cycle: header.seq = cycle(), source SOURCE_PLANT; the

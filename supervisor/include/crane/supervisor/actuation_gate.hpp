@@ -69,6 +69,7 @@ struct SupervisorPermit {
   bool brakes_released{false};
   double trolley_voltage_limit{0.0};  // [V] current magnitude limit on the trolley drive, >= 0
   double slew_voltage_limit{0.0};     // [V] current magnitude limit on the slew drive, >= 0
+  double bridge_voltage_limit{0.0};   // [V] current magnitude limit on the bridge drive (overhead crane), >= 0
 };
 
 struct GateInput {
@@ -165,7 +166,13 @@ namespace crane::supervisor {
 
 /// What the gate takes of a SupervisorStatus.
 [[nodiscard]] inline SupervisorPermit permit_of(const protocol::SupervisorStatus& status) noexcept {
-  return {status.motion_enabled, status.brakes_released, status.trolley_voltage_limit, status.slew_voltage_limit};
+  return {status.motion_enabled, status.brakes_released, status.trolley_voltage_limit, status.slew_voltage_limit,
+          status.bridge_voltage_limit};
+}
+
+/// The drive command an ActuatorCommand carries.
+[[nodiscard]] inline common::DriveCommand drive_command_of(const protocol::ActuatorCommand& command) noexcept {
+  return {command.trolley_voltage, command.slew_voltage, command.hoist_speed, command.bridge_voltage};
 }
 
 /// Lockstep (docs/architecture.md, "The 100 Hz cycle"), the one place of its rules for the plant,
@@ -186,7 +193,7 @@ namespace crane::supervisor {
   GateInput in;
   in.time = static_cast<double>(cycle) * sample_period;
   in.command_received = command != nullptr;
-  if (command != nullptr) in.command = {command->trolley_voltage, command->slew_voltage, command->hoist_speed};
+  if (command != nullptr) in.command = drive_command_of(*command);
   in.command_arrival_time = in.time;
   in.status_received = true;
   in.status = permit_of(gating);

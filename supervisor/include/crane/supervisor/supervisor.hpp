@@ -89,8 +89,10 @@ enum Fault : std::uint32_t {
   kFaultSensorSource = StatusCodes::FAULT_SENSOR_SOURCE,
   kFaultLimitSwitch = StatusCodes::FAULT_LIMIT_SWITCH,
   kFaultZone = StatusCodes::FAULT_ZONE,
+  kFaultBridgeTravel = StatusCodes::FAULT_BRIDGE_TRAVEL,
+  kFaultBridgeOverspeed = StatusCodes::FAULT_BRIDGE_OVERSPEED,
 };
-inline constexpr int kFaultBits = 15;
+inline constexpr int kFaultBits = 17;
 /// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
 [[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
 
@@ -98,6 +100,7 @@ inline constexpr int kFaultBits = 15;
 enum Warning : std::uint32_t {
   kWarningTrolleyApproach = StatusCodes::WARNING_TROLLEY_APPROACH,  // trolley in its approach margin, moving toward the limit
   kWarningSlewApproach = StatusCodes::WARNING_SLEW_APPROACH,        // jib in its approach margin, moving toward the limit
+  kWarningBridgeApproach = StatusCodes::WARNING_BRIDGE_APPROACH,    // bridge in its approach margin, moving toward the limit
   kWarningSpeedLimited = StatusCodes::WARNING_SPEED_LIMITED,        // an approach speed was exceeded: drive voltage limited
   kWarningStageLate = StatusCodes::WARNING_STAGE_LATE,              // a stage is late (not fresh, or a DDS deadline missed):
                                                               // motion inhibited while it lasts, not yet dead
@@ -160,7 +163,19 @@ struct SupervisorParams {
   double trolley_braking_deceleration{0.9929};  // [m/s^2] predicts the trolley's stopping position (zones)
   double slew_braking_deceleration{2.0796};     // [rad/s^2] predicts the slew's stopping angle (zones)
   common::Site site{};               // the no-go zones (a shared fact, `site:`)
+  // An overhead crane's bridge (crane.kind = overhead; bridge_enabled false elsewhere): its runway travel,
+  // guarded like the trolley's.
+  bool bridge_enabled{false};
+  double bridge_min{0.0};            // [m] hard travel limit
+  double bridge_max{1.0};            // [m]
+  double bridge_approach_margin{0.1};  // [m]
+  double bridge_stop_margin{0.02};     // [m]
+  double bridge_approach_speed{0.05};  // [m/s]
+  double bridge_max_speed{1.0};        // [m/s]
 
+  [[nodiscard]] AxisLimits bridge() const noexcept {
+    return {bridge_min, bridge_max, bridge_approach_margin, bridge_stop_margin, bridge_approach_speed, bridge_max_speed};
+  }
   [[nodiscard]] AxisLimits trolley() const noexcept {
     return {trolley_min, trolley_max, trolley_approach_margin, trolley_stop_margin, trolley_approach_speed,
             trolley_max_speed};
@@ -208,6 +223,8 @@ struct SupervisorInput {
   std::uint64_t actuator_seq{0};      // cycle number of the latest actuator command
   double trolley_voltage{0.0};        // [V] latest actuator command
   double slew_voltage{0.0};           // [V]
+  double bridge_position{0.0};        // [m] overhead crane, from the latest sensor sample
+  double bridge_voltage{0.0};         // [V] overhead crane, latest actuator command
   bool emergency_stop_input{false};   // hardware input
   int sensor_writers{1};              // writers matched on the sensors topic
   int actuator_writers{1};            // writers matched on the actuators topic
@@ -234,6 +251,8 @@ struct SupervisorOutput {
   double slew_voltage_limit{0.0};     // [V]
   double trolley_velocity{0.0};       // [m/s] differentiated from the sensor samples
   double slew_rate{0.0};              // [rad/s]
+  double bridge_voltage_limit{0.0};   // [V] overhead crane (0 elsewhere)
+  double bridge_velocity{0.0};        // [m/s]
   std::uint8_t operating_mode{StatusCodes::OPERATION_FULLAUTOMATIC};  // an OPERATION_* code
   std::uint32_t zones_enabled{0};     // bit i: site.zones[i] enforced
   int zone{-1};                       // the zone of fault zone or warning zone_approach (-1: none)
@@ -278,6 +297,10 @@ class Supervisor {
   double slew_rate_{0.0};
   int trolley_overspeed_samples_{0};  // consecutive sensor samples over max_speed
   int slew_overspeed_samples_{0};
+  double previous_bridge_{0.0};
+  double bridge_velocity_{0.0};
+  int bridge_overspeed_samples_{0};
+  double previous_bridge_voltage_{0.0};
   // Voltage rate from successive actuator commands.
   bool have_previous_command_{false};
   std::uint64_t previous_actuator_seq_{0};

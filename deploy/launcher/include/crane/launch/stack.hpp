@@ -28,6 +28,7 @@ struct StackOptions {
   bool lockstep{true};                // plant clock: lockstep (default) or realtime
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]
+  double initial_bridge_position{0.0};    // [m] overhead crane
   bool friction_compensation{true};
   std::string plant_stats_path;       // the sensor writer (plant or hardware_bridge) writes its loop statistics
                                       // (cycles, overruns, latency log) here on exit (optional)

@@ -13,6 +13,7 @@
 // gains). A new law: an enumerator here, its case in anti_swing_stage.cpp, its code in the IDL.
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 #include <variant>
 
@@ -43,6 +44,8 @@ enum class AntiSwingLaw : std::uint8_t {
 struct AntiSwingStageParams {
   AntiSwingLaw law{AntiSwingLaw::delay1};
   AntiSwingParams anti_swing{};  // gains, delay, sample period, gravity, cable range (kind follows law)
+  bool bridge{false};            // an overhead crane (facts.crane_kind): the same law on the bridge, on its
+                                 // gantry view (common::bridge_view), into bridge_action / bridge_reference_*
 };
 
 /// Reads the `anti_swing:` block: controller (a law name), pd_proportional_gain, pd_derivative_gain,
@@ -63,8 +66,18 @@ class AntiSwingStage {
   [[nodiscard]] AntiSwingLaw law() const noexcept { return law_; }
 
  private:
+  using Core = std::variant<AntiSwing, anti_swing_analysis::FuzzyAntiSwing, anti_swing_analysis::DelayedTrajectoryAntiSwing>;
+  struct Result {
+    common::StepStatus status{common::StepStatus::ok};
+    AntiSwingOutput action{};
+    anti_swing_analysis::TrajectoryCorrection correction{};
+  };
+  /// One cycle of `core` on `estimate` (finite); not_ready gives every field 0.
+  [[nodiscard]] static Result run(Core& core, const protocol::CraneState& estimate) noexcept;
+
   AntiSwingLaw law_;
-  std::variant<AntiSwing, anti_swing_analysis::FuzzyAntiSwing, anti_swing_analysis::DelayedTrajectoryAntiSwing> core_;
+  Core core_;
+  std::optional<Core> bridge_core_;
 };
 
 }  // namespace crane::anti_swing

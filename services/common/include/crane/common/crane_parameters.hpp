@@ -8,7 +8,20 @@
 // (coefficient divided by the motor gain K_m, Tables 3.1-4.2), so the same numbers serve the plant
 // and the friction compensator (3.5).
 
+#include <string>
+
 namespace crane::common {
+
+/// Which crane: the config's `crane.kind`, a fact every stage shares (stack_facts.hpp).
+enum class CraneKind {
+  tower,     // trolley along the jib, slew, hoist, two swings (the lab crane, chapter 4)
+  gantry,    // trolley on a rail, hoist, one swing, (2.5)-(2.6): the slew fields are unused
+  overhead,  // bridge and trolley at right angles, hoist, two swings: the bridge fields carry the bridge
+};
+/// "tower", "gantry", "overhead".
+[[nodiscard]] const char* to_string(CraneKind kind) noexcept;
+/// Parses `text`; throws common::ConfigError naming `field`, the value and the accepted values.
+[[nodiscard]] CraneKind crane_kind_from_string(const std::string& text, const std::string& field);
 
 /// Direction-dependent friction of one drive axis, (3.1)-(3.3), in volt-equivalents:
 /// a friction force F on an axis with drive gain K_m [accel/V] is stored as F/(mass*K_m) [V].
@@ -63,6 +76,13 @@ struct BridgeParameters {
   double drive_gain{2.0};    // [m/s^2/V] K_my: bridge acceleration per volt on mass M_y; > 0
   AxisFriction friction{};   // volt-equivalents as for the trolley ((3.1)-(3.3) with K_my)
 };
+
+/// The bridge seen as the trolley of a gantry crane, the way the controllers treat it: the
+/// linearized bridge row of the overhead crane, y_dd - m_ty g theta = K_my V_y with
+/// L theta_dd + g theta + y_dd = 0 (overhead_crane_model.hpp), is the trolley's (2.7)-(2.8) with
+/// phi = -theta, M = M_y, K_mx = K_my and the bridge's friction. Returns `crane` with those
+/// replaced (the load, cable and sensors stay the crane's).
+[[nodiscard]] CraneParameters bridge_as_trolley(const CraneParameters& crane, const BridgeParameters& bridge) noexcept;
 
 /// Throws crane::common::ConfigError naming the field (prefixed by `prefix`), value and bound
 /// if any parameter is non-finite or out of its physical range.

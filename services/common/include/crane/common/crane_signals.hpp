@@ -13,6 +13,7 @@ struct CraneMeasurement {
   double swing_in_plane{0.0};      // [rad] phi
   double swing_out_of_plane{0.0};  // [rad] theta
   double cable_length{1.0};        // [m] L
+  double bridge_position{0.0};     // [m] y, overhead crane (0 elsewhere)
 };
 
 /// Estimated state: positions and their rates (section 4.3).
@@ -58,6 +59,7 @@ struct DriveCommand {
   double trolley_voltage{0.0};  // [V]
   double slew_voltage{0.0};     // [V]
   double hoist_speed{0.0};      // [m/s]
+  double bridge_voltage{0.0};   // [V] overhead crane (0 elsewhere)
 };
 
 /// Result of a cyclic step() of any core: the cyclic path never throws (STYLE.md habit 7).

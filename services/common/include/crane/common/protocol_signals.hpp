@@ -16,6 +16,7 @@ namespace crane::common {
   m.swing_in_plane = s.swing_in_plane;
   m.swing_out_of_plane = s.swing_out_of_plane;
   m.cable_length = s.cable_length;
+  m.bridge_position = s.bridge_position;
   return m;
 }
 
@@ -97,6 +98,52 @@ inline void from_reference(const MotionReference& m, protocol::Reference& r) noe
   r.cable_length = m.cable_length.position;
   r.cable_length_rate = m.cable_length.velocity;
   r.cable_length_acceleration = m.cable_length.acceleration;
+}
+
+// The overhead crane's bridge, seen as the trolley of a gantry crane: how every controller stage
+// runs the bridge axis with its trolley law and the bridge's parameters (common::bridge_as_trolley,
+// which gives the reason). trolley_* := bridge_*, swing_in_plane := -swing_out_of_plane (theta moves
+// the load toward +y where phi moves it toward -x, overhead_crane_model.hpp), the slew and the
+// out-of-plane swing 0; the rest (cable, payload, header) is kept. The bridge's friction in use is the
+// configured one (the online friction estimation covers the trolley and the slew only).
+
+[[nodiscard]] inline protocol::CraneState bridge_view(const protocol::CraneState& s) noexcept {
+  protocol::CraneState v = s;
+  v.trolley_position = s.bridge_position;
+  v.trolley_velocity = s.bridge_velocity;
+  v.trolley_velocity_raw = s.bridge_velocity_raw;
+  v.swing_in_plane = -s.swing_out_of_plane;
+  v.swing_in_plane_rate = -s.swing_out_of_plane_rate;
+  v.slew_angle = v.slew_rate = v.slew_rate_raw = 0.0;
+  v.swing_out_of_plane = v.swing_out_of_plane_rate = 0.0;
+  v.adaptation = 0;
+  return v;
+}
+
+[[nodiscard]] inline protocol::Reference bridge_view(const protocol::Reference& r) noexcept {
+  protocol::Reference v = r;
+  v.trolley_position = r.bridge_position;
+  v.trolley_velocity = r.bridge_velocity;
+  v.trolley_acceleration = r.bridge_acceleration;
+  v.slew_angle = v.slew_rate = v.slew_acceleration = 0.0;
+  return v;
+}
+
+[[nodiscard]] inline protocol::AntiSwingCommand bridge_view(const protocol::AntiSwingCommand& a) noexcept {
+  protocol::AntiSwingCommand v = a;
+  v.trolley_action = a.bridge_action;
+  v.trolley_reference_correction = a.bridge_reference_correction;
+  v.trolley_reference_rate_correction = a.bridge_reference_rate_correction;
+  v.slew_action = v.slew_reference_correction = v.slew_reference_rate_correction = 0.0;
+  return v;
+}
+
+[[nodiscard]] inline protocol::LinearCommand bridge_view(const protocol::LinearCommand& c) noexcept {
+  protocol::LinearCommand v = c;
+  v.trolley_voltage = c.bridge_voltage;
+  v.trolley_tracking_action = c.bridge_tracking_action;
+  v.slew_voltage = v.slew_tracking_action = 0.0;
+  return v;
 }
 
 /// The output's header belongs to the input's cycle: same seq and origin (the node stamps `stamp`

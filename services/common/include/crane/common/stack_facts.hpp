@@ -16,6 +16,8 @@ struct StackFacts {
   double lockstep_hang_timeout{5.0};   // [s] lockstep: wall time a cycle may wait before the chain is
                                        // reported hung (nothing is guessed: the cycle keeps waiting)
   CraneParameters crane;               // the crane as configured (cable range included)
+  CraneKind crane_kind{CraneKind::tower};  // crane.kind: which crane, hence which axes the topics carry
+  BridgeParameters bridge;             // crane.bridge: the overhead crane's bridge (crane_kind overhead only)
   Site site;                           // the jib height and the no-go zones (`site:`, optional: none)
 };
 

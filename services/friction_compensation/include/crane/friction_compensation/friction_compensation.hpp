@@ -40,6 +40,9 @@ struct FrictionCompensationParams {
   AxisCompensationParams slew{common::CraneParameters{}.slew_friction, 0.01, 20.0,
                               VelocitySource::filtered};     // (4.16), (4.15); section 4.4.2
   double voltage_limit{10.0};  // [V] outputs clamped to +-voltage_limit, > 0
+  // An overhead crane's bridge (facts.crane_kind): compensated like the trolley, on its gantry view
+  // (common::bridge_view), with the bridge's friction; absent elsewhere.
+  std::optional<AxisCompensationParams> bridge{};
 };
 
 struct FrictionCompensationInput {

@@ -17,7 +17,8 @@ class YamlSection;
 
 namespace crane::friction_compensation {
 
-/// Reads the `friction_compensation:` block: enabled, and per axis (trolley:, slew:)
+/// Reads the `friction_compensation:` block: enabled, and per axis (trolley:, slew:, and bridge: on an
+/// overhead crane only, with the bridge's friction)
 /// zero_velocity_band [m/s or rad/s] in [0, 10], stiction_slope [1/V] in [1e-3, 1e4],
 /// velocity_source (raw | filtered); the friction model is the crane's (4.12)-(4.16), the voltage
 /// limit the stack's. Throws common::ConfigError naming the field, value and bound.
@@ -36,6 +37,7 @@ class FrictionCompensationStage {
 
  private:
   FrictionCompensation compensation_;
+  std::optional<FrictionCompensation> bridge_;  // the overhead crane's bridge as a trolley
 };
 
 }  // namespace crane::friction_compensation

@@ -34,6 +34,7 @@ struct InProcessOptions {
   plant::PlantMismatch mismatch{};
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]
+  double initial_bridge_position{0.0};    // [m] overhead crane
 };
 
 class InProcessStack {

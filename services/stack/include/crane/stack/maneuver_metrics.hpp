@@ -14,6 +14,8 @@ struct RecordedCycle {
   double swing_out_of_plane{0.0};   // [rad]
   double trolley_voltage{0.0};      // [V] applied
   double slew_voltage{0.0};         // [V] applied
+  double bridge_position{0.0};      // [m] overhead crane (0 elsewhere)
+  double bridge_voltage{0.0};       // [V] applied
 };
 
 struct SettleCriteria {
@@ -27,14 +29,16 @@ struct ManeuverMetrics {
   double settle_time{0.0};            // [s] from the move start until every criterion holds for good; NaN if never
   double final_position_error{0.0};   // [m] |x - target| at the last cycle
   double final_slew_error{0.0};       // [rad] |gamma - target| at the last cycle
+  double final_bridge_error{0.0};     // [m] |y - target| at the last cycle (overhead crane; settles within
+                                      // trolley_tolerance like the trolley)
   double max_swing{0.0};              // [rad] max over the run of max(|phi|, |theta|)
   double residual_swing{0.0};         // [rad] same over the last residual_window
-  double max_voltage{0.0};            // [V] max |applied voltage| over both drives
+  double max_voltage{0.0};            // [V] max |applied voltage| over every drive
 };
 
 /// Evaluates a recording (cycles in time order, at least one). Throws std::invalid_argument when
 /// `cycles` is empty.
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
-                                  double slew_target, const SettleCriteria& criteria = {});
+                                  double slew_target, const SettleCriteria& criteria = {}, double bridge_target = 0.0);
 
 }  // namespace crane::stack

@@ -62,22 +62,26 @@ struct CycleRecord {
   double friction_x{0.0}, friction_gamma{0.0};  // [V] F_f/K_m added by the compensation
   double u_x_cmd{0.0}, u_gamma_cmd{0.0};      // [V] actuator command
   bool brakes{false};                         // brakes engaged over [k, k+1)
+  // An overhead crane's bridge (0 elsewhere; written to the CSV for an overhead crane only):
+  double y{0.0}, u_y{0.0}, y_ref{0.0}, V_y{0.0}, friction_y{0.0}, u_y_cmd{0.0};  // [m], [V], [m], [V], [V], [V]
 };
 [[nodiscard]] CycleRecord record_of(double t, const protocol::SensorSample& sensors, const protocol::SensorSample& next,
                                     const protocol::Reference* reference, const protocol::LinearCommand* linear,
                                     const protocol::ActuatorCommand* actuators) noexcept;
 /// The CSV: header line, rows with 9 significant digits. Every column is a function of the
 /// simulation alone, so two lockstep runs give the same file to the last bit.
-void write_csv(std::ostream& out, const std::vector<CycleRecord>& records);
+/// `bridge` (an overhead crane): the bridge's columns y, u_y, y_ref, V_y, friction_y, u_y_cmd follow.
+void write_csv(std::ostream& out, const std::vector<CycleRecord>& records, bool bridge = false);
 
 /// The figures of merit of the recorded move (throws std::invalid_argument when empty).
 [[nodiscard]] ManeuverMetrics evaluate(const std::vector<CycleRecord>& records, const ManeuverConfig& maneuver);
 
 /// The table (README, crane_demo, crane_sim): header line and one row per run, numbers rounded as
 /// printed ("-" for a settle time never reached).
-[[nodiscard]] std::string table_header();
+/// `bridge` (an overhead crane): a column bridge_err_mm follows.
+[[nodiscard]] std::string table_header(bool bridge = false);
 [[nodiscard]] std::string table_row(const std::string& maneuver, bool friction_compensation,
-                                    const ManeuverMetrics& metrics, double swing_period);
+                                    const ManeuverMetrics& metrics, double swing_period, bool bridge = false);
 /// `value` with `precision` decimals, "-" when not finite.
 [[nodiscard]] std::string format_number(double value, int precision);
 

@@ -37,6 +37,11 @@ struct ManeuverConfig {
   double slew_max_acceleration{2.0796};   // [rad/s^2]
   double cable_length_target{1.0};        // [m] hoisting during the move when it differs from crane.cable_length
   double duration{15.0};                  // [s] recorded after the move starts
+  // Overhead crane only (crane.kind = overhead; unknown fields elsewhere):
+  double initial_bridge_position{0.0};    // [m]
+  double bridge_target{0.0};              // [m]
+  double bridge_max_velocity{0.5};        // [m/s]
+  double bridge_max_acceleration{0.5};    // [m/s^2]
 };
 
 struct StackConfig {

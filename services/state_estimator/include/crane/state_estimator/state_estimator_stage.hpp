@@ -5,6 +5,8 @@
 // (crane::adaptation, online_adaptation.hpp) in its payload_* and *_friction_* fields: the
 // configured values while adaptation is off or has not identified them.
 
+#include <optional>
+
 #include "crane/adaptation/online_adaptation.hpp"
 #include "crane/common/stack_facts.hpp"
 #include "crane/protocol/messages.hpp"
@@ -19,6 +21,8 @@ namespace crane::state_estimator {
 struct StateEstimatorStageParams {
   StateEstimatorParams estimator{};
   adaptation::OnlineAdaptationParams adaptation{};  // the crane and sample period are the stack's facts
+  bool bridge{false};  // an overhead crane (facts.crane_kind): the bridge position is filtered and
+                       // differentiated like the trolley's, into bridge_velocity(_raw)
 };
 
 /// Reads the `state_estimator:` block: cutoff_frequency [Hz] in [1e-3, 0.499 fs], differentiator
@@ -39,6 +43,8 @@ class StateEstimatorStage {
 
  private:
   StateEstimator estimator_;
+  std::optional<StateEstimator> bridge_estimator_;  // the bridge through the trolley's filter (overhead crane)
+  common::CraneStateEstimate bridge_scratch_{};
   adaptation::OnlineAdaptation adaptation_;
   common::CraneStateEstimate scratch_{};
   adaptation::AdaptationEstimate adapted_{};

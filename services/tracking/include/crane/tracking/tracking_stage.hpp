@@ -15,6 +15,7 @@
 // configured crane otherwise.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string_view>
 
@@ -41,6 +42,9 @@ struct TrackingStageParams {
   gain_scheduling::GainSchedulingParams gain_scheduling{};  // the gain-scheduling laws (kind follows law)
   double trolley_drive_mass{22.222};  // [kg] M, > 0: m_t = payload_mass / M when the estimate is confident
   double jib_inertia{7.143};          // [kg m^2] J_o, > 0: m_r = payload_mass / J_o
+  // An overhead crane (facts.crane_kind): the bridge's stage, the same law on the bridge's gantry view
+  // (common::bridge_view) with the bridge's drive (common::bridge_as_trolley); null elsewhere.
+  std::shared_ptr<const TrackingStageParams> bridge;
 };
 
 /// Reads the `tracking:` block: proportional_gain [-] in [0, 1e4], derivative_gain [-] in [0, 1e3],
@@ -69,6 +73,7 @@ class TrackingStage {
   std::optional<gain_scheduling::GainSchedulingController> scheduled_;
   double trolley_drive_mass_;  // [kg]
   double jib_inertia_;         // [kg m^2]
+  std::unique_ptr<TrackingStage> bridge_;  // the overhead crane's bridge (its trolley is the bridge)
 };
 
 }  // namespace crane::tracking

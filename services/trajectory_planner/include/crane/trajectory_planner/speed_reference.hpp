@@ -95,6 +95,7 @@ struct ManualParams {
   SpeedAxisParams trolley{0.4982, 0.9929, true};   // [m/s], [m/s^2]
   SpeedAxisParams slew{1.0435, 2.0796, true};      // [rad/s], [rad/s^2]
   SpeedAxisParams hoist{0.2, 0.5, false};          // [m/s], [m/s^2] (+ lowers the load)
+  SpeedAxisParams bridge{0.5, 0.5, true};          // [m/s], [m/s^2] an overhead crane's bridge (read there only)
   double micro_speed_fraction{0.1};        // (0, 1]: fine positioning (OperatorSpeed RANGE_MICRO)
   double maintenance_speed_fraction{0.25}; // (0, 1]: every speed in MAINTENANCE mode
   double dead_man_timeout{0.2};            // [s] no operator input for longer: every axis released

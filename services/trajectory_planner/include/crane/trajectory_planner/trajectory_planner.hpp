@@ -56,6 +56,24 @@ struct TrajectoryPlannerParams {
   double ei_vibration_tolerance{0.05};  // [-] EI residual-vibration tolerance V, (0, 0.2]
   ManualParams manual{};              // operator speed control and stops (speed_reference.hpp)
   common::Site site{};                // the no-go zones (goals refused inside, paths planned around)
+  // An overhead crane's bridge (crane.kind = overhead; false elsewhere): its runway travel (its manual
+  // motion is manual.bridge). The planner stage runs it as the trolley of a second planner
+  // (bridge_view(); trajectory_planner_stage.hpp); the planner itself has no bridge axis.
+  bool bridge_enabled{false};
+  double bridge_min_position{0.0};    // [m]
+  double bridge_max_position{0.0};    // [m]
+
+  /// The params of the bridge's planner: the trolley's travel and manual motion replaced by the
+  /// bridge's, no zones, bridge_enabled false.
+  [[nodiscard]] TrajectoryPlannerParams bridge_view() const {
+    TrajectoryPlannerParams p = *this;
+    p.trolley_min_position = bridge_min_position;
+    p.trolley_max_position = bridge_max_position;
+    p.manual.trolley = manual.bridge;
+    p.site = common::Site{};
+    p.bridge_enabled = false;
+    return p;
+  }
 
   /// The bounds the speed reference keeps (the travel above).
   [[nodiscard]] SpeedBounds speed_bounds() const noexcept {
@@ -109,6 +127,8 @@ enum class [[nodiscard]] GoalStatus {
   rejected_operating_mode,        // goals are not taken in the operating mode (MANUAL, MAINTENANCE)
   rejected_supervisor_stop,       // the supervisor reports a fault or an emergency stop
   rejected_manual_motion,         // operator speed control is moving the crane
+  rejected_bridge_out_of_range,   // the bridge target (or a bridge waypoint) outside its travel, or a
+                                  // bridge target for a crane without a bridge
 };
 
 enum class MovePhase {

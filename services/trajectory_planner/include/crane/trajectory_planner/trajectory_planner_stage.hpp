@@ -52,16 +52,21 @@ class YamlSection;
 namespace crane::trajectory_planner {
 
 /// Reads the `trajectory_planner:` block: trolley_min_position, trolley_max_position [m] in
-/// [-100, 100], slew_min_angle, slew_max_angle [rad] in [-20 pi, 20 pi] (each max >= its min); the
-/// cable range and gravity come from facts.crane. Throws common::ConfigError naming the field.
+/// [-100, 100], slew_min_angle, slew_max_angle [rad] in [-20 pi, 20 pi] (each max >= its min), the
+/// manual: block; on an overhead crane (facts.crane_kind) also bridge_min_position,
+/// bridge_max_position [m] in [-1000, 1000] and manual.bridge_speed/acceleration (unknown fields
+/// elsewhere), and site zones are refused there. The cable range and gravity come from facts.crane.
+/// Throws common::ConfigError naming the field.
 [[nodiscard]] TrajectoryPlannerParams read_params(config::YamlSection& block, const common::StackFacts& facts);
 
 /// Human-readable GoalStatus ("rejected: trolley target outside the travel limits").
 [[nodiscard]] const char* goal_status_name(GoalStatus status) noexcept;
 
-/// The planner's goal for `request` from `current` (axes, waypoints and 0-limits resolved; an
-/// unknown profile code gives a profile start_move() rejects).
-[[nodiscard]] MoveGoal to_goal(const protocol::MoveRequest& request, const common::CraneStateEstimate& current) noexcept;
+/// The planner's goal for `request` from `current` (axes, waypoints and 0-limits resolved: a limit of
+/// 0 is the configured rated motion of `rated`, the hoist's always (the request has no field for it);
+/// an unknown profile code gives a profile start_move() rejects).
+[[nodiscard]] MoveGoal to_goal(const protocol::MoveRequest& request, const common::CraneStateEstimate& current,
+                               const ManualParams& rated) noexcept;
 
 /// What happened to a goal in a step.
 struct GoalOutcome {
@@ -145,11 +150,29 @@ class TrajectoryPlannerStage {
   void soft_stop(std::uint32_t stop_id) noexcept;
   [[nodiscard]] bool moving() const noexcept;
   void take_speeds(std::span<const protocol::OperatorSpeed> speeds, std::uint64_t seq) noexcept;
-  [[nodiscard]] std::array<double, 3> targets_of(std::uint64_t seq) const noexcept;
+  /// The operator's speed targets: trolley, slew, hoist, bridge (0 without a bridge).
+  [[nodiscard]] std::array<double, 4> targets_of(std::uint64_t seq) const noexcept;
   void report_rest(protocol::MoveStatus& status) const noexcept;
 
   TrajectoryPlanner planner_;
   TrajectoryPlanner scratch_;        // routes around zones are tried here (same params, no allocation)
+  // An overhead crane's bridge: a second planner and speed reference that run it as their trolley
+  // (TrajectoryPlannerParams::bridge_view()), started, stopped and held with the crane's; absent elsewhere.
+  struct BridgeAxis {
+    explicit BridgeAxis(const TrajectoryPlannerParams& p) : params(p), planner(p), trial(p) {}
+    TrajectoryPlannerParams params;
+    TrajectoryPlanner planner;
+    TrajectoryPlanner trial;         // a goal is planned here first: both axes start it, or neither
+    SpeedReference speed{};
+    PlannerOutput output{};
+    double target{0.0};              // [m] of the active goal
+    double operator_speed{0.0};      // [-1, 1] the latest accepted operator bridge speed
+    double speed_target{0.0};        // [m/s] its target of the last step
+    [[nodiscard]] common::AxisReference reference(bool speed_control) const noexcept {
+      return speed_control ? speed.reference().trolley : output.reference.trolley;
+    }
+  };
+  std::optional<BridgeAxis> bridge_;
   SpeedReference speed_{};
   Source source_{Source::profile};
   std::uint8_t operating_mode_{protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC};
