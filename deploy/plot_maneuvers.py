@@ -55,19 +55,29 @@ def main():
             label = "compensation on" if on else "compensation off"
             t = d["t"]
             axes[0].plot(t, d["x"], style, label=f"x, {label}")
-            axes[1].plot(t, [g * deg for g in d["gamma"]], style, label=f"gamma, {label}")
+            # An overhead crane's CSV carries the bridge (y, u_y, y_ref): drawn where a tower crane's slew is.
+            bridge = "y" in d
+            bridge_drawn = bridge
+            if bridge:
+                axes[1].plot(t, d["y"], style, label=f"y, {label}")
+                axes[4].plot(t, d["u_y"], style, label=f"bridge, {label}")
+            else:
+                axes[1].plot(t, [g * deg for g in d["gamma"]], style, label=f"gamma, {label}")
+                axes[4].plot(t, d["u_gamma"], style, label=f"slew, {label}")
             axes[2].plot(t, [p * deg for p in d["phi"]], style, label=f"phi (in-plane), {label}")
             axes[2].plot(t, [p * deg for p in d["theta"]], style, label=f"theta (out-of-plane), {label}")
             axes[3].plot(t, d["u_x"], style, label=f"trolley, {label}")
-            axes[4].plot(t, d["u_gamma"], style, label=f"slew, {label}")
             if on:
                 axes[0].plot(t, d["x_ref"], ":", color="k", label="reference")
-                axes[1].plot(t, [g * deg for g in d["gamma_ref"]], ":", color="k", label="reference")
+                if bridge:
+                    axes[1].plot(t, d["y_ref"], ":", color="k", label="reference")
+                else:
+                    axes[1].plot(t, [g * deg for g in d["gamma_ref"]], ":", color="k", label="reference")
         axes[0].set_ylabel("trolley x [m]")
-        axes[1].set_ylabel("slew gamma [deg]")
+        axes[1].set_ylabel("bridge y [m]" if bridge_drawn else "slew gamma [deg]")
         axes[2].set_ylabel("swing [deg]")
         axes[3].set_ylabel("trolley drive [V]")
-        axes[4].set_ylabel("slew drive [V]")
+        axes[4].set_ylabel("bridge drive [V]" if bridge_drawn else "slew drive [V]")
         axes[4].set_xlabel("time since the move started [s]")
         for ax in axes:
             ax.grid(True, alpha=0.3)
