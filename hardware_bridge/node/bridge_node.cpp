@@ -138,7 +138,9 @@ int main(int argc, char** argv) {
     const hb::EncoderScaling scaling(cfg.facts().crane);
     std::array<hb::CounterUnwrapper, hb::kCounterCount> unwrap{
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
-        hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits())};
+        hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
+        hb::CounterUnwrapper(board->counter_bits())};
+    const bool bridge_axis = bridge_config.board.bridge_axis;  // overhead crane
     const double period_s = cfg.facts().sample_period;
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
     const auto hang_timeout =
@@ -182,16 +184,24 @@ int main(int argc, char** argv) {
       sample.swing_in_plane(m.swing_in_plane);
       sample.swing_out_of_plane(m.swing_out_of_plane);
       sample.cable_length(m.cable_length);
+      sample.bridge_position(m.bridge_position);
       sample.applied_trolley_voltage(out.applied_trolley_voltage);
+      sample.applied_bridge_voltage(out.applied_bridge_voltage);
       sample.applied_slew_voltage(out.applied_slew_voltage);
       sample.applied_hoist_speed(out.applied_hoist_speed);
       sample.brakes_engaged(out.brakes_engaged);
       const bool estop = (inputs >> static_cast<unsigned>(hb::DigitalInput::emergency_stop)) & 1U;
       sample.emergency_stop_input(estop);
-      constexpr unsigned kLimitSwitches = protocol::SensorSample::SWITCH_TROLLEY_MIN | protocol::SensorSample::SWITCH_TROLLEY_MAX |
-                                          protocol::SensorSample::SWITCH_SLEW_MIN | protocol::SensorSample::SWITCH_SLEW_MAX;
-      static_assert(kLimitSwitches == 0x0FU, "the board's inputs 0-3 are the four limit switches, in this order");
-      sample.limit_switches(static_cast<std::uint8_t>(inputs & kLimitSwitches));
+      using Switches = protocol::SensorSample;
+      constexpr unsigned kLimitSwitches = Switches::SWITCH_TROLLEY_MIN | Switches::SWITCH_TROLLEY_MAX |
+                                          Switches::SWITCH_SLEW_MIN | Switches::SWITCH_SLEW_MAX |
+                                          Switches::SWITCH_BRIDGE_MIN | Switches::SWITCH_BRIDGE_MAX;
+      static_assert(kLimitSwitches == hb::kLimitSwitchMask &&
+                        Switches::SWITCH_BRIDGE_MIN == hb::bit(hb::DigitalInput::bridge_min_limit) &&
+                        Switches::SWITCH_BRIDGE_MAX == hb::bit(hb::DigitalInput::bridge_max_limit) &&
+                        Switches::SWITCH_SLEW_MAX == hb::bit(hb::DigitalInput::slew_max_limit),
+                    "the board's limit-switch inputs are laid out as SensorSample_.limit_switches");
+      sample.limit_switches(static_cast<std::uint8_t>(inputs & hb::limit_switch_mask(bridge_axis)));
       in.emergency_stop_pressed = estop;
     };
     // Takes what arrived; returns true once a valid command for cycle k went to the board.
@@ -210,6 +220,7 @@ int main(int argc, char** argv) {
         in.status.brakes_released = incoming_status.brakes_released();
         in.status.trolley_voltage_limit = incoming_status.trolley_voltage_limit();
         in.status.slew_voltage_limit = incoming_status.slew_voltage_limit();
+        in.status.bridge_voltage_limit = incoming_status.bridge_voltage_limit();
         in.status_arrival_time = now_s;
         status_seq = incoming_status.header().seq();
       }

@@ -14,6 +14,7 @@ const char* channel_name(CounterChannel channel) noexcept {
     case CounterChannel::slew_motor: return "slew_motor";
     case CounterChannel::swing_in_plane: return "swing_in_plane";
     case CounterChannel::swing_out_of_plane: return "swing_out_of_plane";
+    case CounterChannel::bridge_motor: return "bridge_motor";
   }
   return "unknown";
 }
@@ -23,6 +24,7 @@ const char* channel_name(AnalogOutput channel) noexcept {
     case AnalogOutput::trolley_drive: return "trolley_drive";
     case AnalogOutput::slew_drive: return "slew_drive";
     case AnalogOutput::hoist_speed: return "hoist_speed";
+    case AnalogOutput::bridge_drive: return "bridge_drive";
   }
   return "unknown";
 }
@@ -33,6 +35,7 @@ const char* line_name(DigitalOutput line) noexcept {
     case DigitalOutput::brake_release_slew: return "brake_release_slew";
     case DigitalOutput::brake_release_hoist: return "brake_release_hoist";
     case DigitalOutput::drive_enable: return "drive_enable";
+    case DigitalOutput::brake_release_bridge: return "brake_release_bridge";
   }
   return "unknown";
 }
@@ -44,6 +47,8 @@ const char* line_name(DigitalInput line) noexcept {
     case DigitalInput::slew_min_limit: return "slew_min_limit";
     case DigitalInput::slew_max_limit: return "slew_max_limit";
     case DigitalInput::emergency_stop: return "emergency_stop";
+    case DigitalInput::bridge_min_limit: return "bridge_min_limit";
+    case DigitalInput::bridge_max_limit: return "bridge_max_limit";
   }
   return "unknown";
 }

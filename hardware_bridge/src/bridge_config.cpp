@@ -4,16 +4,20 @@
 
 namespace crane::hardware_bridge {
 
-HardwareBridgeConfig read_params(config::YamlSection& s, const common::StackFacts& /*facts*/,
+HardwareBridgeConfig read_params(config::YamlSection& s, const common::StackFacts& facts,
                                  const supervisor::ActuationGateParams& gate) {
   HardwareBridgeConfig c;
+  // The bridge's channels exist on an overhead crane only: required there, unknown fields elsewhere.
+  const bool bridge = facts.crane_kind == common::CraneKind::overhead;
   c.bridge.gate = gate;
+  c.bridge.bridge_axis = bridge;
+  c.board.bridge_axis = bridge;
   c.bridge.hoist_speed_per_volt = s.number("hoist_speed_per_volt", 1e-4, 100.0);
   auto& b = c.board;
   b.counter_bits = s.integer("counter_bits", 2, 32);
   auto comedi = s.child("comedi");
   auto counters = comedi.child("counters");
-  for (std::size_t i = 0; i < kCounterCount; ++i) {
+  for (std::size_t i = 0; i < counter_count(bridge); ++i) {
     auto channel = counters.child(channel_name(static_cast<CounterChannel>(i)));
     b.counters[i].subdevice = channel.integer("subdevice", 0, 255);
     b.counters[i].channel = channel.integer("channel", 0, 255);
@@ -23,20 +27,20 @@ HardwareBridgeConfig read_params(config::YamlSection& s, const common::StackFact
   auto analog = comedi.child("analog_outputs");
   b.analog_output_subdevice = analog.integer("subdevice", 0, 255);
   b.analog_output_range = analog.integer("range", 0, 255);
-  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+  for (std::size_t i = 0; i < analog_output_count(bridge); ++i) {
     b.analog_output_channels[i] = analog.integer(channel_name(static_cast<AnalogOutput>(i)), 0, 255);
   }
   analog.finish();
   auto outputs = comedi.child("digital_outputs");
   b.digital_output_subdevice = outputs.integer("subdevice", 0, 255);
-  for (std::size_t i = 0; i < kDigitalOutputCount; ++i) {
+  for (std::size_t i = 0; i < digital_output_count(bridge); ++i) {
     b.digital_output_bits[i] = outputs.integer(line_name(static_cast<DigitalOutput>(i)), 0, 31);
   }
   outputs.finish();
   auto inputs = comedi.child("digital_inputs");
   b.digital_input_subdevice = inputs.integer("subdevice", 0, 255);
   b.digital_inputs_active_low = inputs.flag("active_low");
-  for (std::size_t i = 0; i < kDigitalInputCount; ++i) {
+  for (std::size_t i = 0; i < digital_input_count(bridge); ++i) {
     b.digital_input_bits[i] = inputs.integer(line_name(static_cast<DigitalInput>(i)), 0, 31);
   }
   inputs.finish();

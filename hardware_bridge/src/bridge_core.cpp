@@ -15,7 +15,7 @@ void validate(const BridgeParams& params, const char* prefix) {
 
 BridgeCore::BridgeCore(const BridgeParams& params, const std::array<AnalogRange, kAnalogOutputCount>& ranges)
     : params_(params), ranges_(ranges), gate_((validate(params), params.gate)) {
-  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+  for (std::size_t i = 0; i < analog_output_count(params_.bridge_axis); ++i) {
     const AnalogRange& range = ranges_[i];
     const std::string name = std::string("analog_range.") + channel_name(static_cast<AnalogOutput>(i));
     if (!is_valid(range)) {
@@ -43,13 +43,15 @@ CommandStatus BridgeCore::step(const BridgeInput& input, BridgeOutput& output) n
   if (reason == SafeStateReason::none) {
     const common::DriveCommand& drive = gate_output_.drive;
     const double hoist = drive.hoist_speed / params_.hoist_speed_per_volt;  // [V]
-    const std::array<double, kAnalogOutputCount> volts{drive.trolley_voltage, drive.slew_voltage, hoist};
+    const std::array<double, kAnalogOutputCount> volts{drive.trolley_voltage, drive.slew_voltage, hoist,
+                                                       drive.bridge_voltage};
+    output.board = safe_outputs_;  // an output the crane does not use stays at 0 V
     bool range_clamped = false;
-    for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+    for (std::size_t i = 0; i < analog_output_count(params_.bridge_axis); ++i) {
       range_clamped = range_clamped || volts[i] < ranges_[i].min_volts || volts[i] > ranges_[i].max_volts;
       output.board.dac_codes[i] = volts_to_code(volts[i], ranges_[i]);
     }
-    output.board.digital_outputs = kAllOutputsEnergized;
+    output.board.digital_outputs = all_outputs_energized(params_.bridge_axis);
     output.clamped = gate_output_.clamped || range_clamped;
     output.brakes_engaged = false;
     if (range_clamped && !gate_output_.clamped) gate_.count_clamped();
@@ -64,6 +66,10 @@ CommandStatus BridgeCore::step(const BridgeInput& input, BridgeOutput& output) n
   output.applied_hoist_speed =
       code_to_volts(output.board.dac_codes[index(AnalogOutput::hoist_speed)], ranges_[index(AnalogOutput::hoist_speed)]) *
       params_.hoist_speed_per_volt;
+  output.applied_bridge_voltage =
+      params_.bridge_axis ? code_to_volts(output.board.dac_codes[index(AnalogOutput::bridge_drive)],
+                                          ranges_[index(AnalogOutput::bridge_drive)])
+                          : 0.0;
   output.counters = gate_.counters();
   return gate_output_.command_status;
 }

@@ -99,6 +99,7 @@ EncoderScaling::EncoderScaling(const common::CraneParameters& crane) {
 double EncoderScaling::resolution(CounterChannel channel) const noexcept {
   switch (channel) {
     case CounterChannel::trolley_motor: return trolley_resolution_;
+    case CounterChannel::bridge_motor: return bridge_resolution();
     case CounterChannel::slew_motor: return slew_resolution_;
     case CounterChannel::swing_in_plane:
     case CounterChannel::swing_out_of_plane: return swing_resolution_;
@@ -118,6 +119,10 @@ double EncoderScaling::swing_angle(std::int64_t encoder_counts) const noexcept {
   return static_cast<double>(encoder_counts) * swing_resolution_;
 }
 
+double EncoderScaling::bridge_position(std::int64_t encoder_counts) const noexcept {
+  return static_cast<double>(encoder_counts) * bridge_resolution();
+}
+
 common::CraneMeasurement EncoderScaling::measurement(const std::array<std::int64_t, kCounterCount>& encoder_counts,
                                                      double cable_length) const noexcept {
   common::CraneMeasurement m;
@@ -125,6 +130,7 @@ common::CraneMeasurement EncoderScaling::measurement(const std::array<std::int64
   m.slew_angle = slew_angle(encoder_counts[index(CounterChannel::slew_motor)]);
   m.swing_in_plane = swing_angle(encoder_counts[index(CounterChannel::swing_in_plane)]);
   m.swing_out_of_plane = swing_angle(encoder_counts[index(CounterChannel::swing_out_of_plane)]);
+  m.bridge_position = bridge_position(encoder_counts[index(CounterChannel::bridge_motor)]);
   m.cable_length = cable_length;
   return m;
 }

@@ -227,7 +227,8 @@ ShmBoard::ShmBoard(const std::string& name, const BoardConfig& config)
     : segment_(ShmSegment::open_existing(name)),
       counter_bits_(static_cast<int>(checked_layout(segment_).counter_bits)),
       counter_mask_(mask_of(counter_bits_)),
-      ranges_(ranges_of(segment_.layout())) {
+      ranges_(ranges_of(segment_.layout())),
+      bridge_axis_(config.bridge_axis) {
   if (counter_bits_ != config.counter_bits) {
     fail(segment_.path(), "counter_bits " + std::to_string(counter_bits_) + " of the segment differs from board.counter_bits = " +
                               std::to_string(config.counter_bits));
@@ -271,7 +272,7 @@ std::string ShmBoard::describe() const {
   std::ostringstream text;
   text << "shm:" << segment_.path().substr(std::char_traits<char>::length(kShmSegmentPrefix))
        << " (emulated interface board in " << segment_.path() << ": " << counter_bits_ << "-bit counters";
-  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+  for (std::size_t i = 0; i < analog_output_count(bridge_axis_); ++i) {
     text << ", " << channel_name(static_cast<AnalogOutput>(i)) << " [" << common::format_value(ranges_[i].min_volts)
          << ", " << common::format_value(ranges_[i].max_volts) << "] V maxdata " << ranges_[i].maxdata;
   }

@@ -61,13 +61,15 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
   const auto bridge = cfg.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
     return hb::read_params(block, facts, gate);
   });
+  const bool bridge_axis = bridge.board.bridge_axis;  // overhead crane: the bridge's counter, DAC and brake line
   const auto encoder_counts = [&] {
     const auto& m = simulator.output().measurement;
     return std::array<std::int64_t, hb::kCounterCount>{
         plant::position_to_encoder_counts(m.trolley_position, sensors_model.trolley_resolution()),
         plant::position_to_encoder_counts(m.slew_angle, sensors_model.slew_resolution()),
         plant::position_to_encoder_counts(m.swing_in_plane, sensors_model.swing_resolution()),
-        plant::position_to_encoder_counts(m.swing_out_of_plane, sensors_model.swing_resolution())};
+        plant::position_to_encoder_counts(m.swing_out_of_plane, sensors_model.swing_resolution()),
+        plant::position_to_encoder_counts(m.bridge_position, sensors_model.bridge_resolution())};  // 0 m elsewhere
   };
   // The initial state is on the counters before the board exists for the bridge (a bridge that
   // read zeros here saw the trolley at 0 m, outside its travel, then jumping to 0.25 m).
@@ -119,10 +121,12 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
     const bool drives_enabled = (digital & bit(hb::DigitalOutput::drive_enable)) != 0;
     plant::DriveInput input;
     input.brakes_engaged = (digital & bit(hb::DigitalOutput::brake_release_trolley)) == 0 ||
-                           (digital & bit(hb::DigitalOutput::brake_release_slew)) == 0;
+                           (digital & bit(hb::DigitalOutput::brake_release_slew)) == 0 ||
+                           (bridge_axis && (digital & bit(hb::DigitalOutput::brake_release_bridge)) == 0);
     if (drives_enabled) {
       input.trolley_voltage = board.output_volts(outputs, hb::AnalogOutput::trolley_drive);
       input.slew_voltage = board.output_volts(outputs, hb::AnalogOutput::slew_drive);
+      if (bridge_axis) input.bridge_voltage = board.output_volts(outputs, hb::AnalogOutput::bridge_drive);
       if ((digital & bit(hb::DigitalOutput::brake_release_hoist)) != 0) {
         input.hoist_speed = board.output_volts(outputs, hb::AnalogOutput::hoist_speed) *
                             bridge.bridge.hoist_speed_per_volt;

@@ -92,7 +92,8 @@ common::CraneMeasurement DrivesAndSensors::measure(double trolley_position, doub
 }
 
 double DrivesAndSensors::measure_bridge(double bridge_position) const noexcept {
-  return trolley_encoder_counts_to_position(trolley_position_to_encoder_counts(bridge_position));
+  return encoder_counts_to_position(position_to_encoder_counts(bridge_position, bridge_resolution()),
+                                    bridge_resolution());
 }
 
 }  // namespace crane::plant

@@ -386,6 +386,66 @@ TEST(OverheadConfig, LoadsWithItsBridge) {
   EXPECT_DOUBLE_EQ(plant.model().drive_force_per_volt(crane::plant::DriveAxis::second), 7500.0 * 0.15);
 }
 
+// The hardware bridge's channel map follows the crane (issue 18): the bridge's channels are required
+// on an overhead crane, each missing one named by its field, and unknown fields on a tower crane.
+TEST(OverheadConfig, HardwareBridgeHasTheBridgeChannels) {
+  const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
+  EXPECT_TRUE(c.hardware_bridge.board.bridge_axis);
+  EXPECT_TRUE(c.hardware_bridge.bridge.bridge_axis);
+  using crane::hardware_bridge::AnalogOutput;
+  using crane::hardware_bridge::CounterChannel;
+  using crane::hardware_bridge::DigitalInput;
+  using crane::hardware_bridge::DigitalOutput;
+  using crane::hardware_bridge::index;
+  const auto& board = c.hardware_bridge.board;
+  EXPECT_EQ(board.counters[index(CounterChannel::bridge_motor)].subdevice, 0);
+  EXPECT_EQ(board.counters[index(CounterChannel::bridge_motor)].channel, 4);
+  EXPECT_EQ(board.analog_output_channels[index(AnalogOutput::bridge_drive)], 3);
+  EXPECT_EQ(board.digital_output_bits[index(DigitalOutput::brake_release_bridge)], 4);
+  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_min_limit)], 5);
+  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_max_limit)], 6);
+  // The tower crane's has none.
+  const auto lab = cfg::load_stack_config(kLabConfig);
+  EXPECT_FALSE(lab.hardware_bridge.board.bridge_axis);
+  EXPECT_FALSE(lab.hardware_bridge.bridge.bridge_axis);
+}
+
+TEST(OverheadConfig, AMissingBridgeChannelIsNamed) {
+  const std::string text = read_text(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
+  ASSERT_FALSE(text.empty());
+  ASSERT_EQ(error_of(text), "<no ConfigError thrown>");
+  auto message = error_of(edit_line(text, "hardware_bridge:", "bridge_motor:", std::nullopt).text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.counters.bridge_motor")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "analog_outputs:",
+                               "analog_outputs: {subdevice: 1, range: 0, trolley_drive: 0, slew_drive: 1, hoist_speed: 2}")
+                         .text);
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.analog_outputs.bridge_drive")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "drive_enable: 3,", "drive_enable: 3}").text);
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_outputs.brake_release_bridge")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_max_limit: 6}").text);
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_inputs.bridge_min_limit")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 5}").text);
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_inputs.bridge_max_limit")) << message;
+  // Present but on a line another function uses: named with the value and the other field.
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_motor:", "bridge_motor: {subdevice: 0, channel: 0}").text);
+  EXPECT_TRUE(contains(message, "hardware_bridge.comedi.counters[4].channel = 0")) << message;
+  EXPECT_TRUE(contains(message, "must differ from hardware_bridge.comedi.counters[0].channel")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 4, bridge_max_limit: 6}").text);
+  EXPECT_TRUE(contains(message, "hardware_bridge.comedi.digital_input_bits[5] = 4")) << message;
+}
+
+TEST_F(LabConfigText, ABridgeChannelOnATowerCraneIsAnUnknownField) {
+  auto message = error_of(
+      edit_line(text_, "hardware_bridge:", "swing_out_of_plane:",
+                "swing_out_of_plane: {subdevice: 0, channel: 3}\n      bridge_motor: {subdevice: 0, channel: 4}")
+          .text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.counters.bridge_motor")) << message;
+  message = error_of(edit_line(text_, "hardware_bridge:", "drive_enable:", "drive_enable: 3, brake_release_bridge: 4}").text);
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.digital_outputs.brake_release_bridge")) << message;
+}
+
 TEST_F(LabConfigText, CraneKindIsValidatedLikeTheRest) {
   auto message = error_of(edit_line(text_, "crane:", "kind:", "kind: gantri").text);
   EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;

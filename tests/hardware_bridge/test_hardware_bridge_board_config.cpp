@@ -84,6 +84,57 @@ TEST(BoardConfig, DuplicatesAreRejected) {
   EXPECT_EQ(validation_error(c), "");
 }
 
+// The bridge's entries (the last of each array) are validated on an overhead crane only.
+TEST(BoardConfig, BridgeChannelsAreValidatedOnAnOverheadCraneOnly) {
+  BoardConfig c;
+  c.counters[index(CounterChannel::bridge_motor)] = c.counters[0];
+  c.analog_output_channels[index(AnalogOutput::bridge_drive)] = -1;
+  c.digital_output_bits[index(DigitalOutput::brake_release_bridge)] = 40;
+  c.digital_input_bits[index(DigitalInput::bridge_min_limit)] = 4;  // the emergency stop's line
+  EXPECT_EQ(validation_error(c), "");  // a tower crane has none of them
+  c.bridge_axis = true;
+  EXPECT_TRUE(contains(validation_error(c), "board.counters[4].channel = 0 is out of range: must differ from "
+                                            "board.counters[0].channel on the same subdevice"))
+      << validation_error(c);
+  c.counters[index(CounterChannel::bridge_motor)] = {1, 0};
+  EXPECT_TRUE(contains(validation_error(c), "board.analog_output_channels[3] = -1")) << validation_error(c);
+  c.analog_output_channels[index(AnalogOutput::bridge_drive)] = 3;
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_output_bits[4] = 40 is out of range: must be in [0, 31]"))
+      << validation_error(c);
+  c.digital_output_bits[index(DigitalOutput::brake_release_bridge)] = 4;
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_input_bits[5] = 4 is out of range: must differ from "
+                                            "board.digital_input_bits[4]"))
+      << validation_error(c);
+  c.digital_input_bits[index(DigitalInput::bridge_min_limit)] = 5;
+  EXPECT_EQ(validation_error(c), "");
+  // On one DIO subdevice the bridge's brake line and its switches must differ too.
+  c.digital_input_subdevice = c.digital_output_subdevice;
+  c.digital_input_bits = {8, 9, 10, 11, 12, 13, 4};
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_input_bits[6] = 4")) << validation_error(c);
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_output_bits[4] (same subdevice)")) << validation_error(c);
+}
+
+TEST(BoardChannels, NamesAndTheLogicalLayout) {
+  EXPECT_STREQ(channel_name(CounterChannel::bridge_motor), "bridge_motor");
+  EXPECT_STREQ(channel_name(AnalogOutput::bridge_drive), "bridge_drive");
+  EXPECT_STREQ(line_name(DigitalOutput::brake_release_bridge), "brake_release_bridge");
+  EXPECT_STREQ(line_name(DigitalInput::bridge_min_limit), "bridge_min_limit");
+  EXPECT_STREQ(line_name(DigitalInput::bridge_max_limit), "bridge_max_limit");
+  EXPECT_STREQ(channel_name(static_cast<CounterChannel>(9)), "unknown");
+  // The limit-switch bits are SensorSample_.limit_switches' (idl/crane_msgs.idl): 1, 2, 4, 8, 32, 64.
+  EXPECT_EQ(kLimitSwitchMask, 1U + 2U + 4U + 8U + 32U + 64U);
+  EXPECT_EQ(limit_switch_mask(false), 0x0FU);
+  EXPECT_EQ(limit_switch_mask(true), 0x6FU);
+  EXPECT_EQ(bit(DigitalInput::emergency_stop), 16U);
+  EXPECT_EQ(all_outputs_energized(false), 0x0FU);
+  EXPECT_EQ(all_outputs_energized(true), 0x1FU);
+  EXPECT_EQ(counter_count(false), 4U);
+  EXPECT_EQ(counter_count(true), 5U);
+  EXPECT_EQ(analog_output_count(false), 3U);
+  EXPECT_EQ(digital_input_count(false), 5U);
+  EXPECT_EQ(digital_input_count(true), 7U);
+}
+
 TEST(OpenBoard, MalformedUrisNameTheUriAndTheAcceptedForms) {
   for (const std::string uri : {"", "comedi:", "comedi:/dev/ttyS0", "comedi:/dev/comedi", "comedi:/dev/comedi0x",
                                 "comedi:dev/comedi0", "COMEDI:/dev/comedi0", "shm:", "shm:a/b", "shm:has space",

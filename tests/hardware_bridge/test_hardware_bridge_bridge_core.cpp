@@ -43,7 +43,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 std::array<AnalogRange, kAnalogOutputCount> plant_ranges() {
   const AnalogRange range = plant_dac_range(common::CraneParameters{});
-  return {range, range, range};
+  return {range, range, range, range};
 }
 
 SupervisorPermit permit(double trolley_limit = 10.0, double slew_limit = 10.0) {
@@ -86,7 +86,7 @@ TEST(BridgeCore, SafeOutputsAreZeroVoltsAndEverythingOff) {
   EXPECT_EQ(core.safe_outputs().digital_outputs, 0U);
   // On a 12-bit [-10, 10] V comedi range the nearest code to 0 V is 2048 (2047.5 rounds up).
   const AnalogRange twelve{-10.0, 10.0, 4095U};
-  const BridgeCore other(BridgeParams{}, {twelve, twelve, twelve});
+  const BridgeCore other(BridgeParams{}, {twelve, twelve, twelve, twelve});
   for (const std::uint32_t code : other.safe_outputs().dac_codes) EXPECT_EQ(code, 2048U);
 }
 
@@ -108,7 +108,7 @@ TEST(BridgeCore, AppliesAValidCommand) {
   EXPECT_EQ(out.safe_state_reason, SafeStateReason::none);
   EXPECT_FALSE(out.brakes_engaged);
   EXPECT_FALSE(out.clamped);
-  EXPECT_EQ(out.board.digital_outputs, kAllOutputsEnergized);
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(false));
   // Trolley 2.5 V = 1024 steps exactly: code 4096 + 1024.
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);
   EXPECT_EQ(out.applied_trolley_voltage, 2.5);
@@ -119,6 +119,74 @@ TEST(BridgeCore, AppliesAValidCommand) {
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::hoist_speed)], 4915U);
   EXPECT_DOUBLE_EQ(out.applied_hoist_speed, 819.0 * kStep * 0.05);
   EXPECT_EQ(out.counters.accepted_commands, 1U);
+}
+
+// An overhead crane (bridge_axis): the gated bridge voltage goes to its own DAC output like the
+// trolley's, its brake line is released with the others, and it is clamped to the supervisor's
+// bridge limit and to the output's DAC range.
+TEST(BridgeCore, OverheadCraneDrivesTheBridgeOutput) {
+  BridgeParams params;
+  params.bridge_axis = true;
+  BridgeCore core(params, plant_ranges());
+  EXPECT_EQ(core.safe_outputs().dac_codes[index(AnalogOutput::bridge_drive)], kZeroVoltCode);
+  BridgeOutput out;
+  BridgeInput input = cycle_with_command(1.0, {2.5, 0.0, 0.0, -3.0}, 1.0);
+  input.status.bridge_voltage_limit = 10.0;
+  EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
+  EXPECT_EQ(out.safe_state_reason, SafeStateReason::none);
+  EXPECT_FALSE(out.clamped);
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(true));
+  EXPECT_NE(out.board.digital_outputs & bit(DigitalOutput::brake_release_bridge), 0U);
+  // -3 V = -1228.8 steps -> -1229: code 2867, -1229 steps.
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], 2867U);
+  EXPECT_EQ(out.applied_bridge_voltage, -1229.0 * kStep);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);  // the trolley as before
+
+  // The supervisor's bridge limit: 1 V.
+  input = cycle_with_command(1.01, {0.0, 0.0, 0.0, -3.0}, 1.01);
+  input.status.bridge_voltage_limit = 1.0;
+  EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
+  EXPECT_TRUE(out.clamped);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], kZeroVoltCode - 410U);  // -409.6 steps
+  EXPECT_EQ(out.applied_bridge_voltage, -410.0 * kStep);
+
+  // A bridge amplifier input of [-5, 5] V: 7 V ends at its top code, counted as clamped.
+  auto ranges = plant_ranges();
+  ranges[index(AnalogOutput::bridge_drive)] = AnalogRange{-5.0, 5.0, 4095U};
+  BridgeCore narrow(params, ranges);
+  input = cycle_with_command(2.0, {0.0, 0.0, 0.0, 7.0}, 2.0);
+  input.status.bridge_voltage_limit = 10.0;
+  EXPECT_EQ(narrow.step(input, out), CommandStatus::accepted);
+  EXPECT_TRUE(out.clamped);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], 4095U);
+  EXPECT_EQ(out.applied_bridge_voltage, 5.0);
+  EXPECT_EQ(out.counters.clamped_cycles, 1U);
+
+  // Safe state: 0 V and the bridge's brake engaged too.
+  input.emergency_stop_pressed = true;
+  (void)core.step(input, out);
+  expect_safe(core, out, SafeStateReason::emergency_stop);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], kZeroVoltCode);
+  EXPECT_EQ(out.board.digital_outputs & bit(DigitalOutput::brake_release_bridge), 0U);
+  EXPECT_EQ(out.applied_bridge_voltage, 0.0);
+}
+
+// A tower crane (no bridge_axis) never drives the bridge's output or brake line, whatever the
+// command's bridge voltage and the supervisor's bridge limit say; that output's range is not used.
+TEST(BridgeCore, TowerCraneLeavesTheBridgeOutputAtZero) {
+  auto ranges = plant_ranges();
+  ranges[index(AnalogOutput::bridge_drive)] = AnalogRange{1.0, 5.0, 4095U};  // would be refused on an overhead crane
+  BridgeCore core(BridgeParams{}, ranges);
+  BridgeOutput out;
+  BridgeInput input = cycle_with_command(1.0, {2.5, -1.0, 0.1, 3.0}, 1.0);
+  input.status.bridge_voltage_limit = 10.0;
+  EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
+  EXPECT_FALSE(out.clamped);
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(false));
+  EXPECT_EQ(out.board.digital_outputs & bit(DigitalOutput::brake_release_bridge), 0U);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], core.safe_outputs().dac_codes[3]);
+  EXPECT_EQ(out.applied_bridge_voltage, 0.0);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);
 }
 
 // Watchdog at 100 Hz, W = 30 ms, cycle instants t_k = k * 10 ms. The outputs written at t stay until
@@ -405,6 +473,13 @@ TEST(BridgeCore, ParametersAndRangesAreValidated) {
   ranges = plant_ranges();
   ranges[index(AnalogOutput::hoist_speed)].maxdata = 0;
   EXPECT_TRUE(contains(error_of(BridgeParams{}, ranges), "analog_range.hoist_speed")) << error_of(BridgeParams{}, ranges);
+  // The bridge's output range matters on an overhead crane only.
+  ranges = plant_ranges();
+  ranges[index(AnalogOutput::bridge_drive)] = AnalogRange{0.5, 10.0, 8191U};
+  EXPECT_EQ(error_of(BridgeParams{}, ranges), "");
+  p = BridgeParams{};
+  p.bridge_axis = true;
+  EXPECT_TRUE(contains(error_of(p, ranges), "analog_range.bridge_drive.min_volts = 0.5")) << error_of(p, ranges);
 }
 
 }  // namespace

@@ -204,11 +204,15 @@ TEST(ComediBoard, OpensAndReadsRangesFromTheDriver) {
     const auto board = open_fake(state);
     EXPECT_EQ(state->opens, 1);
     EXPECT_EQ(board->counter_bits(), 24);
-    for (const AnalogRange range : board->analog_ranges()) {
+    for (std::size_t i = 0; i < analog_output_count(false); ++i) {  // a tower crane's three outputs
+      const AnalogRange range = board->analog_ranges()[i];
       EXPECT_EQ(range.min_volts, -10.0);
       EXPECT_EQ(range.max_volts, 10.0);
       EXPECT_EQ(range.maxdata, 4095U);
     }
+    // The bridge's output is not read from the driver on a tower crane: the default range.
+    const AnalogRange unused = board->analog_range(AnalogOutput::bridge_drive);
+    EXPECT_EQ(unused.maxdata, AnalogRange{}.maxdata);
     EXPECT_TRUE(contains(board->describe(), "comedi:/dev/comedi0")) << board->describe();
     EXPECT_TRUE(state->calls_of("data_write").empty()) << "opening must not write the outputs";
     EXPECT_TRUE(state->calls_of("dio_config").empty()) << "separate DO/DI subdevices need no direction";
@@ -367,7 +371,7 @@ TEST(ComediBoard, WriteOrderIsFailSafe) {
   };
   BoardOutputs safe = safe_board_outputs(board->analog_ranges());
   BoardOutputs running = safe;
-  running.digital_outputs = kAllOutputsEnergized;
+  running.digital_outputs = all_outputs_energized(false);
   running.dac_codes[0] = 3000U;
   state->calls.clear();
   board->write_outputs(safe);  // the state of the lines after open is unknown: digital first
@@ -391,7 +395,7 @@ TEST(ComediBoard, DigitalInputsWithBitMapAndPolarity) {
     state->digital_lines[3] = 0xFFU & ~(1U << 7);  // emergency-stop contact open
     EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::emergency_stop));
     state->digital_lines[3] = 0x00U;  // all open (a cut cable): every input active
-    EXPECT_EQ(board->read_digital_inputs(), kAllInputsMask);
+    EXPECT_EQ(board->read_digital_inputs(), (1U << digital_input_count(false)) - 1U);  // a tower crane's five
     const std::vector<Call> reads = state->calls_of("dio_bitfield2");
     ASSERT_FALSE(reads.empty());
     EXPECT_EQ(reads.back().subdevice, 3U);
@@ -425,7 +429,7 @@ TEST(ComediBoard, DioSubdeviceGetsLineDirections) {
   // Writing the outputs leaves the input lines alone.
   state->digital_lines[4] = 0xFF00U;
   BoardOutputs outputs = safe_board_outputs(board->analog_ranges());
-  outputs.digital_outputs = kAllOutputsEnergized;
+  outputs.digital_outputs = all_outputs_energized(false);
   board->write_outputs(outputs);
   EXPECT_EQ(state->digital_lines[4], 0xFF0FU);
 
@@ -433,6 +437,106 @@ TEST(ComediBoard, DioSubdeviceGetsLineDirections) {
   const std::string message = open_error(state, c);
   EXPECT_TRUE(contains(message, "digital output brake_release_trolley (subdevice 4, channel 0): comedi_dio_config"))
       << message;
+}
+
+// An overhead crane's board (bridge_axis): the bridge's counter (here its own counter subdevice, as
+// on an NI 660x), its analog output, brake line and runway limit switches are checked at open, read
+// and written where configured. The same fake opened for a tower crane never touches them.
+BoardConfig overhead_board_config() {
+  BoardConfig c;
+  c.bridge_axis = true;
+  c.counters[index(CounterChannel::bridge_motor)] = {5, 0};
+  c.analog_output_channels = {0, 1, 2, 3};
+  c.digital_output_bits = {0, 1, 2, 3, 6};
+  c.digital_input_bits = {0, 1, 2, 3, 4, 6, 5};  // the runway switches wired to lines 6 and 5
+  return c;
+}
+
+TEST(ComediBoard, OverheadCraneMapsTheBridgeChannels) {
+  const auto state = lab_board();
+  const BoardConfig c = overhead_board_config();
+  const auto board = open_fake(state, c);
+  EXPECT_TRUE(contains(board->describe(), "bridge_drive ch 3")) << board->describe();
+
+  state->counter_values[{0, 0}] = 11U;
+  state->counter_values[{5, 0}] = 0x1ABCDEFU;  // bits above 24 are dropped
+  std::array<std::uint32_t, kCounterCount> raw{};
+  board->read_counters(raw);
+  EXPECT_EQ(raw[index(CounterChannel::trolley_motor)], 11U);
+  EXPECT_EQ(raw[index(CounterChannel::bridge_motor)], 0xABCDEFU);
+  const std::vector<Call> reads = state->calls_of("data_read");
+  ASSERT_EQ(reads.size(), 5U);
+  EXPECT_EQ(reads[4].subdevice, 5U);
+  EXPECT_EQ(reads[4].channel, 0U);
+
+  state->calls.clear();
+  BoardOutputs outputs;
+  outputs.dac_codes = {100U, 200U, 300U, 4000U};
+  outputs.digital_outputs = all_outputs_energized(true);
+  board->write_outputs(outputs);
+  const std::vector<Call> writes = state->calls_of("data_write");
+  ASSERT_EQ(writes.size(), 4U);
+  EXPECT_EQ(writes[3].channel, 3U);
+  EXPECT_EQ(writes[3].data, 4000U);
+  const std::vector<Call> bitfields = state->calls_of("dio_bitfield2");
+  ASSERT_EQ(bitfields.size(), 1U);
+  EXPECT_EQ(bitfields[0].write_mask, 0x0FU | (1U << 6));
+  EXPECT_EQ(state->digital_lines[2], 0x0FU | (1U << 6));
+  // Only the bridge's brake engaged: its line alone goes to 0, written before the voltages.
+  state->calls.clear();
+  outputs.digital_outputs = all_outputs_energized(true) & ~bit(DigitalOutput::brake_release_bridge);
+  board->write_outputs(outputs);
+  EXPECT_EQ(state->calls.front().function, "dio_bitfield2");
+  EXPECT_EQ(state->digital_lines[2], 0x0FU);
+
+  state->digital_lines[3] = 0xFFU & ~(1U << 6);  // active-low: the runway's min switch open
+  EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::bridge_min_limit));
+  state->digital_lines[3] = 0xFFU & ~(1U << 5);
+  EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::bridge_max_limit));
+  EXPECT_EQ(bit(DigitalInput::bridge_max_limit), 64U);  // SWITCH_BRIDGE_MAX of SensorSample_.limit_switches
+
+  // The same board for a tower crane: four counters read, three outputs written, five lines.
+  BoardConfig tower = c;
+  tower.bridge_axis = false;
+  const auto tower_board = open_fake(state, tower);
+  state->calls.clear();
+  state->counter_values[{5, 0}] = 77U;
+  tower_board->read_counters(raw);
+  EXPECT_EQ(state->calls_of("data_read").size(), 4U);
+  EXPECT_EQ(raw[index(CounterChannel::bridge_motor)], 0U);
+  outputs.digital_outputs = all_outputs_energized(true);  // a stray bridge bit is not written
+  tower_board->write_outputs(outputs);
+  EXPECT_EQ(state->calls_of("data_write").size(), 3U);
+  EXPECT_EQ(state->calls_of("dio_bitfield2").back().write_mask, 0x0FU);
+  state->digital_lines[3] = 0x00U;  // every contact open
+  EXPECT_EQ(tower_board->read_digital_inputs(), 0x1FU);
+  EXPECT_FALSE(contains(tower_board->describe(), "bridge_drive")) << tower_board->describe();
+}
+
+TEST(ComediBoard, OverheadCraneBridgeChannelsAreCheckedAtOpen) {
+  const auto state = lab_board();
+  BoardConfig c = overhead_board_config();
+  c.counters[index(CounterChannel::bridge_motor)] = {0, 4};  // the 4-counter subdevice has no fifth
+  std::string message = open_error(state, c);
+  EXPECT_TRUE(contains(message, "counter bridge_motor (subdevice 0, channel 4): the subdevice has only 4 channels"))
+      << message;
+  c = overhead_board_config();
+  c.analog_output_channels[index(AnalogOutput::bridge_drive)] = 4;
+  message = open_error(state, c);
+  EXPECT_TRUE(contains(message, "analog output bridge_drive (subdevice 1, channel 4): the subdevice has only 4 channels"))
+      << message;
+  c = overhead_board_config();
+  c.digital_output_bits[index(DigitalOutput::brake_release_bridge)] = 8;
+  message = open_error(state, c);
+  EXPECT_TRUE(contains(message, "digital output brake_release_bridge (subdevice 2, channel 8)")) << message;
+  c = overhead_board_config();
+  c.digital_input_bits[index(DigitalInput::bridge_max_limit)] = 9;
+  message = open_error(state, c);
+  EXPECT_TRUE(contains(message, "digital input bridge_max_limit (subdevice 3, channel 9)")) << message;
+  // The same out-of-range bridge entries are never looked at on a tower crane.
+  c.bridge_axis = false;
+  c.counters[index(CounterChannel::bridge_motor)] = {0, 4};
+  EXPECT_EQ(open_error(state, c), "");
 }
 
 TEST(ComediBoard, DriverErrorsNameDeviceChannelAndMessage) {

@@ -29,6 +29,14 @@ common::CraneParameters odd_sensor_crane() {
   return p;
 }
 
+// The bridge encoder of deploy/config/overhead_crane.yaml: 2000 lines, 5 mm of travel per motor radian.
+common::CraneParameters overhead_crane() {
+  common::CraneParameters p;
+  p.motor_encoder_lines = 2000;
+  p.leadscrew_pitch = 0.005;  // [m/rad]
+  return p;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Counter registers
 
@@ -154,6 +162,8 @@ TEST(EncoderScaling, AgreesWithThePlantForRandomPositions) {
     EXPECT_DOUBLE_EQ(scaling.trolley_resolution(), io.trolley_resolution());
     EXPECT_DOUBLE_EQ(scaling.slew_resolution(), io.slew_resolution());
     EXPECT_DOUBLE_EQ(scaling.swing_resolution(), io.swing_resolution());
+    EXPECT_DOUBLE_EQ(scaling.bridge_resolution(), io.bridge_resolution());
+    EXPECT_EQ(scaling.resolution(CounterChannel::bridge_motor), scaling.bridge_resolution());
 
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> trolley(-1.5, 3.0);             // [m]
@@ -164,10 +174,12 @@ TEST(EncoderScaling, AgreesWithThePlantForRandomPositions) {
       const double gamma = slew(rng);
       const double phi = swing(rng);
       const double theta = swing(rng);
+      const double y = trolley(rng);  // [m] an overhead crane's bridge
       // The plant's counts, through 24-bit registers, unwrapped from a fresh origin.
       const std::array<std::int64_t, kCounterCount> plant_counts{
           io.trolley_position_to_encoder_counts(x), io.slew_angle_to_encoder_counts(gamma),
-          io.swing_angle_to_encoder_counts(phi), io.swing_angle_to_encoder_counts(theta)};
+          io.swing_angle_to_encoder_counts(phi), io.swing_angle_to_encoder_counts(theta),
+          plant::position_to_encoder_counts(y, io.bridge_resolution())};
       std::array<std::int64_t, kCounterCount> counts{};
       for (std::size_t c = 0; c < kCounterCount; ++c) {
         CounterUnwrapper unwrapper(24);
@@ -180,12 +192,45 @@ TEST(EncoderScaling, AgreesWithThePlantForRandomPositions) {
       ASSERT_DOUBLE_EQ(got.slew_angle, expected.slew_angle) << gamma;
       ASSERT_DOUBLE_EQ(got.swing_in_plane, expected.swing_in_plane) << phi;
       ASSERT_DOUBLE_EQ(got.swing_out_of_plane, expected.swing_out_of_plane) << theta;
+      ASSERT_DOUBLE_EQ(got.bridge_position, io.measure_bridge(y)) << y;
       ASSERT_EQ(got.cable_length, 1.25);
       // Independent bound: a count is the floor, so the measurement lies within one count below.
       ASSERT_LE(got.trolley_position, x + 1e-9 * scaling.trolley_resolution());
       ASSERT_GT(got.trolley_position, x - scaling.trolley_resolution());
     }
   }
+}
+
+// An overhead crane's bridge over its whole runway (deploy/config/overhead_crane.yaml: 60 m, 15.3
+// million counts of 3.9 um, past the +-2^23 of a 24-bit register's first reading): through the 32-bit
+// registers that configuration uses, the bridge's reading is the plant's measurement from any start;
+// through 24-bit registers a start beyond 2^23 counts is taken as negative, the reason for 32 bits.
+TEST(EncoderScaling, BridgeOverTheRunwayAgreesWithThePlant) {
+  const auto c = overhead_crane();
+  const plant::DrivesAndSensors io{c};
+  const EncoderScaling scaling{c};
+  const double resolution = scaling.bridge_resolution();
+  EXPECT_DOUBLE_EQ(resolution, 2.0 * std::numbers::pi * c.leadscrew_pitch / (4.0 * c.motor_encoder_lines));
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> runway(0.0, 60.0);  // [m]
+  std::uniform_real_distribution<double> step(-0.01, 0.01);  // [m] per sample: 1 m/s at 100 Hz
+  for (int i = 0; i < kRandomSamples / 10; ++i) {
+    CounterUnwrapper unwrapper(32);
+    double y = runway(rng);
+    for (int k = 0; k < 10; ++k, y += step(rng)) {
+      const std::int64_t plant_counts = plant::position_to_encoder_counts(y, io.bridge_resolution());
+      std::array<std::int64_t, kCounterCount> counts{};
+      counts[index(CounterChannel::bridge_motor)] = unwrapper.update(counter_register_value(plant_counts, 32));
+      const common::CraneMeasurement got = scaling.measurement(counts, 4.0);
+      ASSERT_DOUBLE_EQ(got.bridge_position, io.measure_bridge(y)) << y;
+      ASSERT_EQ(got.trolley_position, 0.0);
+    }
+  }
+  // 40 m is 10.2 million counts: a 24-bit register's first reading cannot hold it.
+  CounterUnwrapper narrow(24);
+  const std::int64_t far = plant::position_to_encoder_counts(40.0, resolution);
+  ASSERT_GT(far, std::int64_t{1} << 23);
+  EXPECT_LT(scaling.bridge_position(narrow.update(counter_register_value(far, 24))), 0.0);
 }
 
 // A trolley travel of 1 m through a 12-bit register (it wraps about 150 times): the bridge's

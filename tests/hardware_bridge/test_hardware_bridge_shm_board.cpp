@@ -74,7 +74,7 @@ TEST(ShmBoard, CountersWrapLikeTheHardware) {
   const std::string name = unique_name();
   ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});
   ShmBoard board(name);
-  const std::array<std::int64_t, kCounterCount> counts{-1, 8388607, 123456789, -8388609};
+  const std::array<std::int64_t, kCounterCount> counts{-1, 8388607, 123456789, -8388609, 10185916};
   EXPECT_EQ(emulator.publish_sample(counts), 1U);
   std::array<std::uint32_t, kCounterCount> raw{};
   board.read_counters(raw);
@@ -90,7 +90,7 @@ TEST(ShmBoard, CountersWrapLikeTheHardware) {
 // initial 0.25 m: travel and overspeed faults at start-up).
 TEST(ShmBoard, HoldsTheInitialCountsFromTheStart) {
   const std::string name = unique_name();
-  const std::array<std::int64_t, kCounterCount> initial{70000, -5, 123456789, 0};
+  const std::array<std::int64_t, kCounterCount> initial{70000, -5, 123456789, 0, 2546479};
   const ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{}, 24, initial);
   EXPECT_EQ(emulator.sample_tick(), 0U);
   ShmBoard board(name);
@@ -103,12 +103,13 @@ TEST(ShmBoard, OutputsReachTheEmulatorWithTickCountAndTime) {
   const std::string name = unique_name();
   ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});
   ShmBoard board(name);
-  for (int k = 0; k < 3; ++k) (void)emulator.publish_sample({k, 0, 0, 0});
+  for (int k = 0; k < 3; ++k) (void)emulator.publish_sample({k, 0, 0, 0, 0});
   std::array<std::uint32_t, kCounterCount> raw{};
   board.read_counters(raw);  // counters of tick 3: the next outputs answer tick 3
   BoardOutputs outputs;
-  outputs.dac_codes = {100U, 9000U, 4096U};  // 9000 > maxdata: clamped to 8191
-  outputs.digital_outputs = bit(DigitalOutput::drive_enable) | bit(DigitalOutput::brake_release_slew) | 0xF0U;
+  outputs.dac_codes = {100U, 9000U, 4096U, 6000U};  // 9000 > maxdata: clamped to 8191
+  outputs.digital_outputs = bit(DigitalOutput::drive_enable) | bit(DigitalOutput::brake_release_slew) |
+                            bit(DigitalOutput::brake_release_bridge) | 0xE0U;  // bits above the five lines dropped
   const std::int64_t before = monotonic_time_ns();
   board.write_outputs(outputs);
   const std::int64_t after = monotonic_time_ns();
@@ -116,7 +117,9 @@ TEST(ShmBoard, OutputsReachTheEmulatorWithTickCountAndTime) {
   EXPECT_EQ(seen.outputs.dac_codes[0], 100U);
   EXPECT_EQ(seen.outputs.dac_codes[1], 8191U);
   EXPECT_EQ(seen.outputs.dac_codes[2], 4096U);
-  EXPECT_EQ(seen.outputs.digital_outputs, bit(DigitalOutput::drive_enable) | bit(DigitalOutput::brake_release_slew));
+  EXPECT_EQ(seen.outputs.dac_codes[index(AnalogOutput::bridge_drive)], 6000U);
+  EXPECT_EQ(seen.outputs.digital_outputs, bit(DigitalOutput::drive_enable) | bit(DigitalOutput::brake_release_slew) |
+                                              bit(DigitalOutput::brake_release_bridge));
   EXPECT_EQ(seen.outputs_tick, 3U);
   EXPECT_EQ(seen.write_count, 1U);
   EXPECT_GE(seen.last_write_ns, before);
@@ -140,8 +143,11 @@ TEST(ShmBoard, DigitalInputsFromTheEmulator) {
   emulator.set_digital_input(DigitalInput::slew_max_limit, true);
   emulator.set_digital_input(DigitalInput::emergency_stop, false);
   EXPECT_EQ(board.read_digital_inputs(), 1U << 3);  // slew max: bit 3 of SensorSample_.limit_switches
-  emulator.set_digital_inputs(0xFFFFFFFFU);          // only the five defined inputs exist
-  EXPECT_EQ(board.read_digital_inputs(), 0x1FU);
+  emulator.set_digital_input(DigitalInput::slew_max_limit, false);
+  emulator.set_digital_input(DigitalInput::bridge_max_limit, true);
+  EXPECT_EQ(board.read_digital_inputs(), 64U);  // bridge max: SWITCH_BRIDGE_MAX of SensorSample_.limit_switches
+  emulator.set_digital_inputs(0xFFFFFFFFU);    // only the seven defined inputs exist
+  EXPECT_EQ(board.read_digital_inputs(), 0x7FU);
 }
 
 // The code the bridge writes for v, decoded by the emulator, is the voltage the plant itself
@@ -155,7 +161,7 @@ TEST(ShmBoard, EmulatorDecodesThePlantsAppliedVoltage) {
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> volts(-11.0, 11.0);
   for (int i = 0; i < kRandomSamples; ++i) {
-    const std::array<double, kAnalogOutputCount> v{volts(rng), volts(rng), volts(rng)};
+    const std::array<double, kAnalogOutputCount> v{volts(rng), volts(rng), volts(rng), volts(rng)};
     BoardOutputs outputs;
     for (std::size_t c = 0; c < kAnalogOutputCount; ++c) {
       outputs.dac_codes[c] = volts_to_code(v[c], board.analog_range(static_cast<AnalogOutput>(c)));
@@ -200,7 +206,7 @@ TEST(ShmBoard, MagicVersionAndCounterWidthMismatchesThrow) {
   const ShmSegment raw = ShmSegment::open_existing(name);
   raw.layout().version = 99;
   std::string message = board_error(name, BoardConfig{});
-  EXPECT_TRUE(contains(message, "layout version 99 does not match 1")) << message;
+  EXPECT_TRUE(contains(message, "layout version 99 does not match " + std::to_string(kShmBoardVersion))) << message;
   EXPECT_TRUE(contains(message, "/crane_board_" + name)) << message;
   raw.layout().version = kShmBoardVersion;
   raw.layout().magic.store(0xDEADBEEFU);
@@ -281,10 +287,11 @@ TEST(ShmBoard, BoardPacedTickHandshakeBetweenThreads) {
   ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});
   ShmBoard board(name);
   // Counts of sample k: trolley climbs 3,000,000 counts per sample (wraps every ~5.6 samples),
-  // slew descends, the swing counters oscillate in sign.
+  // slew descends, the swing counters oscillate in sign, the bridge climbs 1,000,003 per sample.
   const auto counts_of = [](std::uint64_t k) {
     const auto s = static_cast<std::int64_t>(k);
-    return std::array<std::int64_t, kCounterCount>{3'000'000 * s - 7, -2'500'000 * s, (s % 2 == 0 ? s : -s), -1};
+    return std::array<std::int64_t, kCounterCount>{3'000'000 * s - 7, -2'500'000 * s, (s % 2 == 0 ? s : -s), -1,
+                                                   1'000'003 * s};
   };
   // The driver's answer to counts n: trolley code n mod 8192, slew code (-n) mod 8192.
   const auto code_of = [](std::int64_t n) { return modulo(n, 13); };
@@ -301,13 +308,13 @@ TEST(ShmBoard, BoardPacedTickHandshakeBetweenThreads) {
       const ShmOutputs seen = emulator.read_outputs();
       const auto expected = counts_of(k);
       if (seen.outputs_tick != k || seen.write_count != k || seen.outputs.dac_codes[0] != code_of(expected[0]) ||
-          seen.outputs.dac_codes[1] != code_of(-expected[1])) {
+          seen.outputs.dac_codes[1] != code_of(-expected[1]) || seen.outputs.dac_codes[3] != code_of(expected[4])) {
         ++emulator_failures;
       }
     }
   });
 
-  std::array<CounterUnwrapper, kCounterCount> unwrappers{CounterUnwrapper{24}, CounterUnwrapper{24},
+  std::array<CounterUnwrapper, kCounterCount> unwrappers{CounterUnwrapper{24}, CounterUnwrapper{24}, CounterUnwrapper{24},
                                                          CounterUnwrapper{24}, CounterUnwrapper{24}};
   std::uint64_t last_tick = 0;
   int driver_failures = 0;
@@ -324,7 +331,7 @@ TEST(ShmBoard, BoardPacedTickHandshakeBetweenThreads) {
     for (std::size_t c = 0; c < kCounterCount; ++c) counts[c] = unwrappers[c].update(raw[c]);
     if (counts != counts_of(tick)) ++driver_failures;
     BoardOutputs outputs;
-    outputs.dac_codes = {code_of(counts[0]), code_of(-counts[1]), 4096U};
+    outputs.dac_codes = {code_of(counts[0]), code_of(-counts[1]), 4096U, code_of(counts[4])};
     board.write_outputs(outputs);
     last_tick = tick;
   }
@@ -334,6 +341,7 @@ TEST(ShmBoard, BoardPacedTickHandshakeBetweenThreads) {
   EXPECT_EQ(last_tick, static_cast<std::uint64_t>(kHandshakeSamples));
   // The trolley count went well beyond the register: 3e6 * 300 = 9e8 counts.
   EXPECT_EQ(unwrappers[0].count(), 3'000'000LL * kHandshakeSamples - 7);
+  EXPECT_EQ(unwrappers[4].count(), 1'000'003LL * kHandshakeSamples);
 }
 
 }  // namespace

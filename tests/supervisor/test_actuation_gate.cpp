@@ -71,7 +71,7 @@ class ThreeGates {
             }(),
             [] {
               const auto range = hardware_bridge::plant_dac_range(common::CraneParameters{});
-              return std::array<hardware_bridge::AnalogRange, hardware_bridge::kAnalogOutputCount>{range, range, range};
+              return std::array<hardware_bridge::AnalogRange, hardware_bridge::kAnalogOutputCount>{range, range, range, range};
             }()),
         dac_step_(hardware_bridge::code_step_volts(hardware_bridge::plant_dac_range(common::CraneParameters{}))) {}
 

@@ -581,6 +581,7 @@ int main(int argc, char** argv) {
           std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time / r.swing_period) : json(nullptr);
       j["final_position_error_m"] = r.metrics.final_position_error;
       j["final_slew_error_rad"] = r.metrics.final_slew_error;
+      if (cfg.facts.crane_kind == common::CraneKind::overhead) j["final_bridge_error_m"] = r.metrics.final_bridge_error;
       j["max_swing_rad"] = r.metrics.max_swing;
       j["residual_swing_rad"] = r.metrics.residual_swing;
       j["max_voltage_V"] = r.metrics.max_voltage;

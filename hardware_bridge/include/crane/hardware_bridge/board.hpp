@@ -1,9 +1,10 @@
 #pragma once
 // The crane's encoder/DAC/digital-IO interface board (H. M. Omar, "Control of Gantry and Tower
 // Cranes", Virginia Tech 2003, section 4.1), behind one abstract interface:
-//   - 4 encoder counters (CounterChannel), raw registers counter_bits wide that wrap;
-//   - 3 analog outputs (AnalogOutput) written as unsigned DAC codes 0..maxdata over the range the
-//     driver reports (conversions.hpp converts volts <-> codes);
+//   - 5 encoder counters (CounterChannel; the fifth is the overhead crane's bridge), raw registers
+//     counter_bits wide that wrap;
+//   - 4 analog outputs (AnalogOutput; the fourth is the bridge's) written as unsigned DAC codes
+//     0..maxdata over the range the driver reports (conversions.hpp converts volts <-> codes);
 //   - digital outputs and inputs as logical words (board_channels.hpp): 1 = energized / active.
 // A Board converts nothing: codes in, raw counts out. Implementations: ComediBoard (comedilib
 // device, comedi_board.hpp) and ShmBoard (the emulated board in shared memory, shm_board.hpp).
@@ -54,11 +55,11 @@ class Board {
   Board& operator=(const Board&) = delete;
   virtual ~Board() = default;
 
-  /// Reads the four counter registers, indexed by CounterChannel, each masked to counter_bits()
+  /// Reads the counter registers, indexed by CounterChannel, each masked to counter_bits()
   /// (they wrap; CounterUnwrapper makes them continuous). Throws BoardError.
   virtual void read_counters(std::array<std::uint32_t, kCounterCount>& raw_counts) = 0;
 
-  /// Writes the three DAC codes and the digital output word together. Codes above the channel's
+  /// Writes the DAC codes and the digital output word together. Codes above the channel's
   /// maxdata are clamped to maxdata. Throws BoardError.
   virtual void write_outputs(const BoardOutputs& outputs) = 0;
 
@@ -75,7 +76,7 @@ class Board {
   /// One line for logs: the URI, the device and its channel map.
   [[nodiscard]] virtual std::string describe() const = 0;
 
-  /// The three ranges, indexed by AnalogOutput.
+  /// The ranges, indexed by AnalogOutput.
   [[nodiscard]] std::array<AnalogRange, kAnalogOutputCount> analog_ranges() const noexcept;
 };
 

@@ -6,6 +6,10 @@
 // outputs on 2, digital inputs on 3); set them from `comedi_board_info` of the real board. The
 // emulated (shm) board uses only counter_bits: its registers use the logical layout of
 // board_channels.hpp.
+//
+// bridge_axis (true on an overhead crane, crane.kind: overhead) selects which channels exist: the
+// bridge's entries of the arrays below (their last elements) are used, validated and checked
+// against the driver only when it is set (board_channels.hpp, counter_count() and the others).
 
 #include <array>
 
@@ -21,24 +25,28 @@ struct ComediChannel {
 
 struct BoardConfig {
   int counter_bits{24};  // [bit] width of the counter registers (they wrap), in [2, 32]
+  /// The crane has a bridge axis (overhead crane): its counter, analog output, brake line and
+  /// runway limit switches are used. false: they are ignored (tower and gantry cranes).
+  bool bridge_axis{false};
 
   /// Counter of each encoder, indexed by CounterChannel (some boards have one subdevice per counter).
-  std::array<ComediChannel, kCounterCount> counters{{{0, 0}, {0, 1}, {0, 2}, {0, 3}}};
+  std::array<ComediChannel, kCounterCount> counters{{{0, 0}, {0, 1}, {0, 2}, {0, 3}, {0, 4}}};
 
-  int analog_output_subdevice{1};  // [-] comedi subdevice of the three analog outputs
-  std::array<int, kAnalogOutputCount> analog_output_channels{0, 1, 2};  // indexed by AnalogOutput, distinct
-  int analog_output_range{0};      // [-] comedi range index used for all three outputs, >= 0
+  int analog_output_subdevice{1};  // [-] comedi subdevice of the analog outputs
+  std::array<int, kAnalogOutputCount> analog_output_channels{0, 1, 2, 3};  // indexed by AnalogOutput, distinct
+  int analog_output_range{0};      // [-] comedi range index used for every analog output, >= 0
 
   int digital_output_subdevice{2};  // [-] DO or DIO subdevice
-  std::array<int, kDigitalOutputCount> digital_output_bits{0, 1, 2, 3};  // [bit] indexed by DigitalOutput, 0..31, distinct
+  std::array<int, kDigitalOutputCount> digital_output_bits{0, 1, 2, 3, 4};  // [bit] indexed by DigitalOutput, 0..31, distinct
   int digital_input_subdevice{3};   // [-] DI or DIO subdevice (may equal digital_output_subdevice)
-  std::array<int, kDigitalInputCount> digital_input_bits{0, 1, 2, 3, 4};  // [bit] indexed by DigitalInput, 0..31, distinct
+  std::array<int, kDigitalInputCount> digital_input_bits{0, 1, 2, 3, 4, 5, 6};  // [bit] indexed by DigitalInput, 0..31, distinct
   /// true: an input reads 0 when active (normally closed contacts: a broken wire reads as an
   /// emergency stop / a reached limit, the fail-safe wiring).
   bool digital_inputs_active_low{true};
 };
 
-/// Throws common::ConfigError naming the field (prefixed by `prefix`), the value and the bound:
+/// Throws common::ConfigError naming the field (prefixed by `prefix`), the value and the bound, for
+/// the channels the crane uses (bridge_axis):
 /// counter_bits outside [2, 32]; a negative subdevice, channel or range index; a bit outside
 /// [0, 31]; two analog outputs on the same channel; two counters on the same subdevice/channel; two
 /// functions on the same digital bit (inputs and outputs sharing one subdevice included).

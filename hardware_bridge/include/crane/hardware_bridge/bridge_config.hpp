@@ -19,8 +19,12 @@ struct HardwareBridgeConfig {
 
 /// Reads the `hardware_bridge:` block (hoist_speed_per_volt [m/s/V] in [1e-4, 100], counter_bits
 /// in [2, 32], comedi: counters, analog_outputs, digital_outputs, digital_inputs); the gate's
-/// params are `gate` (the `actuation:` block, supervisor::read_actuation_params). Throws
-/// common::ConfigError naming the field, value and bound.
+/// params are `gate` (the `actuation:` block, supervisor::read_actuation_params). On an overhead
+/// crane (facts.crane_kind) the bridge's channels are required (comedi.counters.bridge_motor,
+/// analog_outputs.bridge_drive, digital_outputs.brake_release_bridge,
+/// digital_inputs.bridge_min_limit and bridge_max_limit) and both results get bridge_axis = true;
+/// on a tower or gantry crane they are unknown fields. Throws common::ConfigError naming the
+/// field, value and bound ("missing field ...", "unknown field ...").
 [[nodiscard]] HardwareBridgeConfig read_params(config::YamlSection& block, const common::StackFacts& facts,
                                                const supervisor::ActuationGateParams& gate);
 

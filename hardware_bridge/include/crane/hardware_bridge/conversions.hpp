@@ -97,6 +97,8 @@ class CounterUnwrapper {
 ///   trolley [m/count]   = 2 pi leadscrew_pitch / (4 motor_encoder_lines)
 ///   slew    [rad/count] = 2 pi / (4 motor_encoder_lines slew_gear_ratio)
 ///   swing   [rad/count] = 2 pi / (4 swing_encoder_lines)
+///   bridge  [m/count]   = the trolley's (overhead crane): the same motor encoder lines and travel
+///                         per motor radian, as the plant's DrivesAndSensors::measure_bridge()
 /// (quadrature x4; leadscrew_pitch in [m/rad]; slew_gear_ratio motor revolutions per jib revolution).
 /// Counts -> position is counts * resolution, as the plant's encoder_counts_to_position().
 class EncoderScaling {
@@ -107,15 +109,18 @@ class EncoderScaling {
   [[nodiscard]] double trolley_resolution() const noexcept { return trolley_resolution_; }  // [m/count]
   [[nodiscard]] double slew_resolution() const noexcept { return slew_resolution_; }        // [rad/count]
   [[nodiscard]] double swing_resolution() const noexcept { return swing_resolution_; }      // [rad/count]
-  /// Resolution of one counter: [m/count] for the trolley, [rad/count] for the others.
+  [[nodiscard]] double bridge_resolution() const noexcept { return trolley_resolution_; }   // [m/count]
+  /// Resolution of one counter: [m/count] for the trolley and the bridge, [rad/count] for the others.
   [[nodiscard]] double resolution(CounterChannel channel) const noexcept;
 
   [[nodiscard]] double trolley_position(std::int64_t encoder_counts) const noexcept;  // [m]
   [[nodiscard]] double slew_angle(std::int64_t encoder_counts) const noexcept;        // [rad]
   [[nodiscard]] double swing_angle(std::int64_t encoder_counts) const noexcept;       // [rad]
+  [[nodiscard]] double bridge_position(std::int64_t encoder_counts) const noexcept;   // [m]
 
-  /// Measurement from the four continuous counts (indexed by CounterChannel). The crane has no
-  /// hoist encoder: `cable_length` [m] is passed through.
+  /// Measurement from the continuous counts (indexed by CounterChannel; the bridge's gives
+  /// bridge_position, 0 on a crane without a bridge, whose board reads that counter as 0). The
+  /// crane has no hoist encoder: `cable_length` [m] is passed through.
   [[nodiscard]] common::CraneMeasurement measurement(const std::array<std::int64_t, kCounterCount>& encoder_counts,
                                                      double cable_length) const noexcept;
 

@@ -2,7 +2,9 @@
 // The emulated interface board: a POSIX shared-memory segment /crane_board_NAME (layout and
 // protocol in shm_board_layout.hpp) that behaves like the dissertation's board (section 4.1):
 // counter_bits-wide wrapping counters, DAC codes over the range the emulator reports (the plant's
-// 13-bit +-10 V DAC, plant_dac_range()), digital inputs and outputs.
+// 13-bit +-10 V DAC, plant_dac_range()), digital inputs and outputs. The segment always holds every
+// channel of board_channels.hpp, the bridge's included (a crane without a bridge leaves its counter
+// at 0 and its output at 0 V): the layout does not depend on the configuration.
 //
 //   ShmBoard          the driver side (the bridge): a Board, plus the board-paced sample clock.
 //   ShmBoardEmulator  the other side (the simulated plant behind the board): creates the segment
@@ -75,7 +77,7 @@ class ShmBoard final : public Board {
   /// or if its counter_bits differs from config.counter_bits. Does not write to the board.
   explicit ShmBoard(const std::string& name, const BoardConfig& config = {});
 
-  /// Seqlock read of the four registers; also remembers the sample_tick they belong to (the tick
+  /// Seqlock read of the counter registers; also remembers the sample_tick they belong to (the tick
   /// the next write_outputs() answers). Throws BoardError if the emulator stays mid-update for
   /// more than ~10 ms (it died while writing).
   void read_counters(std::array<std::uint32_t, kCounterCount>& raw_counts) override;
@@ -104,6 +106,7 @@ class ShmBoard final : public Board {
   std::uint32_t counter_mask_;
   std::array<AnalogRange, kAnalogOutputCount> ranges_;
   std::uint64_t answered_tick_{0};  // tick of the counters last read: written as outputs_tick
+  bool bridge_axis_{false};         // BoardConfig::bridge_axis: describe() names the bridge's output
 };
 
 /// Snapshot of what the driver last wrote (one consistent write_outputs() call).
@@ -118,7 +121,7 @@ struct ShmOutputs {
 class ShmBoardEmulator {
  public:
   /// (Re-)creates /crane_board_NAME: counter_bits wide counters holding `initial_counts` (sample
-  /// tick 0), the three analog outputs with plant_dac_range(crane) and code 0 V, inputs and outputs
+  /// tick 0), the analog outputs with plant_dac_range(crane) and code 0 V, inputs and outputs
   /// 0, then publishes the magic: a driver that opens the board as soon as it exists reads the
   /// plant's initial state, never a zero the plant has not reached. Unlinks the segment when
   /// destroyed. Throws common::ConfigError for a bad NAME, invalid `crane` parameters or

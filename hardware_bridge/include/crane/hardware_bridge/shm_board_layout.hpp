@@ -29,7 +29,7 @@
 namespace crane::hardware_bridge {
 
 inline constexpr std::uint32_t kShmBoardMagic = 0x43524E42U;  // "CRNB"
-inline constexpr std::uint32_t kShmBoardVersion = 1U;
+inline constexpr std::uint32_t kShmBoardVersion = 2U;  // 2: the bridge axis (a fifth counter, a fourth DAC)
 inline constexpr const char* kShmSegmentPrefix = "/crane_board_";
 
 struct ShmBoardLayout {

@@ -48,6 +48,8 @@ class DrivesAndSensors {
   [[nodiscard]] double trolley_resolution() const noexcept { return trolley_resolution_; }  // [m/count]
   [[nodiscard]] double slew_resolution() const noexcept { return slew_resolution_; }        // [rad/count]
   [[nodiscard]] double swing_resolution() const noexcept { return swing_resolution_; }      // [rad/count]
+  /// [m/count] an overhead crane's bridge encoder: the trolley's (see measure_bridge()).
+  [[nodiscard]] double bridge_resolution() const noexcept { return trolley_resolution_; }
 
   [[nodiscard]] std::int64_t trolley_position_to_encoder_counts(double trolley_position) const noexcept;
   [[nodiscard]] double trolley_encoder_counts_to_position(std::int64_t encoder_counts) const noexcept;  // [m]
