@@ -442,3 +442,86 @@ TEST(Zones, SeededRandomManualSessionsNeverPutTheLoadInAZone) {
 }
 
 }  // namespace
+
+namespace {
+
+// The overhead crane's bridge under operator speed control (OperatorSpeed_.bridge): a full bridge
+// stick for 3 s, released; the load stops without swing where the planner published it would
+// (the bridge's speed reference is the trolley's, on the bridge's rated motion). Then a goal's
+// bridge move stopped half-way (COMMAND_STOP) rests without swing where predicted.
+TEST(OverheadCrane, BridgeStickAndSoftStopStopWithoutSwingWherePredicted) {
+  const auto config = stack::load_stack_config(CRANE_SOURCE_DIR "/deploy/config/overhead_crane.yaml");
+  stack::InProcessOptions options;
+  options.initial_trolley_position = 5.0;
+  options.initial_bridge_position = 10.0;
+  {
+    stack::InProcessStack s(config, options);
+    const auto manual = set_mode(1, Status::OPERATION_MANUAL);
+    std::optional<double> rest;
+    double at_release = 0.0, residual = 0.0, max_swing = 0.0;
+    std::optional<std::uint64_t> stopped;
+    for (std::uint64_t k = 0; k < 6000; ++k) {
+      auto speed = stick(k, 0.0, 0.0);
+      speed.bridge = k >= 400 && k < 700 ? 1.0 : 0.0;
+      s.step({}, k >= 400 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &manual : nullptr);
+      if (k == 700) at_release = s.sensors().bridge_position;
+      for (const auto& f : s.planner().move_statuses()) {
+        if (k == 700 && f.result == Feedback::RESULT_MANUAL) rest = f.rest_bridge_position;
+      }
+      max_swing = std::max(max_swing, swing_of(s));
+      if (k > 700 && !stopped && !s.planner().under_speed_control()) stopped = k;
+      if (stopped && k >= *stopped + 200) residual = std::max(residual, swing_of(s));
+      if (stopped && k >= *stopped + 600) break;
+    }
+    ASSERT_TRUE(stopped.has_value());
+    ASSERT_TRUE(rest.has_value()) << "no stopping position published at the release";
+    const double predicted = *rest - at_release;
+    const double measured = s.next_sensors().bridge_position - at_release;
+    std::printf("overhead bridge: full stick 3 s, released: residual swing 2 s after the stop %.3f deg (max %.2f deg on "
+                "the way); stopping distance published %.4f m, measured %.4f m (%.2f %%)\n",
+                residual * kDeg, max_swing * kDeg, predicted, measured, 100.0 * std::abs(measured - predicted) / predicted);
+    EXPECT_EQ(s.status().latched_faults, 0U);
+    EXPECT_GT(s.next_sensors().bridge_position, 10.5) << "the bridge moved";
+    EXPECT_LT(residual * kDeg, 0.5);
+    EXPECT_NEAR(measured, predicted, 0.05 * std::abs(predicted));
+  }
+  {
+    stack::InProcessStack s(config, options);
+    Request goal;
+    goal.request_id = 1;
+    goal.profile = Request::PROFILE_TRAPEZOID;
+    goal.axes = Request::AXIS_BRIDGE;
+    goal.bridge_target = 40.0;
+    Request stop;
+    stop.request_id = 2;
+    stop.command = Request::COMMAND_STOP;
+    std::optional<double> predicted;
+    double at_stop = 0.0, residual = 0.0;
+    std::optional<std::uint64_t> rest_cycle;
+    for (std::uint64_t k = 0; k < 8000; ++k) {
+      const std::span<const Request> goals = k == 300 ? std::span(&goal, 1) : k == 1800 ? std::span(&stop, 1)
+                                                                                        : std::span<const Request>();
+      s.step(goals);
+      if (k == 1800) at_stop = s.sensors().bridge_position;
+      for (const auto& f : s.planner().move_statuses()) {
+        if (f.request_id == 2 && f.result == Feedback::RESULT_STOPPING) predicted = f.rest_bridge_position;
+        if (f.request_id == 2 && f.result == Feedback::RESULT_ARRIVED && !rest_cycle) rest_cycle = k;
+      }
+      if (rest_cycle && k >= *rest_cycle + 200) residual = std::max(residual, swing_of(s));
+      if (rest_cycle && k >= *rest_cycle + 800) break;
+    }
+    ASSERT_TRUE(predicted.has_value());
+    ASSERT_TRUE(rest_cycle.has_value());
+    const double final_position = s.next_sensors().bridge_position;
+    std::printf("overhead bridge soft stop at %.3f m: predicted rest %.3f m, measured %.3f m (%.2f %% of the stopping "
+                "distance), residual swing %.3f deg\n",
+                at_stop, *predicted, final_position,
+                100.0 * std::abs(final_position - *predicted) / std::abs(*predicted - at_stop), residual * kDeg);
+    EXPECT_EQ(s.status().latched_faults, 0U);
+    EXPECT_LT(final_position, 39.0) << "stopped short of the goal";
+    EXPECT_NEAR(final_position - at_stop, *predicted - at_stop, 0.05 * std::abs(*predicted - at_stop));
+    EXPECT_LT(residual * kDeg, 0.5);
+  }
+}
+
+}  // namespace
