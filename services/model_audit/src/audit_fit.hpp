@@ -104,6 +104,21 @@ struct FreeSet {
 /// RMS, Ljung-Box test and input correlation (empty `input`: none) of the fit's training residual.
 [[nodiscard]] ResidualSummary summarize(const Fit& fit, const std::vector<double>& input, std::size_t max_lag);
 
+/// Held-out windows among the moving ones: a window moves when the range of `measured` over it
+/// exceeds kMovingRangeFraction of the largest window range; the windows that start in the last
+/// `fraction` of the record up to the end of its last moving window are held out (train_count = 0);
+/// the windows at rest after it are trained on. A record that moves until its end is split as
+/// before (the last `fraction` of the record); one that ends at rest (a whole demo run) is validated
+/// where the model is exercised, not on the standstill where every model predicts the same.
+inline constexpr double kMovingRangeFraction = 0.02;
+void hold_out_moving_windows(const std::vector<double>& measured, double fraction, std::vector<Window>& windows);
+
+/// Resolution of a measured channel [its unit]: the larger of its quantum (resolution_quantum) and
+/// its noise, estimated robustly from the fourth difference (1.4826 MAD / sqrt(70), Gaussian noise;
+/// the motion's own fourth difference is negligible at the sample rates audited). Samples `stride`
+/// apart. The practical-significance floor of a cause's held-out gain (AuditOptions) is in it.
+[[nodiscard]] double measurement_resolution(const std::vector<double>& measured, std::size_t stride);
+
 /// The smallest nonzero step between samples `stride` apart (0 when there is none).
 [[nodiscard]] double resolution_quantum(const std::vector<double>& measured, std::size_t stride);
 

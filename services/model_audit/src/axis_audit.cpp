@@ -79,14 +79,14 @@ Problem axis_position_problem(const std::shared_ptr<AxisSeries>& s, double windo
   Problem problem;
   const std::size_t n = s->x.size();
   const auto length = std::max<std::size_t>(static_cast<std::size_t>(std::llround(window_duration / s->sample_time)), 10);
-  const auto holdout_start = static_cast<std::size_t>(std::floor((1.0 - holdout_fraction) * static_cast<double>(n)));
   for (std::size_t first = 0; first + 10 <= n; first += length) {
     Window w;
     w.first = first;
     w.count = std::min(length, n - first);
-    w.train_count = first >= holdout_start ? 0 : w.count;
+    w.train_count = w.count;
     problem.windows.push_back(w);
   }
+  hold_out_moving_windows(s->x, holdout_fraction, problem.windows);
   // Nuisance: initial measured position, velocity and (backlash only) where the axis sits in the
   // gap, as a fraction in [-1, 1] of the half gap.
   const bool gap = s->cause != nullptr && s->cause->gap_state;
@@ -408,6 +408,7 @@ Problem AxisAudit::problem(const Candidate* candidate) const {
 }
 
 double AxisAudit::quantum() const { return effort_ ? 0.0 : resolution_quantum(data_.output, 1); }
+double AxisAudit::resolution() const { return effort_ ? 0.0 : measurement_resolution(data_.output, 1); }
 
 double AxisAudit::measured(std::size_t k) const {
   if (!effort_) return data_.output[k];

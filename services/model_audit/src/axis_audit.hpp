@@ -90,6 +90,7 @@ class AxisAudit final : public ChannelAudit {
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
   [[nodiscard]] const std::vector<double>& correlation_input() const override { return data_.input; }
   [[nodiscard]] double quantum() const override;
+  [[nodiscard]] double resolution() const override;
   [[nodiscard]] double measured(std::size_t k) const override;
   [[nodiscard]] std::optional<double> linear_estimate(const Candidate& candidate,
                                                       const std::vector<double>& nominal) const override;

@@ -69,6 +69,9 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
   const double bic_nominal = bic(nominal.train_rss, nominal.train_n, 0);
   const double holdout_nominal = report.before.holdout_rms;
   const double quantum = channel.quantum();
+  // Practical-significance floor of the held-out gain [channel unit].
+  const double floor = std::max(options.min_holdout_gain_quanta * quantum,
+                                options.min_holdout_gain_resolutions * channel.resolution());
   constexpr double kRestartQuanta = 2.0;  // every_grid_start: restart above this training RMS [quanta]
 
   // Candidates.
@@ -208,7 +211,7 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     entry.holdout_gain_percent = holdout_nominal > 0.0 ? 100.0 * (holdout_nominal - entry.holdout_rms) / holdout_nominal : 0.0;
     entry.qualifies = entry.delta_bic < -options.bic_threshold &&
                       entry.holdout_gain_percent >= options.min_holdout_gain_percent &&
-                      holdout_nominal - entry.holdout_rms >= options.min_holdout_gain_quanta * quantum;
+                      holdout_nominal - entry.holdout_rms >= floor;
     report.candidates.push_back(entry);
   }
 
@@ -220,6 +223,40 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     if (!entry.qualifies) continue;
     if (chosen < 0 || entry.delta_bic < report.candidates[static_cast<std::size_t>(chosen)].delta_bic) {
       chosen = static_cast<std::ptrdiff_t>(c);
+    }
+  }
+  // Held-out arbitration, then ambiguity (model_audit.hpp).
+  std::string arbitration;
+  if (chosen >= 0) {
+    const auto& best = report.candidates[static_cast<std::size_t>(chosen)];
+    std::ptrdiff_t better = -1;
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& entry = report.candidates[c];
+      if (!entry.qualifies || static_cast<std::ptrdiff_t>(c) == chosen) continue;
+      const double gain = best.holdout_rms - entry.holdout_rms;
+      if (gain >= floor && gain >= 0.01 * kArbitrationPercent * best.holdout_rms &&
+          (better < 0 || entry.holdout_rms < report.candidates[static_cast<std::size_t>(better)].holdout_rms)) {
+        better = static_cast<std::ptrdiff_t>(c);
+      }
+    }
+    if (better >= 0) {
+      arbitration = "; " + report.candidates[static_cast<std::size_t>(better)].name + " predicts the held-out data better than " +
+                    best.name + " (" + common::format_value(report.candidates[static_cast<std::size_t>(better)].holdout_rms) +
+                    " against " + common::format_value(best.holdout_rms) + " " + report.unit + ")";
+      chosen = better;
+    }
+  }
+  std::ptrdiff_t twin = -1;
+  if (chosen >= 0) {
+    const auto& pick = report.candidates[static_cast<std::size_t>(chosen)];
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& entry = report.candidates[c];
+      if (!entry.qualifies || static_cast<std::ptrdiff_t>(c) == chosen) continue;
+      if (std::abs(entry.delta_bic - pick.delta_bic) < options.bic_threshold &&
+          std::abs(entry.holdout_rms - pick.holdout_rms) < floor &&
+          (twin < 0 || entry.delta_bic < report.candidates[static_cast<std::size_t>(twin)].delta_bic)) {
+        twin = static_cast<std::ptrdiff_t>(c);
+      }
     }
   }
   if (white) {
@@ -251,7 +288,16 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     for (std::size_t j = 0; j < nominal_free.index.size(); ++j) {
       report.extended_nominal[nominal_free.index[j]].standard_error = selected->standard_errors[j];
     }
-    report.stop_reason = "selected " + entry.name + " (lowest delta-BIC among qualifying candidates)";
+    report.stop_reason = "selected " + entry.name + (arbitration.empty() ? " (lowest delta-BIC among qualifying candidates)" : arbitration);
+    if (twin >= 0) {
+      const auto& other = report.candidates[static_cast<std::size_t>(twin)];
+      report.cause = "ambiguous";
+      report.ambiguous_with = {entry.name, other.name};
+      report.stop_reason = "ambiguous: " + entry.name + " and " + other.name + " share a signature on these data (delta-BIC " +
+                           common::format_value(entry.delta_bic) + " and " + common::format_value(other.delta_bic) +
+                           ", held-out RMS within the floor of " + common::format_value(floor) + " " + report.unit +
+                           "); the fit shown is " + entry.name;
+    }
     report.after = summarize(*selected, summary_input, options.max_lag);
     if (report.after.whiteness.p_value >= 0.05) report.stop_reason += "; the residual is now white";
     else report.stop_reason += "; the residual is still not white (single-cause report)";

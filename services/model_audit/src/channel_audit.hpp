@@ -51,6 +51,9 @@ class ChannelAudit {
   [[nodiscard]] virtual const std::vector<double>& correlation_input() const = 0;
   /// Resolution of the measured channel (0: none).
   [[nodiscard]] virtual double quantum() const = 0;
+  /// The sensor's resolution for the practical-significance floor: quantum or noise, the larger
+  /// (measurement_resolution(); default: quantum()).
+  [[nodiscard]] virtual double resolution() const { return quantum(); }
   /// Measured value at sample k for the plots (the channel's first residual of the sample).
   [[nodiscard]] virtual double measured(std::size_t k) const = 0;
 

@@ -231,7 +231,9 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
     }
     for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
-    if (channel.cause != "none" && channel.cause != "payload_mass_error") channel.cause = prefix + channel.cause;
+    const auto prefixed = [&](const std::string& name) { return name == "payload_mass_error" ? name : prefix + name; };
+    if (channel.cause != "none" && channel.cause != "ambiguous") channel.cause = prefixed(channel.cause);
+    for (auto& name : channel.ambiguous_with) name = prefixed(name);
     return channel;
   };
   if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,

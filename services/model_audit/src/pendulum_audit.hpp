@@ -55,6 +55,7 @@ class PendulumAudit final : public ChannelAudit {
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
   [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_input_; }
   [[nodiscard]] double quantum() const override { return resolution_quantum(data_.output, 1); }
+  [[nodiscard]] double resolution() const override { return measurement_resolution(data_.output, 1); }
   [[nodiscard]] double measured(std::size_t k) const override { return data_.output[k]; }
 
  private:

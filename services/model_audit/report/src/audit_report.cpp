@@ -38,6 +38,7 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
   json["model"] = report.plant;
   json["channel"] = report.channel;
   json["cause"] = report.cause;
+  if (!report.ambiguous_with.empty()) json["ambiguous_with"] = report.ambiguous_with;
   json["stop_reason"] = report.stop_reason;
   json["parameters"] = parameters_json(report.parameters);
   json["gain"] = {{"metric", "holdout_rms_" + report.channel + " [" + report.unit + "]"},

@@ -4,9 +4,15 @@
 // parameters, by the Bayesian information criterion (Schwarz 1978)
 //   BIC = n ln(RSS / n) + k ln(n),  delta-BIC = BIC(candidate) - BIC(nominal)   (k = added parameters)
 // and by the error on a held-out part of the data. A candidate qualifies when delta-BIC <
-// -bic_threshold and it lowers the held-out RMS by at least min_holdout_gain_percent; the cause is
-// the qualifying candidate with the lowest delta-BIC, else "none". The audit stops at once ("none")
-// when the nominal residual is already white (Ljung-Box p >= 0.05).
+// -bic_threshold and it lowers the held-out RMS by at least min_holdout_gain_percent and by the
+// practical-significance floor (min_holdout_gain_resolutions sensor resolutions, and on the crane
+// kCraneResolutionQuanta quanta). The cause is the qualifying candidate with the lowest delta-BIC,
+// unless another qualifying candidate predicts the held-out data better by more than the floor and
+// by kArbitrationPercent (then that one: the held-out data separate them, e.g. stiction against a
+// Stribeck curve whose v_s fell to its bound); when the best two qualifying candidates are within
+// bic_threshold of each other and within the floor on the held-out data, the data cannot separate
+// them and the cause is "ambiguous", naming both (ambiguous_with). Else "none". The audit stops at
+// once ("none") when the nominal residual is already white (Ljung-Box p >= 0.05).
 //
 // Channels (what the residual is):
 //  - position (axis) / angle (pendulum): output error. The record is cut into windows (axis:
@@ -123,6 +129,10 @@ struct AuditData {
 /// trolley RMS on 13 clean recordings. Two counts of held-out gain are required of a cause.
 inline constexpr double kCraneResolutionQuanta = 2.0;
 
+/// Held-out arbitration (see the top): a qualifying candidate replaces the one with the lowest
+/// delta-BIC when its held-out RMS is lower by this many percent of the latter's (and by the floor).
+inline constexpr double kArbitrationPercent = 10.0;
+
 struct AuditOptions {
   AuditNominal nominal;  // the nominal model; its alternative chooses the plant (audit_parameters.hpp)
   bool calibrate{false};
@@ -137,6 +147,12 @@ struct AuditOptions {
   // the measured channel (its smallest nonzero step; position and angle channels). The crane audit
   // uses kCraneResolutionQuanta for its channels, whatever is given here.
   double min_holdout_gain_quanta{0.0};   // [-] >= 0
+  // Practical-significance floor of every model (issue 17): a candidate must also lower the held-out
+  // RMS by at least this many resolutions of the measured channel, the larger of its quantum and its
+  // noise (measurement_resolution in src/audit_fit.hpp): an effect the sensor cannot see beyond its
+  // own resolution is not named. The same floor decides the held-out arbitration and `ambiguous`
+  // (run_audit).
+  double min_holdout_gain_resolutions{1.0};  // [-] >= 0
   // Two-parameter candidates (stribeck: level and v_s trade off along a valley) are fitted from the
   // grid optimum and the best grid points at its v_s grid neighbours; with every_grid_start also
   // at every other v_s grid value when the fit still leaves more than two quanta of training RMS
@@ -182,7 +198,10 @@ struct AuditReport {
   std::string plant;
   std::string channel;
   std::string unit;          // of the channel: m, V or rad
-  std::string cause{"none"};
+  std::string cause{"none"};  // a catalog name, "none", or "ambiguous" (then ambiguous_with)
+  // cause "ambiguous": the two candidates that share a signature and that the data cannot separate
+  // (both qualify; see docs/model_audit.md "Ambiguous"), the better one first; else empty.
+  std::vector<std::string> ambiguous_with;
   std::string stop_reason;
   std::vector<FittedParameter> parameters;  // of the cause
   std::vector<FittedParameter> nominal;     // nominal model used (calibrated if asked)
