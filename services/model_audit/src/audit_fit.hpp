@@ -35,6 +35,12 @@ struct Candidate {
   std::size_t entry{0};
   std::string calibration_note;  // non-empty: skipped with --calibrate (the nominal fit absorbs it)
   std::string note;              // non-empty: skipped, with the reason
+  // A shared signature at a bound: when the fitted parameter `limit_parameter` ends at its lower
+  // bound the candidate is the limit case of the catalog entry `limit_of` (a Stribeck curve whose
+  // v_s falls to its bound is a breakaway excess: stiction), and the data cannot separate the two:
+  // the audit reports "ambiguous" naming both (run_channel_audit). Empty: none.
+  std::string limit_of;
+  std::size_t limit_parameter{0};
 };
 
 /// n values evenly spaced over [a, b].

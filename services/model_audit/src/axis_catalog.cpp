@@ -43,7 +43,11 @@ const std::vector<AxisCause>& axis_catalog() {
              t.model.stribeck_level = std::max(p[0], 0.0);
              t.model.stribeck_velocity = std::max(p[1], 1e-6);
            },
-       .substeps = true},
+       .substeps = true,
+       // v_s at its lower bound (2 mm/s: passed within a sample or two after a breakaway at 100 Hz):
+       // the curve is a breakaway excess, the stiction signature.
+       .limit_of = "stiction",
+       .limit_parameter = 1},
       {.name = "deadzone",
        .parameters = [](const S& s) -> std::vector<ParameterSpec> {
          return {{"deadzone", "V", s.volt, 0.0, s.max_input, linspace(0.05 * s.volt, 2.0 * s.volt, 80)}};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "crane/common/validation.hpp"
 
@@ -259,6 +260,20 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       }
     }
   }
+  if (chosen >= 0 && twin < 0) {
+    // A shared signature at a bound (Candidate::limit_of): ambiguous with the entry it reduces to.
+    const Candidate& candidate = candidates[static_cast<std::size_t>(chosen)];
+    const auto& entry = report.candidates[static_cast<std::size_t>(chosen)];
+    if (!candidate.limit_of.empty() && candidate.limit_parameter < entry.parameters.size()) {
+      const ParameterSpec& spec = candidate.parameters[candidate.limit_parameter];
+      const double value = entry.parameters[candidate.limit_parameter].value;
+      if (value <= spec.lower + 0.05 * std::abs(spec.lower) + 1e-12) {
+        for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+          if (report.candidates[c].name == candidate.limit_of && report.candidates[c].fitted) twin = static_cast<std::ptrdiff_t>(c);
+        }
+      }
+    }
+  }
   if (white) {
     report.stop_reason = "the nominal residual is white (Ljung-Box p = " +
                          common::format_value(report.before.whiteness.p_value) + " >= 0.05)";
@@ -271,6 +286,59 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
                                     common::format_value(quantum) + " " + report.unit
                               : std::string()) +
                          ")";
+  }
+
+  // Stepwise: a second cause on top of the first while the residual is still not white, by the same
+  // rules against the model with the first cause (its parameters refitted in every fit), stopping
+  // at "none". When one is found, the other qualifying candidates within kStepwiseBicFraction of
+  // the best delta-BIC are tried as the first too (with several causes every single-cause fit is
+  // wrong, and the best single one need not be one of them), and the pair with the lowest joint
+  // delta-BIC is kept (model_audit.hpp).
+  std::optional<AuditReport> second;
+  std::string second_note;
+  if (options.max_causes > 1 && chosen >= 0 && twin < 0 && !white) {
+    const auto step_two = [&](std::size_t c) -> std::optional<AuditReport> {
+      const ResidualSummary after = summarize(fits[c], summary_input, options.max_lag);
+      if (after.whiteness.lags > 0 && after.whiteness.p_value >= 0.05) return std::nullopt;
+      const auto next = channel.with_first_cause(candidates[c], fits[c].full);
+      if (!next) return std::nullopt;
+      AuditOptions step = options;
+      step.max_causes = options.max_causes - 1;
+      return run_channel_audit(*next, step);
+    };
+    const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none" && r->cause != "ambiguous"; };
+    const auto joint_bic = [&](std::size_t c, const AuditReport& r) {
+      for (const auto& e : r.candidates) {
+        if (e.name == r.cause) return report.candidates[c].delta_bic + e.delta_bic;
+      }
+      return report.candidates[c].delta_bic;
+    };
+    auto first = static_cast<std::size_t>(chosen);
+    second = step_two(first);
+    if (named(second)) {
+      double best_joint = joint_bic(first, *second);
+      double best_single = 0.0;
+      for (const auto& e : report.candidates) best_single = e.qualifies ? std::min(best_single, e.delta_bic) : best_single;
+      std::vector<std::size_t> others;
+      for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+        const auto& e = report.candidates[c];
+        if (c != first && e.qualifies && e.delta_bic <= kStepwiseBicFraction * best_single) others.push_back(c);
+      }
+      std::sort(others.begin(), others.end(),
+                [&](std::size_t x, std::size_t y) { return report.candidates[x].delta_bic < report.candidates[y].delta_bic; });
+      if (others.size() > kStepwiseAlternatives) others.resize(kStepwiseAlternatives);
+      for (const std::size_t c : others) {
+        auto alternative = step_two(c);
+        if (!named(alternative) || joint_bic(c, *alternative) >= best_joint) continue;
+        best_joint = joint_bic(c, *alternative);
+        arbitration = "; first of the pair with the lowest joint delta-BIC (" + common::format_value(best_joint) + ")";
+        chosen = static_cast<std::ptrdiff_t>(c);
+        second = std::move(alternative);
+      }
+    } else {
+      second_note = second ? second->stop_reason : "";
+      second.reset();
+    }
   }
 
   const Fit* selected = &nominal;
@@ -293,14 +361,19 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       const auto& other = report.candidates[static_cast<std::size_t>(twin)];
       report.cause = "ambiguous";
       report.ambiguous_with = {entry.name, other.name};
-      report.stop_reason = "ambiguous: " + entry.name + " and " + other.name + " share a signature on these data (delta-BIC " +
-                           common::format_value(entry.delta_bic) + " and " + common::format_value(other.delta_bic) +
-                           ", held-out RMS within the floor of " + common::format_value(floor) + " " + report.unit +
+      const Candidate& picked = candidates[static_cast<std::size_t>(chosen)];
+      const bool at_bound = picked.limit_of == other.name;
+      report.stop_reason = "ambiguous: " + entry.name + " and " + other.name + " share a signature on these data (" +
+                           (at_bound ? entry.name + "'s " + picked.parameters[picked.limit_parameter].name +
+                                           " ended at its bound, where it is " + other.name
+                                     : "delta-BIC " + common::format_value(entry.delta_bic) + " and " +
+                                           common::format_value(other.delta_bic) + ", held-out RMS within the floor of " +
+                                           common::format_value(floor) + " " + report.unit) +
                            "); the fit shown is " + entry.name;
     }
     report.after = summarize(*selected, summary_input, options.max_lag);
     if (report.after.whiteness.p_value >= 0.05) report.stop_reason += "; the residual is now white";
-    else report.stop_reason += "; the residual is still not white (single-cause report)";
+    else report.stop_reason += "; the residual is still not white";
   } else {
     report.after = report.before;
   }
@@ -329,6 +402,26 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     if (a.fitted != b.fitted) return a.fitted;
     return a.fitted && a.delta_bic < b.delta_bic;
   });
+
+  if (second) {
+    report.second_cause = second->cause;
+    report.second_parameters = second->parameters;
+    // The first cause's parameters as refitted with the second (base entries after the base).
+    for (std::size_t i = 0; i < report.parameters.size() && base_count + i < second->extended_nominal.size(); ++i) {
+      report.parameters[i].value = second->extended_nominal[base_count + i].value;
+      report.parameters[i].standard_error = second->extended_nominal[base_count + i].standard_error;
+    }
+    report.extended_nominal.assign(second->extended_nominal.begin(),
+                                   second->extended_nominal.begin() + static_cast<std::ptrdiff_t>(base_count));
+    report.after = second->after;
+    report.holdout_after = second->holdout_after;
+    report.holdout_percent = holdout_nominal > 0.0 ? 100.0 * (holdout_nominal - report.holdout_after) / holdout_nominal : 0.0;
+    report.extended_prediction = second->extended_prediction;
+    report.second_candidates = second->candidates;
+    report.stop_reason += "; then " + second->stop_reason;
+  } else if (!second_note.empty()) {
+    report.stop_reason += "; no second cause (" + second_note + ")";
+  }
   return report;
 }
 

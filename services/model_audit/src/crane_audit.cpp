@@ -208,6 +208,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     if (!requested) return std::nullopt;
     axis_options.nominal = drive_axis_parameters(friction, gain);
     axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    axis_options.max_causes = 1;  // one cause per channel (the combination picks one)
     axis_options.every_grid_start = true;
     AuditData axis_data;
     axis_data.source = data.source;
@@ -258,6 +259,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     swing_options.nominal = swing_nominal;
     swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
     swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    swing_options.max_causes = 1;
     if (requested) {
       std::vector<double> measured(2 * n);
       for (std::size_t k = 0; k < n; ++k) {
