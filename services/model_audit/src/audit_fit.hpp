@@ -36,11 +36,12 @@ struct Candidate {
   std::string calibration_note;  // non-empty: skipped with --calibrate (the nominal fit absorbs it)
   std::string note;              // non-empty: skipped, with the reason
   // A shared signature at a bound: when the fitted parameter `limit_parameter` ends at its lower
-  // bound the candidate is the limit case of the catalog entry `limit_of` (a Stribeck curve whose
+  // bound (or at or below limit_value) the candidate is the limit case of the catalog entry `limit_of` (a Stribeck curve whose
   // v_s falls to its bound is a breakaway excess: stiction), and the data cannot separate the two:
   // the audit reports "ambiguous" naming both (run_channel_audit). Empty: none.
   std::string limit_of;
   std::size_t limit_parameter{0};
+  double limit_value{-1e300};  // at or below max(this, 1.05 x the lower bound): at the limit
 };
 
 /// n values evenly spaced over [a, b].

@@ -405,7 +405,8 @@ std::vector<Candidate> AxisAudit::candidates() const {
     if (catalog[i].crane_drive_only && !crane_drive) continue;
     if (i == first_entry_) continue;  // the first cause of a second step
     list.push_back({catalog[i].name, catalog[i].parameters(scales), i, catalog[i].calibration_note, "",
-                    catalog[i].limit_of, catalog[i].limit_parameter});
+                    catalog[i].limit_of, catalog[i].limit_parameter,
+                    catalog[i].limit_value != nullptr ? catalog[i].limit_value(scales) : -1e300});
   }
   return list;
 }

@@ -61,8 +61,9 @@ struct AxisCause {
   bool effort_channel{true};        // defined in the effort channel
   const char* calibration_note{""};  // non-empty: absorbed by the calibrated nominal (skipped)
   bool crane_drive_only{false};      // needs the crane's coupling (payload_mass_error)
-  const char* limit_of{""};          // Candidate::limit_of (with limit_parameter)
+  const char* limit_of{""};          // Candidate::limit_of (with limit_parameter and limit_value)
   std::size_t limit_parameter{0};
+  double (*limit_value)(const AxisScales&){nullptr};
 };
 
 /// The axis catalog in catalog order (audit_catalog(axis) lists the entries that are not

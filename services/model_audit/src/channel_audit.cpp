@@ -260,20 +260,29 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       }
     }
   }
-  if (chosen >= 0 && twin < 0) {
-    // A shared signature at a bound (Candidate::limit_of): ambiguous with the entry it reduces to.
-    const Candidate& candidate = candidates[static_cast<std::size_t>(chosen)];
-    const auto& entry = report.candidates[static_cast<std::size_t>(chosen)];
-    if (!candidate.limit_of.empty() && candidate.limit_parameter < entry.parameters.size()) {
-      const ParameterSpec& spec = candidate.parameters[candidate.limit_parameter];
-      const double value = entry.parameters[candidate.limit_parameter].value;
-      if (value <= spec.lower + 0.05 * std::abs(spec.lower) + 1e-12) {
-        for (std::size_t c = 0; c < report.candidates.size(); ++c) {
-          if (report.candidates[c].name == candidate.limit_of && report.candidates[c].fitted) twin = static_cast<std::ptrdiff_t>(c);
-        }
+  // A shared signature at a bound (Candidate::limit_of): the selected candidate at its limit is
+  // ambiguous with the entry it reduces to. (Not the other way round: when the entry it reduces to
+  // is selected, that is already the simpler name of the same signature.)
+  // `value`: the picked candidate's limit parameter as finally fitted (refitted with a second cause).
+  const auto at_limit = [&](std::size_t c, double value) {
+    const Candidate& candidate = candidates[c];
+    if (candidate.limit_of.empty() || !report.candidates[c].fitted) return false;
+    const ParameterSpec& spec = candidate.parameters[candidate.limit_parameter];
+    return value <= std::max(spec.lower + 0.05 * std::abs(spec.lower) + 1e-12, candidate.limit_value);
+  };
+  const auto fitted_limit = [&](std::size_t c) {
+    const auto& p = report.candidates[c].parameters;
+    return candidates[c].limit_parameter < p.size() ? p[candidates[c].limit_parameter].value : kNaN;
+  };
+  const auto limit_twin = [&](std::size_t picked, double picked_value) -> std::ptrdiff_t {
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      if (c == picked || !report.candidates[c].fitted) continue;
+      if (at_limit(picked, picked_value) && report.candidates[c].name == candidates[picked].limit_of) {
+        return static_cast<std::ptrdiff_t>(c);
       }
     }
-  }
+    return -1;
+  };
   if (white) {
     report.stop_reason = "the nominal residual is white (Ljung-Box p = " +
                          common::format_value(report.before.whiteness.p_value) + " >= 0.05)";
@@ -306,39 +315,54 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       step.max_causes = options.max_causes - 1;
       return run_channel_audit(*next, step);
     };
-    const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none" && r->cause != "ambiguous"; };
+    // A second step that names a cause, or two that share a signature (ambiguous).
+    const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none"; };
     const auto joint_bic = [&](std::size_t c, const AuditReport& r) {
+      const std::string& name = r.cause == "ambiguous" ? r.ambiguous_with.front() : r.cause;
       for (const auto& e : r.candidates) {
-        if (e.name == r.cause) return report.candidates[c].delta_bic + e.delta_bic;
+        if (e.name == name) return report.candidates[c].delta_bic + e.delta_bic;
       }
       return report.candidates[c].delta_bic;
     };
-    auto first = static_cast<std::size_t>(chosen);
+    const auto first = static_cast<std::size_t>(chosen);
     second = step_two(first);
+    double best_joint = report.candidates[first].delta_bic;
     if (named(second)) {
-      double best_joint = joint_bic(first, *second);
-      double best_single = 0.0;
-      for (const auto& e : report.candidates) best_single = e.qualifies ? std::min(best_single, e.delta_bic) : best_single;
-      std::vector<std::size_t> others;
-      for (std::size_t c = 0; c < report.candidates.size(); ++c) {
-        const auto& e = report.candidates[c];
-        if (c != first && e.qualifies && e.delta_bic <= kStepwiseBicFraction * best_single) others.push_back(c);
-      }
-      std::sort(others.begin(), others.end(),
-                [&](std::size_t x, std::size_t y) { return report.candidates[x].delta_bic < report.candidates[y].delta_bic; });
-      if (others.size() > kStepwiseAlternatives) others.resize(kStepwiseAlternatives);
-      for (const std::size_t c : others) {
-        auto alternative = step_two(c);
-        if (!named(alternative) || joint_bic(c, *alternative) >= best_joint) continue;
-        best_joint = joint_bic(c, *alternative);
-        arbitration = "; first of the pair with the lowest joint delta-BIC (" + common::format_value(best_joint) + ")";
-        chosen = static_cast<std::ptrdiff_t>(c);
-        second = std::move(alternative);
-      }
+      best_joint = joint_bic(first, *second);
     } else {
       second_note = second ? second->stop_reason : "";
       second.reset();
     }
+    double best_single = 0.0;
+    for (const auto& e : report.candidates) best_single = e.qualifies ? std::min(best_single, e.delta_bic) : best_single;
+    std::vector<std::size_t> others;
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& e = report.candidates[c];
+      if (c != first && e.qualifies && e.delta_bic <= kStepwiseBicFraction * best_single) others.push_back(c);
+    }
+    std::sort(others.begin(), others.end(),
+              [&](std::size_t x, std::size_t y) { return report.candidates[x].delta_bic < report.candidates[y].delta_bic; });
+    if (others.size() > kStepwiseAlternatives) others.resize(kStepwiseAlternatives);
+    for (const std::size_t c : others) {
+      auto alternative = step_two(c);
+      if (!named(alternative) || joint_bic(c, *alternative) >= best_joint) continue;
+      best_joint = joint_bic(c, *alternative);
+      arbitration = "; first of the pair with the lowest joint delta-BIC (" + common::format_value(best_joint) +
+                    ", against " + common::format_value(report.candidates[first].delta_bic) + " for " +
+                    report.candidates[first].name + (second ? " with its second cause" : " alone") + ")";
+      chosen = static_cast<std::ptrdiff_t>(c);
+      second = std::move(alternative);
+      second_note.clear();
+    }
+  }
+
+  if (chosen >= 0 && twin < 0) {  // the (pair's) first cause at a limit, as finally fitted
+    const auto c = static_cast<std::size_t>(chosen);
+    double value = fitted_limit(c);
+    if (second && !candidates[c].limit_of.empty() && base_count + candidates[c].limit_parameter < second->extended_nominal.size()) {
+      value = second->extended_nominal[base_count + candidates[c].limit_parameter].value;
+    }
+    twin = limit_twin(c, value);
   }
 
   const Fit* selected = &nominal;
@@ -362,10 +386,12 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       report.cause = "ambiguous";
       report.ambiguous_with = {entry.name, other.name};
       const Candidate& picked = candidates[static_cast<std::size_t>(chosen)];
-      const bool at_bound = picked.limit_of == other.name;
+      const Candidate& twin_candidate = candidates[static_cast<std::size_t>(twin)];
+      const bool at_bound = picked.limit_of == other.name || twin_candidate.limit_of == entry.name;
+      const Candidate& limit_case = picked.limit_of == other.name ? picked : twin_candidate;
       report.stop_reason = "ambiguous: " + entry.name + " and " + other.name + " share a signature on these data (" +
-                           (at_bound ? entry.name + "'s " + picked.parameters[picked.limit_parameter].name +
-                                           " ended at its bound, where it is " + other.name
+                           (at_bound ? limit_case.name + "'s " + limit_case.parameters[limit_case.limit_parameter].name +
+                                           " is at its limit, where it is " + limit_case.limit_of
                                      : "delta-BIC " + common::format_value(entry.delta_bic) + " and " +
                                            common::format_value(other.delta_bic) + ", held-out RMS within the floor of " +
                                            common::format_value(floor) + " " + report.unit) +
@@ -405,6 +431,7 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
 
   if (second) {
     report.second_cause = second->cause;
+    report.second_ambiguous_with = second->ambiguous_with;
     report.second_parameters = second->parameters;
     // The first cause's parameters as refitted with the second (base entries after the base).
     for (std::size_t i = 0; i < report.parameters.size() && base_count + i < second->extended_nominal.size(); ++i) {

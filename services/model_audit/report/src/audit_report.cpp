@@ -42,6 +42,7 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
   json["stop_reason"] = report.stop_reason;
   json["parameters"] = parameters_json(report.parameters);
   json["second_cause"] = report.second_cause;
+  if (!report.second_ambiguous_with.empty()) json["second_ambiguous_with"] = report.second_ambiguous_with;
   if (report.second_cause != "none") json["second_parameters"] = parameters_json(report.second_parameters);
   json["gain"] = {{"metric", "holdout_rms_" + report.channel + " [" + report.unit + "]"},
                   {"before", number(report.holdout_before)},

@@ -11,15 +11,20 @@
 // by kArbitrationPercent (then that one: the held-out data separate them, e.g. stiction against a
 // Stribeck curve whose v_s fell to its bound); when the best two qualifying candidates are within
 // bic_threshold of each other and within the floor on the held-out data, the data cannot separate
-// them and the cause is "ambiguous", naming both (ambiguous_with). Else "none". The audit stops at
-// once ("none") when the nominal residual is already white (Ljung-Box p >= 0.05).
+// them and the cause is "ambiguous", naming both (ambiguous_with); likewise when the selected
+// candidate's fit is at the limit where it becomes another entry (Candidate::limit_of: a Stribeck
+// curve with v_s <= c T / 2 is stiction on sampled data). Else "none". The audit stops at once
+// ("none") when the nominal residual is already white (Ljung-Box p >= 0.05). Stepwise
+// (max_causes): while the residual with the cause is not white, a second cause by the same rules
+// against the model with the first (second_cause).
 //
 // Channels (what the residual is):
 //  - position (axis) / angle (pendulum): output error. The record is cut into windows (axis:
 //    window_duration; pendulum: one window per maneuver, given by an optional "segment" column),
 //    each simulated from its own initial state (position and velocity, fitted as nuisance
-//    parameters) with the recorded input held per sample. Axis: windows in the last holdout_fraction
-//    of the record are held out (their initial states are refitted with the model fixed). Pendulum:
+//    parameters) with the recorded input held per sample. Axis: the windows that start in the last
+//    holdout_fraction of the record up to the end of its last moving window are held out (their
+//    initial states are refitted with the model fixed; windows at rest after it are trained on). Pendulum:
 //    the last holdout_fraction of each maneuver is held out and predicted by continuing the fit.
 //  - effort (axis, inverse dynamics, for closed-loop data where position cannot tell models apart):
 //    the drive command that the model needs for the measured motion, from centred differences
@@ -133,10 +138,11 @@ inline constexpr double kCraneResolutionQuanta = 2.0;
 /// delta-BIC when its held-out RMS is lower by this many percent of the latter's (and by the floor).
 inline constexpr double kArbitrationPercent = 10.0;
 
-/// Stepwise (AuditOptions::max_causes): when a second cause is found, the other qualifying
-/// first-step candidates whose delta-BIC reaches this fraction of the best one (at most
-/// kStepwiseAlternatives of them, best first) are tried as the first cause too; the pair with the
-/// lowest joint delta-BIC (first step + second step) is reported.
+/// Stepwise (AuditOptions::max_causes): the other qualifying first-step candidates whose delta-BIC
+/// reaches this fraction of the best one (at most kStepwiseAlternatives of them, best first) are
+/// tried as the first cause too; a pair found from one of them replaces the selected first cause
+/// (alone or with its own second cause) when its joint delta-BIC (first step + second step) is
+/// lower.
 inline constexpr double kStepwiseBicFraction = 0.6;
 inline constexpr std::size_t kStepwiseAlternatives = 2;
 
@@ -219,7 +225,8 @@ struct AuditReport {
   std::vector<FittedParameter> parameters;  // of the cause (refitted with the second cause if any)
   // Stepwise: the second cause found on top of the first ("none": none) and its parameters; the
   // held-out figures, `after` and extended_prediction are then those of the model with both.
-  std::string second_cause{"none"};
+  std::string second_cause{"none"};           // a catalog name, "none" or "ambiguous"
+  std::vector<std::string> second_ambiguous_with;  // second_cause "ambiguous": the two it names
   std::vector<FittedParameter> second_parameters;
   std::vector<FittedParameter> nominal;     // nominal model used (calibrated if asked)
   std::vector<FittedParameter> extended_nominal;  // base parameters refitted with the cause
