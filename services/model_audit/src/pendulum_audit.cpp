@@ -74,7 +74,7 @@ std::vector<Candidate> candidates_of(double omega_squared) {
   std::vector<Candidate> list;
   const auto& catalog = pendulum_catalog();
   for (std::size_t i = 0; i < catalog.size(); ++i) {
-    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, ""});
+    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, "", "", 0, -1e300});
   }
   return list;
 }
