@@ -289,6 +289,40 @@ std::vector<std::vector<double>> initial_nuisance(const Problem& problem) {
   return nuisance;
 }
 
+void hold_out_moving_windows(const std::vector<double>& measured, double fraction, std::vector<Window>& windows) {
+  std::vector<double> range(windows.size(), 0.0);
+  double largest = 0.0;
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    const auto begin = measured.begin() + static_cast<std::ptrdiff_t>(windows[i].first);
+    const auto [lo, hi] = std::minmax_element(begin, begin + static_cast<std::ptrdiff_t>(windows[i].count));
+    range[i] = *hi - *lo;
+    largest = std::max(largest, range[i]);
+  }
+  std::size_t end = 0;  // one past the last sample of the last moving window
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    if (range[i] > kMovingRangeFraction * largest) end = windows[i].first + windows[i].count;
+  }
+  if (end == 0) end = measured.size();
+  const auto start = static_cast<std::size_t>(std::floor((1.0 - fraction) * static_cast<double>(end)));
+  for (auto& w : windows) w.train_count = w.first >= start && w.first < end ? 0 : w.count;
+}
+
+double measurement_resolution(const std::vector<double>& measured, std::size_t stride) {
+  std::vector<double> fourth;
+  for (std::size_t k = 4 * stride; k < measured.size(); ++k) {
+    const double d = measured[k] - 4.0 * measured[k - stride] + 6.0 * measured[k - 2 * stride] -
+                     4.0 * measured[k - 3 * stride] + measured[k - 4 * stride];
+    if (std::isfinite(d)) fourth.push_back(std::abs(d));
+  }
+  double noise = 0.0;
+  if (!fourth.empty()) {
+    auto middle = fourth.begin() + static_cast<std::ptrdiff_t>(fourth.size() / 2);
+    std::nth_element(fourth.begin(), middle, fourth.end());
+    noise = 1.4826 * *middle / std::sqrt(70.0);
+  }
+  return std::max(resolution_quantum(measured, stride), noise);
+}
+
 double resolution_quantum(const std::vector<double>& measured, std::size_t stride) {
   double quantum = std::numeric_limits<double>::infinity();
   for (std::size_t k = stride; k < measured.size(); ++k) {

@@ -35,6 +35,13 @@ struct Candidate {
   std::size_t entry{0};
   std::string calibration_note;  // non-empty: skipped with --calibrate (the nominal fit absorbs it)
   std::string note;              // non-empty: skipped, with the reason
+  // A shared signature at a bound: when the fitted parameter `limit_parameter` ends at its lower
+  // bound (or at or below limit_value) the candidate is the limit case of the catalog entry `limit_of` (a Stribeck curve whose
+  // v_s falls to its bound is a breakaway excess: stiction), and the data cannot separate the two:
+  // the audit reports "ambiguous" naming both (run_channel_audit). Empty: none.
+  std::string limit_of;
+  std::size_t limit_parameter{0};
+  double limit_value{-1e300};  // at or below max(this, 1.05 x the lower bound): at the limit
 };
 
 /// n values evenly spaced over [a, b].
@@ -103,6 +110,21 @@ struct FreeSet {
 
 /// RMS, Ljung-Box test and input correlation (empty `input`: none) of the fit's training residual.
 [[nodiscard]] ResidualSummary summarize(const Fit& fit, const std::vector<double>& input, std::size_t max_lag);
+
+/// Held-out windows among the moving ones: a window moves when the range of `measured` over it
+/// exceeds kMovingRangeFraction of the largest window range; the windows that start in the last
+/// `fraction` of the record up to the end of its last moving window are held out (train_count = 0);
+/// the windows at rest after it are trained on. A record that moves until its end is split as
+/// before (the last `fraction` of the record); one that ends at rest (a whole demo run) is validated
+/// where the model is exercised, not on the standstill where every model predicts the same.
+inline constexpr double kMovingRangeFraction = 0.02;
+void hold_out_moving_windows(const std::vector<double>& measured, double fraction, std::vector<Window>& windows);
+
+/// Resolution of a measured channel [its unit]: the larger of its quantum (resolution_quantum) and
+/// its noise, estimated robustly from the fourth difference (1.4826 MAD / sqrt(70), Gaussian noise;
+/// the motion's own fourth difference is negligible at the sample rates audited). Samples `stride`
+/// apart. The practical-significance floor of a cause's held-out gain (AuditOptions) is in it.
+[[nodiscard]] double measurement_resolution(const std::vector<double>& measured, std::size_t stride);
 
 /// The smallest nonzero step between samples `stride` apart (0 when there is none).
 [[nodiscard]] double resolution_quantum(const std::vector<double>& measured, std::size_t stride);

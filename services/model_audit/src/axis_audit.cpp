@@ -14,6 +14,13 @@ struct AxisSeries {
   double sample_time{0.0};
   int substeps{1};
   const AxisCause* cause{nullptr};  // nullptr: the nominal model
+  // Second step of the stepwise audit: the first cause, its parameters at full[kAxisBase ..
+  // kAxisBase + first_count), the candidate's after them.
+  const AxisCause* first{nullptr};
+  std::size_t first_count{0};
+  [[nodiscard]] bool gap() const {
+    return (cause != nullptr && cause->gap_state) || (first != nullptr && first->gap_state);
+  }
   double dead_band{0.0};
   AxisModel nominal;  // nominal asymmetries and stiction (catalog entries add to them)
   // Crane drive axis (empty for a lone axis): the axis row I a + C = I_drive (drive - friction) with
@@ -39,7 +46,8 @@ AxisTerms axis_terms(const AxisSeries& s, const std::vector<double>& full) {
   t.model.motor_constant = std::max(full[0], 1e-9);
   t.model.viscous = std::max(full[1], 0.0);
   t.model.coulomb = std::max(full[2], 0.0);
-  if (s.cause != nullptr) s.cause->apply(full.data() + kAxisBase, t);
+  if (s.first != nullptr) s.first->apply(full.data() + kAxisBase, t);
+  if (s.cause != nullptr) s.cause->apply(full.data() + kAxisBase + s.first_count, t);
   return t;
 }
 
@@ -79,17 +87,17 @@ Problem axis_position_problem(const std::shared_ptr<AxisSeries>& s, double windo
   Problem problem;
   const std::size_t n = s->x.size();
   const auto length = std::max<std::size_t>(static_cast<std::size_t>(std::llround(window_duration / s->sample_time)), 10);
-  const auto holdout_start = static_cast<std::size_t>(std::floor((1.0 - holdout_fraction) * static_cast<double>(n)));
   for (std::size_t first = 0; first + 10 <= n; first += length) {
     Window w;
     w.first = first;
     w.count = std::min(length, n - first);
-    w.train_count = first >= holdout_start ? 0 : w.count;
+    w.train_count = w.count;
     problem.windows.push_back(w);
   }
+  hold_out_moving_windows(s->x, holdout_fraction, problem.windows);
   // Nuisance: initial measured position, velocity and (backlash only) where the axis sits in the
   // gap, as a fraction in [-1, 1] of the half gap.
-  const bool gap = s->cause != nullptr && s->cause->gap_state;
+  const bool gap = s->gap();
   problem.nuisance_size = gap ? 3 : 2;
   problem.initial_nuisance = [s, gap](const Window& w, double* out) {
     const auto [x0, v0] = local_state(s->x, w.first, w.first + w.count, s->sample_time);
@@ -105,7 +113,7 @@ Problem axis_position_problem(const std::shared_ptr<AxisSeries>& s, double windo
     AxisState initial;
     initial.load_position = nuisance[0];
     initial.velocity = nuisance[1];
-    const double sign = s->cause != nullptr && s->cause->gap_state ? std::clamp(nuisance[2], -1.0, 1.0) : 0.0;
+    const double sign = s->gap() ? std::clamp(nuisance[2], -1.0, 1.0) : 0.0;
     initial.position = nuisance[0] + 0.5 * model.backlash * sign;
     std::span<double> prediction(out, count);
     replay_axis(model, s->u, s->sample_time, w.first, initial, s->substeps, prediction, coupling.external,
@@ -218,8 +226,8 @@ std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vecto
 // with the command held over each sample, a breakaway can only start at a sample instant, so the
 // data only say that the threshold c + Delta_s lies between the drive K_m u of the last held
 // sample and that of the breakaway sample. This estimator reads those brackets off the record:
-// a rest episode is a run of >= 5 samples within kRestQuanta position quanta (the smallest
-// nonzero step of the record) of its first sample, followed by motion; the breakaway instant is
+// a rest episode is a run of >= 5 samples within kRestQuanta position quanta (the record's
+// resolution: the smallest nonzero step, or its noise when that is larger) of its first sample, followed by motion; the breakaway instant is
 // the one (of the last four of the episode) whose nominal-model motion from rest (kinetic friction
 // only, which does not depend on Delta_s) best matches the next kMotionSamples samples. The
 // estimate is the middle of the stretch covered by the most brackets; nullopt below two brackets.
@@ -233,12 +241,8 @@ constexpr std::size_t kMotionSamples = 5;
 
 std::optional<std::pair<double, double>> axis_breakaway_bracket(const AxisSeries& s, const std::vector<double>& full) {
   const std::size_t n = s.x.size();
-  double quantum = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 1; k < n; ++k) {
-    const double step = std::abs(s.x[k] - s.x[k - 1]);
-    if (step > 1e-12) quantum = std::min(quantum, step);
-  }
-  if (!std::isfinite(quantum)) return std::nullopt;
+  const double quantum = measurement_resolution(s.x, 1);  // the quantum, or the noise when larger
+  if (!(quantum > 0.0)) return std::nullopt;
   const double tolerance = kRestQuanta * quantum;
   AxisSeries base = s;
   base.cause = nullptr;
@@ -363,7 +367,23 @@ AxisAudit::AxisAudit(const AuditData& data, const AxisAuditParameters& nominal, 
 AxisAudit::~AxisAudit() = default;
 
 std::vector<std::size_t> AxisAudit::nominal_free(bool calibrate) const {
-  return calibrate ? std::vector<std::size_t>{0, 1, 2} : std::vector<std::size_t>{};
+  std::vector<std::size_t> free = calibrate ? std::vector<std::size_t>{0, 1, 2} : std::vector<std::size_t>{};
+  for (std::size_t i = first_base_; i < base_.size() && first_base_ > 0; ++i) free.push_back(i);
+  return free;
+}
+
+std::unique_ptr<ChannelAudit> AxisAudit::with_first_cause(const Candidate& first, const std::vector<double>& full) const {
+  if (series_->first != nullptr) return nullptr;  // two causes at most
+  auto next = std::make_unique<AxisAudit>(*this);
+  next->first_entry_ = first.entry;
+  next->first_base_ = base_.size();
+  next->base_.assign(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(base_.size() + first.parameters.size()));
+  for (const auto& spec : first.parameters) next->base_specs_.push_back(spec);
+  auto s = std::make_shared<AxisSeries>(*series_);
+  s->first = &axis_catalog()[first.entry];
+  s->first_count = first.parameters.size();
+  next->series_ = std::move(s);
+  return next;
 }
 
 std::vector<Candidate> AxisAudit::candidates() const {
@@ -383,7 +403,10 @@ std::vector<Candidate> AxisAudit::candidates() const {
   const auto& catalog = axis_catalog();
   for (std::size_t i = 0; i < catalog.size(); ++i) {
     if (catalog[i].crane_drive_only && !crane_drive) continue;
-    list.push_back({catalog[i].name, catalog[i].parameters(scales), i, catalog[i].calibration_note, ""});
+    if (i == first_entry_) continue;  // the first cause of a second step
+    list.push_back({catalog[i].name, catalog[i].parameters(scales), i, catalog[i].calibration_note, "",
+                    catalog[i].limit_of, catalog[i].limit_parameter,
+                    catalog[i].limit_value != nullptr ? catalog[i].limit_value(scales) : -1e300});
   }
   return list;
 }
@@ -398,7 +421,7 @@ std::string AxisAudit::unavailable(const Candidate& candidate) const {
 std::shared_ptr<AxisSeries> AxisAudit::series(const AxisCause* cause) const {
   auto s = std::make_shared<AxisSeries>(*series_);
   s->cause = cause;
-  s->substeps = cause != nullptr && cause->substeps ? substeps_ : 1;
+  s->substeps = (cause != nullptr && cause->substeps) || (s->first != nullptr && s->first->substeps) ? substeps_ : 1;
   return s;
 }
 
@@ -408,6 +431,7 @@ Problem AxisAudit::problem(const Candidate* candidate) const {
 }
 
 double AxisAudit::quantum() const { return effort_ ? 0.0 : resolution_quantum(data_.output, 1); }
+double AxisAudit::resolution() const { return effort_ ? 0.0 : measurement_resolution(data_.output, 1); }
 
 double AxisAudit::measured(std::size_t k) const {
   if (!effort_) return data_.output[k];
@@ -425,7 +449,7 @@ void AxisAudit::refine(const Candidate& candidate, const Problem& problem, const
   const auto bracket = axis_breakaway_bracket(*series_, fit.full);
   if (!bracket) return;
   std::vector<double> held = fit.full;
-  held[kAxisBase] = std::max(0.5 * (bracket->first + bracket->second), 0.0);
+  held[base_.size()] = std::max(0.5 * (bracket->first + bracket->second), 0.0);
   const double half_width = 0.5 * (bracket->second - bracket->first);
   Fit refit = fit_problem(problem, held, nominal_free, fit.nuisance, samples());
   refit.standard_errors.push_back(half_width / std::sqrt(3.0));  // uniform within the bracket

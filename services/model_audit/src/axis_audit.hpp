@@ -61,6 +61,9 @@ struct AxisCause {
   bool effort_channel{true};        // defined in the effort channel
   const char* calibration_note{""};  // non-empty: absorbed by the calibrated nominal (skipped)
   bool crane_drive_only{false};      // needs the crane's coupling (payload_mass_error)
+  const char* limit_of{""};          // Candidate::limit_of (with limit_parameter and limit_value)
+  std::size_t limit_parameter{0};
+  double (*limit_value)(const AxisScales&){nullptr};
 };
 
 /// The axis catalog in catalog order (audit_catalog(axis) lists the entries that are not
@@ -90,12 +93,15 @@ class AxisAudit final : public ChannelAudit {
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
   [[nodiscard]] const std::vector<double>& correlation_input() const override { return data_.input; }
   [[nodiscard]] double quantum() const override;
+  [[nodiscard]] double resolution() const override;
   [[nodiscard]] double measured(std::size_t k) const override;
   [[nodiscard]] std::optional<double> linear_estimate(const Candidate& candidate,
                                                       const std::vector<double>& nominal) const override;
   void refine(const Candidate& candidate, const Problem& problem, const FreeSet& nominal_free, Fit& fit) const override;
   void second_opinion(const std::vector<double>& nominal, const Candidate* selected,
                       const std::vector<double>& selected_full, AuditReport& report) const override;
+  [[nodiscard]] std::unique_ptr<ChannelAudit> with_first_cause(const Candidate& first,
+                                                               const std::vector<double>& full) const override;
 
  private:
   [[nodiscard]] std::shared_ptr<AxisSeries> series(const AxisCause* cause) const;
@@ -108,7 +114,9 @@ class AxisAudit final : public ChannelAudit {
   int substeps_;
   std::vector<double> base_;
   std::vector<ParameterSpec> base_specs_;
-  std::shared_ptr<const AxisSeries> series_;  // the nominal series (no cause)
+  std::shared_ptr<const AxisSeries> series_;  // the nominal series (no cause; the first cause in a second step)
+  std::size_t first_entry_{static_cast<std::size_t>(-1)};  // catalog entry of the first cause (second step)
+  std::size_t first_base_{0};                                // base parameters before the first cause's
 };
 
 }  // namespace crane::model_audit::detail

@@ -43,7 +43,13 @@ const std::vector<AxisCause>& axis_catalog() {
              t.model.stribeck_level = std::max(p[0], 0.0);
              t.model.stribeck_velocity = std::max(p[1], 1e-6);
            },
-       .substeps = true},
+       .substeps = true,
+       // v_s at or below half the speed that the Coulomb level's acceleration gives in one sample
+       // (c T / 2): the drop is over within the first sample after a breakaway, so the sampled
+       // record sees a breakaway excess, the stiction signature.
+       .limit_of = "stiction",
+       .limit_parameter = 1,
+       .limit_value = [](const S& s) { return 0.5 * s.c_scale * s.sample_time; }},
       {.name = "deadzone",
        .parameters = [](const S& s) -> std::vector<ParameterSpec> {
          return {{"deadzone", "V", s.volt, 0.0, s.max_input, linspace(0.05 * s.volt, 2.0 * s.volt, 80)}};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "crane/common/validation.hpp"
 
@@ -69,6 +70,9 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
   const double bic_nominal = bic(nominal.train_rss, nominal.train_n, 0);
   const double holdout_nominal = report.before.holdout_rms;
   const double quantum = channel.quantum();
+  // Practical-significance floor of the held-out gain [channel unit].
+  const double floor = std::max(options.min_holdout_gain_quanta * quantum,
+                                options.min_holdout_gain_resolutions * channel.resolution());
   constexpr double kRestartQuanta = 2.0;  // every_grid_start: restart above this training RMS [quanta]
 
   // Candidates.
@@ -208,7 +212,7 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     entry.holdout_gain_percent = holdout_nominal > 0.0 ? 100.0 * (holdout_nominal - entry.holdout_rms) / holdout_nominal : 0.0;
     entry.qualifies = entry.delta_bic < -options.bic_threshold &&
                       entry.holdout_gain_percent >= options.min_holdout_gain_percent &&
-                      holdout_nominal - entry.holdout_rms >= options.min_holdout_gain_quanta * quantum;
+                      holdout_nominal - entry.holdout_rms >= floor;
     report.candidates.push_back(entry);
   }
 
@@ -222,6 +226,63 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       chosen = static_cast<std::ptrdiff_t>(c);
     }
   }
+  // Held-out arbitration, then ambiguity (model_audit.hpp).
+  std::string arbitration;
+  if (chosen >= 0) {
+    const auto& best = report.candidates[static_cast<std::size_t>(chosen)];
+    std::ptrdiff_t better = -1;
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& entry = report.candidates[c];
+      if (!entry.qualifies || static_cast<std::ptrdiff_t>(c) == chosen) continue;
+      const double gain = best.holdout_rms - entry.holdout_rms;
+      if (gain >= floor && gain >= 0.01 * kArbitrationPercent * best.holdout_rms &&
+          (better < 0 || entry.holdout_rms < report.candidates[static_cast<std::size_t>(better)].holdout_rms)) {
+        better = static_cast<std::ptrdiff_t>(c);
+      }
+    }
+    if (better >= 0) {
+      arbitration = "; " + report.candidates[static_cast<std::size_t>(better)].name + " predicts the held-out data better than " +
+                    best.name + " (" + common::format_value(report.candidates[static_cast<std::size_t>(better)].holdout_rms) +
+                    " against " + common::format_value(best.holdout_rms) + " " + report.unit + ")";
+      chosen = better;
+    }
+  }
+  std::ptrdiff_t twin = -1;
+  if (chosen >= 0) {
+    const auto& pick = report.candidates[static_cast<std::size_t>(chosen)];
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& entry = report.candidates[c];
+      if (!entry.qualifies || static_cast<std::ptrdiff_t>(c) == chosen) continue;
+      if (std::abs(entry.delta_bic - pick.delta_bic) < options.bic_threshold &&
+          std::abs(entry.holdout_rms - pick.holdout_rms) < floor &&
+          (twin < 0 || entry.delta_bic < report.candidates[static_cast<std::size_t>(twin)].delta_bic)) {
+        twin = static_cast<std::ptrdiff_t>(c);
+      }
+    }
+  }
+  // A shared signature at a bound (Candidate::limit_of): the selected candidate at its limit is
+  // ambiguous with the entry it reduces to. (Not the other way round: when the entry it reduces to
+  // is selected, that is already the simpler name of the same signature.)
+  // `value`: the picked candidate's limit parameter as finally fitted (refitted with a second cause).
+  const auto at_limit = [&](std::size_t c, double value) {
+    const Candidate& candidate = candidates[c];
+    if (candidate.limit_of.empty() || !report.candidates[c].fitted) return false;
+    const ParameterSpec& spec = candidate.parameters[candidate.limit_parameter];
+    return value <= std::max(spec.lower + 0.05 * std::abs(spec.lower) + 1e-12, candidate.limit_value);
+  };
+  const auto fitted_limit = [&](std::size_t c) {
+    const auto& p = report.candidates[c].parameters;
+    return candidates[c].limit_parameter < p.size() ? p[candidates[c].limit_parameter].value : kNaN;
+  };
+  const auto limit_twin = [&](std::size_t picked, double picked_value) -> std::ptrdiff_t {
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      if (c == picked || !report.candidates[c].fitted) continue;
+      if (at_limit(picked, picked_value) && report.candidates[c].name == candidates[picked].limit_of) {
+        return static_cast<std::ptrdiff_t>(c);
+      }
+    }
+    return -1;
+  };
   if (white) {
     report.stop_reason = "the nominal residual is white (Ljung-Box p = " +
                          common::format_value(report.before.whiteness.p_value) + " >= 0.05)";
@@ -234,6 +295,74 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
                                     common::format_value(quantum) + " " + report.unit
                               : std::string()) +
                          ")";
+  }
+
+  // Stepwise: a second cause on top of the first while the residual is still not white, by the same
+  // rules against the model with the first cause (its parameters refitted in every fit), stopping
+  // at "none". When one is found, the other qualifying candidates within kStepwiseBicFraction of
+  // the best delta-BIC are tried as the first too (with several causes every single-cause fit is
+  // wrong, and the best single one need not be one of them), and the pair with the lowest joint
+  // delta-BIC is kept (model_audit.hpp).
+  std::optional<AuditReport> second;
+  std::string second_note;
+  if (options.max_causes > 1 && chosen >= 0 && twin < 0 && !white) {
+    const auto step_two = [&](std::size_t c) -> std::optional<AuditReport> {
+      const ResidualSummary after = summarize(fits[c], summary_input, options.max_lag);
+      if (after.whiteness.lags > 0 && after.whiteness.p_value >= 0.05) return std::nullopt;
+      const auto next = channel.with_first_cause(candidates[c], fits[c].full);
+      if (!next) return std::nullopt;
+      AuditOptions step = options;
+      step.max_causes = options.max_causes - 1;
+      return run_channel_audit(*next, step);
+    };
+    // A second step that names a cause, or two that share a signature (ambiguous).
+    const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none"; };
+    const auto joint_bic = [&](std::size_t c, const AuditReport& r) {
+      const std::string& name = r.cause == "ambiguous" ? r.ambiguous_with.front() : r.cause;
+      for (const auto& e : r.candidates) {
+        if (e.name == name) return report.candidates[c].delta_bic + e.delta_bic;
+      }
+      return report.candidates[c].delta_bic;
+    };
+    const auto first = static_cast<std::size_t>(chosen);
+    second = step_two(first);
+    double best_joint = report.candidates[first].delta_bic;
+    if (named(second)) {
+      best_joint = joint_bic(first, *second);
+    } else {
+      second_note = second ? second->stop_reason : "";
+      second.reset();
+    }
+    double best_single = 0.0;
+    for (const auto& e : report.candidates) best_single = e.qualifies ? std::min(best_single, e.delta_bic) : best_single;
+    std::vector<std::size_t> others;
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      const auto& e = report.candidates[c];
+      if (c != first && e.qualifies && e.delta_bic <= kStepwiseBicFraction * best_single) others.push_back(c);
+    }
+    std::sort(others.begin(), others.end(),
+              [&](std::size_t x, std::size_t y) { return report.candidates[x].delta_bic < report.candidates[y].delta_bic; });
+    if (others.size() > kStepwiseAlternatives) others.resize(kStepwiseAlternatives);
+    for (const std::size_t c : others) {
+      auto alternative = step_two(c);
+      if (!named(alternative) || joint_bic(c, *alternative) >= best_joint) continue;
+      best_joint = joint_bic(c, *alternative);
+      arbitration = "; first of the pair with the lowest joint delta-BIC (" + common::format_value(best_joint) +
+                    ", against " + common::format_value(report.candidates[first].delta_bic) + " for " +
+                    report.candidates[first].name + (second ? " with its second cause" : " alone") + ")";
+      chosen = static_cast<std::ptrdiff_t>(c);
+      second = std::move(alternative);
+      second_note.clear();
+    }
+  }
+
+  if (chosen >= 0 && twin < 0) {  // the (pair's) first cause at a limit, as finally fitted
+    const auto c = static_cast<std::size_t>(chosen);
+    double value = fitted_limit(c);
+    if (second && !candidates[c].limit_of.empty() && base_count + candidates[c].limit_parameter < second->extended_nominal.size()) {
+      value = second->extended_nominal[base_count + candidates[c].limit_parameter].value;
+    }
+    twin = limit_twin(c, value);
   }
 
   const Fit* selected = &nominal;
@@ -251,10 +380,26 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     for (std::size_t j = 0; j < nominal_free.index.size(); ++j) {
       report.extended_nominal[nominal_free.index[j]].standard_error = selected->standard_errors[j];
     }
-    report.stop_reason = "selected " + entry.name + " (lowest delta-BIC among qualifying candidates)";
+    report.stop_reason = "selected " + entry.name + (arbitration.empty() ? " (lowest delta-BIC among qualifying candidates)" : arbitration);
+    if (twin >= 0) {
+      const auto& other = report.candidates[static_cast<std::size_t>(twin)];
+      report.cause = "ambiguous";
+      report.ambiguous_with = {entry.name, other.name};
+      const Candidate& picked = candidates[static_cast<std::size_t>(chosen)];
+      const Candidate& twin_candidate = candidates[static_cast<std::size_t>(twin)];
+      const bool at_bound = picked.limit_of == other.name || twin_candidate.limit_of == entry.name;
+      const Candidate& limit_case = picked.limit_of == other.name ? picked : twin_candidate;
+      report.stop_reason = "ambiguous: " + entry.name + " and " + other.name + " share a signature on these data (" +
+                           (at_bound ? limit_case.name + "'s " + limit_case.parameters[limit_case.limit_parameter].name +
+                                           " is at its limit, where it is " + limit_case.limit_of
+                                     : "delta-BIC " + common::format_value(entry.delta_bic) + " and " +
+                                           common::format_value(other.delta_bic) + ", held-out RMS within the floor of " +
+                                           common::format_value(floor) + " " + report.unit) +
+                           "); the fit shown is " + entry.name;
+    }
     report.after = summarize(*selected, summary_input, options.max_lag);
     if (report.after.whiteness.p_value >= 0.05) report.stop_reason += "; the residual is now white";
-    else report.stop_reason += "; the residual is still not white (single-cause report)";
+    else report.stop_reason += "; the residual is still not white";
   } else {
     report.after = report.before;
   }
@@ -283,6 +428,27 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
     if (a.fitted != b.fitted) return a.fitted;
     return a.fitted && a.delta_bic < b.delta_bic;
   });
+
+  if (second) {
+    report.second_cause = second->cause;
+    report.second_ambiguous_with = second->ambiguous_with;
+    report.second_parameters = second->parameters;
+    // The first cause's parameters as refitted with the second (base entries after the base).
+    for (std::size_t i = 0; i < report.parameters.size() && base_count + i < second->extended_nominal.size(); ++i) {
+      report.parameters[i].value = second->extended_nominal[base_count + i].value;
+      report.parameters[i].standard_error = second->extended_nominal[base_count + i].standard_error;
+    }
+    report.extended_nominal.assign(second->extended_nominal.begin(),
+                                   second->extended_nominal.begin() + static_cast<std::ptrdiff_t>(base_count));
+    report.after = second->after;
+    report.holdout_after = second->holdout_after;
+    report.holdout_percent = holdout_nominal > 0.0 ? 100.0 * (holdout_nominal - report.holdout_after) / holdout_nominal : 0.0;
+    report.extended_prediction = second->extended_prediction;
+    report.second_candidates = second->candidates;
+    report.stop_reason += "; then " + second->stop_reason;
+  } else if (!second_note.empty()) {
+    report.stop_reason += "; no second cause (" + second_note + ")";
+  }
   return report;
 }
 

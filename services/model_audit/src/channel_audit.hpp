@@ -9,6 +9,7 @@
 // crane's swing).
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +52,9 @@ class ChannelAudit {
   [[nodiscard]] virtual const std::vector<double>& correlation_input() const = 0;
   /// Resolution of the measured channel (0: none).
   [[nodiscard]] virtual double quantum() const = 0;
+  /// The sensor's resolution for the practical-significance floor: quantum or noise, the larger
+  /// (measurement_resolution(); default: quantum()).
+  [[nodiscard]] virtual double resolution() const { return quantum(); }
   /// Measured value at sample k for the plots (the channel's first residual of the sample).
   [[nodiscard]] virtual double measured(std::size_t k) const = 0;
 
@@ -60,6 +64,14 @@ class ChannelAudit {
   }
   /// Refines the candidate's fit after the Ceres fits (the axis stiction threshold).
   virtual void refine(const Candidate&, const Problem&, const FreeSet&, Fit&) const {}
+  /// The second step of the stepwise audit: this channel's model with `first` (a candidate of this
+  /// channel) added, its fitted values `values` appended to the base parameters (so they are
+  /// refitted in every fit of the step) and `first` no longer a candidate. `base` = the first step's
+  /// full parameter vector of the selected fit (base, then the cause's). nullptr: no second step.
+  [[nodiscard]] virtual std::unique_ptr<ChannelAudit> with_first_cause(const Candidate& /*first*/,
+                                                                       const std::vector<double>& /*full*/) const {
+    return nullptr;
+  }
   /// Fills AuditReport::effort_holdout_before/after (default: NaN) from the nominal and the
   /// selected fit (`selected` nullptr: none selected).
   virtual void second_opinion(const std::vector<double>& nominal, const Candidate* selected,

@@ -208,6 +208,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     if (!requested) return std::nullopt;
     axis_options.nominal = drive_axis_parameters(friction, gain);
     axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    axis_options.max_causes = 1;  // one cause per channel (the combination picks one)
     axis_options.every_grid_start = true;
     AuditData axis_data;
     axis_data.source = data.source;
@@ -231,7 +232,9 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
     }
     for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
-    if (channel.cause != "none" && channel.cause != "payload_mass_error") channel.cause = prefix + channel.cause;
+    const auto prefixed = [&](const std::string& name) { return name == "payload_mass_error" ? name : prefix + name; };
+    if (channel.cause != "none" && channel.cause != "ambiguous") channel.cause = prefixed(channel.cause);
+    for (auto& name : channel.ambiguous_with) name = prefixed(name);
     return channel;
   };
   if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
@@ -256,6 +259,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     swing_options.nominal = swing_nominal;
     swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
     swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
+    swing_options.max_causes = 1;
     if (requested) {
       std::vector<double> measured(2 * n);
       for (std::size_t k = 0; k < n; ++k) {

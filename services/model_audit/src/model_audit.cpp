@@ -64,6 +64,10 @@ void validate(const AuditOptions& options) {
   common::require_at_least("bic_threshold", options.bic_threshold, 0.0);
   common::require_at_least("min_holdout_gain_percent", options.min_holdout_gain_percent, 0.0);
   common::require_at_least("min_holdout_gain_quanta", options.min_holdout_gain_quanta, 0.0);
+  common::require_at_least("min_holdout_gain_resolutions", options.min_holdout_gain_resolutions, 0.0);
+  if (options.max_causes < 1 || options.max_causes > 2) {
+    throw common::ConfigError("max_causes = " + std::to_string(options.max_causes) + " must be 1 or 2");
+  }
   if (options.substeps < 1) throw common::ConfigError("substeps = " + std::to_string(options.substeps) + " must be >= 1");
 }
 

@@ -53,6 +53,8 @@ struct PendulumSeries {
   double gravity{9.80665};
   int substeps{4};
   const PendulumCause* cause{nullptr};  // nullptr: the nominal model
+  const PendulumCause* first{nullptr};  // second step: the first cause (its parameter after the base)
+  std::size_t first_count{0};
 };
 
 struct SwingSeries {
@@ -72,7 +74,7 @@ std::vector<Candidate> candidates_of(double omega_squared) {
   std::vector<Candidate> list;
   const auto& catalog = pendulum_catalog();
   for (std::size_t i = 0; i < catalog.size(); ++i) {
-    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, ""});
+    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, "", "", 0, -1e300});
   }
   return list;
 }
@@ -85,7 +87,8 @@ PendulumModel pendulum_model(const PendulumSeries& s, const std::vector<double>&
   m.damping = std::max(full[1], 0.0);
   m.theta_zero = full[2];
   m.gravity = s.gravity;
-  if (s.cause != nullptr) s.cause->apply(full.data() + kPendulumBase, m);
+  if (s.first != nullptr) s.first->apply(full.data() + kPendulumBase, m);
+  if (s.cause != nullptr) s.cause->apply(full.data() + kPendulumBase + s.first_count, m);
   return m;
 }
 
@@ -216,10 +219,29 @@ std::vector<std::size_t> PendulumAudit::nominal_free(bool calibrate) const {
   std::vector<std::size_t> free;
   if (calibrate) free = {0, 1};
   if (!theta_zero_known_) free.push_back(2);
+  for (std::size_t i = first_base_; i < base_.size() && first_base_ > 0; ++i) free.push_back(i);
   return free;
 }
 
-std::vector<Candidate> PendulumAudit::candidates() const { return candidates_of(gravity_ / base_[0]); }
+std::vector<Candidate> PendulumAudit::candidates() const {
+  auto list = candidates_of(gravity_ / base_[0]);
+  std::erase_if(list, [&](const Candidate& c) { return c.entry == first_entry_; });
+  return list;
+}
+
+std::unique_ptr<ChannelAudit> PendulumAudit::with_first_cause(const Candidate& first, const std::vector<double>& full) const {
+  if (series_->first != nullptr) return nullptr;  // two causes at most
+  auto next = std::make_unique<PendulumAudit>(*this);
+  next->first_entry_ = first.entry;
+  next->first_base_ = base_.size();
+  next->base_.assign(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(base_.size() + first.parameters.size()));
+  for (const auto& spec : first.parameters) next->base_specs_.push_back(spec);
+  auto s = std::make_shared<PendulumSeries>(*series_);
+  s->first = &pendulum_catalog()[first.entry];
+  s->first_count = first.parameters.size();
+  next->series_ = std::move(s);
+  return next;
+}
 
 std::string PendulumAudit::unavailable(const Candidate& candidate) const {
   if (!theta_zero_known_ && pendulum_catalog()[candidate.entry].needs_known_zero) {

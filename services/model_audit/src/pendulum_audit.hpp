@@ -55,7 +55,10 @@ class PendulumAudit final : public ChannelAudit {
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
   [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_input_; }
   [[nodiscard]] double quantum() const override { return resolution_quantum(data_.output, 1); }
+  [[nodiscard]] double resolution() const override { return measurement_resolution(data_.output, 1); }
   [[nodiscard]] double measured(std::size_t k) const override { return data_.output[k]; }
+  [[nodiscard]] std::unique_ptr<ChannelAudit> with_first_cause(const Candidate& first,
+                                                               const std::vector<double>& full) const override;
 
  private:
   const AuditData& data_;
@@ -66,7 +69,9 @@ class PendulumAudit final : public ChannelAudit {
   std::vector<double> base_;
   std::vector<ParameterSpec> base_specs_;
   std::vector<double> no_input_;
-  std::shared_ptr<const PendulumSeries> series_;
+  std::shared_ptr<const PendulumSeries> series_;  // the nominal series (the first cause in a second step)
+  std::size_t first_entry_{static_cast<std::size_t>(-1)};  // catalog entry of the first cause (second step)
+  std::size_t first_base_{0};                                // base parameters before the first cause's
 };
 
 /// The crane's swing channel: `measured` interleaves phi and theta [rad] per sample; `motion` is the

@@ -195,6 +195,12 @@ int main(int argc, char** argv) {
     for (const auto& p : report.parameters) {
       std::cout << "  " << p.name << " = " << p.value << " +- " << p.standard_error << " " << p.unit << '\n';
     }
+    if (report.second_cause != "none") {
+      std::cout << "second cause: " << report.second_cause << '\n';
+      for (const auto& p : report.second_parameters) {
+        std::cout << "  " << p.name << " = " << p.value << " +- " << p.standard_error << " " << p.unit << '\n';
+      }
+    }
     std::cout << "held-out RMS " << report.holdout_before << " -> " << report.holdout_after << " " << report.unit
               << " (" << report.holdout_percent << " %)\n";
     std::cout << "wrote " << out_dir << "/report.json, report.md, series.csv\n";

@@ -38,8 +38,12 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
   json["model"] = report.plant;
   json["channel"] = report.channel;
   json["cause"] = report.cause;
+  if (!report.ambiguous_with.empty()) json["ambiguous_with"] = report.ambiguous_with;
   json["stop_reason"] = report.stop_reason;
   json["parameters"] = parameters_json(report.parameters);
+  json["second_cause"] = report.second_cause;
+  if (!report.second_ambiguous_with.empty()) json["second_ambiguous_with"] = report.second_ambiguous_with;
+  if (report.second_cause != "none") json["second_parameters"] = parameters_json(report.second_parameters);
   json["gain"] = {{"metric", "holdout_rms_" + report.channel + " [" + report.unit + "]"},
                   {"before", number(report.holdout_before)},
                   {"after", number(report.holdout_after)},
@@ -103,6 +107,15 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
     if (!report.parameters.empty()) {
       md << "| parameter | value | std. error | unit |\n|---|---|---|---|\n";
       for (const auto& p : report.parameters) {
+        md << "| " << p.name << " | " << common::format_value(p.value) << " | " << common::format_value(p.standard_error)
+           << " | " << p.unit << " |\n";
+      }
+      md << "\n";
+    }
+    if (report.second_cause != "none") {
+      md << "\n**Second cause: `" << report.second_cause << "`** (stepwise, on top of the first)\n\n";
+      md << "| parameter | value | std. error | unit |\n|---|---|---|---|\n";
+      for (const auto& p : report.second_parameters) {
         md << "| " << p.name << " | " << common::format_value(p.value) << " | " << common::format_value(p.standard_error)
            << " | " << p.unit << " |\n";
       }

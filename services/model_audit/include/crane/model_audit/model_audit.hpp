@@ -4,16 +4,27 @@
 // parameters, by the Bayesian information criterion (Schwarz 1978)
 //   BIC = n ln(RSS / n) + k ln(n),  delta-BIC = BIC(candidate) - BIC(nominal)   (k = added parameters)
 // and by the error on a held-out part of the data. A candidate qualifies when delta-BIC <
-// -bic_threshold and it lowers the held-out RMS by at least min_holdout_gain_percent; the cause is
-// the qualifying candidate with the lowest delta-BIC, else "none". The audit stops at once ("none")
-// when the nominal residual is already white (Ljung-Box p >= 0.05).
+// -bic_threshold and it lowers the held-out RMS by at least min_holdout_gain_percent and by the
+// practical-significance floor (min_holdout_gain_resolutions sensor resolutions, and on the crane
+// kCraneResolutionQuanta quanta). The cause is the qualifying candidate with the lowest delta-BIC,
+// unless another qualifying candidate predicts the held-out data better by more than the floor and
+// by kArbitrationPercent (then that one: the held-out data separate them, e.g. stiction against a
+// Stribeck curve whose v_s fell to its bound); when the best two qualifying candidates are within
+// bic_threshold of each other and within the floor on the held-out data, the data cannot separate
+// them and the cause is "ambiguous", naming both (ambiguous_with); likewise when the selected
+// candidate's fit is at the limit where it becomes another entry (Candidate::limit_of: a Stribeck
+// curve with v_s <= c T / 2 is stiction on sampled data). Else "none". The audit stops at once
+// ("none") when the nominal residual is already white (Ljung-Box p >= 0.05). Stepwise
+// (max_causes): while the residual with the cause is not white, a second cause by the same rules
+// against the model with the first (second_cause).
 //
 // Channels (what the residual is):
 //  - position (axis) / angle (pendulum): output error. The record is cut into windows (axis:
 //    window_duration; pendulum: one window per maneuver, given by an optional "segment" column),
 //    each simulated from its own initial state (position and velocity, fitted as nuisance
-//    parameters) with the recorded input held per sample. Axis: windows in the last holdout_fraction
-//    of the record are held out (their initial states are refitted with the model fixed). Pendulum:
+//    parameters) with the recorded input held per sample. Axis: the windows that start in the last
+//    holdout_fraction of the record up to the end of its last moving window are held out (their
+//    initial states are refitted with the model fixed; windows at rest after it are trained on). Pendulum:
 //    the last holdout_fraction of each maneuver is held out and predicted by continuing the fit.
 //  - effort (axis, inverse dynamics, for closed-loop data where position cannot tell models apart):
 //    the drive command that the model needs for the measured motion, from centred differences
@@ -123,6 +134,18 @@ struct AuditData {
 /// trolley RMS on 13 clean recordings. Two counts of held-out gain are required of a cause.
 inline constexpr double kCraneResolutionQuanta = 2.0;
 
+/// Held-out arbitration (see the top): a qualifying candidate replaces the one with the lowest
+/// delta-BIC when its held-out RMS is lower by this many percent of the latter's (and by the floor).
+inline constexpr double kArbitrationPercent = 10.0;
+
+/// Stepwise (AuditOptions::max_causes): the other qualifying first-step candidates whose delta-BIC
+/// reaches this fraction of the best one (at most kStepwiseAlternatives of them, best first) are
+/// tried as the first cause too; a pair found from one of them replaces the selected first cause
+/// (alone or with its own second cause) when its joint delta-BIC (first step + second step) is
+/// lower.
+inline constexpr double kStepwiseBicFraction = 0.6;
+inline constexpr std::size_t kStepwiseAlternatives = 2;
+
 struct AuditOptions {
   AuditNominal nominal;  // the nominal model; its alternative chooses the plant (audit_parameters.hpp)
   bool calibrate{false};
@@ -137,12 +160,24 @@ struct AuditOptions {
   // the measured channel (its smallest nonzero step; position and angle channels). The crane audit
   // uses kCraneResolutionQuanta for its channels, whatever is given here.
   double min_holdout_gain_quanta{0.0};   // [-] >= 0
+  // Practical-significance floor of every model (issue 17): a candidate must also lower the held-out
+  // RMS by at least this many resolutions of the measured channel, the larger of its quantum and its
+  // noise (measurement_resolution in src/audit_fit.hpp): an effect the sensor cannot see beyond its
+  // own resolution is not named. The same floor decides the held-out arbitration and `ambiguous`
+  // (run_audit).
+  double min_holdout_gain_resolutions{1.0};  // [-] >= 0
   // Two-parameter candidates (stribeck: level and v_s trade off along a valley) are fitted from the
   // grid optimum and the best grid points at its v_s grid neighbours; with every_grid_start also
   // at every other v_s grid value when the fit still leaves more than two quanta of training RMS
   // (set for the crane drives: with the coupling, the grid scores of the unfitted initial states
   // often put the optimum at the wrong end of the valley).
   bool every_grid_start{false};
+  // Stepwise (issue 17): after the first cause, while the residual is still not white, look for a
+  // further cause on top of it (the first cause's parameters refitted in every fit), by the same
+  // rules (delta-BIC, held-out gain, the floor) against the model with the first cause; stop at
+  // "none". In [1, 2]: the axis and pendulum audits go to two causes; the crane's channels stay at
+  // one (their combination picks one cause over the channels).
+  int max_causes{2};
   int substeps{4};                  // >= 1, for the non-closed-form entries
   std::size_t max_lag{20};          // [samples] Ljung-Box lags
 };
@@ -182,9 +217,17 @@ struct AuditReport {
   std::string plant;
   std::string channel;
   std::string unit;          // of the channel: m, V or rad
-  std::string cause{"none"};
+  std::string cause{"none"};  // a catalog name, "none", or "ambiguous" (then ambiguous_with)
+  // cause "ambiguous": the two candidates that share a signature and that the data cannot separate
+  // (both qualify; see docs/model_audit.md "Ambiguous"), the better one first; else empty.
+  std::vector<std::string> ambiguous_with;
   std::string stop_reason;
-  std::vector<FittedParameter> parameters;  // of the cause
+  std::vector<FittedParameter> parameters;  // of the cause (refitted with the second cause if any)
+  // Stepwise: the second cause found on top of the first ("none": none) and its parameters; the
+  // held-out figures, `after` and extended_prediction are then those of the model with both.
+  std::string second_cause{"none"};           // a catalog name, "none" or "ambiguous"
+  std::vector<std::string> second_ambiguous_with;  // second_cause "ambiguous": the two it names
+  std::vector<FittedParameter> second_parameters;
   std::vector<FittedParameter> nominal;     // nominal model used (calibrated if asked)
   std::vector<FittedParameter> extended_nominal;  // base parameters refitted with the cause
   double holdout_before{0.0};
@@ -196,6 +239,7 @@ struct AuditReport {
   double effort_holdout_after{0.0};
   std::vector<AuditReport> channels;  // crane: the trolley, slew and swing sub-audits
   std::vector<CandidateReport> candidates;  // ranked by delta-BIC (fitted first)
+  std::vector<CandidateReport> second_candidates;  // the second step's (against the first cause)
   double sample_time{0.0};
   std::size_t samples{0};
   // Series for the plots (all samples of the channel; NaN where undefined).
