@@ -131,8 +131,12 @@ struct AuditData {
 /// replayed from 100 Hz samples leaves a systematic residual of one to three encoder counts on clean
 /// data (the coupling is held per sample; it grows with the load mass), which the BIC alone
 /// attributes to tiny causes: a payload off by 0.02-0.05 %, gaining up to 1.4 counts of held-out
-/// trolley RMS on 13 clean recordings. Two counts of held-out gain are required of a cause.
-inline constexpr double kCraneResolutionQuanta = 2.0;
+/// trolley RMS on 13 clean recordings. Since the held-out windows are taken among the moving ones
+/// (where that residual is largest), a clean stack recording (integration test
+/// CraneAuditOfAStackRecordingNamesAHeavierPayload: the plant is the nominal model) left 2.5 counts
+/// of held-out trolley RMS, of which a 1e-4 m/s^2 Coulomb asymmetry explained 2.2 counts. Three
+/// counts of held-out gain are required of a cause (a payload 0.5 kg off gains over 100 counts).
+inline constexpr double kCraneResolutionQuanta = 3.0;
 
 /// Held-out arbitration (see the top): a qualifying candidate replaces the one with the lowest
 /// delta-BIC when its held-out RMS is lower by this many percent of the latter's (and by the floor).
