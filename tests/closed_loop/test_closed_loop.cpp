@@ -320,6 +320,29 @@ TEST(ClosedLoopOverhead, ManeuversSettleOnBothAxes) {
       EXPECT_LT(m.final_bridge_error, 0.005) << maneuver.name << " " << profile;
       EXPECT_LT(m.residual_swing, 0.5 * kDeg) << maneuver.name << " " << profile;
       EXPECT_LE(peak_y_speed, maneuver.bridge_max_velocity * 1.0001) << maneuver.name << " " << profile;
+      if (std::string(profile) == "time_optimal") {
+        // Per axis within 1.1x of its bound: the reference's end against the rigid-body minimum time
+        // at the axis's velocity and acceleration bounds (a trapezoid, d/v + v/a).
+        const auto ends = [&](auto field) {
+          double t = 0.0;
+          for (std::size_t i = 1; i < result.records.size(); ++i) {
+            if (std::abs(field(result.records[i]) - field(result.records.back())) > 1e-9) t = result.records[i].t;
+          }
+          return t;
+        };
+        const double x_bound = std::abs(maneuver.trolley_target - maneuver.initial_trolley_position) /
+                                   maneuver.trolley_max_velocity + maneuver.trolley_max_velocity / maneuver.trolley_max_acceleration;
+        const double x_end = ends([](const auto& c) { return c.x_ref; });
+        std::printf("  time-optimal trolley reference %.2f s = %.3f x its bound %.2f s\n", x_end, x_end / x_bound, x_bound);
+        EXPECT_LE(x_end, 1.1 * x_bound) << maneuver.name;
+        if (maneuver.bridge_target != maneuver.initial_bridge_position) {
+          const double y_bound = std::abs(maneuver.bridge_target - maneuver.initial_bridge_position) /
+                                     maneuver.bridge_max_velocity + maneuver.bridge_max_velocity / maneuver.bridge_max_acceleration;
+          const double y_end = ends([](const auto& c) { return c.y_ref; });
+          std::printf("  time-optimal bridge reference %.2f s = %.3f x its bound %.2f s\n", y_end, y_end / y_bound, y_bound);
+          EXPECT_LE(y_end, 1.1 * y_bound) << maneuver.name;
+        }
+      }
       EXPECT_EQ(result.plant_step_failures, 0u);
       // The bridge moved where it was asked (the diagonal), and the slew channel stayed at rest.
       EXPECT_NEAR(result.records.back().y_ref, maneuver.bridge_target, 1e-9) << maneuver.name;
