@@ -100,16 +100,16 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
   validate(p.wind, "plant.wind.");
   validate(p.rope, "plant.rope.");
   if (p.kind != PlantKind::tower && p.rope.enabled) {
-    throw common::ConfigError(std::string("plant.rope.enabled = true needs plant.kind = tower (is ") +
+    throw common::ConfigError(std::string("plant.rope.enabled = true needs crane.kind = tower (is ") +
                               to_string(p.kind) + ")");
   }
   if (p.kind != PlantKind::tower) {
     if (p.hook.enabled) {
-      throw common::ConfigError(std::string("plant.hook.enabled = true needs plant.kind = tower (is ") +
+      throw common::ConfigError(std::string("plant.hook.enabled = true needs crane.kind = tower (is ") +
                                 to_string(p.kind) + ")");
     }
     if (p.wind.enabled) {
-      throw common::ConfigError(std::string("plant.wind.enabled = true needs plant.kind = tower (is ") +
+      throw common::ConfigError(std::string("plant.wind.enabled = true needs crane.kind = tower (is ") +
                                 to_string(p.kind) + ")");
     }
   }

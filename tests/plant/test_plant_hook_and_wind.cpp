@@ -172,7 +172,7 @@ TEST(HookModel, ConfigurationErrorsNameTheField) {
   p = {};
   p.kind = PlantKind::gantry;
   p.hook.enabled = true;
-  expect_error(p, "plant.hook.enabled = true needs plant.kind = tower");
+  expect_error(p, "plant.hook.enabled = true needs crane.kind = tower");
   p = {};
   p.wind.enabled = true;
   p.wind.gust_time_constant = 0.0;
