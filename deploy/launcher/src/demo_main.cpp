@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -31,6 +32,8 @@ using Clock = std::chrono::steady_clock;
 using json = nlohmann::json;
 
 constexpr double kPi = 3.14159265358979323846;
+// The start cycle of the readiness probe (crane_demo's first request of a run): never reached.
+constexpr std::uint64_t kNeverCycle = std::numeric_limits<std::uint64_t>::max();
 
 struct DemoOptions {
   std::string config_path;
@@ -107,6 +110,7 @@ class Operator {
         linear_(participant.make_recording_reader<tp::LinearCommand>(nullptr, 8192)),
         actuators_(participant.make_recording_reader<tp::Actuators>(nullptr, 8192)),
         diagnostics_(participant.make_recording_reader<tp::LoopDiagnostics>(nullptr, 256)),
+        move_status_(participant.make_recording_reader<tp::MoveStatus>(nullptr, 64)),
         goal_(participant.make_writer<tp::Goal>()) {}
 
   transport::Wakeup& wakeup() { return wakeup_; }
@@ -124,6 +128,9 @@ class Operator {
     actuators_->take_latest(d);
     tp::msgs::LoopDiagnostics_ e;
     diagnostics_->take_latest(e);
+    tp::msgs::MoveStatus_ f;
+    while (move_status_->take_next(f)) {
+    }
   }
 
   std::optional<tp::msgs::SupervisorStatus_> latest_status() {
@@ -150,6 +157,16 @@ class Operator {
   }
 
   int goal_matches() const { return goal_->health().matched_readers; }
+  /// Whether the planner has reported request `request_id` waiting for its start cycle (its reader
+  /// has matched this process's goal writer: discovery is not symmetric, and between vendors the
+  /// reader's side was seen to lag the writer's by more than a second).
+  bool planner_waits_for(std::uint32_t request_id) {
+    tp::msgs::MoveStatus_ f;
+    while (move_status_->take_next(f)) {
+      if (f.request_id() == request_id && f.result() == protocol::MoveStatus::RESULT_WAITING) probe_seen_ = request_id;
+    }
+    return probe_seen_ == request_id;
+  }
   bool send_goal(const tp::msgs::MoveRequest_& goal) { return goal_->write(goal); }
 
  private:
@@ -160,8 +177,10 @@ class Operator {
   std::unique_ptr<transport::Reader<tp::LinearCommand>> linear_;
   std::unique_ptr<transport::Reader<tp::Actuators>> actuators_;
   std::unique_ptr<transport::Reader<tp::LoopDiagnostics>> diagnostics_;
+  std::unique_ptr<transport::Reader<tp::MoveStatus>> move_status_;
   std::unique_ptr<transport::Writer<tp::Goal>> goal_;
   std::optional<tp::msgs::SupervisorStatus_> last_status_;
+  std::uint32_t probe_seen_{0};
 };
 
 class RunFailure : public std::runtime_error {
@@ -227,10 +246,19 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
     result.processes.push_back(ProcessRecord{spec.name, pid, launch::vendor_of(stack, spec.name), run_name});
   }
 
-  // 1. Wait until every stage is matched and alive, the supervisor is ready, and this operator
-  //    itself receives every stream it records from this run's processes (its own discovery of a
-  //    fresh stack can lag the stages' discovery of each other by up to an announcement period,
-  //    which in lockstep is hundreds of cycles).
+  // 1. Wait until every stage is matched and alive, the supervisor is ready, this operator itself
+  //    receives every stream it records from this run's processes (its own discovery of a fresh
+  //    stack can lag the stages' discovery of each other by up to an announcement period, which in
+  //    lockstep is hundreds of cycles), and the planner has this operator's goals: a probe request
+  //    whose start cycle never comes is reported waiting. Our writer matching the planner's reader
+  //    does not prove it: with the planner on Cyclone and this process on Fast DDS the reader's
+  //    side was seen to lag by 570 and 720 cycles, and the move then started late (issue: CI of
+  //    stop 22). The move request replaces the probe before anything moves.
+  const std::uint32_t probe_id = request_id;
+  const std::uint32_t move_id = request_id + 1;
+  tp::msgs::MoveRequest_ probe;
+  protocol::to_dds(stack::move_request(m, cfg.facts, probe_id, options.profile_code, kNeverCycle), probe);
+  auto next_probe = Clock::now();
   const auto plant_pid = result.processes.back().pid;  // the sensor writer (plant or bridge) starts last
   Recording rec;
   const auto ready_deadline = Clock::now() + std::chrono::duration<double>(options.ready_timeout);
@@ -243,9 +271,14 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
                            rec.sensors.rbegin()->second.writer_pid() == static_cast<std::uint32_t>(plant_pid) &&
                            !rec.sensors.rbegin()->second.brakes_engaged() && !rec.references.empty() &&
                            !rec.linear.empty() && !rec.actuators.empty();
-    if (status && status->stages_alive() == protocol::SupervisorStatus::STAGES_ALL &&
-        status->mode() == protocol::SupervisorStatus::MODE_READY && op.goal_matches() > 0 && recording) {
-      break;
+    const bool stack_ready = status && status->stages_alive() == protocol::SupervisorStatus::STAGES_ALL &&
+                             status->mode() == protocol::SupervisorStatus::MODE_READY && op.goal_matches() > 0 &&
+                             recording;
+    if (stack_ready && op.planner_waits_for(probe_id)) break;
+    if (stack_ready && Clock::now() >= next_probe) {
+      probe.header().stamp(runtime::now_stamp());
+      op.send_goal(probe);
+      next_probe = Clock::now() + std::chrono::milliseconds(100);
     }
 
     if (Clock::now() > ready_deadline) {
@@ -258,7 +291,8 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
                                : std::string(" (last from pid ") + std::to_string(rec.sensors.rbegin()->second.writer_pid()) +
                                      ", brakes " + (rec.sensors.rbegin()->second.brakes_engaged() ? "on" : "off") + ")") +
           ", references " + std::to_string(rec.references.size()) + ", linear " + std::to_string(rec.linear.size()) +
-          ", actuators " + std::to_string(rec.actuators.size()) + "; see " + log_dir.string() + ")");
+          ", actuators " + std::to_string(rec.actuators.size()) + ", planner reported our probe request waiting " +
+          (op.planner_waits_for(probe_id) ? "yes" : "no") + "; see " + log_dir.string() + ")");
     }
     op.wakeup().wait_until(Clock::now() + std::chrono::milliseconds(20));
   }
@@ -278,10 +312,10 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   const std::uint64_t start_at = options.realtime ? 0 : std::max(stack::kMoveStartCycle, ready_seq + kStartAhead);
   result.move_start_cycle = start_at;
   tp::msgs::MoveRequest_ goal;
-  protocol::to_dds(stack::move_request(m, cfg.facts, request_id, options.profile_code, start_at), goal);
+  protocol::to_dds(stack::move_request(m, cfg.facts, move_id, options.profile_code, start_at), goal);
   goal.header().stamp(runtime::now_stamp());
   if (!op.send_goal(goal)) throw RunFailure(run_name + ": the move request could not be written");
-  spdlog::info("{}: stack ready, move {} sent", run_name, request_id);
+  spdlog::info("{}: stack ready, move {} sent", run_name, move_id);
   auto next_resend = Clock::now() + std::chrono::milliseconds(100);
 
   // 3. Record until `duration` seconds of cycles after the move started.
@@ -301,7 +335,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
     }
     if (!start_seq) {
       for (const auto& [seq, r] : rec.references) {
-        if (r.request_id() == request_id && r.phase() != protocol::Reference::PHASE_HOLDING) {
+        if (r.request_id() == move_id && r.phase() != protocol::Reference::PHASE_HOLDING) {
           start_seq = seq;
           break;
         }
@@ -538,7 +572,8 @@ int main(int argc, char** argv) {
         auto op = std::make_unique<Operator>(*participant);
         runtime::install_stop_handlers(&op->wakeup());
         try {
-          results.push_back(run_maneuver(options, cfg, m, compensation, *op, request_id++, node.domain_id));
+          results.push_back(run_maneuver(options, cfg, m, compensation, *op, request_id, node.domain_id));
+          request_id += 2;  // the probe's and the move's
         } catch (...) {
           runtime::install_stop_handlers(nullptr);
           throw;
