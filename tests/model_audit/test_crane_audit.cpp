@@ -4,10 +4,12 @@
 // encoder quantization) audited against the right and against a wrong payload mass.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -118,6 +120,32 @@ TEST(CraneAuditData, ParameterMappingRoundTripsAndDriveAxisFollowsThePlantRule) 
   EXPECT_NEAR(axis.stiction_asymmetry, 0.1, 1e-12);
 }
 
+// The configuration's drive terms back from the axis nominal: the inverse of drive_axis_parameters,
+// to rounding, for both drives of the lab crane; a negative coefficient is refused naming it.
+TEST(CraneAuditData, DriveParametersFromTheAxisNominalInvertTheMapping) {
+  const crane::common::CraneParameters crane;
+  for (const auto& [friction, gain] : {std::pair{crane.trolley_friction, crane.trolley_drive_gain},
+                                       std::pair{crane.slew_friction, crane.slew_drive_gain}}) {
+    const auto back = ma::drive_parameters_from_axis(ma::drive_axis_parameters(friction, gain));
+    EXPECT_NEAR(back.gain, gain, 1e-15);
+    EXPECT_NEAR(back.friction.viscous_positive, friction.viscous_positive, 1e-12);
+    EXPECT_NEAR(back.friction.viscous_negative, friction.viscous_negative, 1e-12);
+    EXPECT_NEAR(back.friction.coulomb_positive, friction.coulomb_positive, 1e-12);
+    EXPECT_NEAR(back.friction.coulomb_negative, friction.coulomb_negative, 1e-12);
+    // The plant's rule keeps max(static, coulomb): a static below Coulomb comes back as Coulomb.
+    EXPECT_NEAR(back.friction.static_positive, std::max(friction.static_positive, friction.coulomb_positive), 1e-12);
+    EXPECT_NEAR(back.friction.static_negative, std::max(friction.static_negative, friction.coulomb_negative), 1e-12);
+  }
+  auto axis = ma::drive_axis_parameters(crane.trolley_friction, crane.trolley_drive_gain);
+  axis.coulomb = -1.0;
+  try {
+    (void)ma::drive_parameters_from_axis(axis);
+    ADD_FAILURE() << "a negative Coulomb coefficient was accepted";
+  } catch (const crane::common::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("coulomb_positive"), std::string::npos) << e.what();
+  }
+}
+
 // Cross-check of the swing elimination against the plant model's own forward dynamics: with the
 // drive forces that eliminate_swing says the motion needs, TowerCraneModel::acceleration must give
 // back the same drive and swing accelerations (two independent computations).
@@ -161,6 +189,59 @@ TEST(CraneAudit, StackRecordingGivesNoneAndAWrongPayloadIsFound) {
     if (p.name == "load_mass") fitted_mass = p.value;
   }
   EXPECT_NEAR(fitted_mass, true_mass, 0.1 * true_mass);
+}
+
+// --calibrate on the crane: a clean recording audited against a configuration whose drive gains
+// and Coulomb friction are off (trolley gain -15 %, Coulomb +0.4 V both ways (+33-44 %); slew gain +10 %). Without
+// calibration the audit blames a drive; with it, each drive's K_m, b, c are fitted first, the
+// answer is `none`, and the report's nominal gives the true gains and Coulomb levels back in the
+// configuration's terms. A payload 25 % off is not a drive parameter: calibrated, it is still found.
+TEST(CraneAudit, CalibrateRecoversTheDrivesAndStillFindsAWrongPayload) {
+  const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, "none", 77);
+  const auto& truth = std::get<crane::common::CraneParameters>(c.nominal);
+  crane::common::CraneParameters off = truth;
+  off.trolley_drive_gain *= 0.85;
+  off.trolley_friction.coulomb_positive += 0.4;  // [V] both directions alike: the asymmetry as configured
+  off.trolley_friction.coulomb_negative += 0.4;
+  // The breakaway excess over Coulomb as configured (calibration fits K_m, b, c, not stiction).
+  off.trolley_friction.static_positive += off.trolley_friction.coulomb_positive - truth.trolley_friction.coulomb_positive;
+  off.trolley_friction.static_negative += off.trolley_friction.coulomb_negative - truth.trolley_friction.coulomb_negative;
+  off.slew_drive_gain *= 1.1;
+  ma::AuditOptions options;
+  options.nominal = off;
+  const auto plain = ma::run_audit(c.data, options);
+  EXPECT_NE(plain.cause, "none") << "the wrong drives went unnoticed: " << plain.stop_reason;
+  std::printf("[ figure   ] uncalibrated: cause %s\n", plain.cause.c_str());
+
+  options.calibrate = true;
+  const auto calibrated = ma::run_audit(c.data, options);
+  EXPECT_EQ(calibrated.cause, "none") << calibrated.stop_reason;
+  std::map<std::string, ma::FittedParameter> nominal;
+  for (const auto& p : calibrated.nominal) nominal[p.name] = p;
+  const auto expect_within = [&](const std::string& name, double true_value, double tolerance) {
+    ASSERT_EQ(nominal.count(name), 1U) << name;
+    const double relative = nominal[name].value / true_value - 1.0;
+    std::printf("[ figure   ] calibrated %s = %.6g (true %.6g, %+.3f %%, standard error %.3g)\n", name.c_str(),
+                nominal[name].value, true_value, 100.0 * relative, nominal[name].standard_error);
+    EXPECT_LT(std::fabs(relative), tolerance) << name;
+    EXPECT_GT(nominal[name].standard_error, 0.0) << name;
+  };
+  expect_within("trolley_drive_gain", truth.trolley_drive_gain, 0.02);
+  expect_within("slew_drive_gain", truth.slew_drive_gain, 0.02);
+  expect_within("trolley_coulomb_positive", truth.trolley_friction.coulomb_positive, 0.10);
+  expect_within("trolley_coulomb_negative", truth.trolley_friction.coulomb_negative, 0.10);
+  EXPECT_EQ(nominal["load_mass"].value, truth.load_mass);  // not a drive parameter: as configured
+
+  std::get<crane::common::CraneParameters>(options.nominal).load_mass = 1.25 * truth.load_mass;
+  const auto heavy = ma::run_audit(c.data, options);
+  ASSERT_EQ(heavy.cause, "payload_mass_error") << heavy.stop_reason;
+  double fitted_mass = 0.0;
+  for (const auto& p : heavy.parameters) {
+    if (p.name == "load_mass") fitted_mass = p.value;
+  }
+  std::printf("[ figure   ] calibrated, load 25 %% off: payload_mass_error, load_mass %.5g kg (true %.5g)\n", fitted_mass,
+              truth.load_mass);
+  EXPECT_NEAR(fitted_mass, truth.load_mass, 0.1 * truth.load_mass);
 }
 
 // A recording of the project's own plant simulator (plant::CraneSimulator: CVODE with exact
@@ -243,9 +324,13 @@ TEST(CraneAuditCli, ConfigAndParamGiveTheNominalAndBadDataIsRefused) {
   EXPECT_NE(text.str().find("\"cause\": \"none\""), std::string::npos) << text.str().substr(0, 600);
   EXPECT_NE(text.str().find("\"channels\""), std::string::npos);
   EXPECT_EQ(run_tool("--model crane --data " + data.string() + " --out " + dir.string()), 2);  // no nominal
-  EXPECT_EQ(run_tool("--model crane --data " + data.string() + " --config " + CRANE_LAB_CONFIG + mass +
-                     " --calibrate --out " + dir.string()),
-            2);
+  ASSERT_EQ(run_tool("--model crane --data " + data.string() + " --config " + CRANE_LAB_CONFIG + mass +
+                     " --calibrate --cause payload_mass_error --out " + dir.string()),
+            0);
+  std::ifstream calibrated(dir / "report.json");
+  std::stringstream calibrated_text;
+  calibrated_text << calibrated.rdbuf();
+  EXPECT_NE(calibrated_text.str().find("\"trolley_drive_gain\""), std::string::npos) << calibrated_text.str().substr(0, 600);
   EXPECT_EQ(run_tool("--model crane --data " + data.string() + " --config " + CRANE_LAB_CONFIG + mass +
                      " --columns L=hoist --out " + dir.string()),
             2);

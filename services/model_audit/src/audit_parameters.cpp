@@ -217,4 +217,23 @@ AxisAuditParameters drive_axis_parameters(const common::AxisFriction& f, double 
   return p;
 }
 
+DriveParameters drive_parameters_from_axis(const AxisAuditParameters& axis) {
+  common::require_greater("K_m", axis.motor_constant, 0.0);
+  const double k = axis.motor_constant;
+  DriveParameters d;
+  d.gain = k;
+  auto& f = d.friction;
+  f.viscous_positive = (axis.viscous + axis.viscous_asymmetry) / k;
+  f.viscous_negative = (axis.viscous - axis.viscous_asymmetry) / k;
+  f.coulomb_positive = (axis.coulomb + axis.coulomb_asymmetry) / k;
+  f.coulomb_negative = (axis.coulomb - axis.coulomb_asymmetry) / k;
+  f.static_positive = f.coulomb_positive + (axis.stiction + axis.stiction_asymmetry) / k;
+  f.static_negative = f.coulomb_negative + (axis.stiction - axis.stiction_asymmetry) / k;
+  for (const auto& [name, value] : {std::pair{"viscous_positive", f.viscous_positive}, std::pair{"viscous_negative", f.viscous_negative},
+                                    std::pair{"coulomb_positive", f.coulomb_positive}, std::pair{"coulomb_negative", f.coulomb_negative}}) {
+    common::require_at_least(name, value, 0.0);
+  }
+  return d;
+}
+
 }  // namespace crane::model_audit

@@ -23,6 +23,11 @@ struct AxisSeries {
   }
   double dead_band{0.0};
   AxisModel nominal;  // nominal asymmetries and stiction (catalog entries add to them)
+  // A crane drive's nominal asymmetries and stiction are configured in volts: with a calibrated
+  // K_m they scale with K_m / nominal_gain (a lone axis keeps them in m/s^2; without calibration
+  // K_m is nominal_gain and nothing changes).
+  bool asymmetries_in_volts{false};
+  double nominal_gain{1.0};  // [m/s^2/V] the nominal K_m
   // Crane drive axis (empty for a lone axis): the axis row I a + C = I_drive (drive - friction) with
   // I = inertia + dm inertia_per_mass and C = force + dm force_per_mass at t_k (dm = the
   // payload_mass_error parameter [kg]); see AuditData.
@@ -40,9 +45,22 @@ constexpr std::size_t kAxisBase = 3;  // K_m, b, c
 
 
 // The nominal model with the base parameters of `full` (K_m, b, c), and the cause's terms.
+// The nominal asymmetries and stiction for base K_m `gain` (asymmetries_in_volts).
+AxisModel scaled_nominal(const AxisSeries& s, double gain) {
+  AxisModel m = s.nominal;
+  if (s.asymmetries_in_volts) {
+    const double scale = gain / s.nominal_gain;
+    m.coulomb_asymmetry *= scale;
+    m.viscous_asymmetry *= scale;
+    m.stiction *= scale;
+    m.stiction_asymmetry *= scale;
+  }
+  return m;
+}
+
 AxisTerms axis_terms(const AxisSeries& s, const std::vector<double>& full) {
   AxisTerms t;
-  t.model = s.nominal;
+  t.model = scaled_nominal(s, std::max(full[0], 1e-9));
   t.model.motor_constant = std::max(full[0], 1e-9);
   t.model.viscous = std::max(full[1], 0.0);
   t.model.coulomb = std::max(full[2], 0.0);
@@ -192,6 +210,7 @@ Problem axis_effort_problem(const std::shared_ptr<AxisSeries>& s, double holdout
 
 std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vector<double>& base, const AxisCause& cause) {
   if (cause.regressor == nullptr) return std::nullopt;
+  const AxisModel nominal = scaled_nominal(s, base[0]);
   std::vector<double> y;
   std::vector<double> phi;
   const double t = s.sample_time;
@@ -204,8 +223,8 @@ std::optional<double> axis_linear_estimate(const AxisSeries& s, const std::vecto
     const double sign = v > 0.0 ? 1.0 : -1.0;
     const double u = 0.5 * (s.u[k - 1] + s.u[k]);
     const double needed = s.inertia.empty() ? a : (s.inertia[k] * a + s.force[k]) / s.drive_inertia;
-    y.push_back(base[0] * u - needed - base[1] * v - s.nominal.viscous_asymmetry * std::abs(v) - base[2] * sign -
-                s.nominal.coulomb_asymmetry);
+    y.push_back(base[0] * u - needed - base[1] * v - nominal.viscous_asymmetry * std::abs(v) - base[2] * sign -
+                nominal.coulomb_asymmetry);
     AxisRegressorSample sample;
     sample.drive = base[0] * u;
     sample.velocity = v;
@@ -359,6 +378,8 @@ AxisAudit::AxisAudit(const AuditData& data, const AxisAuditParameters& nominal, 
   s->force = data.coupling_force;
   s->force_per_mass = data.coupling_force_per_mass;
   s->drive_inertia = data.drive_inertia;
+  s->asymmetries_in_volts = !data.coupling_inertia.empty();
+  s->nominal_gain = nominal.motor_constant;
   s->sample_time = sample_time_;
   s->dead_band = options.dead_band;
   series_ = std::move(s);

@@ -2,6 +2,7 @@
 // (AxisAudit per drive with the coupling of the full model, SwingAudit), combined.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -164,10 +165,6 @@ std::string slew_unit(const std::string& unit) {
 }  // namespace
 
 AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) {
-  if (options.calibrate) {
-    throw common::ConfigError("calibrate: not available for the crane model (give the nominal parameters with "
-                              "--config and --param)");
-  }
   if (options.channel == AuditChannel::effort) {
     throw common::ConfigError("channel: the crane audit fits the position and swing channels and reports the "
                               "effort channel of each drive as a second opinion; do not give --channel effort");
@@ -194,7 +191,56 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
   report.plant = "crane";
   report.sample_time = sample_time;
   report.samples = n;
-  for (const auto& [name, value] : parameter_values(crane)) report.nominal.push_back({name, "", value, 0.0});
+  // With calibrate, each drive's K_m, b and c are fitted first (the AxisAudit's nominal_free); the
+  // nominal asymmetries and breakaway excess stay as configured, in volts. The swing channel has no parameter of its own to calibrate (the
+  // cable length is measured, gravity is gravity); its catalog is searched as without calibrate.
+  common::CraneParameters calibrated = crane;
+  std::map<std::string, double> calibrated_errors;  // [the field's unit] first-order standard errors
+  std::string calibration_notes;
+
+  // The calibrated K_m, b, c of one drive (its channel's nominal) back in the configuration's terms.
+  const auto calibrate_drive = [&](const std::string& prefix, const std::vector<FittedParameter>& fitted,
+                                   AxisAuditParameters axis) {
+    std::map<std::string, FittedParameter> by_name;
+    for (const auto& p : fitted) by_name[p.name] = p;
+    // The asymmetries and breakaway excess are the configured volts (AxisAudit scales them with K_m).
+    const double scale = by_name.at("K_m").value / axis.motor_constant;
+    axis.coulomb_asymmetry *= scale;
+    axis.viscous_asymmetry *= scale;
+    axis.stiction *= scale;
+    axis.stiction_asymmetry *= scale;
+    axis.motor_constant = by_name.at("K_m").value;
+    axis.viscous = by_name.at("b").value;
+    axis.coulomb = by_name.at("c").value;
+    DriveParameters drive;
+    try {
+      drive = drive_parameters_from_axis(axis);
+    } catch (const common::ConfigError& e) {
+      calibration_notes += prefix + "drive: calibrated K_m " + common::format_value(axis.motor_constant) + ", b " +
+                           common::format_value(axis.viscous) + ", c " + common::format_value(axis.coulomb) +
+                           " with the configured asymmetries give " + e.what() +
+                           ": not expressible in the configuration's terms, its configured values are shown; ";
+      return;
+    }
+    const bool slew = prefix == kSlewPrefix;
+    (slew ? calibrated.slew_friction : calibrated.trolley_friction) = drive.friction;
+    (slew ? calibrated.slew_drive_gain : calibrated.trolley_drive_gain) = drive.gain;
+    // First order, without the covariance of K_m with b and c: (x/K)' = x'/K - x K'/K^2.
+    const double k = axis.motor_constant;
+    const double se_k = by_name.at("K_m").standard_error;
+    const auto ratio_error = [&](double numerator, double se_numerator) {
+      return std::hypot(se_numerator / k, numerator * se_k / (k * k));
+    };
+    calibrated_errors[prefix + "drive_gain"] = se_k;
+    const double se_b = by_name.at("b").standard_error;
+    const double se_c = by_name.at("c").standard_error;
+    calibrated_errors[prefix + "viscous_positive"] = ratio_error(axis.viscous + axis.viscous_asymmetry, se_b);
+    calibrated_errors[prefix + "viscous_negative"] = ratio_error(axis.viscous - axis.viscous_asymmetry, se_b);
+    calibrated_errors[prefix + "coulomb_positive"] = ratio_error(axis.coulomb + axis.coulomb_asymmetry, se_c);
+    calibrated_errors[prefix + "coulomb_negative"] = ratio_error(axis.coulomb - axis.coulomb_asymmetry, se_c);
+    calibrated_errors[prefix + "static_positive"] = calibrated_errors[prefix + "coulomb_positive"];
+    calibrated_errors[prefix + "static_negative"] = calibrated_errors[prefix + "coulomb_negative"];
+  };
 
   // Drive axes.
   const auto& drive_catalog = audit_catalog(AuditPlant::axis);
@@ -235,6 +281,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     const auto prefixed = [&](const std::string& name) { return name == "payload_mass_error" ? name : prefix + name; };
     if (channel.cause != "none" && channel.cause != "ambiguous") channel.cause = prefixed(channel.cause);
     for (auto& name : channel.ambiguous_with) name = prefixed(name);
+    if (options.calibrate) calibrate_drive(prefix, channel.nominal, std::get<AxisAuditParameters>(axis_options.nominal));
     return channel;
   };
   if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
@@ -260,6 +307,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
     swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
     swing_options.max_causes = 1;
+    swing_options.calibrate = false;  // nothing of its own to calibrate (above)
     if (requested) {
       std::vector<double> measured(2 * n);
       for (std::size_t k = 0; k < n; ++k) {
@@ -275,6 +323,12 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
                              std::move(measured), mean_length, crane.gravity, swing_options);
       report.channels.push_back(run_channel_audit(swing, swing_options));
     }
+  }
+
+  // The nominal as used: the configuration's, with the calibrated drives if asked.
+  for (const auto& [name, value] : parameter_values(calibrated)) {
+    const auto error = calibrated_errors.find(name);
+    report.nominal.push_back({name, "", value, error == calibrated_errors.end() ? 0.0 : error->second});
   }
 
   // Combine: the qualifying candidate with the lowest delta-BIC over the channels whose nominal
@@ -338,6 +392,10 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     }
     report.stop_reason.resize(report.stop_reason.size() - 2);
     report.stop_reason += ")";
+  }
+  if (!calibration_notes.empty()) {
+    calibration_notes.resize(calibration_notes.size() - 2);
+    report.stop_reason += " (calibrate: " + calibration_notes + ")";
   }
   return report;
 }

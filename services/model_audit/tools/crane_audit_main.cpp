@@ -15,8 +15,9 @@
 // u_gamma [V], x [m], gamma, phi, theta [rad], L [m]; nominal parameters from --config (the stack's
 // YAML, crane section, loaded by crane::config) and --param (names: audit_parameter_names(crane),
 // e.g. --param load_mass=2.4); every parameter is required, so give --config or all of them.
-// --config for axis: the trolley drive (K_m, b, c and the nominal asymmetries). --calibrate is
-// refused for the crane.
+// --config for axis: the trolley drive (K_m, b, c and the nominal asymmetries). --calibrate for
+// the crane fits each drive's gain, viscous and Coulomb friction first (report.json "nominal" gives
+// them in the configuration's terms).
 // Exit codes: 0 success; 2 input refused (message names the file, row, column, option or cause);
 // 1 anything else.
 #include <CLI/CLI.hpp>

@@ -97,4 +97,16 @@ void validate(const AuditNominal& nominal);
 /// plant's rule, axis_friction.hpp).
 [[nodiscard]] AxisAuditParameters drive_axis_parameters(const common::AxisFriction& friction, double gain) noexcept;
 
+/// A crane drive in the configuration's terms: volt-equivalent friction and the drive gain.
+struct DriveParameters {
+  common::AxisFriction friction;  // [V s/m], [V] (slew: [V s/rad], [V])
+  double gain{0.0};               // K_m [m/s^2/V] (slew: [rad/s^2/V])
+};
+
+/// The inverse of drive_axis_parameters(): gain = K_m, b+- = (b +- viscous_asymmetry)/K_m,
+/// c+- = (c +- coulomb_asymmetry)/K_m, static+- = c+- + (stiction +- stiction_asymmetry)/K_m.
+/// Throws common::ConfigError naming the field if K_m <= 0 or a resulting coefficient is negative
+/// (the configuration's rule, common::validate).
+[[nodiscard]] DriveParameters drive_parameters_from_axis(const AxisAuditParameters& axis);
+
 }  // namespace crane::model_audit

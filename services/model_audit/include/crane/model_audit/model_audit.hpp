@@ -52,7 +52,10 @@
 //    windows of at least 5 s, initial swing state as nuisance; catalog: the pendulum entries.
 //  - combination: the qualifying candidate with the lowest delta-BIC over the channels whose nominal
 //    residual is not white; a candidate must also gain kCraneResolutionQuanta quanta of held-out RMS.
-//    --calibrate and the effort channel as the fitting channel are refused for the crane.
+//    The effort channel as the fitting channel is refused for the crane. With calibrate, each
+//    drive's K_m, b, c are fitted first (the asymmetries and breakaway excess stay as configured)
+//    and the report's nominal gives them back in the configuration's terms (drive gain, volt
+//    equivalents; drive_parameters_from_axis()); the swing channel has nothing to calibrate.
 // Fitting: a candidate that is linear in its parameters in the effort domain (friction asymmetries,
 // gain error, position-dependent friction) is first solved by linear least squares (Eigen,
 // column-pivoted QR); every candidate is then refined by nonlinear least squares (Ceres,
