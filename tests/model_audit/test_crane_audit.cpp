@@ -11,7 +11,9 @@
 #include <filesystem>
 #include <map>
 #include <fstream>
+#include <limits>
 #include <numbers>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -246,26 +248,24 @@ TEST(CraneAudit, CalibrateRecoversTheDrivesAndStillFindsAWrongPayload) {
 
 // A recording of the project's own plant simulator (plant::CraneSimulator: CVODE with exact
 // stick-slip event location, the DAC and the encoders; an integrator independent of the audit's
-// and of the generator's) under a PD on each drive. The recorder reports the middle of each encoder
-// count (the simulator's counts are lower edges). Audited against its own configuration: none; with
-// the load mass 20 % low in the nominal: payload_mass_error with the plant's mass within 10 %.
-TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
-  crane::plant::SimulatorParameters parameters;
-  parameters.initial_state.trolley_position = 0.65;
-  parameters.initial_state.cable_length = parameters.crane.cable_length;
+// and of the generator's) under a PD on each drive, 18 s at 100 Hz, the generator's sines without
+// its creep phase. The recorder reports the middle of each encoder count (the simulator's counts
+// are lower edges); `phi_offset` [rad] is added to the recorded in-plane swing (an encoder offset).
+ma::AuditData record_plant_simulator(const crane::plant::SimulatorParameters& parameters, double phi_offset = 0.0) {
   crane::plant::CraneSimulator simulator(parameters);
   const auto& sensors = simulator.drives_and_sensors();
   const double period = parameters.sample_period;
+  const double centre = parameters.initial_state.trolley_position;
   ma::AuditData data;
   data.source = "plant::CraneSimulator recording";
-  double previous_x = 0.65;
+  double previous_x = centre;
   double previous_gamma = 0.0;
   for (std::size_t k = 0; k <= 1800; ++k) {
     const double t = static_cast<double>(k) * period;
     const auto m = simulator.output().measurement;
     const double x = m.trolley_position + 0.5 * sensors.trolley_resolution();
     const double gamma = m.slew_angle + 0.5 * sensors.slew_resolution();
-    const double trolley_reference = 0.65 + 0.2 * std::sin(2.0 * std::numbers::pi * 0.25 * t) - 0.2 * std::sin(2.0 * std::numbers::pi * t / 3.0);
+    const double trolley_reference = centre + 0.2 * std::sin(2.0 * std::numbers::pi * 0.25 * t) - 0.2 * std::sin(2.0 * std::numbers::pi * t / 3.0);
     const double slew_reference = 0.25 * std::sin(2.0 * std::numbers::pi * 0.15 * t) - 0.25 * std::sin(2.0 * std::numbers::pi * 0.3 * t);
     const double v_x = k == 0 ? 0.0 : (x - previous_x) / period;
     const double v_gamma = k == 0 ? 0.0 : (gamma - previous_gamma) / period;
@@ -275,16 +275,26 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
     input.trolley_voltage = 100.0 * (trolley_reference - x - 0.2 * v_x);
     input.slew_voltage = 40.0 * (slew_reference - gamma - 0.2 * v_gamma);
     input.brakes_engaged = false;
-    ASSERT_EQ(simulator.step(input), crane::common::StepStatus::ok);
+    EXPECT_EQ(simulator.step(input), crane::common::StepStatus::ok);
     data.time.push_back(t);
     data.input.push_back(simulator.output().applied_trolley_voltage);  // held over [t_k, t_k+1)
     data.slew_input.push_back(simulator.output().applied_slew_voltage);
     data.output.push_back(x);
     data.slew_angle.push_back(gamma);
-    data.swing_in_plane.push_back(m.swing_in_plane + 0.5 * sensors.swing_resolution());
+    data.swing_in_plane.push_back(m.swing_in_plane + 0.5 * sensors.swing_resolution() + phi_offset);
     data.swing_out_of_plane.push_back(m.swing_out_of_plane + 0.5 * sensors.swing_resolution());
     data.cable_length.push_back(m.cable_length);
   }
+  return data;
+}
+
+// Audited against its own configuration: none; with the load mass 20 % low in the nominal:
+// payload_mass_error with the plant's mass within 10 %.
+TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
+  crane::plant::SimulatorParameters parameters;
+  parameters.initial_state.trolley_position = 0.65;
+  parameters.initial_state.cable_length = parameters.crane.cable_length;
+  const ma::AuditData data = record_plant_simulator(parameters);
   ma::AuditOptions options;
   options.nominal = parameters.crane;
   const auto right = ma::run_audit(data, options);
@@ -304,6 +314,120 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
                   parameters.crane.load_mass, p.value, wrong.channel.c_str());
     }
   }
+}
+
+std::size_t env_cases(const char* name, std::size_t fallback) {
+  const char* text = std::getenv(name);
+  return text != nullptr ? static_cast<std::size_t>(std::strtoul(text, nullptr, 10)) : fallback;
+}
+
+// The wind and hook entries on recordings of the project's plant simulator with its own options
+// (plant.wind: a steady force; plant.hook: the hook as a double pendulum, integrated by CVODE over
+// six coordinates), seeded random magnitudes in the generator's ranges (hidden_effect_generator.hpp),
+// load 1-3 kg and cable 0.6-1.6 m drawn per case. Case i: wind_force, hook_double_pendulum and
+// encoder_offset in turn (the offset tests the other direction: wind must not take it), then clean
+// cases. The nominal is the configuration with the suspended mass (hook and load). Env
+// CRANE_AUDIT_PLANT_CASES (default 3), CRANE_AUDIT_PLANT_CLEAN (default 0: the test above is a clean
+// recording audited with these entries in the catalog), CRANE_AUDIT_PLANT_FIRST (first case index,
+// for shards).
+TEST(CraneAudit, PlantSimulatorWindHookAndOffsetAreNamed) {
+  const std::size_t cases = env_cases("CRANE_AUDIT_PLANT_CASES", 3);
+  const std::size_t clean = env_cases("CRANE_AUDIT_PLANT_CLEAN", 0);
+  const char* entries[] = {"wind_force", "hook_double_pendulum", "encoder_offset"};
+  std::size_t effect_cases = 0;
+  std::size_t right = 0;
+  std::size_t clean_cases = 0;
+  std::size_t clean_none = 0;
+  std::size_t within = 0;
+  for (std::size_t i = env_cases("CRANE_AUDIT_PLANT_FIRST", 0); i < cases + clean; ++i) {
+    const std::uint64_t seed = 4700 + i;
+    std::mt19937_64 rng(seed);
+    const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+    const std::string effect = i < cases ? entries[i % 3] : "none";
+    crane::plant::SimulatorParameters parameters;
+    parameters.crane.load_mass = uniform(1.0, 3.0);
+    parameters.crane.cable_length = uniform(0.6, 1.6);
+    parameters.initial_state.trolley_position = 0.65;
+    parameters.initial_state.cable_length = parameters.crane.cable_length;
+    crane::common::CraneParameters nominal = parameters.crane;
+    std::string main_parameter;
+    double main_value = 0.0;
+    double phi_offset = 0.0;
+    if (effect == "wind_force") {
+      const double force = uniform(0.01, 0.05) * parameters.crane.load_mass * parameters.crane.gravity;
+      const double direction = uniform(0.0, 2.0 * std::numbers::pi);
+      parameters.wind.enabled = true;
+      parameters.wind.mean_force_x = force * std::cos(direction);
+      parameters.wind.mean_force_y = force * std::sin(direction);
+      const bool x = std::abs(parameters.wind.mean_force_x) >= std::abs(parameters.wind.mean_force_y);
+      main_parameter = x ? "wind_force_x" : "wind_force_y";
+      main_value = x ? parameters.wind.mean_force_x : parameters.wind.mean_force_y;
+    } else if (effect == "hook_double_pendulum") {
+      const double share = uniform(0.1, 0.4);
+      parameters.hook.enabled = true;
+      parameters.hook.rigging_length = uniform(0.15, 0.5);
+      parameters.hook.hook_mass = share * nominal.load_mass;
+      parameters.crane.load_mass = (1.0 - share) * nominal.load_mass;
+      main_parameter = "rigging_length";
+      main_value = parameters.hook.rigging_length;
+    } else if (effect == "encoder_offset") {
+      phi_offset = (uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0) * uniform(0.01, 0.05);
+      main_parameter = "encoder_offset";
+      main_value = phi_offset;
+    }
+    const ma::AuditData data = record_plant_simulator(parameters, phi_offset);
+    ma::AuditOptions options;
+    options.nominal = nominal;
+    const auto report = ma::run_audit(data, options);
+    double fitted = std::numeric_limits<double>::quiet_NaN();
+    for (const auto& p : report.parameters) {
+      if (p.name == main_parameter) fitted = p.value;
+    }
+    const auto delta_bic = [&](const std::string& name) {
+      for (const auto& c : report.candidates) {
+        if (c.name == name && c.fitted) return c.delta_bic;
+      }
+      return std::numeric_limits<double>::quiet_NaN();
+    };
+    std::printf("case %zu seed %llu %s: %s=%g -> %s (fitted %g); delta-BIC wind %.0f, offset %.0f, hook %.0f, length %.0f\n",
+                i, static_cast<unsigned long long>(seed), effect.c_str(), main_parameter.c_str(), main_value,
+                report.cause.c_str(), fitted, delta_bic("wind_force"), delta_bic("encoder_offset"),
+                delta_bic("hook_double_pendulum"), delta_bic("cable_length_error"));
+    if (effect == "none") {
+      ++clean_cases;
+      clean_none += report.cause == "none" ? 1 : 0;
+      continue;
+    }
+    ++effect_cases;
+    if (report.cause != effect) continue;
+    ++right;
+    within += std::abs(fitted - main_value) <= 0.1 * std::abs(main_value) ? 1 : 0;
+  }
+  std::printf("plant simulator: right cause %zu/%zu, main parameter within 10 %% %zu/%zu, clean none %zu/%zu\n", right,
+              effect_cases, within, right, clean_none, clean_cases);
+  EXPECT_GE(right, static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(effect_cases))));
+  EXPECT_EQ(within, right);
+  EXPECT_EQ(clean_none, clean_cases);
+}
+
+// The elastic rope (plant.rope: the load on a spring of stiffness EA / L in series with the cable)
+// has no catalog entry of its own. The lab's rope (EA = 2e5 N: a static stretch of m g / EA = 1e-4 of
+// the length) is below the audit's resolution floor: a recording of the plant simulator with it is
+// clean (none), started at the static stretch as the plant stage does. A soft rope is not named
+// right (docs/model_audit.md, Limits: EA = 1500 N is taken for the hook).
+TEST(CraneAudit, PlantSimulatorWithTheLabsElasticRopeGivesNone) {
+  crane::plant::SimulatorParameters parameters;
+  parameters.rope.enabled = true;
+  parameters.rope.axial_stiffness = 2.0e5;
+  parameters.initial_state.trolley_position = 0.65;
+  parameters.initial_state.cable_length = parameters.crane.cable_length;
+  parameters.initial_state.rope_stretch = parameters.crane.load_mass * parameters.crane.gravity *
+                                          parameters.crane.cable_length / parameters.rope.axial_stiffness;
+  const ma::AuditData data = record_plant_simulator(parameters);
+  ma::AuditOptions options;
+  options.nominal = parameters.crane;
+  const auto report = ma::run_audit(data, options);
+  EXPECT_EQ(report.cause, "none") << report.stop_reason;
 }
 
 // crane_audit end to end: the nominal from the lab configuration (--config) with the recording's

@@ -66,9 +66,10 @@ void print(const std::string& title, const Tally& tally, const std::vector<std::
 
 // Case i has the catalog entry (i * stride) % size (stride coprime to the size: every entry covered
 // once in `size` cases, and a short run spreads over the catalog).
+// `entries`: a part of the catalog to run instead of all of it.
 Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_cases, std::uint64_t seed_base,
-          std::size_t stride = 1, std::size_t first = 0) {
-  const auto& catalog = ma::audit_catalog(plant);
+          std::size_t stride = 1, std::size_t first = 0, const std::vector<std::string>* entries = nullptr) {
+  const auto& catalog = entries != nullptr ? *entries : ma::audit_catalog(plant);
   Tally tally;
   for (std::size_t i = first; i < effect_cases + clean_cases; ++i) {
     const bool clean = i >= effect_cases;
@@ -139,14 +140,32 @@ TEST(HiddenEffects, PendulumAuditNamesTheEffectRecoversItsSizeAndInventsNothing)
 
 // The crane (full plant, three channels): env CRANE_AUDIT_CRANE_CASES effect cases (default 6: the
 // whole suite stays short; about 8 s per case on one core) and CRANE_AUDIT_CRANE_CLEAN_CASES clean
-// cases (default 1). Entries in steps of 7 through the 26-entry catalog (all in 26 cases). A long
+// cases (default 1). Entries in steps of 9 through the 28-entry catalog (all in 28 cases). A long
 // run can be split: CRANE_AUDIT_CRANE_FIRST = the first case index to run (cases keep their seeds).
 TEST(CraneHiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
   const std::size_t cases = env_count("CRANE_AUDIT_CRANE_CASES", 6);
   const std::size_t clean = env_count("CRANE_AUDIT_CRANE_CLEAN_CASES", 1);
-  const Tally crane = run(ma::AuditPlant::crane, cases, clean, 9000, 7, env_count("CRANE_AUDIT_CRANE_FIRST", 0));
+  const Tally crane = run(ma::AuditPlant::crane, cases, clean, 9000, 9, env_count("CRANE_AUDIT_CRANE_FIRST", 0));
   print("crane", crane, ma::audit_catalog(ma::AuditPlant::crane));
   EXPECT_GE(crane.correct, static_cast<int>(std::ceil(0.95 * crane.cases)));
   EXPECT_EQ(crane.parameter_within, crane.parameter_checked);
   EXPECT_EQ(crane.clean_none, crane.clean_cases);
+}
+
+// The crane's swing entries, the two of the plant's options first (wind_force, hook_double_pendulum),
+// then encoder_offset and cable_length_error (the entries they resemble) and the damping entries:
+// entry i % 7, seeds 9500 + i. Env CRANE_AUDIT_SWING_CASES (default 2: wind and hook, about 25 s),
+// CRANE_AUDIT_SWING_CLEAN (default 0; the crane test above has a clean case), CRANE_AUDIT_SWING_FIRST.
+TEST(CraneHiddenEffects, SwingEntriesWindAndHookAreNamed) {
+  const std::vector<std::string> entries{"wind_force",          "hook_double_pendulum",     "encoder_offset",
+                                         "cable_length_error",  "pendulum_viscous_damping", "pendulum_coulomb_damping",
+                                         "pendulum_quadratic_damping"};
+  const std::size_t cases = env_count("CRANE_AUDIT_SWING_CASES", 2);
+  const std::size_t clean = env_count("CRANE_AUDIT_SWING_CLEAN", 0);
+  const Tally swing =
+      run(ma::AuditPlant::crane, cases, clean, 9500, 1, env_count("CRANE_AUDIT_SWING_FIRST", 0), &entries);
+  print("crane swing entries", swing, entries);
+  EXPECT_GE(swing.correct, static_cast<int>(std::ceil(0.95 * swing.cases)));
+  EXPECT_EQ(swing.parameter_within, swing.parameter_checked);
+  EXPECT_EQ(swing.clean_none, swing.clean_cases);
 }

@@ -139,6 +139,7 @@ std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
     d.trolley_position = m.state[k].position[plant::kTrolleyIndex];
     d.trolley_velocity = m.state[k].velocity[plant::kTrolleyIndex];
     d.trolley_acceleration = 0.5 * (m.acceleration[k][plant::kTrolleyIndex] + m.acceleration[next][plant::kTrolleyIndex]);
+    d.slew_angle = m.state[k].position[plant::kSlewIndex];
     d.slew_rate = m.state[k].velocity[plant::kSlewIndex];
     d.slew_acceleration = 0.5 * (m.acceleration[k][plant::kSlewIndex] + m.acceleration[next][plant::kSlewIndex]);
     d.cable_length = m.hoist[k].cable_length;
@@ -297,7 +298,9 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
   {
     bool requested = false;
     AuditOptions swing_options = options;
-    swing_options.causes = channel_causes(options.causes, "", audit_catalog(AuditPlant::pendulum), false, requested);
+    std::vector<std::string> swing_catalog;  // the pendulum entries and the crane-only swing entries
+    for (const auto& cause : pendulum_catalog()) swing_catalog.emplace_back(cause.name);
+    swing_options.causes = channel_causes(options.causes, "", swing_catalog, false, requested);
     double mean_length = 0.0;
     for (const double L : data.cable_length) mean_length += L / static_cast<double>(n);
     PendulumAuditParameters swing_nominal;

@@ -2,7 +2,9 @@
 
 #include <Eigen/LU>
 #include <cassert>
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace crane::model_audit {
 
@@ -35,6 +37,58 @@ SwingElimination eliminate_swing(const plant::CoordinateMatrix& mass, const plan
   return e;
 }
 
+HookedSwingElimination eliminate_hooked_swing(const plant::ExtendedMatrix& mass, const plant::ExtendedVector& bias,
+                                              const Eigen::Vector2d& swing_extra) noexcept {
+  constexpr int kSwing[4] = {plant::kInPlaneSwingIndex, plant::kOutOfPlaneSwingIndex, plant::kRiggingInPlaneIndex,
+                             plant::kRiggingOutOfPlaneIndex};
+  constexpr int kDrive[2] = {plant::kTrolleyIndex, plant::kSlewIndex};
+  Eigen::Matrix4d m_ss;
+  Eigen::Matrix<double, 4, 2> m_sa;
+  Eigen::Matrix<double, 2, 4> m_as;
+  Eigen::Matrix2d m_aa;
+  Eigen::Vector4d b_s;
+  Eigen::Vector2d b_a;
+  for (int r = 0; r < 4; ++r) {
+    b_s(r) = bias[kSwing[r]];
+    for (int c = 0; c < 4; ++c) m_ss(r, c) = mass(kSwing[r], kSwing[c]);
+    for (int c = 0; c < 2; ++c) {
+      m_sa(r, c) = mass(kSwing[r], kDrive[c]);
+      m_as(c, r) = mass(kDrive[c], kSwing[r]);
+    }
+  }
+  for (int r = 0; r < 2; ++r) {
+    b_a(r) = bias[kDrive[r]];
+    for (int c = 0; c < 2; ++c) m_aa(r, c) = mass(kDrive[r], kDrive[c]);
+  }
+  const auto lu = m_ss.partialPivLu();
+  HookedSwingElimination e;
+  e.swing_gain = -lu.solve(m_sa);
+  e.swing_free = -lu.solve(b_s);
+  e.swing_free.head<2>() += swing_extra;
+  e.drive_inertia = m_aa + m_as * e.swing_gain;
+  e.drive_bias = b_a + m_as * e.swing_free;
+  return e;
+}
+
+plant::TowerCraneModel hooked_model(const common::CraneParameters& suspended, const SwingEffects& effects) {
+  common::CraneParameters p = suspended;
+  const double total = suspended.load_mass > 0.0 ? suspended.load_mass : 1.0;
+  const double share = std::clamp(effects.hook_mass_share, kMinHookMassShare, kMaxHookMassShare);
+  plant::HookParameters hook;
+  hook.enabled = true;
+  hook.rigging_length = std::clamp(effects.rigging_length, kMinRiggingLength, kMaxRiggingLength);
+  hook.hook_mass = share * total;
+  p.load_mass = (1.0 - share) * total;
+  return plant::TowerCraneModel(p, hook);
+}
+
+plant::ExtendedVector wind_generalized_force(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                             const plant::ExtendedState& state,
+                                             const plant::HoistMotion& hoist) noexcept {
+  if (effects.wind_force_x == 0.0 && effects.wind_force_y == 0.0) return plant::ExtendedVector::Zero();
+  return model.load_force(state, hoist, effects.wind_force_x, effects.wind_force_y);
+}
+
 Eigen::Vector2d swing_damping(const SwingEffects& effects, double in_plane_rate, double out_of_plane_rate) noexcept {
   const auto damping = [&](double rate) {
     return -effects.extra_viscous * rate - effects.coulomb * std::tanh(rate / kSwingCoulombRate) -
@@ -53,7 +107,7 @@ void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects&
   plant::ModelState q;
   q.position[kTrolleyIndex] = motion.trolley_position;
   q.position[kInPlaneSwingIndex] = state.in_plane;
-  q.position[kSlewIndex] = 0.0;  // gamma is cyclic
+  q.position[kSlewIndex] = motion.slew_angle;  // cyclic: only the wind's direction depends on it
   q.position[kOutOfPlaneSwingIndex] = state.out_of_plane;
   q.velocity[kTrolleyIndex] = motion.trolley_velocity;
   q.velocity[kInPlaneSwingIndex] = state.in_plane_rate;
@@ -65,60 +119,133 @@ void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects&
   plant::CoordinateMatrix mass;
   plant::CoordinateVector bias;
   model.compute_dynamics(q, hoist, mass, bias);
+  if (effects.wind_force_x != 0.0 || effects.wind_force_y != 0.0) {
+    plant::ExtendedState extended;
+    extended.position.head<plant::kNumCoordinates>() = q.position;
+    extended.velocity.head<plant::kNumCoordinates>() = q.velocity;
+    bias -= wind_generalized_force(model, effects, extended, hoist).head<plant::kNumCoordinates>();
+  }
   const SwingElimination e = eliminate_swing(mass, bias, swing_damping(effects, state.in_plane_rate, state.out_of_plane_rate));
   const Eigen::Vector2d s = e.swing_gain * Eigen::Vector2d(motion.trolley_acceleration, motion.slew_acceleration) + e.swing_free;
   in_plane_acceleration = s(0);
   out_of_plane_acceleration = s(1);
 }
 
+namespace {
+
+using SwingVector = Eigen::Matrix<double, 8, 1>;  // phi, phi', theta, theta', phi2, phi2', theta2, theta2'
+
+// Swing accelerations of the hooked model (phi'', theta'', phi2'', theta2'').
+Eigen::Vector4d hooked_acceleration(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                    const SwingVector& s, const DriveMotion& motion) noexcept {
+  plant::ExtendedState q;
+  q.position << motion.trolley_position, s(0), motion.slew_angle, s(2), s(4), s(6);
+  q.velocity << motion.trolley_velocity, s(1), motion.slew_rate, s(3), s(5), s(7);
+  const double scale = 1.0 + effects.length_error;
+  const plant::HoistMotion hoist{motion.cable_length * scale, motion.cable_length_rate * scale,
+                                 motion.cable_length_acceleration * scale};
+  plant::ExtendedMatrix mass;
+  plant::ExtendedVector bias;
+  model.compute_extended_dynamics(q, hoist, mass, bias);
+  bias -= wind_generalized_force(model, effects, q, hoist);
+  // The swing rows only (eliminate_hooked_swing without the drive rows): s'' = -M_ss^-1 (M_sa a'' + b_s).
+  constexpr int kSwing[4] = {plant::kInPlaneSwingIndex, plant::kOutOfPlaneSwingIndex, plant::kRiggingInPlaneIndex,
+                             plant::kRiggingOutOfPlaneIndex};
+  Eigen::Matrix4d m_ss;
+  Eigen::Vector4d rhs;
+  for (int r = 0; r < 4; ++r) {
+    rhs(r) = bias[kSwing[r]] + mass(kSwing[r], plant::kTrolleyIndex) * motion.trolley_acceleration +
+             mass(kSwing[r], plant::kSlewIndex) * motion.slew_acceleration;
+    for (int c = 0; c < 4; ++c) m_ss(r, c) = mass(kSwing[r], kSwing[c]);
+  }
+  Eigen::Vector4d acceleration = -(m_ss.inverse() * rhs);  // closed-form 4x4 inverse (M_ss is regular for |theta| < pi/2)
+  acceleration.head<2>() += swing_damping(effects, s(1), s(3));
+  return acceleration;
+}
+
+}  // namespace
+
 void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
                         std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,
                         SwingState initial, int substeps, std::span<double> out) noexcept {
   assert(first + count <= motion.size());
   assert(out.size() >= 2 * count);
-  const int steps = substeps < 1 ? 1 : substeps;
+  const bool hooked = effects.rigging_length > 0.0;
+  // The hooked model allocates nothing per step; it is built once per replay (noexcept: the
+  // clamped hook parameters are within the model's bounds).
+  const std::optional<plant::TowerCraneModel> hook =
+      hooked ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), effects)) : std::nullopt;
+  int steps = substeps < 1 ? 1 : substeps;
+  if (hooked) {
+    // The rigging's mode is fast for a short rigging or a light hook: at least as many RK4 steps as
+    // keep h omega_2 <= 0.3 (omega_2 of the double pendulum at rest, at the first sample's length).
+    const common::CraneParameters& p = hook->parameters();
+    const double length = motion[first].cable_length * (1.0 + effects.length_error);
+    const double omega = plant::double_pendulum_frequencies(length, hook->hook().rigging_length, hook->hook().hook_mass,
+                                                            p.load_mass, p.gravity)
+                             .second;
+    if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
+  }
   const double h = sample_time / steps;
-  SwingState state = initial;
-  const auto derivative = [&](const SwingState& s, const DriveMotion& d) {
-    double a0 = 0.0;
-    double a1 = 0.0;
-    swing_acceleration(model, effects, s, d, a0, a1);
-    return SwingState{s.in_plane_rate, a0, s.out_of_plane_rate, a1};
-  };
-  const auto add = [](const SwingState& s, const SwingState& k, double dt) {
-    return SwingState{s.in_plane + dt * k.in_plane, s.in_plane_rate + dt * k.in_plane_rate,
-                      s.out_of_plane + dt * k.out_of_plane, s.out_of_plane_rate + dt * k.out_of_plane_rate};
+  SwingVector state;
+  state << initial.in_plane, initial.in_plane_rate, initial.out_of_plane, initial.out_of_plane_rate,
+      initial.rigging_in_plane, initial.rigging_in_plane_rate, initial.rigging_out_of_plane,
+      initial.rigging_out_of_plane_rate;
+  const auto derivative = [&](const SwingVector& s, const DriveMotion& d) {
+    SwingVector k = SwingVector::Zero();
+    k(0) = s(1);
+    k(2) = s(3);
+    if (hooked) {
+      const Eigen::Vector4d a = hooked_acceleration(*hook, effects, s, d);
+      k(1) = a(0);
+      k(3) = a(1);
+      k(4) = s(5);
+      k(5) = a(2);
+      k(6) = s(7);
+      k(7) = a(3);
+    } else {
+      const SwingState single{s(0), s(1), s(2), s(3)};
+      swing_acceleration(model, effects, single, d, k(1), k(3));
+    }
+    return k;
   };
   for (std::size_t i = 0; i < count; ++i) {
-    out[2 * i] = state.in_plane + effects.encoder_offset;
-    out[2 * i + 1] = state.out_of_plane;
+    out[2 * i] = state(0) + effects.encoder_offset;
+    out[2 * i + 1] = state(2);
     if (i + 1 == count) break;
     const DriveMotion& held = motion[first + i];
     DriveMotion d = held;
     for (int step = 0; step < steps; ++step) {
-      // The trolley position follows its held velocity and acceleration within the sample.
+      // The trolley position and the slew angle follow their held rates and accelerations within
+      // the sample.
       const double tau = step * h;
       d.trolley_position = held.trolley_position + held.trolley_velocity * tau + 0.5 * held.trolley_acceleration * tau * tau;
       d.trolley_velocity = held.trolley_velocity + held.trolley_acceleration * tau;
+      d.slew_angle = held.slew_angle + held.slew_rate * tau + 0.5 * held.slew_acceleration * tau * tau;
       d.slew_rate = held.slew_rate + held.slew_acceleration * tau;
       DriveMotion mid = d;
       mid.trolley_position += d.trolley_velocity * 0.5 * h + 0.125 * held.trolley_acceleration * h * h;
       mid.trolley_velocity += 0.5 * h * held.trolley_acceleration;
+      mid.slew_angle += d.slew_rate * 0.5 * h + 0.125 * held.slew_acceleration * h * h;
       mid.slew_rate += 0.5 * h * held.slew_acceleration;
       DriveMotion end = d;
       end.trolley_position += d.trolley_velocity * h + 0.5 * held.trolley_acceleration * h * h;
       end.trolley_velocity += h * held.trolley_acceleration;
+      end.slew_angle += d.slew_rate * h + 0.5 * held.slew_acceleration * h * h;
       end.slew_rate += h * held.slew_acceleration;
-      const SwingState k1 = derivative(state, d);
-      const SwingState k2 = derivative(add(state, k1, 0.5 * h), mid);
-      const SwingState k3 = derivative(add(state, k2, 0.5 * h), mid);
-      const SwingState k4 = derivative(add(state, k3, h), end);
-      state.in_plane += h / 6.0 * (k1.in_plane + 2.0 * k2.in_plane + 2.0 * k3.in_plane + k4.in_plane);
-      state.in_plane_rate +=
-          h / 6.0 * (k1.in_plane_rate + 2.0 * k2.in_plane_rate + 2.0 * k3.in_plane_rate + k4.in_plane_rate);
-      state.out_of_plane += h / 6.0 * (k1.out_of_plane + 2.0 * k2.out_of_plane + 2.0 * k3.out_of_plane + k4.out_of_plane);
-      state.out_of_plane_rate += h / 6.0 * (k1.out_of_plane_rate + 2.0 * k2.out_of_plane_rate +
-                                            2.0 * k3.out_of_plane_rate + k4.out_of_plane_rate);
+      const SwingVector k1 = derivative(state, d);
+      const SwingVector k2 = derivative(state + 0.5 * h * k1, mid);
+      const SwingVector k3 = derivative(state + 0.5 * h * k2, mid);
+      const SwingVector k4 = derivative(state + h * k3, end);
+      const SwingVector next = state + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      // A fit may try parameters or initial states far from the data: a swing beyond 1.5 rad (the
+      // model is singular at pi/2) or a non-finite state is held where it was, so that the
+      // prediction stays finite (and far from the data).
+      if (!next.allFinite() || std::abs(next(0)) > 1.5 || std::abs(next(2)) > 1.5 || std::abs(next(4)) > 1.5 ||
+          std::abs(next(6)) > 1.5) {
+        break;
+      }
+      state = next;
     }
   }
 }

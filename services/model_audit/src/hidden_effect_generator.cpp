@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <functional>
 #include <numbers>
 #include <random>
@@ -219,6 +220,9 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
     p.cable_length = truth.crane.cable_length * (1.0 + truth.swing.length_error);
     return p;
   }());
+  const bool hooked = truth.swing.rigging_length > 0.0;
+  const std::optional<plant::TowerCraneModel> hook =
+      hooked ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), truth.swing)) : std::nullopt;
   const plant::DrivesAndSensors sensors(truth.crane);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 0.5);  // encoder edge jitter [counts]
@@ -275,17 +279,44 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
     };
     for (int i = 0; i < kCraneSubsteps; ++i) {
       const double at = (i + 0.5) * h;  // delays are whole substeps: a substep never straddles a sample edge
-      plant::ModelState q;
-      q.position << trolley.position, swing.in_plane, slew.position, swing.out_of_plane;
-      q.velocity << trolley.velocity, swing.in_plane_rate, slew.velocity, swing.out_of_plane_rate;
-      plant::CoordinateMatrix mass;
-      plant::CoordinateVector bias;
-      model.compute_dynamics(q, hoist, mass, bias);
-      // Swing rows eliminated (with the swing entries' damping): s'' = S a'' + s0, M_eff a'' + b_eff = Q.
-      const SwingElimination e =
-          eliminate_swing(mass, bias, swing_damping(truth.swing, swing.in_plane_rate, swing.out_of_plane_rate));
-      const Eigen::Matrix2d& m_eff = e.drive_inertia;
-      const Eigen::Vector2d& b_eff = e.drive_bias;
+      // Swing rows eliminated (with the swing entries' damping and the wind's generalized force):
+      // s'' = S a'' + s0, M_eff a'' + b_eff = Q; s = (phi, theta) or, with the hook, (phi, theta, phi2, theta2).
+      const Eigen::Vector2d damping = swing_damping(truth.swing, swing.in_plane_rate, swing.out_of_plane_rate);
+      Eigen::Matrix<double, 4, 2> swing_gain = Eigen::Matrix<double, 4, 2>::Zero();
+      Eigen::Vector4d swing_free = Eigen::Vector4d::Zero();
+      Eigen::Matrix2d m_eff;
+      Eigen::Vector2d b_eff;
+      plant::ExtendedState extended;
+      extended.position << trolley.position, swing.in_plane, slew.position, swing.out_of_plane, swing.rigging_in_plane,
+          swing.rigging_out_of_plane;
+      extended.velocity << trolley.velocity, swing.in_plane_rate, slew.velocity, swing.out_of_plane_rate,
+          swing.rigging_in_plane_rate, swing.rigging_out_of_plane_rate;
+      if (hooked) {
+        plant::ExtendedMatrix mass;
+        plant::ExtendedVector bias;
+        hook->compute_extended_dynamics(extended, hoist, mass, bias);
+        bias -= wind_generalized_force(*hook, truth.swing, extended, hoist);
+        const HookedSwingElimination e = eliminate_hooked_swing(mass, bias, damping);
+        swing_gain = e.swing_gain;
+        swing_free = e.swing_free;
+        m_eff = e.drive_inertia;
+        b_eff = e.drive_bias;
+      } else {
+        plant::ModelState q;
+        q.position = extended.position.head<plant::kNumCoordinates>();
+        q.velocity = extended.velocity.head<plant::kNumCoordinates>();
+        plant::CoordinateMatrix mass;
+        plant::CoordinateVector bias;
+        model.compute_dynamics(q, hoist, mass, bias);
+        if (truth.swing.wind_force_x != 0.0 || truth.swing.wind_force_y != 0.0) {
+          bias -= wind_generalized_force(model, truth.swing, extended, hoist).head<plant::kNumCoordinates>();
+        }
+        const SwingElimination e = eliminate_swing(mass, bias, damping);
+        swing_gain.topRows<2>() = e.swing_gain;
+        swing_free.head<2>() = e.swing_free;
+        m_eff = e.drive_inertia;
+        b_eff = e.drive_bias;
+      }
       // Each drive with its own effective inertia; the small cross term from the other drive's
       // acceleration of the previous substep.
       const double ratio_x = truth.crane.trolley_drive_mass / m_eff(0, 0);
@@ -298,11 +329,17 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
       advance_axis(scale_axis_inertia(truth.slew, ratio_g), held(u_gamma, truth.slew.input_delay, at), h, 1, slew, ext_g);
       trolley_acceleration = (trolley.velocity - v_x0) / h;
       slew_acceleration = (slew.velocity - v_g0) / h;
-      const Eigen::Vector2d s_dd = e.swing_gain * Eigen::Vector2d(trolley_acceleration, slew_acceleration) + e.swing_free;
+      const Eigen::Vector4d s_dd = swing_gain * Eigen::Vector2d(trolley_acceleration, slew_acceleration) + swing_free;
       swing.in_plane_rate += h * s_dd(0);
       swing.out_of_plane_rate += h * s_dd(1);
       swing.in_plane += h * swing.in_plane_rate;
       swing.out_of_plane += h * swing.out_of_plane_rate;
+      if (hooked) {
+        swing.rigging_in_plane_rate += h * s_dd(2);
+        swing.rigging_out_of_plane_rate += h * s_dd(3);
+        swing.rigging_in_plane += h * swing.rigging_in_plane_rate;
+        swing.rigging_out_of_plane += h * swing.rigging_out_of_plane_rate;
+      }
     }
   }
   return max_input;
@@ -355,6 +392,18 @@ HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, d
     const double dm = -signed_uniform(0.15, 0.4) * truth.crane.load_mass;  // the nominal is off by -dm
     nominal.load_mass = truth.crane.load_mass - dm;
     drawn = {"load_mass_error", dm};
+  } else if (e == "wind_force") {
+    const double force = uniform(0.01, 0.05) * truth.crane.load_mass * truth.crane.gravity;
+    const double direction = uniform(0.0, 2.0 * std::numbers::pi);
+    truth.swing.wind_force_x = force * std::cos(direction);
+    truth.swing.wind_force_y = force * std::sin(direction);
+    drawn = std::abs(truth.swing.wind_force_x) >= std::abs(truth.swing.wind_force_y)
+                ? Drawn{"wind_force_x", truth.swing.wind_force_x}
+                : Drawn{"wind_force_y", truth.swing.wind_force_y};
+  } else if (e == "hook_double_pendulum") {
+    truth.swing.rigging_length = uniform(0.15, 0.5);
+    truth.swing.hook_mass_share = uniform(0.1, 0.4);
+    drawn = {"rigging_length", truth.swing.rigging_length};
   } else if (e != "none") {
     drawn = draw_pendulum_effect(e, truth.swing, truth.crane.gravity / truth.crane.cable_length, uniform, signed_uniform);
   }

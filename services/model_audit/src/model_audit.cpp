@@ -20,6 +20,13 @@ const std::vector<std::string>& audit_catalog(AuditPlant plant) {
   }();
   static const std::vector<std::string> pendulum = [] {
     std::vector<std::string> list;
+    for (const auto& cause : detail::pendulum_catalog()) {
+      if (!cause.crane_only) list.emplace_back(cause.name);
+    }
+    return list;
+  }();
+  static const std::vector<std::string> swing = [] {
+    std::vector<std::string> list;
     for (const auto& cause : detail::pendulum_catalog()) list.emplace_back(cause.name);
     return list;
   }();
@@ -29,7 +36,7 @@ const std::vector<std::string>& audit_catalog(AuditPlant plant) {
     for (const char* prefix : {"trolley_", "slew_"}) {
       for (const auto& name : axis) list.push_back(prefix + name);
     }
-    list.insert(list.end(), pendulum.begin(), pendulum.end());
+    list.insert(list.end(), swing.begin(), swing.end());
     for (const auto& cause : detail::axis_catalog()) {
       if (cause.crane_drive_only) list.emplace_back(cause.name);
     }
@@ -47,6 +54,13 @@ void validate(const AuditOptions& options) {
     const auto& axis = detail::axis_catalog();
     if (plant == AuditPlant::axis && std::any_of(axis.begin(), axis.end(), [&](const auto& c) {
           return c.crane_drive_only && cause == c.name;
+        })) {
+      continue;
+    }
+    // Likewise the swing entries of the crane only (wind, hook) on the pendulum: the crane's swing channel.
+    const auto& swing = detail::pendulum_catalog();
+    if (plant == AuditPlant::pendulum && std::any_of(swing.begin(), swing.end(), [&](const auto& c) {
+          return c.crane_only && cause == c.name;
         })) {
       continue;
     }

@@ -9,39 +9,73 @@ namespace crane::model_audit::detail {
 const std::vector<PendulumCause>& pendulum_catalog() {
   static const std::vector<PendulumCause> catalog{
       {.name = "pendulum_viscous_damping",
-       .parameter = [](double) -> ParameterSpec {
-         return {"extra_viscous_damping", "1/s", 0.1, -1.0, 20.0, linspace(0.0, 0.6, 61)};
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"extra_viscous_damping", "1/s", 0.1, -1.0, 20.0, linspace(0.0, 0.6, 61)}};
        },
        .apply = [](const double* p, PendulumModel& m) { m.extra_viscous = std::max(p[0], -m.damping); },
        .apply_swing = [](const double* p, SwingEffects& e) { e.extra_viscous = p[0]; },
        .calibration_note = "absorbed by the calibrated nominal parameters"},
       {.name = "pendulum_coulomb_damping",
-       .parameter = [](double omega2) -> ParameterSpec {
-         return {"coulomb_damping", "rad/s^2", 0.005 * omega2, 0.0, 2.0 * omega2,
-                 linspace(0.0002 * omega2, 0.012 * omega2, 60)};
+       .parameters = [](const SwingScales& scales) -> std::vector<ParameterSpec> {
+         const double omega2 = scales.omega_squared;
+         return {{"coulomb_damping", "rad/s^2", 0.005 * omega2, 0.0, 2.0 * omega2,
+                 linspace(0.0002 * omega2, 0.012 * omega2, 60)}};
        },
        .apply = [](const double* p, PendulumModel& m) { m.coulomb = std::max(p[0], 0.0); },
        .apply_swing = [](const double* p, SwingEffects& e) { e.coulomb = std::max(p[0], 0.0); }},
       {.name = "pendulum_quadratic_damping",
-       .parameter = [](double) -> ParameterSpec {
-         return {"quadratic_damping", "1/rad", 0.1, 0.0, 50.0, linspace(0.0, 1.0, 51)};
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"quadratic_damping", "1/rad", 0.1, 0.0, 50.0, linspace(0.0, 1.0, 51)}};
        },
        .apply = [](const double* p, PendulumModel& m) { m.quadratic = std::max(p[0], 0.0); },
        .apply_swing = [](const double* p, SwingEffects& e) { e.quadratic = std::max(p[0], 0.0); }},
       {.name = "cable_length_error",
-       .parameter = [](double) -> ParameterSpec {
-         return {"length_error", "-", 0.05, -0.8, 2.0, linspace(-0.25, 0.25, 51)};
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"length_error", "-", 0.05, -0.8, 2.0, linspace(-0.25, 0.25, 51)}};
        },
        .apply = [](const double* p, PendulumModel& m) { m.length_error = std::max(p[0], -0.9); },
        .apply_swing = [](const double* p, SwingEffects& e) { e.length_error = std::max(p[0], -0.9); },
        .calibration_note = "absorbed by the calibrated nominal parameters"},
       {.name = "encoder_offset",
-       .parameter = [](double) -> ParameterSpec {
-         return {"encoder_offset", "rad", 0.02, -0.5, 0.5, linspace(-0.1, 0.1, 41)};
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"encoder_offset", "rad", 0.02, -0.5, 0.5, linspace(-0.1, 0.1, 41)}};
        },
        .apply = [](const double* p, PendulumModel& m) { m.encoder_offset = p[0]; },
        .apply_swing = [](const double* p, SwingEffects& e) { e.encoder_offset = p[0]; },
        .needs_known_zero = true},
+      // Crane only (the plant's tower-crane options plant.wind and plant.hook). A steady wind
+      // force F (inertial x, y) on the load: the swing's equilibrium moves to about F / (m g) in the
+      // jib frame, so it turns with the slew angle, and both swing planes feel it (an offset of the
+      // in-plane encoder does neither). Grid: up to 6 % of the load's weight per component.
+      {.name = "wind_force",
+       .parameters = [](const SwingScales& scales) -> std::vector<ParameterSpec> {
+         const double w = std::max(scales.load_weight, 1e-6);
+         return {{"wind_force_x", "N", 0.01 * w, -0.5 * w, 0.5 * w, linspace(-0.06 * w, 0.06 * w, 7)},
+                 {"wind_force_y", "N", 0.01 * w, -0.5 * w, 0.5 * w, linspace(-0.06 * w, 0.06 * w, 7)}};
+       },
+       .apply = nullptr,
+       .apply_swing =
+           [](const double* p, SwingEffects& e) {
+             e.wind_force_x = p[0];
+             e.wind_force_y = p[1];
+           },
+       .crane_only = true},
+      // The hook as a double pendulum: rigging of length l below the hook, the hook's share s of the
+      // configured suspended mass (crane_swing.hpp). The encoders measure the cable (trolley to
+      // hook); the rigging's initial state is four more nuisance values per window.
+      {.name = "hook_double_pendulum",
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"rigging_length", "m", 0.1, kMinRiggingLength, kMaxRiggingLength, linspace(0.1, 0.6, 6)},
+                 {"hook_mass_share", "-", 0.1, kMinHookMassShare, kMaxHookMassShare, {0.1, 0.2, 0.35, 0.5}}};
+       },
+       .apply = nullptr,
+       .apply_swing =
+           [](const double* p, SwingEffects& e) {
+             e.rigging_length = std::max(p[0], kMinRiggingLength);
+             e.hook_mass_share = p[1];
+           },
+       .crane_only = true,
+       .extra_nuisance = 4},
   };
   return catalog;
 }
@@ -70,11 +104,12 @@ namespace {
 
 constexpr std::size_t kPendulumBase = 3;  // L, damping, theta_zero
 
-std::vector<Candidate> candidates_of(double omega_squared) {
+std::vector<Candidate> candidates_of(const SwingScales& scales, bool crane) {
   std::vector<Candidate> list;
   const auto& catalog = pendulum_catalog();
   for (std::size_t i = 0; i < catalog.size(); ++i) {
-    list.push_back({catalog[i].name, {catalog[i].parameter(omega_squared)}, i, catalog[i].calibration_note, "", "", 0, -1e300});
+    if (catalog[i].crane_only && !crane) continue;
+    list.push_back({catalog[i].name, catalog[i].parameters(scales), i, catalog[i].calibration_note, "", "", 0, -1e300});
   }
   return list;
 }
@@ -148,8 +183,9 @@ Problem crane_swing_problem(const std::shared_ptr<SwingSeries>& s, double window
     const std::size_t count = std::min(length, n - first);
     problem.windows.push_back({2 * first, 2 * count, first >= holdout_start ? 0 : 2 * count});
   }
-  problem.nuisance_size = 4;
-  problem.initial_nuisance = [s](const Window& w, double* out) {
+  const std::size_t extra = s->cause != nullptr ? s->cause->extra_nuisance : 0;
+  problem.nuisance_size = 4 + extra;
+  problem.initial_nuisance = [s, extra](const Window& w, double* out) {
     std::vector<double> phi(w.count / 2);
     std::vector<double> theta(w.count / 2);
     for (std::size_t i = 0; i < phi.size(); ++i) {
@@ -162,11 +198,23 @@ Problem crane_swing_problem(const std::shared_ptr<SwingSeries>& s, double window
     out[1] = phi_rate;
     out[2] = theta0;
     out[3] = theta_rate;
+    if (extra == 4) {  // the hook's rigging starts in line with the cable
+      out[4] = phi0;
+      out[5] = phi_rate;
+      out[6] = theta0;
+      out[7] = theta_rate;
+    }
   };
-  problem.residual = [s](const std::vector<double>& full, const double* nuisance, const Window& w, std::size_t count,
-                         double* out) {
+  problem.residual = [s, extra](const std::vector<double>& full, const double* nuisance, const Window& w,
+                                std::size_t count, double* out) {
     const SwingEffects effects = swing_effects(*s, full);
-    const SwingState initial{nuisance[0] - effects.encoder_offset, nuisance[1], nuisance[2], nuisance[3]};
+    SwingState initial{nuisance[0] - effects.encoder_offset, nuisance[1], nuisance[2], nuisance[3]};
+    if (extra == 4) {
+      initial.rigging_in_plane = nuisance[4];
+      initial.rigging_in_plane_rate = nuisance[5];
+      initial.rigging_out_of_plane = nuisance[6];
+      initial.rigging_out_of_plane_rate = nuisance[7];
+    }
     replay_crane_swing(*s->model, effects, s->motion, s->sample_time, w.first / 2, count / 2, initial, s->substeps,
                        std::span<double>(out, count));
     for (std::size_t i = 0; i < count; ++i) out[i] = s->measured[w.first + i] - out[i];
@@ -224,7 +272,7 @@ std::vector<std::size_t> PendulumAudit::nominal_free(bool calibrate) const {
 }
 
 std::vector<Candidate> PendulumAudit::candidates() const {
-  auto list = candidates_of(gravity_ / base_[0]);
+  auto list = candidates_of({.omega_squared = gravity_ / base_[0], .load_weight = 0.0, .cable_length = base_[0]}, false);
   std::erase_if(list, [&](const Candidate& c) { return c.entry == first_entry_; });
   return list;
 }
@@ -263,7 +311,9 @@ SwingAudit::SwingAudit(const AuditData& data, std::shared_ptr<const plant::Tower
       sample_time_(checked_sample_time(data)),
       holdout_fraction_(options.holdout_fraction),
       window_duration_(options.window_duration),
-      omega_squared_(gravity / mean_cable_length) {
+      scales_{.omega_squared = gravity / mean_cable_length,
+              .load_weight = model->parameters().load_mass * gravity,
+              .cable_length = mean_cable_length} {
   auto s = std::make_shared<SwingSeries>();
   s->model = std::move(model);
   s->motion = std::move(motion);
@@ -275,7 +325,7 @@ SwingAudit::SwingAudit(const AuditData& data, std::shared_ptr<const plant::Tower
 
 SwingAudit::~SwingAudit() = default;
 
-std::vector<Candidate> SwingAudit::candidates() const { return candidates_of(omega_squared_); }
+std::vector<Candidate> SwingAudit::candidates() const { return candidates_of(scales_, true); }
 
 Problem SwingAudit::problem(const Candidate* candidate) const {
   auto s = std::make_shared<SwingSeries>(*series_);

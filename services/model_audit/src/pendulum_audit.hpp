@@ -19,13 +19,22 @@
 
 namespace crane::model_audit::detail {
 
+/// Scales of a record for the catalog's parameters.
+struct SwingScales {
+  double omega_squared{1.0};  // g / L [1/s^2]
+  double load_weight{0.0};    // m g [N] of the configured (suspended) load; 0 on the planar pendulum
+  double cable_length{1.0};   // L [m] (mean)
+};
+
 struct PendulumCause {
   const char* name;
-  ParameterSpec (*parameter)(double omega_squared);  // g / L [1/s^2] sets the scale
-  void (*apply)(const double* parameters, PendulumModel& model);   // model with its base parameters
+  std::vector<ParameterSpec> (*parameters)(const SwingScales& scales);
+  void (*apply)(const double* parameters, PendulumModel& model);   // model with its base parameters (nullptr: crane only)
   void (*apply_swing)(const double* parameters, SwingEffects& effects);
   const char* calibration_note{""};  // non-empty: absorbed by the calibrated nominal (skipped)
   bool needs_known_zero{false};      // not identifiable when theta_zero is estimated
+  bool crane_only{false};            // an entry of the crane's swing channel only (wind, hook: plant options of the tower crane)
+  std::size_t extra_nuisance{0};     // initial-state values per window beyond the swing's (the hook's rigging: 4)
 };
 
 /// The pendulum catalog in catalog order.
@@ -104,7 +113,7 @@ class SwingAudit final : public ChannelAudit {
   double sample_time_;
   double holdout_fraction_;
   double window_duration_;
-  double omega_squared_;
+  SwingScales scales_;
   std::vector<double> no_base_;
   std::vector<ParameterSpec> no_specs_;
   std::shared_ptr<const SwingSeries> series_;

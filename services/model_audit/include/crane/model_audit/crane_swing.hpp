@@ -13,6 +13,14 @@
 //         regularized over kSwingCoulombRate, pendulum_quadratic_damping q [1/rad])
 //   the true cable length is L (1 + e), L' (1 + e), L'' (1 + e) for the recorded L (cable_length_error e)
 //   measured phi = phi + offset                              (encoder_offset [rad], in-plane encoder)
+//   Q += (dp_load/dq) . F for a steady horizontal force F = (F_x, F_y, 0) [N] on the load in the
+//        inertial frame (wind_force; TowerCraneModel::load_force: it turns with the slew angle in
+//        the jib frame, and the drive rows get it too)
+//   the hook as a double pendulum (hook_double_pendulum): the cable (phi, theta, length L) ends at
+//        a hook of mass m_h and the load hangs l below it (TowerCraneModel with HookParameters:
+//        coordinates (x, phi, gamma, theta, phi2, theta2)); the configured load_mass M is the
+//        suspended mass, hook and load: m_h = s M, m = (1 - s) M (the share s [-]); the swing rows
+//        depend on s and l only. The swing rows (phi, theta, phi2, theta2) are eliminated as below.
 // Integration (replay): classical Runge-Kutta 4 with the drive and hoist motion held per sample.
 //
 // Offline: noexcept and allocation-free except where stated; the model is validated by its owner.
@@ -33,13 +41,24 @@ struct SwingEffects {
   double quadratic{0.0};       // q [1/rad] >= 0
   double length_error{0.0};    // e [-] > -1
   double encoder_offset{0.0};  // [rad] added to the measured in-plane swing phi
+  double wind_force_x{0.0};     // [N] steady horizontal force on the load, inertial x (x along the jib at slew 0)
+  double wind_force_y{0.0};     // [N] inertial y
+  double rigging_length{0.0};   // l [m], hook to the load's centre of mass; 0: no hook (the single pendulum)
+  double hook_mass_share{0.0};  // s = m_h / (m_h + m) [-] in (0, 1), with a hook
 };
+
+/// Bounds of the hook entry in the replay (its fits are clamped to them): l [m] and s [-].
+inline constexpr double kMinRiggingLength = 0.02;
+inline constexpr double kMaxRiggingLength = 5.0;
+inline constexpr double kMinHookMassShare = 0.01;
+inline constexpr double kMaxHookMassShare = 0.95;
 
 /// Drive and hoist motion at one instant (measured, or simulated).
 struct DriveMotion {
   double trolley_position{0.0};           // x [m]
   double trolley_velocity{0.0};           // [m/s]
   double trolley_acceleration{0.0};       // [m/s^2]
+  double slew_angle{0.0};                 // gamma [rad] (turns the wind force into the jib frame)
   double slew_rate{0.0};                  // gamma' [rad/s]
   double slew_acceleration{0.0};          // gamma'' [rad/s^2]
   double cable_length{1.0};               // L [m] > 0 as recorded
@@ -52,6 +71,11 @@ struct SwingState {
   double in_plane_rate{0.0};      // [rad/s]
   double out_of_plane{0.0};       // theta [rad]
   double out_of_plane_rate{0.0};  // [rad/s]
+  // With a hook (SwingEffects::rigging_length > 0): the rigging's absolute angles (phi2, theta2).
+  double rigging_in_plane{0.0};           // [rad]
+  double rigging_in_plane_rate{0.0};      // [rad/s]
+  double rigging_out_of_plane{0.0};       // [rad]
+  double rigging_out_of_plane_rate{0.0};  // [rad/s]
 };
 
 /// The swing eliminated from M q'' + bias = Q (TowerCraneModel::compute_dynamics at one state; a =
@@ -69,11 +93,35 @@ struct SwingElimination {
 [[nodiscard]] SwingElimination eliminate_swing(const plant::CoordinateMatrix& mass, const plant::CoordinateVector& bias,
                                                const Eigen::Vector2d& swing_extra = Eigen::Vector2d::Zero()) noexcept;
 
+/// The same with a hook: the four swing rows (phi, theta, phi2, theta2) of
+/// TowerCraneModel::compute_extended_dynamics eliminated (swing_extra: damping of phi and theta).
+struct HookedSwingElimination {
+  Eigen::Matrix<double, 4, 2> swing_gain;  // rows phi, theta, phi2, theta2
+  Eigen::Vector4d swing_free;
+  Eigen::Matrix2d drive_inertia;
+  Eigen::Vector2d drive_bias;
+};
+[[nodiscard]] HookedSwingElimination eliminate_hooked_swing(const plant::ExtendedMatrix& mass,
+                                                            const plant::ExtendedVector& bias,
+                                                            const Eigen::Vector2d& swing_extra) noexcept;
+
+/// The model with the hook of `effects` (rigging_length clamped to [kMinRiggingLength,
+/// kMaxRiggingLength], hook_mass_share to [kMinHookMassShare, kMaxHookMassShare]): `suspended`'s
+/// load_mass M (> 0; 1 kg when not) split into the hook's s M and the load's (1 - s) M. Allocates.
+[[nodiscard]] plant::TowerCraneModel hooked_model(const common::CraneParameters& suspended, const SwingEffects& effects);
+
+/// The wind's generalized force (TowerCraneModel::load_force with the effects' F_x, F_y [N]) at
+/// `state` (slot 2 = the slew angle gamma [rad]); zero without wind or without a load mass.
+[[nodiscard]] plant::ExtendedVector wind_generalized_force(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                                           const plant::ExtendedState& state,
+                                                           const plant::HoistMotion& hoist) noexcept;
+
 /// The catalog's damping terms [rad/s^2] for the swing rates (phi', theta') [rad/s].
 [[nodiscard]] Eigen::Vector2d swing_damping(const SwingEffects& effects, double in_plane_rate,
                                             double out_of_plane_rate) noexcept;
 
-/// Swing accelerations (phi'', theta'') [rad/s^2] of the equations above.
+/// Swing accelerations (phi'', theta'') [rad/s^2] of the equations above (without a hook; a
+/// hooked replay goes through replay_crane_swing).
 void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects& effects, const SwingState& state,
                         const DriveMotion& motion, double& in_plane_acceleration,
                         double& out_of_plane_acceleration) noexcept;
@@ -81,6 +129,9 @@ void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects&
 /// Replays the swing from `initial` at sample `first`: motion[k] is held over [t_k, t_k + sample_time)
 /// with `substeps` >= 1 RK4 steps per sample; writes the measured angles of samples first ..
 /// first + count - 1 interleaved: out[2 i] = phi + encoder_offset, out[2 i + 1] = theta [rad].
+/// With a hook (effects.rigging_length > 0) `model` is the single pendulum with the suspended mass
+/// (hooked_model() builds the double pendulum; allocates once per call) and `initial` carries the
+/// rigging's state.
 /// Preconditions (asserted): first + count <= motion.size(), out.size() >= 2 count.
 void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
                         std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,

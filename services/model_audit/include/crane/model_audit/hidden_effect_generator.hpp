@@ -41,7 +41,13 @@
 // trolley's nominal b- is four times b+; 0.3 b keeps b+ positive), position_dependent_friction over
 // 0.6 m (trolley) or 0.5 rad (slew), input_delay rounded to whole substeps (31 us); the pendulum
 // ranges with g/L; payload_mass_error: the nominal load mass is off by dm = +-[0.15, 0.4] m_true
-// (main parameter load_mass_error = m_true - m_nominal [kg]); encoder_offset on phi.
+// (main parameter load_mass_error = m_true - m_nominal [kg]); encoder_offset on phi;
+// wind_force: a steady force of [0.01, 0.05] m g in a direction drawn in [0, 2 pi) (inertial frame;
+// the swing's equilibrium moves by 0.6-2.9 deg; main parameter the larger of wind_force_x,
+// wind_force_y); hook_double_pendulum: rigging l = [0.15, 0.5] m, hook share s = [0.1, 0.4] of the
+// suspended mass M (the drawn load mass; the nominal keeps M, the single pendulum on the cable);
+// main parameter rigging_length. With the hook the plant is TowerCraneModel with HookParameters
+// (six coordinates, the four swing rows eliminated, the same substeps).
 // Offline, allocates; throws common::ConfigError for an unknown effect name.
 
 #include <cstdint>
