@@ -96,6 +96,23 @@ TEST(PlannerStage, AMoveReportsWaitingMovingEveryTenCyclesAndArrived) {
   EXPECT_NEAR(feedback[1].trolley_to_go, 0.30, 1e-3);
 }
 
+// A client that resends a waiting request (it may have missed the first answer: crane_demo's
+// readiness probe) hears WAITING again each time; the request still starts once, at its cycle.
+TEST(PlannerStage, AResentWaitingRequestIsReportedWaitingAgain) {
+  auto stage = lab_planner();
+  const auto request = trolley_goal(7, 0.55, 40);
+  const auto feedback = run(stage, 0, 60, {{2, request}, {12, request}, {22, request}});
+  std::vector<std::uint64_t> waiting;
+  int started = 0;
+  for (const auto& f : feedback) {
+    EXPECT_EQ(f.request_id, 7U);
+    if (f.result == Feedback::RESULT_WAITING) waiting.push_back(f.header.seq);
+    if (f.result == Feedback::RESULT_MOVING && f.header.seq == 40U) ++started;
+  }
+  EXPECT_EQ(waiting, (std::vector<std::uint64_t>{2, 12, 22}));
+  EXPECT_EQ(started, 1);
+}
+
 TEST(PlannerStage, ANewerRequestAbortsTheRunningOneAndAnOlderIdIsIgnored) {
   auto stage = lab_planner();
   const auto feedback = run(stage, 0, 30, {{1, trolley_goal(7, 1.0)}, {15, trolley_goal(8, 0.5)}, {20, trolley_goal(6, 0.9)}});

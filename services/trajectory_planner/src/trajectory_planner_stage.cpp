@@ -439,6 +439,12 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     }
     if (request.request_id <= last_request_) {
       outcome(request, GoalOutcome::When::ignored, GoalStatus::accepted);
+      // A resend of the request that waits for its start cycle is answered again: the client may
+      // not have heard the first answer (its status reader can match after our reader matched its
+      // writer; MoveStatus keeps no history for late joiners).
+      if (pending_.has_value() && pending_->request_id == request.request_id) {
+        report(request.request_id, Feedback::RESULT_WAITING);
+      }
       continue;
     }
     last_request_ = request.request_id;
