@@ -111,6 +111,30 @@ TEST(FrictionCompensation, NonFiniteRejected) {
   EXPECT_EQ(comp.step(in, out), StepStatus::ok);
 }
 
+TEST(FrictionCompensation, OverflowOfFiniteInputsGivesTheSafeOutput) {
+  // Found by the topic-gates fuzzer (tests/fuzz, regression-compensation-overflowing-friction): a
+  // foreign CraneState_ flagged the slew friction as re-estimated with a viscous coefficient of
+  // 8e283 V s/rad, every coefficient finite and >= 0, and a slew rate of -1.6e202 rad/s: b- |v| is
+  // Inf, so the stage wrote slew_friction_voltage = -Inf with status ok before the fix (the clamp
+  // passed -10 V on, the next node's gate refuses the sample).
+  fc::FrictionCompensation comp(fc::FrictionCompensationParams{});
+  auto in = input(0.0, 1.0, -1.6e202, 0.5);
+  crane::common::AxisFriction absurd = fc::FrictionCompensationParams{}.slew.friction;
+  absurd.viscous_negative = 8e283;
+  in.slew_friction = absurd;
+  fc::FrictionCompensationOutput out;
+  out.command.slew_voltage = 3.0;
+  EXPECT_EQ(comp.step(in, out), StepStatus::rejected_nonfinite);
+  EXPECT_EQ(out.command.trolley_voltage, 0.0);
+  EXPECT_EQ(out.command.slew_voltage, 0.0);
+  EXPECT_EQ(out.slew_friction, 0.0);
+  // The same estimate at a plausible rate is an ordinary step: large but finite, clamped.
+  in.estimate.slew_rate = -0.2;
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_TRUE(std::isfinite(out.slew_friction));
+  EXPECT_EQ(out.command.slew_voltage, -fc::FrictionCompensationParams{}.voltage_limit);
+}
+
 TEST(FrictionCompensation, BadParamsThrowNamingField) {
   auto expect_throw = [](const fc::FrictionCompensationParams& p, const std::string& field) {
     try {

@@ -100,6 +100,12 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
         friction_voltage(in_use(params_.trolley, input.trolley_friction), trolley_velocity, input.command.trolley_voltage);
     output.slew_friction =
         friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
+    // Finite inputs can still overflow (a coefficient of 1e284 times a rate of 1e202): the clamp
+    // below would pass Inf as the limit and NaN as is, so such a step gives the safe output.
+    if (!std::isfinite(output.trolley_friction) || !std::isfinite(output.slew_friction)) {
+      output = FrictionCompensationOutput{};
+      return common::StepStatus::rejected_nonfinite;
+    }
   }
   // (3.5): u = V + F_f/K_m
   output.command.trolley_voltage = clamp_voltage(input.command.trolley_voltage + output.trolley_friction,

@@ -89,7 +89,8 @@ class FrictionCompensation {
   /// unknown velocity source.
   explicit FrictionCompensation(const FrictionCompensationParams& params);
 
-  /// rejected_nonfinite if a used input is NaN/Inf: output set to zero voltages and hoist speed.
+  /// rejected_nonfinite if a used input is NaN/Inf, or finite inputs overflow the friction voltage
+  /// (an absurd online coefficient times an absurd rate): output set to zero voltages and hoist speed.
   [[nodiscard]] common::StepStatus step(const FrictionCompensationInput& input,
                                         FrictionCompensationOutput& output) const noexcept;
 
