@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include "crane/common/validation.hpp"
 #include "crane/friction_compensation/friction_compensation.hpp"
@@ -56,21 +58,29 @@ struct ImpulseFigures {
   double correlation{1.0};
 };
 ImpulseFigures impulse_figures(const state_estimator::DiscreteTransferFunction& tf) {
+  // A stable filter's response decays geometrically: it is followed until it has stayed below
+  // 1e-17 of its peak for kQuietSamples samples (about 250 samples for the 4 Hz Butterworth at
+  // 100 Hz; the sums then hold to the last bit), at most kMaxLength samples.
+  constexpr int kMaxLength = 100000;
+  constexpr int kQuietSamples = 1000;
   state_estimator::DiscreteFilter filter(tf);
   filter.initialize(0.0, 0.0);
-  constexpr int kLength = 100000;
-  std::vector<double> h(kLength);
+  std::vector<double> h;
+  h.reserve(2 * kQuietSamples);
   double peak = 0.0;
-  for (int k = 0; k < kLength; ++k) {
-    h[static_cast<std::size_t>(k)] = filter.update(k == 0 ? 1.0 : 0.0);
-    peak = std::max(peak, std::abs(h[static_cast<std::size_t>(k)]));
+  int quiet = 0;
+  for (int k = 0; k < kMaxLength && quiet < kQuietSamples; ++k) {
+    const double v = filter.update(k == 0 ? 1.0 : 0.0);
+    h.push_back(v);
+    peak = std::max(peak, std::abs(v));
+    quiet = std::abs(v) < 1e-17 * peak ? quiet + 1 : 0;
   }
   ImpulseFigures f;
   double sum = 0.0;
   double sum_squares = 0.0;
-  for (int k = 0; k < kLength; ++k) {
-    const double v = h[static_cast<std::size_t>(k)];
-    if (std::abs(v) >= 0.01 * peak) f.memory = k + 1;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    const double v = h[k];
+    if (std::abs(v) >= 0.01 * peak) f.memory = static_cast<int>(k) + 1;
     sum += v;
     sum_squares += v * v;
   }
