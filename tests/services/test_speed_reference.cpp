@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -327,4 +328,37 @@ TEST(SpeedReference, AShaperLongerThanTheHistoryIsTheIdentity) {
     (void)unshaped.step({0.3, 0.0, 0.0}, kDt, params, SpeedShaping::none, bounds, {}, 0);
   }
   EXPECT_NEAR(shaped.reference().trolley.velocity, 0.5 * unshaped.reference().trolley.velocity, 1e-12);
+}
+
+TEST(SpeedReference, AnAbsurdHandedOverSpeedIsReportedAsNeverComingToRestAtOnce) {
+  // Found by the topic-gates fuzzer (tests/fuzz, regression-speed-rest-of-an-absurd-speed): a goal
+  // with limits of 2e37 m/s and 8e34 m/s^2 was planned, a stop handed its 8e32 m/s over to the
+  // speed reference, and rest() ran its ramp to zero forward, about 1e33 cycles: the planner's step
+  // never returned (a libFuzzer timeout in keeps_bounds).
+  const ManualParams params;
+  SpeedReference reference;
+  common::MotionReference start;
+  start.trolley.position = 4e30;
+  start.trolley.velocity = 8e32;
+  start.slew.velocity = -3e20;
+  start.cable_length.position = 1.0;
+  reference.start(start);
+  const auto rest = reference.rest(kDt, params, SpeedShaping::zv, wide_bounds());
+  EXPECT_EQ(rest[0], std::numeric_limits<double>::max());
+  EXPECT_EQ(rest[1], -std::numeric_limits<double>::max());
+  EXPECT_EQ(rest[2], 1.0);  // the hoist at rest stays where it is
+  // Every candidate's rest is outside the travel bounds, so the one with all axes released is
+  // taken: the two asked-for axes are reported held, and the reference stays finite.
+  EXPECT_EQ(reference.step({0.5, 0.5, 0.0}, kDt, params, SpeedShaping::zv, wide_bounds(), {}, 0), 3);
+  EXPECT_TRUE(std::isfinite(reference.reference().trolley.position));
+  // A real stop (1 m/s at the default 1 m/s^2: 100 cycles of ramp) is still run forward exactly.
+  SpeedReference real;
+  start = {};
+  start.trolley.velocity = 1.0;
+  start.cable_length.position = 1.0;
+  real.start(start);
+  const double predicted = real.rest(kDt, params, SpeedShaping::zv, wide_bounds())[0];
+  EXPECT_LT(predicted, 10.0);
+  for (int k = 0; k < 2000; ++k) (void)real.step({0.0, 0.0, 0.0}, kDt, params, SpeedShaping::zv, wide_bounds(), {}, 0);
+  EXPECT_NEAR(real.reference().trolley.position, predicted, 1e-9);
 }

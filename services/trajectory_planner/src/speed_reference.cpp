@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace crane::trajectory_planner {
 namespace {
@@ -55,6 +56,12 @@ double SpeedAxis::rest(double dt, const SpeedAxisParams& params, const InputShap
   const double decrement = params.acceleration * dt;
   const double ramp_steps = std::ceil(std::abs(command_) / decrement);
   const double horizon = ramp_steps + shaper.length() / dt + 2.0;
+  // No crane ramps this long to a stop; only an absurd speed handed over from a corrupted state gets
+  // here (fuzz finding 7: 8e32 m/s, 1e38 cycles). Reported as not coming to rest: the largest finite
+  // position in the direction of the command, at once.
+  if (!(horizon <= static_cast<double>(kMaxRestCycles))) {
+    return std::copysign(std::numeric_limits<double>::max(), command_);
+  }
   double position = position_;
   double velocity = velocity_;
   for (double j = 1.0; j <= horizon; j += 1.0) {

@@ -62,7 +62,11 @@ class SpeedAxis {
   /// acceleration * dt, shapes it with `shaper` (its impulse times must be below kHistory * dt) and
   /// integrates. Non-finite arguments are treated as a target of 0.
   void step(double target_speed, double dt, const SpeedAxisParams& params, const InputShaper& shaper) noexcept;
+  static constexpr std::size_t kMaxRestCycles = 1000000;  // longest stop rest() runs forward (10^4 s at 100 Hz)
+
   /// Where the reference comes to rest if the target is 0 from now on, with `shaper` [axis unit].
+  /// A stop longer than kMaxRestCycles cycles (an absurd handed-over speed) gives
+  /// +-std::numeric_limits<double>::max() in the direction of the command, without running it.
   [[nodiscard]] double rest(double dt, const SpeedAxisParams& params, const InputShaper& shaper) const noexcept;
   /// True when the commanded and the shaped speeds are both 0 and the shaper (of the last step) has
   /// let all of the commanded motion through.
