@@ -140,8 +140,8 @@ TEST(AuditOptions, UnknownParameterAndCauseAreRefusedByName) {
 }
 
 // Each model's catalog: non-empty, names unique; the crane's is the axis catalog once per drive, the
-// pendulum catalog, the crane-only swing entries (wind_force, hook_double_pendulum) and
-// payload_mass_error (28 entries).
+// pendulum catalog, the crane-only swing entries (wind_force, hook_double_pendulum, elastic_rope)
+// and payload_mass_error (29 entries).
 TEST(AuditCatalog, EveryModelHasAUniqueNonEmptyCatalog) {
   for (const auto plant : {ma::AuditPlant::axis, ma::AuditPlant::pendulum, ma::AuditPlant::crane}) {
     const auto& catalog = ma::audit_catalog(plant);
@@ -155,7 +155,7 @@ TEST(AuditCatalog, EveryModelHasAUniqueNonEmptyCatalog) {
   const auto& crane = ma::audit_catalog(ma::AuditPlant::crane);
   EXPECT_EQ(axis.size(), 10U);
   EXPECT_EQ(pendulum.size(), 5U);
-  ASSERT_EQ(crane.size(), 2 * axis.size() + pendulum.size() + 3);
+  ASSERT_EQ(crane.size(), 2 * axis.size() + pendulum.size() + 4);
   for (std::size_t i = 0; i < axis.size(); ++i) {
     EXPECT_EQ(crane[i], "trolley_" + axis[i]);
     EXPECT_EQ(crane[axis.size() + i], "slew_" + axis[i]);
@@ -164,9 +164,10 @@ TEST(AuditCatalog, EveryModelHasAUniqueNonEmptyCatalog) {
   const std::size_t crane_only = 2 * axis.size() + pendulum.size();
   EXPECT_EQ(crane[crane_only], "wind_force");
   EXPECT_EQ(crane[crane_only + 1], "hook_double_pendulum");
+  EXPECT_EQ(crane[crane_only + 2], "elastic_rope");
   EXPECT_EQ(crane.back(), "payload_mass_error");
   // The crane-only swing entries are not in the lab pendulum's catalog.
-  for (const char* name : {"wind_force", "hook_double_pendulum"}) {
+  for (const char* name : {"wind_force", "hook_double_pendulum", "elastic_rope"}) {
     EXPECT_EQ(std::find(pendulum.begin(), pendulum.end(), name), pendulum.end()) << name;
   }
 }

@@ -140,7 +140,7 @@ TEST(HiddenEffects, PendulumAuditNamesTheEffectRecoversItsSizeAndInventsNothing)
 
 // The crane (full plant, three channels): env CRANE_AUDIT_CRANE_CASES effect cases (default 6: the
 // whole suite stays short; about 8 s per case on one core) and CRANE_AUDIT_CRANE_CLEAN_CASES clean
-// cases (default 1). Entries in steps of 9 through the 28-entry catalog (all in 28 cases). A long
+// cases (default 1). Entries in steps of 9 through the 29-entry catalog (all in 29 cases). A long
 // run can be split: CRANE_AUDIT_CRANE_FIRST = the first case index to run (cases keep their seeds).
 TEST(CraneHiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
   const std::size_t cases = env_count("CRANE_AUDIT_CRANE_CASES", 6);
@@ -152,15 +152,16 @@ TEST(CraneHiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
   EXPECT_EQ(crane.clean_none, crane.clean_cases);
 }
 
-// The crane's swing entries, the two of the plant's options first (wind_force, hook_double_pendulum),
-// then encoder_offset and cable_length_error (the entries they resemble) and the damping entries:
-// entry i % 7, seeds 9500 + i. Env CRANE_AUDIT_SWING_CASES (default 2: wind and hook, about 25 s),
-// CRANE_AUDIT_SWING_CLEAN (default 0; the crane test above has a clean case), CRANE_AUDIT_SWING_FIRST.
-TEST(CraneHiddenEffects, SwingEntriesWindAndHookAreNamed) {
-  const std::vector<std::string> entries{"wind_force",          "hook_double_pendulum",     "encoder_offset",
-                                         "cable_length_error",  "pendulum_viscous_damping", "pendulum_coulomb_damping",
-                                         "pendulum_quadratic_damping"};
-  const std::size_t cases = env_count("CRANE_AUDIT_SWING_CASES", 2);
+// The crane's swing entries, the three of the plant's options first (wind_force,
+// hook_double_pendulum, elastic_rope), then encoder_offset and cable_length_error (the entries they
+// resemble) and the damping entries: entry i % 8, seeds 9500 + i. Env CRANE_AUDIT_SWING_CASES
+// (default 3: wind, hook and rope, about 35 s), CRANE_AUDIT_SWING_CLEAN (default 0; the crane test
+// above has a clean case), CRANE_AUDIT_SWING_FIRST.
+TEST(CraneHiddenEffects, SwingEntriesWindHookAndRopeAreNamed) {
+  const std::vector<std::string> entries{"wind_force",          "hook_double_pendulum",     "elastic_rope",
+                                         "encoder_offset",      "cable_length_error",       "pendulum_viscous_damping",
+                                         "pendulum_coulomb_damping", "pendulum_quadratic_damping"};
+  const std::size_t cases = env_count("CRANE_AUDIT_SWING_CASES", 3);
   const std::size_t clean = env_count("CRANE_AUDIT_SWING_CLEAN", 0);
   const Tally swing =
       run(ma::AuditPlant::crane, cases, clean, 9500, 1, env_count("CRANE_AUDIT_SWING_FIRST", 0), &entries);

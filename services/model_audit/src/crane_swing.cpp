@@ -82,6 +82,16 @@ plant::TowerCraneModel hooked_model(const common::CraneParameters& suspended, co
   return plant::TowerCraneModel(p, hook);
 }
 
+plant::TowerCraneModel roped_model(const common::CraneParameters& suspended, const SwingEffects& effects) {
+  common::CraneParameters p = suspended;
+  if (!(p.load_mass > 0.0)) p.load_mass = 1.0;
+  plant::RopeParameters rope;
+  rope.enabled = true;
+  rope.axial_stiffness =
+      p.load_mass * p.gravity / std::clamp(effects.rope_stretch_ratio, kMinRopeStretchRatio, kMaxRopeStretchRatio);
+  return plant::TowerCraneModel(p, {}, rope);
+}
+
 plant::ExtendedVector wind_generalized_force(const plant::TowerCraneModel& model, const SwingEffects& effects,
                                              const plant::ExtendedState& state,
                                              const plant::HoistMotion& hoist) noexcept {
@@ -135,7 +145,8 @@ namespace {
 
 using SwingVector = Eigen::Matrix<double, 8, 1>;  // phi, phi', theta, theta', phi2, phi2', theta2, theta2'
 
-// Swing accelerations of the hooked model (phi'', theta'', phi2'', theta2'').
+// Swing accelerations of the hooked model (phi'', theta'', phi2'', theta2''), or of the roped one
+// (phi'', theta'', s'', 0).
 Eigen::Vector4d hooked_acceleration(const plant::TowerCraneModel& model, const SwingEffects& effects,
                                     const SwingVector& s, const DriveMotion& motion) noexcept {
   plant::ExtendedState q;
@@ -171,17 +182,29 @@ void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects&
   assert(first + count <= motion.size());
   assert(out.size() >= 2 * count);
   const bool hooked = effects.rigging_length > 0.0;
-  // The hooked model allocates nothing per step; it is built once per replay (noexcept: the
-  // clamped hook parameters are within the model's bounds).
+  const bool roped = !hooked && effects.rope_stretch_ratio > 0.0;
+  // The hooked or roped model allocates nothing per step; it is built once per replay (noexcept:
+  // the clamped hook and rope parameters are within the model's bounds). Both go through the
+  // extended rows (slots 4 and 5: the rigging's angles, or the stretch and an unused slot).
   const std::optional<plant::TowerCraneModel> hook =
-      hooked ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), effects)) : std::nullopt;
+      hooked  ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), effects))
+      : roped ? std::optional<plant::TowerCraneModel>(roped_model(model.parameters(), effects))
+              : std::nullopt;
+  const bool extended = hook.has_value();
   int steps = substeps < 1 ? 1 : substeps;
+  const double first_length = motion[first].cable_length * (1.0 + effects.length_error);
+  if (roped) {
+    // The load's bounce on the rope, sqrt(k / m) = sqrt(g / (e_r L)): h omega <= 0.3 as for the hook.
+    const double omega = std::sqrt(hook->parameters().gravity /
+                                   (std::clamp(effects.rope_stretch_ratio, kMinRopeStretchRatio, kMaxRopeStretchRatio) *
+                                    first_length));
+    if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
+  }
   if (hooked) {
     // The rigging's mode is fast for a short rigging or a light hook: at least as many RK4 steps as
     // keep h omega_2 <= 0.3 (omega_2 of the double pendulum at rest, at the first sample's length).
     const common::CraneParameters& p = hook->parameters();
-    const double length = motion[first].cable_length * (1.0 + effects.length_error);
-    const double omega = plant::double_pendulum_frequencies(length, hook->hook().rigging_length, hook->hook().hook_mass,
+    const double omega = plant::double_pendulum_frequencies(first_length, hook->hook().rigging_length, hook->hook().hook_mass,
                                                             p.load_mass, p.gravity)
                              .second;
     if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
@@ -191,11 +214,16 @@ void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects&
   state << initial.in_plane, initial.in_plane_rate, initial.out_of_plane, initial.out_of_plane_rate,
       initial.rigging_in_plane, initial.rigging_in_plane_rate, initial.rigging_out_of_plane,
       initial.rigging_out_of_plane_rate;
+  if (roped) {  // the stretch at rest under the load's weight, e_r L, not moving; slot 5 unused
+    state.tail<4>() << hook->parameters().load_mass * hook->parameters().gravity * first_length /
+                           hook->rope().axial_stiffness,
+        0.0, 0.0, 0.0;
+  }
   const auto derivative = [&](const SwingVector& s, const DriveMotion& d) {
     SwingVector k = SwingVector::Zero();
     k(0) = s(1);
     k(2) = s(3);
-    if (hooked) {
+    if (extended) {
       const Eigen::Vector4d a = hooked_acceleration(*hook, effects, s, d);
       k(1) = a(0);
       k(3) = a(1);

@@ -220,9 +220,14 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
     p.cable_length = truth.crane.cable_length * (1.0 + truth.swing.length_error);
     return p;
   }());
+  // A hook or an elastic rope: the extended rows (slots 4 and 5: the rigging, or the stretch).
   const bool hooked = truth.swing.rigging_length > 0.0;
+  const bool roped = !hooked && truth.swing.rope_stretch_ratio > 0.0;
   const std::optional<plant::TowerCraneModel> hook =
-      hooked ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), truth.swing)) : std::nullopt;
+      hooked  ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), truth.swing))
+      : roped ? std::optional<plant::TowerCraneModel>(roped_model(model.parameters(), truth.swing))
+              : std::nullopt;
+  const bool extended_rows = hook.has_value();
   const plant::DrivesAndSensors sensors(truth.crane);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 0.5);  // encoder edge jitter [counts]
@@ -237,6 +242,9 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
   trolley.position = trolley.load_position = kTrolleyCentre;
   AxisState slew;
   SwingState swing;
+  if (roped) {  // the rope starts stretched by the load's weight, at rest (slot 4)
+    swing.rigging_in_plane = hook->parameters().load_mass * hook->parameters().gravity * length / hook->rope().axial_stiffness;
+  }
   double trolley_acceleration = 0.0;
   double slew_acceleration = 0.0;
   std::vector<double> u_x;
@@ -291,7 +299,7 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
           swing.rigging_out_of_plane;
       extended.velocity << trolley.velocity, swing.in_plane_rate, slew.velocity, swing.out_of_plane_rate,
           swing.rigging_in_plane_rate, swing.rigging_out_of_plane_rate;
-      if (hooked) {
+      if (extended_rows) {
         plant::ExtendedMatrix mass;
         plant::ExtendedVector bias;
         hook->compute_extended_dynamics(extended, hoist, mass, bias);
@@ -334,7 +342,7 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
       swing.out_of_plane_rate += h * s_dd(1);
       swing.in_plane += h * swing.in_plane_rate;
       swing.out_of_plane += h * swing.out_of_plane_rate;
-      if (hooked) {
+      if (extended_rows) {
         swing.rigging_in_plane_rate += h * s_dd(2);
         swing.rigging_out_of_plane_rate += h * s_dd(3);
         swing.rigging_in_plane += h * swing.rigging_in_plane_rate;
@@ -404,6 +412,9 @@ HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, d
     truth.swing.rigging_length = uniform(0.15, 0.5);
     truth.swing.hook_mass_share = uniform(0.1, 0.4);
     drawn = {"rigging_length", truth.swing.rigging_length};
+  } else if (e == "elastic_rope") {
+    truth.swing.rope_stretch_ratio = uniform(0.01, 0.04);
+    drawn = {"rope_stretch_ratio", truth.swing.rope_stretch_ratio};
   } else if (e != "none") {
     drawn = draw_pendulum_effect(e, truth.swing, truth.crane.gravity / truth.crane.cable_length, uniform, signed_uniform);
   }

@@ -76,6 +76,20 @@ const std::vector<PendulumCause>& pendulum_catalog() {
            },
        .crane_only = true,
        .extra_nuisance = 4},
+      // The rope as a spring (the plant's plant.rope): the static stretch ratio e_r = M g / EA. Its
+      // constant part is a cable length error; what only the rope does is a stretch that follows
+      // the tension (crane_swing.hpp). The stretch starts each window at rest: no nuisance values.
+      {.name = "elastic_rope",
+       .parameters = [](const SwingScales&) -> std::vector<ParameterSpec> {
+         return {{"rope_stretch_ratio", "-", 0.005, kMinRopeStretchRatio, kMaxRopeStretchRatio,
+                  {0.002, 0.005, 0.01, 0.02, 0.04, 0.08}}};
+       },
+       .apply = nullptr,
+       .apply_swing =
+           [](const double* p, SwingEffects& e) {
+             e.rope_stretch_ratio = std::clamp(p[0], kMinRopeStretchRatio, kMaxRopeStretchRatio);
+           },
+       .crane_only = true},
   };
   return catalog;
 }

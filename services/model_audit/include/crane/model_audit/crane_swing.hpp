@@ -21,6 +21,14 @@
 //        coordinates (x, phi, gamma, theta, phi2, theta2)); the configured load_mass M is the
 //        suspended mass, hook and load: m_h = s M, m = (1 - s) M (the share s [-]); the swing rows
 //        depend on s and l only. The swing rows (phi, theta, phi2, theta2) are eliminated as below.
+//   an elastic rope (elastic_rope): the load hangs at the paid-out length plus a stretch s
+//        (TowerCraneModel with RopeParameters: coordinates (x, phi, gamma, theta, s), k = EA / L);
+//        the parameter is the static stretch ratio e_r = M g / EA [-] of the configured load mass
+//        M (EA = M g / e_r, the rope's damping ratio the plant's default), the stretch starts each
+//        replay at its static value e_r L (1 + e) at rest; the rows (phi, theta, s) are eliminated
+//        as for the hook (slot 5 unused). A constant stretch alone is a cable_length_error; the
+//        rope's own signature is the stretch following the tension (the swing's centripetal and
+//        gravity terms at twice the swing frequency) and the load's bounce at sqrt(g / (e_r L)).
 // Integration (replay): classical Runge-Kutta 4 with the drive and hoist motion held per sample.
 //
 // Offline: noexcept and allocation-free except where stated; the model is validated by its owner.
@@ -45,6 +53,7 @@ struct SwingEffects {
   double wind_force_y{0.0};     // [N] inertial y
   double rigging_length{0.0};   // l [m], hook to the load's centre of mass; 0: no hook (the single pendulum)
   double hook_mass_share{0.0};  // s = m_h / (m_h + m) [-] in (0, 1), with a hook
+  double rope_stretch_ratio{0.0};  // e_r = M g / EA [-]; 0: an inextensible cable (not with a hook)
 };
 
 /// Bounds of the hook entry in the replay (its fits are clamped to them): l [m] and s [-].
@@ -52,6 +61,10 @@ inline constexpr double kMinRiggingLength = 0.02;
 inline constexpr double kMaxRiggingLength = 5.0;
 inline constexpr double kMinHookMassShare = 0.01;
 inline constexpr double kMaxHookMassShare = 0.95;
+
+/// Bounds of the rope entry in the replay (its fits are clamped to them): e_r [-].
+inline constexpr double kMinRopeStretchRatio = 1e-3;
+inline constexpr double kMaxRopeStretchRatio = 0.2;
 
 /// Drive and hoist motion at one instant (measured, or simulated).
 struct DriveMotion {
@@ -110,6 +123,11 @@ struct HookedSwingElimination {
 /// load_mass M (> 0; 1 kg when not) split into the hook's s M and the load's (1 - s) M. Allocates.
 [[nodiscard]] plant::TowerCraneModel hooked_model(const common::CraneParameters& suspended, const SwingEffects& effects);
 
+/// The model with the elastic rope of `effects` (rope_stretch_ratio clamped to
+/// [kMinRopeStretchRatio, kMaxRopeStretchRatio]): EA = M g / e_r with `suspended`'s load_mass M
+/// (> 0; 1 kg when not) and gravity g. Allocates.
+[[nodiscard]] plant::TowerCraneModel roped_model(const common::CraneParameters& suspended, const SwingEffects& effects);
+
 /// The wind's generalized force (TowerCraneModel::load_force with the effects' F_x, F_y [N]) at
 /// `state` (slot 2 = the slew angle gamma [rad]); zero without wind or without a load mass.
 [[nodiscard]] plant::ExtendedVector wind_generalized_force(const plant::TowerCraneModel& model, const SwingEffects& effects,
@@ -131,7 +149,8 @@ void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects&
 /// first + count - 1 interleaved: out[2 i] = phi + encoder_offset, out[2 i + 1] = theta [rad].
 /// With a hook (effects.rigging_length > 0) `model` is the single pendulum with the suspended mass
 /// (hooked_model() builds the double pendulum; allocates once per call) and `initial` carries the
-/// rigging's state.
+/// rigging's state. With a rope (effects.rope_stretch_ratio > 0, no hook) likewise roped_model(),
+/// the stretch starting at its static value.
 /// Preconditions (asserted): first + count <= motion.size(), out.size() >= 2 count.
 void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
                         std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,

@@ -47,7 +47,10 @@
 // wind_force_y); hook_double_pendulum: rigging l = [0.15, 0.5] m, hook share s = [0.1, 0.4] of the
 // suspended mass M (the drawn load mass; the nominal keeps M, the single pendulum on the cable);
 // main parameter rigging_length. With the hook the plant is TowerCraneModel with HookParameters
-// (six coordinates, the four swing rows eliminated, the same substeps).
+// (six coordinates, the four swing rows eliminated, the same substeps); elastic_rope: the static
+// stretch ratio e_r = m g / EA in [0.01, 0.04] (a soft or long rope: EA = 250 to 2900 N for the
+// drawn loads; the lab's rope is 1e-4), the plant TowerCraneModel with RopeParameters (five
+// coordinates, the rows phi, theta and the stretch eliminated), started at the static stretch.
 // Offline, allocates; throws common::ConfigError for an unknown effect name.
 
 #include <cstdint>
