@@ -205,7 +205,8 @@ function compare(decodedPath, recordedPath) {
 function scrape(url) {
   const http = require("http");
   return new Promise((resolve, reject) => {
-    http.get(url.replace(/^ws:/, "http:") + "/metrics", (res) => {
+    // agent false: a fresh connection per request (crane_web closes each HTTP connection after its answer).
+    http.get(url.replace(/^ws:/, "http:") + "/metrics", { agent: false }, (res) => {
       let body = "";
       res.on("data", (d) => (body += d));
       res.on("end", () => {
