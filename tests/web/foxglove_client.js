@@ -17,14 +17,15 @@
 //   node foxglove_client.js load URL CLIENTS SECONDS
 //       CLIENTS connections subscribed to every channel for SECONDS (deploy/bench_web.sh).
 //   node foxglove_client.js abuse URL SECONDS STALLED_CLOSE
-//       bad input while a well-behaved client takes rt/crane/hw/sensors for SECONDS: malformed JSON,
-//       an unknown channel id, a binary frame, a 200 KiB frame, a handshake without the subprotocol,
-//       and a client subscribed to everything that does not read (crane_web started with
-//       --close-stalled STALLED_CLOSE, less than SECONDS - 2); checks each answer (error status,
-//       close 1009, HTTP 400, and for the stalled client a close 1008 with its reason within the
-//       window), that the good client still gets 100 +- 5 Hz through all of it and stays open, and
-//       that /metrics counted it all (refusals, dropped samples, the stalled close, samples
-//       received, rates, supervisor mode, plant cycles).
+//       bad input while a well-behaved client takes rt/crane/hw/sensors for SECONDS (or until 1 s
+//       after the stalled client's close, at most SECONDS + 10): malformed JSON, an unknown channel
+//       id, a binary frame, a 200 KiB frame, a handshake without the subprotocol, and a client
+//       subscribed to everything that does not read until /metrics counts its close (crane_web
+//       started with --close-stalled STALLED_CLOSE); checks each answer (error status, close 1009,
+//       HTTP 400, and for the stalled client a close 1008 with its reason), that the good client
+//       still gets 100 +- 5 Hz through all of it and stays open, and that /metrics counted it all
+//       (refusals, dropped samples, the stalled close, samples received, rates, supervisor mode,
+//       plant cycles).
 "use strict";
 const fs = require("fs");
 const WebSocket = require("ws");
@@ -279,22 +280,35 @@ async function abuse(url, seconds, stalledClose) {
   const wrongProtocol = await rawClient(url, ["not.foxglove"]);
   const start = good.binaryFrames;
   const t0 = Date.now();
-  // The window; /metrics polled for the stalled client's close meanwhile.
+  // The window: SECONDS, longer if need be so that it takes in the stalled client's close and 1 s
+  // after it (at most 10 s more); /metrics polled for that close meanwhile.
   const STALLED_CLOSED = "crane_web_stalled_clients_closed_total";
   let stalledClosedAfter = null;  // [s] since the stalled client subscribed
-  while (Date.now() - t0 < seconds * 1000) {
+  const windowOver = () => {
+    const elapsed = Date.now() - t0;
+    if (elapsed >= (seconds + 10) * 1000) return true;
+    if (stalledClosedAfter === null) return false;
+    return elapsed >= seconds * 1000 && Date.now() - stalledStart >= (stalledClosedAfter + 1) * 1000;
+  };
+  while (!windowOver()) {
     await sleep(250);
     if (stalledClosedAfter === null && ((await scrape(url)).get(STALLED_CLOSED) || 0) > (before.get(STALLED_CLOSED) || 0)) {
       stalledClosedAfter = (Date.now() - stalledStart) / 1000;
+      // It reads now, within the closing handshake's time (websocketpp ends the connection 5 s
+      // after its close frame when no answer came): the samples on their way, then the close frame.
+      stalled.stdin.write("read now\n");
     }
   }
-  const goodRate = ((good.binaryFrames - start) * 1000) / (Date.now() - t0);
+  const windowEnd = Date.now();
+  const goodRate = ((good.binaryFrames - start) * 1000) / (windowEnd - t0);
   const after = await scrape(url);
-  // What the stalled client finally reads: the data before the close, then close 1008 and its reason.
-  stalled.stdin.write("read now\n");
+  // What the stalled client read once closed: the data before the close, then close 1008 and its
+  // reason (told to read at the window's end if it was never closed).
+  if (stalledClosedAfter === null) stalled.stdin.write("read now\n");
   const stalledEnd = JSON.parse((await stalledLines.next()).value || "{}");
   const delta = (k) => (after.get(k) || 0) - (before.get(k) || 0);
   const summary = {
+    window_s: (windowEnd - t0) / 1000,
     good_client_sensor_rate_hz: goodRate,
     good_client_close_code: good.closeCode,
     stalled_client_closed_after_s: stalledClosedAfter,
