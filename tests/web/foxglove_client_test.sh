@@ -49,7 +49,7 @@ if [ "${1:-}" = "--install-only" ]; then
   install_clients "$2"
   exit 0
 fi
-BIN=$1 CONFIG=$2 NPM_DIR=$3 OUT=$4
+BIN=$(realpath "$1") CONFIG=$(realpath "$2") NPM_DIR=$(realpath -m "$3") OUT=$(realpath -m "$4")  # absolute: the audit runs in a folder of OUT
 
 # 1. The client's packages, outside the namespace (the registry is on the network).
 if [ -z "${CRANE_WEB_TEST_IN_NAMESPACE:-}" ]; then
