@@ -40,7 +40,7 @@ rss_kb() { awk '/VmRSS/ {print $2}' "/proc/$1/status"; }
 echo "alone: crane_bench latency --duration $DURATION" >&2
 "$BIN/crane_bench" latency --config "$CONFIG" --domain 30 --duration "$DURATION" --realtime-priority "$PRIORITY" --json > "$OUT/alone.json"
 
-${CRANE_WEB_PREFIX:-} "$BIN/crane_web" --port 0 --domain 30 > "$OUT/web.log" 2>&1 &
+${CRANE_WEB_PREFIX:-} "$BIN/crane_web" --config "$CONFIG" --port 0 --domain 30 > "$OUT/web.log" 2>&1 &
 WEB=$!
 pids+=($WEB)
 for _ in $(seq 100); do grep -q "ws://" "$OUT/web.log" && break; sleep 0.1; done

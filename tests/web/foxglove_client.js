@@ -16,12 +16,16 @@
 //       exits 1 on a difference or when a decoded rt/crane/hw/sensors sample has no recorded twin.
 //   node foxglove_client.js load URL CLIENTS SECONDS
 //       CLIENTS connections subscribed to every channel for SECONDS (deploy/bench_web.sh).
-//   node foxglove_client.js abuse URL SECONDS
-//       bad input while a well-behaved client takes rt/crane/hw/sensors: malformed JSON, an unknown
-//       channel id, a binary frame, a 200 KiB frame, a handshake without the subprotocol, and a
-//       client subscribed to everything that never reads; checks each answer (error status, close
-//       1009, HTTP 400), that the good client still gets 100 +- 5 Hz, and that /metrics counted it
-//       all (refusals, dropped samples, samples received, rates, supervisor mode, plant cycles).
+//   node foxglove_client.js abuse URL SECONDS STALLED_CLOSE
+//       bad input while a well-behaved client takes rt/crane/hw/sensors for SECONDS (or until 1 s
+//       after the stalled client's close, at most SECONDS + 10): malformed JSON, an unknown channel
+//       id, a binary frame, a 200 KiB frame, a handshake without the subprotocol, and a client
+//       subscribed to everything that does not read until /metrics counts its close (crane_web
+//       started with --close-stalled STALLED_CLOSE); checks each answer (error status, close 1009,
+//       HTTP 400, and for the stalled client a close 1008 with its reason), that the good client
+//       still gets 100 +- 5 Hz through all of it and stays open, and that /metrics counted it all
+//       (refusals, dropped samples, the stalled close, samples received, rates, supervisor mode,
+//       plant cycles).
 "use strict";
 const fs = require("fs");
 const WebSocket = require("ws");
@@ -202,7 +206,8 @@ function compare(decodedPath, recordedPath) {
 function scrape(url) {
   const http = require("http");
   return new Promise((resolve, reject) => {
-    http.get(url.replace(/^ws:/, "http:") + "/metrics", (res) => {
+    // agent false: a fresh connection per request (crane_web closes each HTTP connection after its answer).
+    http.get(url.replace(/^ws:/, "http:") + "/metrics", { agent: false }, (res) => {
       let body = "";
       res.on("data", (d) => (body += d));
       res.on("end", () => {
@@ -243,16 +248,20 @@ function rawClient(url, protocols = [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) {
   });
 }
 
-async function abuse(url, seconds) {
+async function abuse(url, seconds, stalledClose) {
   const before = await scrape(url);
   const problems = [];
-  // A client subscribed to every channel that never reads (stalled_client.py: its receive buffer
-  // is fixed small, so the server's queue for it fills within seconds).
+  // A client subscribed to every channel that does not read (stalled_client.py: its receive buffer
+  // is fixed small, so the server's queue for it fills within seconds) until told to, after the
+  // window: then it reads what the server sent it, the close frame last.
   const { spawn } = require("child_process");
+  const readline = require("readline");
   const [host, port] = url.replace(/^ws:\/\//, "").split(":");
-  const stalled = spawn("python3", [require("path").join(__dirname, "stalled_client.py"), host, port, String(seconds + 5)],
-                        { stdio: ["ignore", "pipe", "inherit"] });
-  const stalledChannels = await new Promise((resolve) => stalled.stdout.once("data", (d) => resolve(Number(d))));
+  const stalled = spawn("python3", [require("path").join(__dirname, "stalled_client.py"), host, port, String(seconds + 30)],
+                        { stdio: ["pipe", "pipe", "inherit"] });
+  const stalledLines = readline.createInterface({ input: stalled.stdout })[Symbol.asyncIterator]();
+  const stalledChannels = Number((await stalledLines.next()).value);
+  const stalledStart = Date.now();
 
   // A well-behaved client on rt/crane/hw/sensors through all of it.
   const good = await rawClient(url);
@@ -271,12 +280,39 @@ async function abuse(url, seconds) {
   const wrongProtocol = await rawClient(url, ["not.foxglove"]);
   const start = good.binaryFrames;
   const t0 = Date.now();
-  await sleep(seconds * 1000);
-  const goodRate = ((good.binaryFrames - start) * 1000) / (Date.now() - t0);
+  // The window: SECONDS, longer if need be so that it takes in the stalled client's close and 1 s
+  // after it (at most 10 s more); /metrics polled for that close meanwhile.
+  const STALLED_CLOSED = "crane_web_stalled_clients_closed_total";
+  let stalledClosedAfter = null;  // [s] since the stalled client subscribed
+  const windowOver = () => {
+    const elapsed = Date.now() - t0;
+    if (elapsed >= (seconds + 10) * 1000) return true;
+    if (stalledClosedAfter === null) return false;
+    return elapsed >= seconds * 1000 && Date.now() - stalledStart >= (stalledClosedAfter + 1) * 1000;
+  };
+  while (!windowOver()) {
+    await sleep(250);
+    if (stalledClosedAfter === null && ((await scrape(url)).get(STALLED_CLOSED) || 0) > (before.get(STALLED_CLOSED) || 0)) {
+      stalledClosedAfter = (Date.now() - stalledStart) / 1000;
+      // It reads now, within the closing handshake's time (websocketpp ends the connection 5 s
+      // after its close frame when no answer came): the samples on their way, then the close frame.
+      stalled.stdin.write("read now\n");
+    }
+  }
+  const windowEnd = Date.now();
+  const goodRate = ((good.binaryFrames - start) * 1000) / (windowEnd - t0);
   const after = await scrape(url);
+  // What the stalled client read once closed: the data before the close, then close 1008 and its
+  // reason (told to read at the window's end if it was never closed).
+  if (stalledClosedAfter === null) stalled.stdin.write("read now\n");
+  const stalledEnd = JSON.parse((await stalledLines.next()).value || "{}");
   const delta = (k) => (after.get(k) || 0) - (before.get(k) || 0);
   const summary = {
+    window_s: (windowEnd - t0) / 1000,
     good_client_sensor_rate_hz: goodRate,
+    good_client_close_code: good.closeCode,
+    stalled_client_closed_after_s: stalledClosedAfter,
+    stalled_client_end: stalledEnd,
     malformed_status: malformed.statuses.map((s) => s.message),
     unknown_channel_status: unknown.statuses.map((s) => s.message),
     binary_status: binary.statuses.map((s) => s.message),
@@ -288,6 +324,7 @@ async function abuse(url, seconds) {
       refused_handshake: delta('crane_web_requests_refused_total{kind="handshake"}'),
       refused_oversized: delta('crane_web_requests_refused_total{kind="oversized"}'),
       samples_dropped: delta("crane_web_samples_dropped_total"),
+      stalled_clients_closed: delta(STALLED_CLOSED),
       sensors_received: delta(`crane_topic_samples_received_total{topic="${SENSORS}"}`),
     },
     metrics_after: {
@@ -315,6 +352,14 @@ async function abuse(url, seconds) {
          "refusals not counted");
   expect(stalledChannels >= 10, `the stalled client subscribed to ${stalledChannels} channels`);
   expect(d.samples_dropped > 0, "the stalled client's queue dropped nothing");
+  // Closed after --close-stalled of drops (its queue fills first), within the good client's window,
+  // with 1008 and the reason; counted once; the good client still open.
+  expect(d.stalled_clients_closed === 1, `${STALLED_CLOSED} grew by ${d.stalled_clients_closed}, expected 1`);
+  expect(stalledClosedAfter !== null && stalledClosedAfter >= stalledClose,
+         `the stalled client was closed ${stalledClosedAfter} s after it subscribed (--close-stalled ${stalledClose} s)`);
+  expect(stalledEnd.close_code === 1008 && /^not reading: every sample dropped for/.test(stalledEnd.close_reason) &&
+         stalledEnd.eof === true, `the stalled client read ${JSON.stringify(stalledEnd)}, expected close 1008 "not reading..."`);
+  expect(good.closeCode === null, `the good client was closed (${good.closeCode})`);
   expect(d.sensors_received >= 95 * seconds, `sensors received grew by ${d.sensors_received} only`);
   const a = summary.metrics_after;
   expect(a.sensor_rate_hz >= 90 && a.sensor_rate_hz <= 110, `crane_topic_rate_hz of the sensors ${a.sensor_rate_hz}`);
@@ -356,7 +401,7 @@ const [mode, ...args] = process.argv.slice(2);
 if (mode === "live") live(args[0], args[1], Number(args[2]), Number(args[3] || 10));
 else if (mode === "compare") compare(args[0], args[1]);
 else if (mode === "load") load(args[0], Number(args[1]), Number(args[2])).catch((e) => { console.error(e); process.exit(1); });
-else if (mode === "abuse") abuse(args[0], Number(args[1])).catch((e) => { console.error(e); process.exit(1); });
+else if (mode === "abuse") abuse(args[0], Number(args[1]), Number(args[2])).catch((e) => { console.error(e); process.exit(1); });
 else {
   console.error("usage: foxglove_client.js live URL OUT.jsonl SECONDS [MIN_CHANNELS] | compare DECODED.jsonl RECORDED.jsonl");
   process.exit(2);

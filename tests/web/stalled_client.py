@@ -1,17 +1,25 @@
 #!/usr/bin/env python3
-"""A Foxglove WebSocket client that subscribes to every channel and then never reads (crane_web's
+"""A Foxglove WebSocket client that subscribes to every channel and then does not read (crane_web's
 bad-input test, tests/web/foxglove_client.js abuse).
 
 Its socket's receive buffer is fixed small (SO_RCVBUF before connecting: no autotuning), so the
 bytes the kernel takes for it are bounded and the server's queue for it must fill and drop within
-seconds, whatever the machine's TCP settings. The few frames it writes and reads (the handshake,
-serverInfo, advertise, one subscribe) are RFC 6455 by hand: a test stub, not a client library.
+seconds, whatever the machine's TCP settings; crane_web then closes it (--close-stalled). The few
+frames it writes and reads (the handshake, serverInfo, advertise, one subscribe, and at the end
+what the server sent) are RFC 6455 by hand: a test stub, not a client library.
 
-    stalled_client.py HOST PORT SECONDS      prints the number of channels subscribed, then stalls
+    stalled_client.py HOST PORT SECONDS
+
+prints the number of channels subscribed, then stalls until a line arrives on its standard input
+(or SECONDS pass); then reads what the server had sent, for at most 10 s, and prints one JSON line:
+{"close_code": N or null, "close_reason": "...", "eof": bool, "data_frames": N}, a close frame's
+code and reason if one came, whether the server ended the TCP connection, and the data frames
+before that.
 """
 import base64
 import json
 import os
+import select
 import socket
 import struct
 import sys
@@ -23,7 +31,7 @@ def read_exact(sock, n):
     while len(data) < n:
         chunk = sock.recv(n - len(data))
         if not chunk:
-            raise SystemExit("stalled_client: connection closed early")
+            raise ConnectionError("stalled_client: the server ended the connection")
         data += chunk
     return data
 
@@ -38,10 +46,10 @@ def read_frame(sock):
     return first & 0x0F, read_exact(sock, length)
 
 
-def send_text(sock, text):
-    payload = text.encode()
+def send_text(sock, text, opcode=0x1):
+    payload = text if isinstance(text, bytes) else text.encode()
     mask = os.urandom(4)
-    header = bytes([0x81])
+    header = bytes([0x80 | opcode])
     if len(payload) < 126:
         header += bytes([0x80 | len(payload)])
     else:
@@ -73,9 +81,36 @@ def main():
     send_text(sock, json.dumps({"op": "subscribe",
                                 "subscriptions": [{"id": i, "channelId": c} for i, c in enumerate(channels)]}))
     print(len(channels), flush=True)
-    time.sleep(seconds)  # never reads again
+    select.select([sys.stdin], [], [], seconds)  # reads nothing from the server meanwhile
+    print(json.dumps(read_to_the_end(sock, 10.0)), flush=True)
     sock.close()
     return 0
+
+
+def read_to_the_end(sock, timeout):
+    """Frames until a close frame, the end of the connection or `timeout` [s]."""
+    result = {"close_code": None, "close_reason": "", "eof": False, "data_frames": 0}
+    sock.settimeout(timeout)
+    deadline = time.monotonic() + timeout
+    try:
+        while time.monotonic() < deadline:
+            opcode, payload = read_frame(sock)
+            if opcode == 8:
+                if len(payload) >= 2:
+                    result["close_code"] = struct.unpack(">H", payload[:2])[0]
+                    result["close_reason"] = payload[2:].decode(errors="replace")
+                send_text(sock, payload[:2], opcode=0x8)  # the closing handshake's answer
+                break
+            result["data_frames"] += 1
+        # After a close frame the server ends the connection (or after the close handshake's timeout).
+        while time.monotonic() < deadline and sock.recv(65536):
+            pass
+        result["eof"] = time.monotonic() < deadline
+    except ConnectionError:
+        result["eof"] = True
+    except socket.timeout:
+        pass
+    return result
 
 
 if __name__ == "__main__":

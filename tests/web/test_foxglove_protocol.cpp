@@ -4,6 +4,7 @@
 // The end-to-end check with Foxglove's own client is tests/web/foxglove_client_test.sh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <regex>
@@ -103,13 +104,65 @@ TEST(FoxgloveProtocol, BadRequestsAreRefusedNamingWhatWasWrongAndChangeNothing) 
 
 TEST(SendQueue, DropsTheOldestFrameWhenFull) {
   web::SendQueue queue(3);
-  for (int i = 1; i <= 5; ++i) EXPECT_EQ(queue.push(std::to_string(i)), i > 3) << i;
+  for (int i = 1; i <= 5; ++i) EXPECT_EQ(queue.push(std::to_string(i), 0.01 * i), i > 3) << i;
   EXPECT_EQ(queue.dropped(), 2U);
   std::string frame;
   std::string order;
   while (queue.pop(frame)) order += frame;
   EXPECT_EQ(order, "345");
   EXPECT_THROW(web::SendQueue(0), std::invalid_argument);
+}
+
+// The rule that closes a client that never reads (crane_web --close-stalled): every push dropping a
+// frame for the limit. Pushes at 100 Hz into a queue of 4 frames; the client takes `reads_per_push`
+// frames after each push (what the socket took), or nothing.
+TEST(SendQueue, AClientWhoseEverySampleIsDroppedForTheLimitIsNotReadingAndAnyReadEndsTheRun) {
+  constexpr double kLimit = 10.0;  // [s]
+  constexpr double kPeriod = 0.01;  // [s]
+  std::string frame;
+  {
+    // Never reads: the queue fills at the 4th push; the 5th drops (t = 0.04 s) and every push after
+    // it does; not reading once 10 s have passed since that first drop, not a push before.
+    web::SendQueue queue(4);
+    double first_not_reading = -1.0;
+    for (int i = 0; i <= 1100 && first_not_reading < 0.0; ++i) {
+      const double t = i * kPeriod;
+      EXPECT_EQ(queue.push("s", t), i >= 4) << i;
+      if (queue.not_reading(t, kLimit)) first_not_reading = t;
+    }
+    EXPECT_NEAR(first_not_reading, 0.04 + kLimit, 1e-9);
+    EXPECT_NEAR(queue.dropping_for(first_not_reading), kLimit, 1e-9);
+  }
+  {
+    // Reads one frame in three (a client at a third of the rate): drops most samples, but every
+    // third push finds room, so it is never "not reading", over 60 s.
+    web::SendQueue queue(4);
+    double longest_run = 0.0;
+    for (int i = 0; i < 6000; ++i) {
+      const double t = i * kPeriod;
+      queue.push("s", t);
+      if (i % 3 == 0) queue.pop(frame);
+      longest_run = std::max(longest_run, queue.dropping_for(t));
+      ASSERT_FALSE(queue.not_reading(t, kLimit)) << "t = " << t;
+    }
+    EXPECT_GT(queue.dropped(), 3000U);  // it did lose most samples
+    EXPECT_LT(longest_run, 3 * kPeriod);
+  }
+  {
+    // Stalls for 9.96 s (dropping), reads once, stalls again: the run starts over at the next drop.
+    web::SendQueue queue(4);
+    int i = 0;
+    for (; i * kPeriod < 10.0; ++i) queue.push("s", i * kPeriod);
+    const double t_read = i * kPeriod;  // 10.0 s: dropping since 0.04 s, 9.96 s
+    EXPECT_FALSE(queue.not_reading(t_read, kLimit));
+    queue.pop(frame);
+    EXPECT_FALSE(queue.push("s", t_read));  // found room: the run of drops ended
+    EXPECT_EQ(queue.dropping_for(t_read), 0.0);
+    EXPECT_FALSE(queue.not_reading(t_read + 5.0, kLimit));
+    EXPECT_TRUE(queue.push("s", t_read + kPeriod));  // full again: a new run from here
+    EXPECT_FALSE(queue.not_reading(t_read + kPeriod + 9.99, kLimit));
+    EXPECT_TRUE(queue.not_reading(t_read + kPeriod + kLimit + 1e-9, kLimit));
+  }
 }
 
 TEST(IdlSchema, IsTheIdlWithItsHexLiteralsInDecimal) {

@@ -40,6 +40,7 @@ TEST(WebMetrics, CountsRatesSupervisorProcessesAndServer) {
   server.clients = 3;
   server.frames_dropped = 17;
   server.bad_requests = 4;
+  server.stalled_closed = 1;
   const std::string text = "\n" + metrics.text(&server);
 
   EXPECT_TRUE(has_line(text, R"(crane_topic_samples_received_total{topic="rt/a"} 50)")) << text;
@@ -59,6 +60,7 @@ TEST(WebMetrics, CountsRatesSupervisorProcessesAndServer) {
   EXPECT_TRUE(has_line(text, "crane_web_clients 3"));
   EXPECT_TRUE(has_line(text, "crane_web_samples_dropped_total 17"));
   EXPECT_TRUE(has_line(text, R"(crane_web_requests_refused_total{kind="request"} 4)"));
+  EXPECT_TRUE(has_line(text, "crane_web_stalled_clients_closed_total 1"));
   EXPECT_NE(text.find("# TYPE crane_web_samples_dropped_total counter"), std::string::npos);
 
   // Counters follow the server's counts up, never down.

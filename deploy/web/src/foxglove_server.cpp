@@ -4,6 +4,8 @@
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/post.hpp>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -23,6 +25,11 @@ using websocketpp::connection_hdl;
 
 constexpr long kFlushPeriodMs = 10;  // [ms] the send queues drain at least this often
 
+/// [s] on the steady clock: the send queues' timeline.
+double steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 std::string session_id() {
   return std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(
                             std::chrono::system_clock::now().time_since_epoch())
@@ -36,6 +43,7 @@ struct FoxgloveServer::Impl {
     ClientSession session;
     SendQueue queue;
     std::string operator_name;  // "" for a read-only client
+    bool closing{false};        // closed for reading nothing: no more frames queued for it
   };
 
   ServerOptions options;
@@ -204,6 +212,10 @@ FoxgloveServer::FoxgloveServer(ServerOptions options, std::vector<Channel> chann
                                Authenticator authenticate, ClientMessageHandler on_client_message) {
   if (options.queue_frames == 0) throw std::invalid_argument("web.queue_frames = 0: must be at least 1");
   if (options.socket_buffer_bytes == 0) throw std::invalid_argument("web.socket_buffer_bytes = 0: must be at least 1");
+  if (!(options.stalled_close_seconds > 0.0) || !std::isfinite(options.stalled_close_seconds)) {
+    throw std::invalid_argument("web.stalled_close_seconds = " + std::to_string(options.stalled_close_seconds) +
+                                " s: must be finite and > 0");
+  }
   if (options.max_request_bytes < 1024) {
     throw std::invalid_argument("web.max_request_bytes = " + std::to_string(options.max_request_bytes) +
                                 ": must be at least 1024");
@@ -272,13 +284,28 @@ void FoxgloveServer::publish(std::uint32_t channel_id, std::uint64_t receive_ns,
                              std::shared_ptr<const std::vector<std::uint8_t>> payload) {
   if (!impl_->running.load()) return;
   boost::asio::post(impl_->server.get_io_service(), [impl = impl_.get(), channel_id, receive_ns, payload = std::move(payload)] {
+    const double now = steady_seconds();
+    const double limit = impl->options.stalled_close_seconds;
+    std::vector<connection_hdl> not_reading;
     for (auto& [hdl, client] : impl->clients) {
       std::uint32_t subscription = 0;
-      if (!client.session.subscription_of(channel_id, subscription)) continue;
-      if (client.queue.push(message_data_frame(subscription, receive_ns, payload->data(), payload->size()))) {
+      if (client.closing || !client.session.subscription_of(channel_id, subscription)) continue;
+      if (client.queue.push(message_data_frame(subscription, receive_ns, payload->data(), payload->size()), now)) {
         impl->stats.frames_dropped.fetch_add(1);
       }
       impl->flush(hdl, client);
+      if (client.queue.not_reading(now, limit)) {
+        client.closing = true;
+        not_reading.push_back(hdl);
+      }
+    }
+    // After the loop: a close may end the connection at once (its close handler erases the client).
+    char reason[96];
+    std::snprintf(reason, sizeof reason, "not reading: every sample dropped for %.1f s", limit);
+    for (const auto& hdl : not_reading) {
+      impl->stats.stalled_closed.fetch_add(1);
+      websocketpp::lib::error_code ec;
+      impl->server.close(hdl, websocketpp::close::status::policy_violation, reason, ec);
     }
   });
 }

@@ -1,6 +1,7 @@
 // crane_web: the crane's bus for Foxglove Studio, Lichtblick and any Foxglove WebSocket client.
 //
-//   crane_web [--port 8765] [--bind 127.0.0.1] [--queue 256] [--nice 10] [--dds fast|cyclone] [--domain N] [--lan]
+//   crane_web --config FILE [--port 8765] [--bind 127.0.0.1] [--queue 256] [--close-stalled 10] [--nice 10]
+//             [--dds fast|cyclone] [--domain N] [--lan]
 //
 // A read-only DDS participant (readers only) takes every topic of the bus (the topic table,
 // transport::topics::for_each_topic) and forwards each sample, as the CDR bytes a DDS writer puts
@@ -14,9 +15,10 @@
 // deserialized, checked for NaN/Inf and written to the bus by this process, and logged with the
 // operator's name. HTTP on the same port: / the operator page (deploy/web/www: views, plots, mode
 // and faults over the same protocol, and the controls for a logged-in operator), POST /login (the
-// token as the body: sets the session cookie), POST /logout, GET /whoami, /about (what this is) and
-// /metrics (the Prometheus text format, web_metrics.hpp: per topic, the supervisor, each process,
-// the server).
+// token as the body: sets the session cookie), POST /logout, GET /whoami, /site.json (the crane's
+// kind, travel and no-go zones from --config, the file the stack runs with: site_view.hpp), /about
+// (what this is) and /metrics (the Prometheus text format, web_metrics.hpp: per topic, the
+// supervisor, each process, the server). A client that reads nothing is closed (--close-stalled).
 //   crane_web --operators FILE --new-operator NAME   appends an operator and prints its token once.
 // Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
 // CLI11's message and code.
@@ -45,6 +47,7 @@
 #include "crane/transport/cdr.hpp"
 #include "crane/web/foxglove_server.hpp"
 #include "crane/web/operator_auth.hpp"
+#include "crane/web/site_view.hpp"
 #include "crane/web/web_metrics.hpp"
 
 namespace {
@@ -84,11 +87,17 @@ int main(int argc, char** argv) {
                  "address to listen on (default loopback only; 0.0.0.0: every interface)");
   app.add_option("--queue", server_options.queue_frames, "per-client send queue [samples]; the oldest is dropped when full")
       ->check(CLI::Range(1, 1000000));
+  app.add_option("--close-stalled", server_options.stalled_close_seconds,
+                 "[s] close a client (1008) when every sample to it has been dropped this long: it reads nothing")
+      ->check(CLI::Range(0.1, 86400.0));
   app.add_option("--dds", node.dds, "DDS vendor: fast | cyclone (default: $CRANE_DDS, else fast)");
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
   runtime::add_security_options(app, node);
+  std::string config_path;
+  app.add_option("--config", config_path, "the stack's configuration (YAML): the crane and the no-go zones the page draws")
+      ->check(CLI::ExistingFile);
   std::string assets = CRANE_WEB_ASSETS_DIR;
   app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
   std::string operators_path;
@@ -119,6 +128,17 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "crane_web: %s\n", error.what());
       return 2;
     }
+  }
+  if (config_path.empty()) {
+    std::fprintf(stderr, "crane_web: --config FILE is required (the stack's configuration: what the page draws)\n");
+    return 2;
+  }
+  std::string site;  // /site.json
+  try {
+    site = web::site_json_of_config(config_path).dump();
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "crane_web: %s\n", error.what());
+    return 2;
   }
   std::unique_ptr<web::OperatorAuth> auth;
   if (!operators_path.empty()) {
@@ -234,6 +254,10 @@ int main(int argc, char** argv) {
           spdlog::default_logger()->flush();
           response.body = who ? nlohmann::json{{"operator", *who}}.dump() : R"j({"error": "unknown token"})j";
         }
+      } else if (path == "/site.json") {
+        response.status = 200;
+        response.content_type = "application/json";
+        response.body = site;
       } else if (path == "/metrics") {
         response.status = 200;
         response.content_type = "text/plain; version=0.0.4; charset=utf-8";

@@ -68,6 +68,10 @@ struct WebMetrics::Impl {
                                        "handshake (no foxglove.websocket.v1), "
                                        "oversized (frame over the limit: client closed, 1009)")
                                  .Register(registry);
+  Family<Counter>& stalled = BuildCounter().Name("crane_web_stalled_clients_closed_total")
+                                 .Help("Clients closed (1008) for reading nothing: every sample to them dropped "
+                                       "for --close-stalled seconds")
+                                 .Register(registry);
   Family<Gauge>& operator_clients = BuildGauge().Name("crane_web_operator_clients")
                                         .Help("Connected clients logged in as an operator (may publish)").Register(registry);
   Family<Counter>& client_messages = BuildCounter().Name("crane_web_operator_messages_total")
@@ -145,6 +149,7 @@ std::string WebMetrics::text(const ServerStats* server) {
     counter_to(impl_->refused.Add({{"kind", "binary"}}), static_cast<double>(server->binary_refused.load()));
     counter_to(impl_->refused.Add({{"kind", "handshake"}}), static_cast<double>(server->handshakes_refused.load()));
     counter_to(impl_->refused.Add({{"kind", "oversized"}}), static_cast<double>(server->oversized_closed.load()));
+    counter_to(impl_->stalled.Add({}), static_cast<double>(server->stalled_closed.load()));
     impl_->operator_clients.Add({}).Set(static_cast<double>(server->operator_clients.load()));
     counter_to(impl_->client_messages.Add({}), static_cast<double>(server->client_messages.load()));
   }

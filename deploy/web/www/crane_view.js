@@ -3,7 +3,8 @@
 // names and the command codes come from that schema (the IDL's constants), not from this file.
 // Read-only until an operator logs in (POST /login with the token; the server sets a session cookie
 // and announces clientPublish on the next connection): then the controls publish goals and
-// supervisor commands as CDR, encoded with the same schema (Foxglove client publishing).
+// supervisor commands as CDR, encoded with the same schema (Foxglove client publishing). The views
+// are drawn to the crane and the no-go zones of /site.json (the server's --config).
 "use strict";
 
 // ---- OMG IDL, the subset of idl/crane_msgs.idl: modules, @annotations, const, struct, arrays ----
@@ -127,7 +128,7 @@ function encodeCdr(idl, typeName, value) {
 
 // ---- the page ----
 const view = { connected: false, sensors: 0, last: null, lastPayload: null, actuators: null, status: null, mode: "", faults: [],
-               operator: "", moveStatus: null, sent: [] };
+               operator: "", moveStatus: null, sent: [], site: null, zonesEnabled: null, zonesDrawn: [] };
 window.craneView = view; // read by tests/web/page_check.js
 const history = []; // {t, x, gamma, phi, theta, ux, ugamma}
 const channels = new Map(); // subscription id -> {topic, schemaName, idl}
@@ -228,8 +229,22 @@ function wireControls() {
   });
 }
 
+// The crane's kind, travel and no-go zones, from the configuration crane_web was given (/site.json,
+// deploy/web/site_view.hpp): what the views are drawn to.
+async function loadSite() {
+  try {
+    const response = await fetch("/site.json", { credentials: "same-origin" });
+    if (!response.ok) throw new Error(`HTTP ${response.status}`);
+    view.site = await response.json();
+  } catch (e) {
+    $("link").textContent = `no site geometry (/site.json: ${e.message || e}); retrying`;
+    setTimeout(loadSite, 2000);
+  }
+}
+
 function connect() {
-  const ws = new WebSocket(`ws://${location.host}/`, ["foxglove.websocket.v1"]);
+  // The same host and port as the page, over TLS when the page came over TLS (a proxy in front).
+  const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/`, ["foxglove.websocket.v1"]);
   socket = ws;
   ws.binaryType = "arraybuffer";
   ws.onopen = () => { view.connected = true; $("link").textContent = "connected to " + location.host; };
@@ -297,41 +312,118 @@ function connect() {
       view.mode = mode ? mode.name : String(sample.mode);
       const operation = codeNames(ch.idl, module, "OPERATION").find((c) => c.value === sample.operating_mode);
       view.operation = operation ? operation.name : String(sample.operating_mode);
-      view.zones = [];
-      for (let i = 0; i < 32; ++i) if ((sample.zones_enabled >>> i) & 1) view.zones.push(i);
+      view.zonesEnabled = sample.zones_enabled >>> 0;
       view.faults = codeNames(ch.idl, module, "FAULT").filter((c) => (sample.active_faults & c.value) !== 0).map((c) => c.name);
       view.warnings = codeNames(ch.idl, module, "WARNING").filter((c) => (sample.warnings & c.value) !== 0).map((c) => c.name);
     }
   };
 }
 
+// The site's zones with the state the supervisor enforces (its status's zones_enabled, bit i:
+// zones[i]); the configured state until a status has come.
+function zoneStates() {
+  const zones = view.site ? view.site.zones : [];
+  return zones.map((z) => ({ index: z.index, name: z.name, polygon: z.polygon, bottom: z.bottom, top: z.top,
+                             enabled: view.zonesEnabled === null ? z.enabled_at_start : ((view.zonesEnabled >>> z.index) & 1) === 1 }));
+}
+
+// A uniform scale [px/m] fitting the box [x0, x1] x [y0, y1] (m) in the canvas with a margin, y up.
+function fit(c, x0, x1, y0, y1, margin = 14) {
+  const scale = Math.min((c.width - 2 * margin) / Math.max(x1 - x0, 1e-6), (c.height - 2 * margin) / Math.max(y1 - y0, 1e-6));
+  const ox = c.width / 2 - scale * (x0 + x1) / 2, oy = c.height / 2 + scale * (y0 + y1) / 2;
+  return { scale, at: (x, y) => [ox + scale * x, oy - scale * y] };
+}
+
+// Top view, the site's frame (x along the jib at slew 0, y across, the slew axis at the origin):
+// the no-go zones (enforced: filled red; off: dashed grey), the crane (tower: the jib at the slew
+// angle within its reach; gantry: the rail; overhead: the runway and the girder at the bridge's
+// position), the trolley, and the load with its swing (2.11): in the trolley's frame, along its axis
+// -L cos(theta) sin(phi), across L sin(theta).
 function drawTop() {
-  const c = $("top"), g = c.getContext("2d"), s = view.last;
+  const c = $("top"), g = c.getContext("2d"), s = view.last, site = view.site;
   g.clearRect(0, 0, c.width, c.height);
-  const scale = 110, cx = c.width / 2, cy = c.height / 2; // [px/m], the tower at the centre
-  g.strokeStyle = "#bbb"; g.beginPath(); g.arc(cx, cy, 1.2 * scale, 0, 2 * Math.PI); g.stroke();
+  if (!site) return;
+  const zones = zoneStates();
+  const xs = [site.trolley.min, site.trolley.max], ys = [0];
+  if (site.kind === "tower") { xs.push(-site.trolley.max); ys.push(-site.trolley.max, site.trolley.max); }
+  if (site.kind === "overhead") ys.push(site.bridge.min, site.bridge.max);
+  if (site.kind === "gantry") ys.push(-(site.trolley.max - site.trolley.min) / 2, (site.trolley.max - site.trolley.min) / 2);
+  for (const z of zones) for (const [x, y] of z.polygon) { xs.push(x); ys.push(y); }
+  const pad = 0.05 * Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys));
+  const { scale, at } = fit(c, Math.min(...xs) - pad, Math.max(...xs) + pad, Math.min(...ys) - pad, Math.max(...ys) + pad);
+  g.font = "11px sans-serif";
+  for (const z of zones) {
+    g.beginPath();
+    z.polygon.forEach(([x, y], k) => (k ? g.lineTo(...at(x, y)) : g.moveTo(...at(x, y))));
+    g.closePath();
+    g.setLineDash(z.enabled ? [] : [5, 4]);
+    g.fillStyle = z.enabled ? "rgba(220, 40, 40, 0.35)" : "rgba(150, 150, 150, 0.10)";
+    g.strokeStyle = z.enabled ? "#c22" : "#888";
+    g.lineWidth = z.enabled ? 2 : 1;
+    g.fill(); g.stroke();
+    g.setLineDash([]);
+    const [lx, ly] = at(Math.min(...z.polygon.map((p) => p[0])), Math.max(...z.polygon.map((p) => p[1])));
+    g.fillStyle = z.enabled ? "#a11" : "#777";
+    const label = `${z.name}: ${z.enabled ? "enforced" : "off"}, top ${z.top} m`;
+    g.fillText(label, Math.max(2, Math.min(lx, c.width - g.measureText(label).width - 2)), Math.max(12, ly - 4));
+  }
+  view.zonesDrawn = zones.map(({ index, name, enabled, polygon }) => {
+    const [cx, cy] = at(polygon.reduce((a, p) => a + p[0], 0) / polygon.length, polygon.reduce((a, p) => a + p[1], 0) / polygon.length);
+    return { index, name, enabled, centre_px: [Math.round(cx), Math.round(cy)] };
+  });
+  g.lineWidth = 1;
+  // The crane, then the trolley and the load. pose(a, b): a along the trolley's axis, b across, in the site's frame.
+  let pose;
+  if (site.kind === "tower") {
+    const gam = s ? s.slew_angle : 0;
+    pose = (a, b) => at(a * Math.cos(gam) - b * Math.sin(gam), a * Math.sin(gam) + b * Math.cos(gam));
+    g.strokeStyle = "#bbb"; g.setLineDash([3, 3]);
+    g.beginPath(); g.arc(...at(0, 0), site.trolley.max * scale, 0, 2 * Math.PI); g.stroke(); g.setLineDash([]);
+    g.strokeStyle = "#333"; g.lineWidth = 4;
+    g.beginPath(); g.moveTo(...pose(-0.15 * site.trolley.max, 0)); g.lineTo(...pose(site.trolley.max, 0)); g.stroke();
+    g.fillStyle = "#333"; g.fillRect(at(0, 0)[0] - 4, at(0, 0)[1] - 4, 8, 8);
+  } else if (site.kind === "overhead") {
+    const yb = s ? s.bridge_position : site.bridge.min;
+    pose = (a, b) => at(a, yb + b);
+    g.strokeStyle = "#999"; g.lineWidth = 2;
+    for (const x of [site.trolley.min, site.trolley.max]) { g.beginPath(); g.moveTo(...at(x, site.bridge.min)); g.lineTo(...at(x, site.bridge.max)); g.stroke(); }
+    g.strokeStyle = "#333"; g.lineWidth = 4;
+    g.beginPath(); g.moveTo(...at(site.trolley.min, yb)); g.lineTo(...at(site.trolley.max, yb)); g.stroke();
+  } else {
+    pose = (a, b) => at(a, b);
+    g.strokeStyle = "#333"; g.lineWidth = 4;
+    g.beginPath(); g.moveTo(...at(site.trolley.min, 0)); g.lineTo(...at(site.trolley.max, 0)); g.stroke();
+  }
+  g.lineWidth = 1;
   if (!s) return;
-  // Jib frame: x along the jib, y across; load at (x - L cos(theta) sin(phi), L sin(theta)) (2.11).
-  const gam = s.slew_angle, x = s.trolley_position, L = s.cable_length;
-  const lx = x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane), ly = L * Math.sin(s.swing_out_of_plane);
-  const world = (a, b) => [cx + scale * (a * Math.cos(gam) - b * Math.sin(gam)), cy - scale * (a * Math.sin(gam) + b * Math.cos(gam))];
-  g.strokeStyle = "#333"; g.lineWidth = 4; g.beginPath(); g.moveTo(...world(-0.2, 0)); g.lineTo(...world(1.25, 0)); g.stroke();
-  g.lineWidth = 1; g.fillStyle = "#36c"; const [tx, ty] = world(x, 0); g.fillRect(tx - 6, ty - 6, 12, 12);
-  const [px, py] = world(lx, ly); g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, ty); g.lineTo(px, py); g.stroke();
+  const x = s.trolley_position, L = s.cable_length;
+  const [tx, ty] = pose(x, 0);
+  const [px, py] = pose(x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane), L * Math.sin(s.swing_out_of_plane));
+  g.fillStyle = "#36c"; g.fillRect(tx - 6, ty - 6, 12, 12);
+  g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, ty); g.lineTo(px, py); g.stroke();
   g.fillStyle = "#c33"; g.beginPath(); g.arc(px, py, 7, 0, 2 * Math.PI); g.fill();
 }
 
+// Side view along the trolley's axis: the ground, the jib (or girder) at the site's jib height,
+// the trolley, the cable and the load at height jib_height - L cos(theta) cos(phi).
 function drawSide() {
-  const c = $("side"), g = c.getContext("2d"), s = view.last;
+  const c = $("side"), g = c.getContext("2d"), s = view.last, site = view.site;
   g.clearRect(0, 0, c.width, c.height);
-  const scale = 140, ox = 30, oy = 40; // [px/m]; the jib at the top
-  g.strokeStyle = "#333"; g.lineWidth = 4; g.beginPath(); g.moveTo(ox, oy); g.lineTo(ox + 1.25 * scale, oy); g.stroke(); g.lineWidth = 1;
+  if (!site) return;
+  const h = site.jib_height, x0 = site.kind === "tower" ? -0.15 * site.trolley.max : site.trolley.min;
+  const { at } = fit(c, x0, site.trolley.max, 0, h * 1.05);
+  g.strokeStyle = "#8a6"; g.lineWidth = 2; g.beginPath(); g.moveTo(...at(x0, 0)); g.lineTo(...at(site.trolley.max, 0)); g.stroke();
+  g.strokeStyle = "#333"; g.lineWidth = 4;
+  g.beginPath(); g.moveTo(...at(x0, h)); g.lineTo(...at(site.trolley.max, h)); g.stroke();
+  if (site.kind === "tower") { g.beginPath(); g.moveTo(...at(0, 0)); g.lineTo(...at(0, h)); g.stroke(); }
+  g.lineWidth = 1;
   if (!s) return;
   const x = s.trolley_position, L = s.cable_length;
-  const lx = x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane), lz = -L * Math.cos(s.swing_out_of_plane) * Math.cos(s.swing_in_plane);
-  const tx = ox + scale * x, px = ox + scale * lx, pz = oy - scale * lz;
-  g.fillStyle = "#36c"; g.fillRect(tx - 6, oy - 6, 12, 12);
-  g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, oy); g.lineTo(px, pz); g.stroke();
+  const [tx, ty] = at(x, h);
+  const [px, pz] = at(x - L * Math.cos(s.swing_out_of_plane) * Math.sin(s.swing_in_plane),
+                      h - L * Math.cos(s.swing_out_of_plane) * Math.cos(s.swing_in_plane));
+  g.fillStyle = "#36c"; g.fillRect(tx - 6, ty - 6, 12, 12);
+  g.strokeStyle = "#36c"; g.beginPath(); g.moveTo(tx, ty); g.lineTo(px, pz); g.stroke();
   g.fillStyle = "#c33"; g.beginPath(); g.arc(px, pz, 8, 0, 2 * Math.PI); g.fill();
 }
 
@@ -359,7 +451,8 @@ function draw() {
   $("mode").textContent = view.mode || "waiting";
   $("mode").className = view.mode === "ready" || view.mode === "operating" ? "ok" : view.mode ? "bad" : "";
   $("operation").textContent = view.operation || "-";
-  $("zones").textContent = view.zones && view.zones.length ? view.zones.join(", ") : "none";
+  const enforced = zoneStates().filter((z) => z.enabled).map((z) => `${z.index} (${z.name})`);
+  $("zones").textContent = view.site ? (enforced.length ? enforced.join(", ") : "none") : "-";
   $("faults").textContent = view.faults.length ? view.faults.join(", ") : "none";
   $("warnings").textContent = view.warnings && view.warnings.length ? view.warnings.join(", ") : "none";
   if (s) {
@@ -388,5 +481,6 @@ function render() {
 }
 
 wireControls();
+loadSite();
 connect();
 requestAnimationFrame(render);

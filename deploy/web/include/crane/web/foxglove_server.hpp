@@ -3,7 +3,9 @@
 // port, over websocketpp (Debian's libwebsocketpp-dev) on Boost.Asio. One I/O thread owns every
 // connection; publish() may be called from any thread and never blocks on a client: each client
 // has a bounded SendQueue (the oldest frame dropped when full) that drains as its socket takes
-// data.
+// data. A client that reads nothing (every sample to it dropped for stalled_close_seconds,
+// SendQueue::not_reading) is closed with 1008 (policy violation) and the reason; the others are
+// not touched.
 
 #include <atomic>
 #include <cstdint>
@@ -23,6 +25,8 @@ struct ServerOptions {
   std::size_t socket_buffer_bytes{64 * 1024};  // [bytes] a client's kernel send buffer (SO_SNDBUF), and
                                                // what websocketpp may hold for it before the queue
   std::size_t max_request_bytes{64 * 1024};    // [bytes] largest frame a client may send (else closed, 1009)
+  double stalled_close_seconds{10.0};          // [s] > 0: a client whose every sample was dropped this long
+                                               // reads nothing: closed, 1008
   std::string name{"crane_web"};               // serverInfo name
   // Client publishing: the topics an operator's client may publish (empty: publishing off for all).
   std::vector<PublishableTopic> publishable{};
@@ -40,6 +44,7 @@ struct ServerStats {
   std::atomic<std::uint64_t> operator_clients{0};   // clients connected as an operator now
   std::atomic<std::uint64_t> handshakes_refused{0}; // WebSocket handshakes without foxglove.websocket.v1
   std::atomic<std::uint64_t> oversized_closed{0};   // clients closed (1009) for a frame over max_request_bytes
+  std::atomic<std::uint64_t> stalled_closed{0};     // clients closed (1008) for reading nothing (stalled_close_seconds)
 };
 
 /// An HTTP request (not a WebSocket handshake) and the handler's answer.

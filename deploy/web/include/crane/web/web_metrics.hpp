@@ -15,7 +15,8 @@
 //   crane_process_nonfinite_rejected{process}     each process's LoopDiagnostics_ (once a second)
 //   crane_process_latency_us{process,quantile}    its latency p50 ("0.5"), p99 ("0.99"), max ("1")
 //   crane_web_clients, crane_web_connections_total, crane_web_samples_sent_total,
-//   crane_web_samples_dropped_total, crane_web_requests_refused_total{kind=request|binary|handshake|oversized}
+//   crane_web_samples_dropped_total, crane_web_requests_refused_total{kind=request|binary|handshake|oversized},
+//   crane_web_stalled_clients_closed_total
 // Label values are the IDL's code names (protocol::code_name): mode="operating", fault="swing".
 //
 // Thread safety: the updates come from one thread (the DDS loop); text() may run concurrently on
