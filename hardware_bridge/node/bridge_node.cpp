@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
         hb::CounterUnwrapper(board->counter_bits()), hb::CounterUnwrapper(board->counter_bits()),
         hb::CounterUnwrapper(board->counter_bits())};
-    const bool bridge_axis = bridge_config.board.bridge_axis;  // overhead crane
+    const hb::BoardAxes axes = bridge_config.board.axes;  // the crane's switches: the slew's or the bridge's
     const double period_s = cfg.facts().sample_period;
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
     const auto hang_timeout =
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
                         Switches::SWITCH_BRIDGE_MAX == hb::bit(hb::DigitalInput::bridge_max_limit) &&
                         Switches::SWITCH_SLEW_MAX == hb::bit(hb::DigitalInput::slew_max_limit),
                     "the board's limit-switch inputs are laid out as SensorSample_.limit_switches");
-      sample.limit_switches(static_cast<std::uint8_t>(inputs & hb::limit_switch_mask(bridge_axis)));
+      sample.limit_switches(static_cast<std::uint8_t>(inputs & hb::limit_switch_mask(axes)));
       in.emergency_stop_pressed = estop;
     };
     // Takes what arrived; returns true once a valid command for cycle k went to the board.

@@ -15,7 +15,8 @@ void validate(const BridgeParams& params, const char* prefix) {
 
 BridgeCore::BridgeCore(const BridgeParams& params, const std::array<AnalogRange, kAnalogOutputCount>& ranges)
     : params_(params), ranges_(ranges), gate_((validate(params), params.gate)) {
-  for (std::size_t i = 0; i < analog_output_count(params_.bridge_axis); ++i) {
+  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+    if (!uses(params_.axes, static_cast<AnalogOutput>(i))) continue;
     const AnalogRange& range = ranges_[i];
     const std::string name = std::string("analog_range.") + channel_name(static_cast<AnalogOutput>(i));
     if (!is_valid(range)) {
@@ -47,11 +48,12 @@ CommandStatus BridgeCore::step(const BridgeInput& input, BridgeOutput& output) n
                                                        drive.bridge_voltage};
     output.board = safe_outputs_;  // an output the crane does not use stays at 0 V
     bool range_clamped = false;
-    for (std::size_t i = 0; i < analog_output_count(params_.bridge_axis); ++i) {
+    for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+      if (!uses(params_.axes, static_cast<AnalogOutput>(i))) continue;
       range_clamped = range_clamped || volts[i] < ranges_[i].min_volts || volts[i] > ranges_[i].max_volts;
       output.board.dac_codes[i] = volts_to_code(volts[i], ranges_[i]);
     }
-    output.board.digital_outputs = all_outputs_energized(params_.bridge_axis);
+    output.board.digital_outputs = all_outputs_energized(params_.axes);
     output.clamped = gate_output_.clamped || range_clamped;
     output.brakes_engaged = false;
     if (range_clamped && !gate_output_.clamped) gate_.count_clamped();
@@ -62,12 +64,14 @@ CommandStatus BridgeCore::step(const BridgeInput& input, BridgeOutput& output) n
   output.applied_trolley_voltage =
       code_to_volts(output.board.dac_codes[index(AnalogOutput::trolley_drive)], ranges_[index(AnalogOutput::trolley_drive)]);
   output.applied_slew_voltage =
-      code_to_volts(output.board.dac_codes[index(AnalogOutput::slew_drive)], ranges_[index(AnalogOutput::slew_drive)]);
+      params_.axes.slew ? code_to_volts(output.board.dac_codes[index(AnalogOutput::slew_drive)],
+                                        ranges_[index(AnalogOutput::slew_drive)])
+                        : 0.0;
   output.applied_hoist_speed =
       code_to_volts(output.board.dac_codes[index(AnalogOutput::hoist_speed)], ranges_[index(AnalogOutput::hoist_speed)]) *
       params_.hoist_speed_per_volt;
   output.applied_bridge_voltage =
-      params_.bridge_axis ? code_to_volts(output.board.dac_codes[index(AnalogOutput::bridge_drive)],
+      params_.axes.bridge ? code_to_volts(output.board.dac_codes[index(AnalogOutput::bridge_drive)],
                                           ranges_[index(AnalogOutput::bridge_drive)])
                           : 0.0;
   output.counters = gate_.counters();

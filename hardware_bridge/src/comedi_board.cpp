@@ -55,9 +55,11 @@ ComediBoard::ComediBoard(const std::string& device_path, const BoardConfig& conf
   device_ = api_->open(device_path_);
   if (device_ == nullptr) fail("comedi_open failed");
   try {
-    // Counters: those of the crane (the bridge's on an overhead crane only, BoardConfig::bridge_axis).
-    const bool bridge = config_.bridge_axis;
-    for (std::size_t i = 0; i < counter_count(bridge); ++i) {
+    // Counters: those of the crane (the slew's on a tower crane only, the bridge's on an overhead
+    // crane only: BoardConfig::axes).
+    const BoardAxes axes = config_.axes;
+    for (std::size_t i = 0; i < kCounterCount; ++i) {
+      if (!uses(axes, static_cast<CounterChannel>(i))) continue;
       const ComediChannel& counter = config_.counters[i];
       const std::string role = std::string("counter ") + channel_name(static_cast<CounterChannel>(i));
       int n_channels = 0;
@@ -79,7 +81,8 @@ ComediBoard::ComediBoard(const std::string& device_path, const BoardConfig& conf
     // Analog outputs: ranges and maxdata, read once.
     int n_channels = 0;
     check_subdevice(config_.analog_output_subdevice, "analog output", is_analog_output, n_channels);
-    for (std::size_t i = 0; i < analog_output_count(bridge); ++i) {
+    for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+      if (!uses(axes, static_cast<AnalogOutput>(i))) continue;
       const int channel = config_.analog_output_channels[i];
       const std::string role = std::string("analog output ") + channel_name(static_cast<AnalogOutput>(i)) + " " +
                                where(config_.analog_output_subdevice, channel);
@@ -108,7 +111,8 @@ ComediBoard::ComediBoard(const std::string& device_path, const BoardConfig& conf
     // Digital outputs and inputs; the lines of a DIO subdevice get their direction.
     check_subdevice(config_.digital_output_subdevice, "digital output", is_digital_output, n_channels);
     const int output_type = api_->get_subdevice_type(device_, as_unsigned(config_.digital_output_subdevice));
-    for (std::size_t i = 0; i < digital_output_count(bridge); ++i) {
+    for (std::size_t i = 0; i < kDigitalOutputCount; ++i) {
+      if (!uses(axes, static_cast<DigitalOutput>(i))) continue;
       const int line = config_.digital_output_bits[i];
       const std::string role = std::string("digital output ") + line_name(static_cast<DigitalOutput>(i)) + " " +
                                where(config_.digital_output_subdevice, line);
@@ -125,7 +129,8 @@ ComediBoard::ComediBoard(const std::string& device_path, const BoardConfig& conf
     }
     check_subdevice(config_.digital_input_subdevice, "digital input", is_digital_input, n_channels);
     const int input_type = api_->get_subdevice_type(device_, as_unsigned(config_.digital_input_subdevice));
-    for (std::size_t i = 0; i < digital_input_count(bridge); ++i) {
+    for (std::size_t i = 0; i < kDigitalInputCount; ++i) {
+      if (!uses(axes, static_cast<DigitalInput>(i))) continue;
       const int line = config_.digital_input_bits[i];
       const std::string role = std::string("digital input ") + line_name(static_cast<DigitalInput>(i)) + " " +
                                where(config_.digital_input_subdevice, line);
@@ -176,7 +181,8 @@ void ComediBoard::check_subdevice(int subdevice, const char* role, bool (*type_o
 
 void ComediBoard::read_counters(std::array<std::uint32_t, kCounterCount>& raw_counts) {
   raw_counts.fill(0);  // a counter the crane does not have (the bridge's on a tower crane) reads 0
-  for (std::size_t i = 0; i < counter_count(config_.bridge_axis); ++i) {
+  for (std::size_t i = 0; i < kCounterCount; ++i) {
+    if (!uses(config_.axes, static_cast<CounterChannel>(i))) continue;
     const ComediChannel& counter = config_.counters[i];
     std::uint32_t value = 0;
     if (api_->data_read(device_, as_unsigned(counter.subdevice), as_unsigned(counter.channel), 0,
@@ -189,7 +195,8 @@ void ComediBoard::read_counters(std::array<std::uint32_t, kCounterCount>& raw_co
 }
 
 void ComediBoard::write_analog_outputs(const BoardOutputs& outputs) {
-  for (std::size_t i = 0; i < analog_output_count(config_.bridge_axis); ++i) {
+  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+    if (!uses(config_.axes, static_cast<AnalogOutput>(i))) continue;
     const int channel = config_.analog_output_channels[i];
     const std::uint32_t code = std::min(outputs.dac_codes[i], ranges_[i].maxdata);
     if (api_->data_write(device_, as_unsigned(config_.analog_output_subdevice), as_unsigned(channel),
@@ -202,10 +209,11 @@ void ComediBoard::write_analog_outputs(const BoardOutputs& outputs) {
 
 void ComediBoard::write_digital_outputs(std::uint32_t logical_outputs) {
   unsigned bits = 0;
-  for (std::size_t i = 0; i < digital_output_count(config_.bridge_axis); ++i) {
+  for (std::size_t i = 0; i < kDigitalOutputCount; ++i) {
+    if (!uses(config_.axes, static_cast<DigitalOutput>(i))) continue;
     if ((logical_outputs & (1U << i)) != 0U) bits |= 1U << as_unsigned(config_.digital_output_bits[i]);
   }
-  last_digital_outputs_ = all_outputs_energized(config_.bridge_axis);  // unknown until the write succeeds
+  last_digital_outputs_ = all_outputs_energized(config_.axes);  // unknown until the write succeeds
   if (api_->dio_bitfield2(device_, as_unsigned(config_.digital_output_subdevice), digital_output_mask_, bits, 0) < 0) {
     fail("comedi_dio_bitfield2 of the digital outputs (subdevice " + std::to_string(config_.digital_output_subdevice) +
          ") failed");
@@ -214,7 +222,7 @@ void ComediBoard::write_digital_outputs(std::uint32_t logical_outputs) {
 }
 
 void ComediBoard::write_outputs(const BoardOutputs& outputs) {
-  const std::uint32_t logical = outputs.digital_outputs & all_outputs_energized(config_.bridge_axis);
+  const std::uint32_t logical = outputs.digital_outputs & all_outputs_energized(config_.axes);
   const bool de_energizes = (last_digital_outputs_ & ~logical) != 0U;
   if (de_energizes) {
     write_digital_outputs(logical);  // brakes engage and drives disable before the voltages change
@@ -232,7 +240,8 @@ std::uint32_t ComediBoard::read_digital_inputs() {
          ") failed");
   }
   std::uint32_t logical = 0;
-  for (std::size_t i = 0; i < digital_input_count(config_.bridge_axis); ++i) {
+  for (std::size_t i = 0; i < kDigitalInputCount; ++i) {
+    if (!uses(config_.axes, static_cast<DigitalInput>(i))) continue;
     const bool level = ((bits >> as_unsigned(config_.digital_input_bits[i])) & 1U) != 0U;
     if (level != config_.digital_inputs_active_low) logical |= 1U << i;
   }
@@ -243,22 +252,28 @@ AnalogRange ComediBoard::analog_range(AnalogOutput channel) const noexcept { ret
 
 std::string ComediBoard::describe() const {
   std::ostringstream text;
-  const bool bridge = config_.bridge_axis;
+  const BoardAxes axes = config_.axes;
   text << "comedi:" << device_path_ << " (" << config_.counter_bits << "-bit counters at";
-  for (std::size_t i = 0; i < counter_count(bridge); ++i) {
+  for (std::size_t i = 0; i < kCounterCount; ++i) {
+    if (!uses(axes, static_cast<CounterChannel>(i))) continue;
     text << " " << config_.counters[i].subdevice << "/" << config_.counters[i].channel;
   }
   text << "; analog outputs on subdevice " << config_.analog_output_subdevice << " range "
        << config_.analog_output_range << ":";
-  for (std::size_t i = 0; i < analog_output_count(bridge); ++i) {
+  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+    if (!uses(axes, static_cast<AnalogOutput>(i))) continue;
     text << " " << channel_name(static_cast<AnalogOutput>(i)) << " ch " << config_.analog_output_channels[i] << " ["
          << common::format_value(ranges_[i].min_volts) << ", " << common::format_value(ranges_[i].max_volts)
          << "] V maxdata " << ranges_[i].maxdata;
   }
   text << "; digital outputs on subdevice " << config_.digital_output_subdevice << " bits";
-  for (std::size_t i = 0; i < digital_output_count(bridge); ++i) text << " " << config_.digital_output_bits[i];
+  for (std::size_t i = 0; i < kDigitalOutputCount; ++i) {
+    if (uses(axes, static_cast<DigitalOutput>(i))) text << " " << config_.digital_output_bits[i];
+  }
   text << "; digital inputs on subdevice " << config_.digital_input_subdevice << " bits";
-  for (std::size_t i = 0; i < digital_input_count(bridge); ++i) text << " " << config_.digital_input_bits[i];
+  for (std::size_t i = 0; i < kDigitalInputCount; ++i) {
+    if (uses(axes, static_cast<DigitalInput>(i))) text << " " << config_.digital_input_bits[i];
+  }
   text << (config_.digital_inputs_active_low ? " active-low)" : " active-high)");
   return text.str();
 }

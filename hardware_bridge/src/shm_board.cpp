@@ -228,7 +228,7 @@ ShmBoard::ShmBoard(const std::string& name, const BoardConfig& config)
       counter_bits_(static_cast<int>(checked_layout(segment_).counter_bits)),
       counter_mask_(mask_of(counter_bits_)),
       ranges_(ranges_of(segment_.layout())),
-      bridge_axis_(config.bridge_axis) {
+      axes_(config.axes) {
   if (counter_bits_ != config.counter_bits) {
     fail(segment_.path(), "counter_bits " + std::to_string(counter_bits_) + " of the segment differs from board.counter_bits = " +
                               std::to_string(config.counter_bits));
@@ -272,7 +272,8 @@ std::string ShmBoard::describe() const {
   std::ostringstream text;
   text << "shm:" << segment_.path().substr(std::char_traits<char>::length(kShmSegmentPrefix))
        << " (emulated interface board in " << segment_.path() << ": " << counter_bits_ << "-bit counters";
-  for (std::size_t i = 0; i < analog_output_count(bridge_axis_); ++i) {
+  for (std::size_t i = 0; i < kAnalogOutputCount; ++i) {
+    if (!uses(axes_, static_cast<AnalogOutput>(i))) continue;
     text << ", " << channel_name(static_cast<AnalogOutput>(i)) << " [" << common::format_value(ranges_[i].min_volts)
          << ", " << common::format_value(ranges_[i].max_volts) << "] V maxdata " << ranges_[i].maxdata;
   }

@@ -61,7 +61,8 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
   const auto bridge = cfg.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
     return hb::read_params(block, facts, gate);
   });
-  const bool bridge_axis = bridge.board.bridge_axis;  // overhead crane: the bridge's counter, DAC and brake line
+  const hb::BoardAxes axes = bridge.board.axes;  // the crane's drives and brake lines: the slew's or the bridge's
+  const std::uint32_t travel_brakes = hb::travel_brake_lines(axes);
   const auto encoder_counts = [&] {
     const auto& m = simulator.output().measurement;
     return std::array<std::int64_t, hb::kCounterCount>{
@@ -120,13 +121,11 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
     const std::uint32_t digital = outputs.outputs.digital_outputs;
     const bool drives_enabled = (digital & bit(hb::DigitalOutput::drive_enable)) != 0;
     plant::DriveInput input;
-    input.brakes_engaged = (digital & bit(hb::DigitalOutput::brake_release_trolley)) == 0 ||
-                           (digital & bit(hb::DigitalOutput::brake_release_slew)) == 0 ||
-                           (bridge_axis && (digital & bit(hb::DigitalOutput::brake_release_bridge)) == 0);
+    input.brakes_engaged = (digital & travel_brakes) != travel_brakes;
     if (drives_enabled) {
       input.trolley_voltage = board.output_volts(outputs, hb::AnalogOutput::trolley_drive);
-      input.slew_voltage = board.output_volts(outputs, hb::AnalogOutput::slew_drive);
-      if (bridge_axis) input.bridge_voltage = board.output_volts(outputs, hb::AnalogOutput::bridge_drive);
+      if (axes.slew) input.slew_voltage = board.output_volts(outputs, hb::AnalogOutput::slew_drive);
+      if (axes.bridge) input.bridge_voltage = board.output_volts(outputs, hb::AnalogOutput::bridge_drive);
       if ((digital & bit(hb::DigitalOutput::brake_release_hoist)) != 0) {
         input.hoist_speed = board.output_volts(outputs, hb::AnalogOutput::hoist_speed) *
                             bridge.bridge.hoist_speed_per_volt;

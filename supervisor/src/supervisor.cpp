@@ -75,9 +75,12 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.trolley_min", p.trolley_min, -100.0, 100.0);
   require_in_range("supervisor.trolley_max", p.trolley_max, p.trolley_min + 1e-3, 100.0);
   validate_axis("trolley", "max_speed", p.trolley());
-  require_in_range("supervisor.slew_min", p.slew_min, -100.0, 100.0);
-  require_in_range("supervisor.slew_max", p.slew_max, p.slew_min + 1e-3, 100.0);
-  validate_axis("slew", "max_rate", p.slew());
+  if (p.slew_enabled) {
+    require_in_range("supervisor.slew_min", p.slew_min, -100.0, 100.0);
+    require_in_range("supervisor.slew_max", p.slew_max, p.slew_min + 1e-3, 100.0);
+    validate_axis("slew", "max_rate", p.slew());
+    require_in_range("supervisor.slew_braking_deceleration", p.slew_braking_deceleration, 1e-3, 1e3);
+  }
   if (p.bridge_enabled) {
     require_in_range("supervisor.bridge_min", p.bridge_min, -1000.0, 1000.0);
     require_in_range("supervisor.bridge_max", p.bridge_max, p.bridge_min + 1e-3, 1000.0);
@@ -92,7 +95,6 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.sample_period", p.sample_period, 1e-4, 1.0);
   require_in_range("supervisor.expected_sensor_source", p.expected_sensor_source, 0.0, 2.0);
   require_in_range("supervisor.trolley_braking_deceleration", p.trolley_braking_deceleration, 1e-3, 1e3);
-  require_in_range("supervisor.slew_braking_deceleration", p.slew_braking_deceleration, 1e-3, 1e3);
   common::validate(p.site, "site");
 }
 
@@ -151,7 +153,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   if (dead_mask != 0 && chain_was_up_) active |= kFaultStageSilent;
   chain_was_up_ = chain_was_up_ || chain_healthy;
   double trolley_limit = params_.voltage_limit;
-  double slew_limit = params_.voltage_limit;
+  double slew_limit = params_.slew_enabled ? params_.voltage_limit : 0.0;
   double bridge_limit = params_.bridge_enabled ? params_.voltage_limit : 0.0;
   if (in.sensors_valid && finite_sensors) {
     if (params_.bridge_enabled) {
@@ -165,16 +167,23 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       }
     }
     const AxisVerdict trolley = check_axis(params_.trolley(), in.trolley_position, trolley_velocity_);
-    const AxisVerdict slew = check_axis(params_.slew(), in.slew_angle, slew_rate_);
     if (trolley.range_fault) active |= kFaultTrolleyTravel;
     if (trolley.overspeed && trolley_overspeed_samples_ >= kOverspeedSamples) active |= kFaultTrolleyOverspeed;
-    if (slew.range_fault) active |= kFaultSlewRange;
-    if (slew.overspeed && slew_overspeed_samples_ >= kOverspeedSamples) active |= kFaultSlewOverspeed;
     if (trolley.approaching) warnings |= kWarningTrolleyApproach;
-    if (slew.approaching) warnings |= kWarningSlewApproach;
-    if (trolley.speed_limited) trolley_limit = params_.approach_voltage_limit;
-    if (slew.speed_limited) slew_limit = params_.approach_voltage_limit;
-    if (trolley.speed_limited || slew.speed_limited) warnings |= kWarningSpeedLimited;
+    if (trolley.speed_limited) {
+      trolley_limit = params_.approach_voltage_limit;
+      warnings |= kWarningSpeedLimited;
+    }
+    if (params_.slew_enabled) {
+      const AxisVerdict slew = check_axis(params_.slew(), in.slew_angle, slew_rate_);
+      if (slew.range_fault) active |= kFaultSlewRange;
+      if (slew.overspeed && slew_overspeed_samples_ >= kOverspeedSamples) active |= kFaultSlewOverspeed;
+      if (slew.approaching) warnings |= kWarningSlewApproach;
+      if (slew.speed_limited) {
+        slew_limit = params_.approach_voltage_limit;
+        warnings |= kWarningSpeedLimited;
+      }
+    }
     if (std::fabs(in.swing_in_plane) > params_.max_swing || std::fabs(in.swing_out_of_plane) > params_.max_swing) {
       active |= kFaultSwing;
     }

@@ -15,12 +15,15 @@ SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& f
   p.trolley_stop_margin = s.number("trolley_stop_margin", 0.0, 100.0);
   p.trolley_approach_speed = s.number("trolley_approach_speed", 0.0, 100.0);
   p.trolley_max_speed = s.number("trolley_max_speed", 1e-3, 100.0);
-  p.slew_min = s.number("slew_min", -100.0, 100.0);
-  p.slew_max = s.number("slew_max", -100.0, 100.0);
-  p.slew_approach_margin = s.number("slew_approach_margin", 0.0, 100.0);
-  p.slew_stop_margin = s.number("slew_stop_margin", 0.0, 100.0);
-  p.slew_approach_rate = s.number("slew_approach_rate", 0.0, 100.0);
-  p.slew_max_rate = s.number("slew_max_rate", 1e-3, 100.0);
+  p.slew_enabled = facts.crane_kind == common::CraneKind::tower;
+  if (p.slew_enabled) {  // elsewhere these are unknown fields
+    p.slew_min = s.number("slew_min", -100.0, 100.0);
+    p.slew_max = s.number("slew_max", -100.0, 100.0);
+    p.slew_approach_margin = s.number("slew_approach_margin", 0.0, 100.0);
+    p.slew_stop_margin = s.number("slew_stop_margin", 0.0, 100.0);
+    p.slew_approach_rate = s.number("slew_approach_rate", 0.0, 100.0);
+    p.slew_max_rate = s.number("slew_max_rate", 1e-3, 100.0);
+  }
   p.bridge_enabled = facts.crane_kind == common::CraneKind::overhead;
   if (p.bridge_enabled) {  // elsewhere these are unknown fields
     p.bridge_min = s.number("bridge_min", -1000.0, 1000.0);
@@ -37,7 +40,7 @@ SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& f
   p.stage_dead_timeout = s.number("stage_dead_timeout", p.stage_timeout, 60.0);
   p.arm_on_start = s.flag("arm_on_start");
   p.trolley_braking_deceleration = s.number("trolley_braking_deceleration", 1e-3, 1e3);
-  p.slew_braking_deceleration = s.number("slew_braking_deceleration", 1e-3, 1e3);
+  if (p.slew_enabled) p.slew_braking_deceleration = s.number("slew_braking_deceleration", 1e-3, 1e3);
   s.finish();
   p.site = facts.site;
   validate(p);

@@ -387,27 +387,72 @@ TEST(OverheadConfig, LoadsWithItsBridge) {
 }
 
 // The hardware bridge's channel map follows the crane (issue 18): the bridge's channels are required
-// on an overhead crane, each missing one named by its field, and unknown fields on a tower crane.
+// on an overhead crane, each missing one named by its field, and unknown fields on a tower crane;
+// the overhead crane has no slew channels.
 TEST(OverheadConfig, HardwareBridgeHasTheBridgeChannels) {
   const auto c = cfg::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
-  EXPECT_TRUE(c.hardware_bridge.board.bridge_axis);
-  EXPECT_TRUE(c.hardware_bridge.bridge.bridge_axis);
+  EXPECT_TRUE(c.hardware_bridge.board.axes == crane::hardware_bridge::kOverheadCraneAxes);
+  EXPECT_TRUE(c.hardware_bridge.bridge.axes == crane::hardware_bridge::kOverheadCraneAxes);
+  EXPECT_FALSE(c.supervisor.slew_enabled);
   using crane::hardware_bridge::AnalogOutput;
   using crane::hardware_bridge::CounterChannel;
   using crane::hardware_bridge::DigitalInput;
   using crane::hardware_bridge::DigitalOutput;
   using crane::hardware_bridge::index;
   const auto& board = c.hardware_bridge.board;
+  // Wired where the lab tower crane has its slew's.
   EXPECT_EQ(board.counters[index(CounterChannel::bridge_motor)].subdevice, 0);
-  EXPECT_EQ(board.counters[index(CounterChannel::bridge_motor)].channel, 4);
-  EXPECT_EQ(board.analog_output_channels[index(AnalogOutput::bridge_drive)], 3);
-  EXPECT_EQ(board.digital_output_bits[index(DigitalOutput::brake_release_bridge)], 4);
-  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_min_limit)], 5);
-  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_max_limit)], 6);
-  // The tower crane's has none.
+  EXPECT_EQ(board.counters[index(CounterChannel::bridge_motor)].channel, 1);
+  EXPECT_EQ(board.analog_output_channels[index(AnalogOutput::bridge_drive)], 1);
+  EXPECT_EQ(board.digital_output_bits[index(DigitalOutput::brake_release_bridge)], 1);
+  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_min_limit)], 2);
+  EXPECT_EQ(board.digital_input_bits[index(DigitalInput::bridge_max_limit)], 3);
+  // The tower crane's has the slew's and no bridge.
   const auto lab = cfg::load_stack_config(kLabConfig);
-  EXPECT_FALSE(lab.hardware_bridge.board.bridge_axis);
-  EXPECT_FALSE(lab.hardware_bridge.bridge.bridge_axis);
+  EXPECT_TRUE(lab.hardware_bridge.board.axes == crane::hardware_bridge::kTowerCraneAxes);
+  EXPECT_TRUE(lab.hardware_bridge.bridge.axes == crane::hardware_bridge::kTowerCraneAxes);
+  EXPECT_TRUE(lab.supervisor.slew_enabled);
+}
+
+// A gantry crane has no slew (issue 18): its configuration names no slew channel and no slew limit,
+// loads, and a slew channel or slew limit in it is refused as an unknown field, as a bridge channel
+// on a tower crane is; the tower crane's slew channels and limits stay required.
+TEST(GantryConfig, HasNoSlewChannelsAndNoSlewLimits) {
+  const std::string path = std::string(CRANE_SOURCE_DIR) + "/deploy/config/gantry_crane.yaml";
+  const auto c = cfg::load_stack_config(path);
+  EXPECT_TRUE(c.hardware_bridge.board.axes == crane::hardware_bridge::kGantryCraneAxes);
+  EXPECT_TRUE(c.hardware_bridge.bridge.axes == crane::hardware_bridge::kGantryCraneAxes);
+  EXPECT_FALSE(c.supervisor.slew_enabled);
+  EXPECT_FALSE(c.supervisor.bridge_enabled);
+  const std::string text = read_text(path);
+  ASSERT_FALSE(text.empty());
+  auto message = error_of(
+      edit_line(text, "hardware_bridge:", "swing_out_of_plane:",
+                "swing_out_of_plane: {subdevice: 0, channel: 3}\n      slew_motor: {subdevice: 0, channel: 1}")
+          .text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.counters.slew_motor")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "analog_outputs:",
+                               "analog_outputs: {subdevice: 1, range: 0, trolley_drive: 0, slew_drive: 1, hoist_speed: 2}")
+                         .text);
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.analog_outputs.slew_drive")) << message;
+  message = error_of(edit_line(text, "hardware_bridge:", "digital_inputs:",
+                               "digital_inputs: {subdevice: 3, active_low: true, trolley_min_limit: 0, "
+                               "trolley_max_limit: 1, slew_min_limit: 2, emergency_stop: 4}")
+                         .text);
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.digital_inputs.slew_min_limit")) << message;
+  message = error_of(edit_line(text, "supervisor:", "max_swing:", "max_swing: 0.6\n  slew_max_rate: 2.0").text);
+  EXPECT_TRUE(contains(message, "unknown field supervisor.slew_max_rate")) << message;
+}
+
+TEST_F(LabConfigText, ASlewChannelOrLimitMissingOnATowerCraneIsNamed) {
+  auto message = error_of(edit_line(text_, "hardware_bridge:", "slew_motor:", std::nullopt).text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.counters.slew_motor")) << message;
+  message = error_of(edit_line(text_, "supervisor:", "slew_max_rate:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field supervisor.slew_max_rate")) << message;
+  message = error_of(edit_line(text_, "supervisor:", "slew_braking_deceleration:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field supervisor.slew_braking_deceleration")) << message;
 }
 
 TEST(OverheadConfig, AMissingBridgeChannelIsNamed) {
@@ -418,20 +463,27 @@ TEST(OverheadConfig, AMissingBridgeChannelIsNamed) {
   EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
   EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.counters.bridge_motor")) << message;
   message = error_of(edit_line(text, "hardware_bridge:", "analog_outputs:",
-                               "analog_outputs: {subdevice: 1, range: 0, trolley_drive: 0, slew_drive: 1, hoist_speed: 2}")
+                               "analog_outputs: {subdevice: 1, range: 0, trolley_drive: 0, hoist_speed: 2}")
                          .text);
   EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.analog_outputs.bridge_drive")) << message;
-  message = error_of(edit_line(text, "hardware_bridge:", "drive_enable: 3,", "drive_enable: 3}").text);
+  message = error_of(edit_line(text, "hardware_bridge:", "digital_outputs:",
+                               "digital_outputs: {subdevice: 2, brake_release_trolley: 0, brake_release_hoist: 2,")
+                         .text);
   EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_outputs.brake_release_bridge")) << message;
-  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_max_limit: 6}").text);
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_max_limit: 3,").text);
   EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_inputs.bridge_min_limit")) << message;
-  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 5}").text);
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 2,").text);
   EXPECT_TRUE(contains(message, "missing field hardware_bridge.comedi.digital_inputs.bridge_max_limit")) << message;
+  // A slew channel on an overhead crane: an unknown field, as the bridge's on a tower crane.
+  message = error_of(edit_line(text, "hardware_bridge:", "swing_in_plane:",
+                               "swing_in_plane: {subdevice: 0, channel: 2}\n      slew_motor: {subdevice: 0, channel: 4}")
+                         .text);
+  EXPECT_TRUE(contains(message, "unknown field hardware_bridge.comedi.counters.slew_motor")) << message;
   // Present but on a line another function uses: named with the value and the other field.
   message = error_of(edit_line(text, "hardware_bridge:", "bridge_motor:", "bridge_motor: {subdevice: 0, channel: 0}").text);
   EXPECT_TRUE(contains(message, "hardware_bridge.comedi.counters[4].channel = 0")) << message;
   EXPECT_TRUE(contains(message, "must differ from hardware_bridge.comedi.counters[0].channel")) << message;
-  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 4, bridge_max_limit: 6}").text);
+  message = error_of(edit_line(text, "hardware_bridge:", "bridge_min_limit:", "bridge_min_limit: 4, bridge_max_limit: 3,").text);
   EXPECT_TRUE(contains(message, "hardware_bridge.comedi.digital_input_bits[5] = 4")) << message;
 }
 
@@ -476,6 +528,13 @@ TEST_F(LabConfigText, AdaptationFieldsAreValidatedByName) {
   EXPECT_TRUE(contains(message, "state_estimator.adaptation.max_mass = 0")) << message;
   message = error_of(edit_line(text_, "adaptation:", "filter_cutoff:", std::nullopt).text);
   EXPECT_TRUE(contains(message, "missing field state_estimator.adaptation.filter_cutoff")) << message;
+  // The configured load (2 kg) must lie within [min_mass, max_mass].
+  message = error_of(edit_line(text_, "adaptation:", "max_mass:", "max_mass: 1.5").text);
+  EXPECT_TRUE(contains(message, "state_estimator.adaptation.min_mass, max_mass = [0, 1.5] kg is out of range: "
+                                "must contain crane.load_mass = 2 kg"))
+      << message;
+  message = error_of(edit_line(text_, "adaptation:", "min_mass:", "min_mass: 3").text);
+  EXPECT_TRUE(contains(message, "must contain crane.load_mass = 2 kg")) << message;
   message = error_of(edit_line(text_, "adaptation:", "enabled:", "enabled: maybe").text);
   EXPECT_TRUE(contains(message, "state_estimator.adaptation.enabled")) << message;
 }

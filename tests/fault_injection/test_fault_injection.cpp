@@ -140,7 +140,7 @@ class BoardMonitor {
 };
 
 bool safe(const BoardMonitor::Write& w) { return w.digital == 0 && w.trolley_volts == 0.0 && w.slew_volts == 0.0; }
-bool energized(const BoardMonitor::Write& w) { return w.digital == hb::all_outputs_energized(false); }
+bool energized(const BoardMonitor::Write& w) { return w.digital == hb::all_outputs_energized(hb::kTowerCraneAxes); }
 
 /// The hardware-in-the-loop stack plus this process's participant (observer, operator, rogue).
 class HilStack {

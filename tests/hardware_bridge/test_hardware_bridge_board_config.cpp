@@ -92,7 +92,9 @@ TEST(BoardConfig, BridgeChannelsAreValidatedOnAnOverheadCraneOnly) {
   c.digital_output_bits[index(DigitalOutput::brake_release_bridge)] = 40;
   c.digital_input_bits[index(DigitalInput::bridge_min_limit)] = 4;  // the emergency stop's line
   EXPECT_EQ(validation_error(c), "");  // a tower crane has none of them
-  c.bridge_axis = true;
+  c.axes = kOverheadCraneAxes;
+  c.counters[index(CounterChannel::slew_motor)] = c.counters[0];  // nor has an overhead crane the slew's
+  c.analog_output_channels[index(AnalogOutput::slew_drive)] = -1;
   EXPECT_TRUE(contains(validation_error(c), "board.counters[4].channel = 0 is out of range: must differ from "
                                             "board.counters[0].channel on the same subdevice"))
       << validation_error(c);
@@ -114,6 +116,38 @@ TEST(BoardConfig, BridgeChannelsAreValidatedOnAnOverheadCraneOnly) {
   EXPECT_TRUE(contains(validation_error(c), "board.digital_output_bits[4] (same subdevice)")) << validation_error(c);
 }
 
+// The slew's entries (counter 1, analog output 1, output line 1, input lines 2 and 3) are validated
+// on a tower crane only: a gantry or overhead crane has no slew.
+TEST(BoardConfig, SlewChannelsAreValidatedOnATowerCraneOnly) {
+  BoardConfig c;
+  c.counters[index(CounterChannel::slew_motor)] = c.counters[0];
+  c.analog_output_channels[index(AnalogOutput::slew_drive)] = -1;
+  c.digital_output_bits[index(DigitalOutput::brake_release_slew)] = 40;
+  c.digital_input_bits[index(DigitalInput::slew_min_limit)] = 4;  // the emergency stop's line
+  c.digital_input_bits[index(DigitalInput::slew_max_limit)] = 0;  // the trolley's min switch
+  c.axes = kGantryCraneAxes;
+  EXPECT_EQ(validation_error(c), "");
+  c.axes = kTowerCraneAxes;
+  EXPECT_TRUE(contains(validation_error(c), "board.counters[1].channel = 0 is out of range: must differ from "
+                                            "board.counters[0].channel on the same subdevice"))
+      << validation_error(c);
+  c.counters[index(CounterChannel::slew_motor)] = {0, 1};
+  EXPECT_TRUE(contains(validation_error(c), "board.analog_output_channels[1] = -1")) << validation_error(c);
+  c.analog_output_channels[index(AnalogOutput::slew_drive)] = 1;
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_output_bits[1] = 40 is out of range: must be in [0, 31]"))
+      << validation_error(c);
+  c.digital_output_bits[index(DigitalOutput::brake_release_slew)] = 1;
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_input_bits[3] = 0 is out of range: must differ from "
+                                            "board.digital_input_bits[0]"))
+      << validation_error(c);
+  c.digital_input_bits[index(DigitalInput::slew_max_limit)] = 3;
+  EXPECT_TRUE(contains(validation_error(c), "board.digital_input_bits[4] = 4 is out of range: must differ from "
+                                            "board.digital_input_bits[2]"))
+      << validation_error(c);
+  c.digital_input_bits[index(DigitalInput::slew_min_limit)] = 2;
+  EXPECT_EQ(validation_error(c), "");
+}
+
 TEST(BoardChannels, NamesAndTheLogicalLayout) {
   EXPECT_STREQ(channel_name(CounterChannel::bridge_motor), "bridge_motor");
   EXPECT_STREQ(channel_name(AnalogOutput::bridge_drive), "bridge_drive");
@@ -123,16 +157,25 @@ TEST(BoardChannels, NamesAndTheLogicalLayout) {
   EXPECT_STREQ(channel_name(static_cast<CounterChannel>(9)), "unknown");
   // The limit-switch bits are SensorSample_.limit_switches' (idl/crane_msgs.idl): 1, 2, 4, 8, 32, 64.
   EXPECT_EQ(kLimitSwitchMask, 1U + 2U + 4U + 8U + 32U + 64U);
-  EXPECT_EQ(limit_switch_mask(false), 0x0FU);
-  EXPECT_EQ(limit_switch_mask(true), 0x6FU);
+  // Limit switches: trolley and slew on a tower crane, trolley alone on a gantry, trolley and
+  // runway on an overhead crane.
+  EXPECT_EQ(limit_switch_mask(kTowerCraneAxes), 0x0FU);
+  EXPECT_EQ(limit_switch_mask(kGantryCraneAxes), 0x03U);
+  EXPECT_EQ(limit_switch_mask(kOverheadCraneAxes), 0x63U);
   EXPECT_EQ(bit(DigitalInput::emergency_stop), 16U);
-  EXPECT_EQ(all_outputs_energized(false), 0x0FU);
-  EXPECT_EQ(all_outputs_energized(true), 0x1FU);
-  EXPECT_EQ(counter_count(false), 4U);
-  EXPECT_EQ(counter_count(true), 5U);
-  EXPECT_EQ(analog_output_count(false), 3U);
-  EXPECT_EQ(digital_input_count(false), 5U);
-  EXPECT_EQ(digital_input_count(true), 7U);
+  // Brake lines and the drive enable: 0 trolley, 1 slew, 2 hoist, 3 enable, 4 bridge.
+  EXPECT_EQ(all_outputs_energized(kTowerCraneAxes), 0x0FU);
+  EXPECT_EQ(all_outputs_energized(kGantryCraneAxes), 0x0DU);
+  EXPECT_EQ(all_outputs_energized(kOverheadCraneAxes), 0x1DU);
+  EXPECT_EQ(travel_brake_lines(kTowerCraneAxes), 0x03U);
+  EXPECT_EQ(travel_brake_lines(kGantryCraneAxes), 0x01U);
+  EXPECT_EQ(travel_brake_lines(kOverheadCraneAxes), 0x11U);
+  EXPECT_TRUE(uses(kTowerCraneAxes, CounterChannel::slew_motor));
+  EXPECT_FALSE(uses(kTowerCraneAxes, CounterChannel::bridge_motor));
+  EXPECT_FALSE(uses(kGantryCraneAxes, AnalogOutput::slew_drive));
+  EXPECT_FALSE(uses(kOverheadCraneAxes, DigitalInput::slew_max_limit));
+  EXPECT_TRUE(uses(kOverheadCraneAxes, DigitalInput::bridge_min_limit));
+  EXPECT_TRUE(uses(kGantryCraneAxes, CounterChannel::swing_out_of_plane));
 }
 
 TEST(OpenBoard, MalformedUrisNameTheUriAndTheAcceptedForms) {

@@ -108,7 +108,7 @@ TEST(BridgeCore, AppliesAValidCommand) {
   EXPECT_EQ(out.safe_state_reason, SafeStateReason::none);
   EXPECT_FALSE(out.brakes_engaged);
   EXPECT_FALSE(out.clamped);
-  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(false));
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(kTowerCraneAxes));
   // Trolley 2.5 V = 1024 steps exactly: code 4096 + 1024.
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);
   EXPECT_EQ(out.applied_trolley_voltage, 2.5);
@@ -121,22 +121,25 @@ TEST(BridgeCore, AppliesAValidCommand) {
   EXPECT_EQ(out.counters.accepted_commands, 1U);
 }
 
-// An overhead crane (bridge_axis): the gated bridge voltage goes to its own DAC output like the
-// trolley's, its brake line is released with the others, and it is clamped to the supervisor's
-// bridge limit and to the output's DAC range.
+// An overhead crane (kOverheadCraneAxes): the gated bridge voltage goes to its own DAC output like
+// the trolley's, its brake line is released with the others, and it is clamped to the supervisor's
+// bridge limit and to the output's DAC range; it has no slew, whose output and brake line stay off.
 TEST(BridgeCore, OverheadCraneDrivesTheBridgeOutput) {
   BridgeParams params;
-  params.bridge_axis = true;
+  params.axes = kOverheadCraneAxes;
   BridgeCore core(params, plant_ranges());
   EXPECT_EQ(core.safe_outputs().dac_codes[index(AnalogOutput::bridge_drive)], kZeroVoltCode);
   BridgeOutput out;
-  BridgeInput input = cycle_with_command(1.0, {2.5, 0.0, 0.0, -3.0}, 1.0);
+  BridgeInput input = cycle_with_command(1.0, {2.5, -1.0, 0.0, -3.0}, 1.0);
   input.status.bridge_voltage_limit = 10.0;
   EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
   EXPECT_EQ(out.safe_state_reason, SafeStateReason::none);
   EXPECT_FALSE(out.clamped);
-  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(true));
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(kOverheadCraneAxes));
   EXPECT_NE(out.board.digital_outputs & bit(DigitalOutput::brake_release_bridge), 0U);
+  EXPECT_EQ(out.board.digital_outputs & bit(DigitalOutput::brake_release_slew), 0U);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::slew_drive)], kZeroVoltCode);
+  EXPECT_EQ(out.applied_slew_voltage, 0.0);
   // -3 V = -1228.8 steps -> -1229: code 2867, -1229 steps.
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], 2867U);
   EXPECT_EQ(out.applied_bridge_voltage, -1229.0 * kStep);
@@ -171,7 +174,7 @@ TEST(BridgeCore, OverheadCraneDrivesTheBridgeOutput) {
   EXPECT_EQ(out.applied_bridge_voltage, 0.0);
 }
 
-// A tower crane (no bridge_axis) never drives the bridge's output or brake line, whatever the
+// A tower crane (kTowerCraneAxes) never drives the bridge's output or brake line, whatever the
 // command's bridge voltage and the supervisor's bridge limit say; that output's range is not used.
 TEST(BridgeCore, TowerCraneLeavesTheBridgeOutputAtZero) {
   auto ranges = plant_ranges();
@@ -182,11 +185,35 @@ TEST(BridgeCore, TowerCraneLeavesTheBridgeOutputAtZero) {
   input.status.bridge_voltage_limit = 10.0;
   EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
   EXPECT_FALSE(out.clamped);
-  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(false));
+  EXPECT_EQ(out.board.digital_outputs, all_outputs_energized(kTowerCraneAxes));
   EXPECT_EQ(out.board.digital_outputs & bit(DigitalOutput::brake_release_bridge), 0U);
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], core.safe_outputs().dac_codes[3]);
   EXPECT_EQ(out.applied_bridge_voltage, 0.0);
   EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);
+}
+
+// A gantry crane (kGantryCraneAxes) has neither a slew nor a bridge: their outputs stay at 0 V and
+// their brake lines at 0 whatever the command says, and their ranges are not used; the trolley,
+// the hoist and the drive enable work as on the tower crane.
+TEST(BridgeCore, GantryCraneLeavesTheSlewAndBridgeOutputsAtZero) {
+  auto ranges = plant_ranges();
+  ranges[index(AnalogOutput::slew_drive)] = AnalogRange{1.0, 5.0, 4095U};  // would be refused on a tower crane
+  ranges[index(AnalogOutput::bridge_drive)] = AnalogRange{1.0, 5.0, 4095U};
+  BridgeParams params;
+  params.axes = kGantryCraneAxes;
+  BridgeCore core(params, ranges);
+  BridgeOutput out;
+  BridgeInput input = cycle_with_command(1.0, {2.5, -1.0, 0.1, 3.0}, 1.0);
+  input.status.bridge_voltage_limit = 10.0;
+  EXPECT_EQ(core.step(input, out), CommandStatus::accepted);
+  EXPECT_EQ(out.board.digital_outputs, bit(DigitalOutput::brake_release_trolley) |
+                                           bit(DigitalOutput::brake_release_hoist) | bit(DigitalOutput::drive_enable));
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::slew_drive)], core.safe_outputs().dac_codes[1]);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::bridge_drive)], core.safe_outputs().dac_codes[3]);
+  EXPECT_EQ(out.applied_slew_voltage, 0.0);
+  EXPECT_EQ(out.applied_bridge_voltage, 0.0);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::trolley_drive)], 5120U);
+  EXPECT_EQ(out.board.dac_codes[index(AnalogOutput::hoist_speed)], 4915U);
 }
 
 // Watchdog at 100 Hz, W = 30 ms, cycle instants t_k = k * 10 ms. The outputs written at t stay until
@@ -478,7 +505,7 @@ TEST(BridgeCore, ParametersAndRangesAreValidated) {
   ranges[index(AnalogOutput::bridge_drive)] = AnalogRange{0.5, 10.0, 8191U};
   EXPECT_EQ(error_of(BridgeParams{}, ranges), "");
   p = BridgeParams{};
-  p.bridge_axis = true;
+  p.axes = kOverheadCraneAxes;
   EXPECT_TRUE(contains(error_of(p, ranges), "analog_range.bridge_drive.min_volts = 0.5")) << error_of(p, ranges);
 }
 

@@ -204,7 +204,7 @@ TEST(ComediBoard, OpensAndReadsRangesFromTheDriver) {
     const auto board = open_fake(state);
     EXPECT_EQ(state->opens, 1);
     EXPECT_EQ(board->counter_bits(), 24);
-    for (std::size_t i = 0; i < analog_output_count(false); ++i) {  // a tower crane's three outputs
+    for (std::size_t i = 0; i < 3; ++i) {  // a tower crane's three outputs: trolley, slew, hoist
       const AnalogRange range = board->analog_ranges()[i];
       EXPECT_EQ(range.min_volts, -10.0);
       EXPECT_EQ(range.max_volts, 10.0);
@@ -371,7 +371,7 @@ TEST(ComediBoard, WriteOrderIsFailSafe) {
   };
   BoardOutputs safe = safe_board_outputs(board->analog_ranges());
   BoardOutputs running = safe;
-  running.digital_outputs = all_outputs_energized(false);
+  running.digital_outputs = all_outputs_energized(kTowerCraneAxes);
   running.dac_codes[0] = 3000U;
   state->calls.clear();
   board->write_outputs(safe);  // the state of the lines after open is unknown: digital first
@@ -395,7 +395,7 @@ TEST(ComediBoard, DigitalInputsWithBitMapAndPolarity) {
     state->digital_lines[3] = 0xFFU & ~(1U << 7);  // emergency-stop contact open
     EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::emergency_stop));
     state->digital_lines[3] = 0x00U;  // all open (a cut cable): every input active
-    EXPECT_EQ(board->read_digital_inputs(), (1U << digital_input_count(false)) - 1U);  // a tower crane's five
+    EXPECT_EQ(board->read_digital_inputs(), 0x1FU);  // a tower crane's five
     const std::vector<Call> reads = state->calls_of("dio_bitfield2");
     ASSERT_FALSE(reads.empty());
     EXPECT_EQ(reads.back().subdevice, 3U);
@@ -429,7 +429,7 @@ TEST(ComediBoard, DioSubdeviceGetsLineDirections) {
   // Writing the outputs leaves the input lines alone.
   state->digital_lines[4] = 0xFF00U;
   BoardOutputs outputs = safe_board_outputs(board->analog_ranges());
-  outputs.digital_outputs = all_outputs_energized(false);
+  outputs.digital_outputs = all_outputs_energized(kTowerCraneAxes);
   board->write_outputs(outputs);
   EXPECT_EQ(state->digital_lines[4], 0xFF0FU);
 
@@ -439,12 +439,13 @@ TEST(ComediBoard, DioSubdeviceGetsLineDirections) {
       << message;
 }
 
-// An overhead crane's board (bridge_axis): the bridge's counter (here its own counter subdevice, as
-// on an NI 660x), its analog output, brake line and runway limit switches are checked at open, read
-// and written where configured. The same fake opened for a tower crane never touches them.
+// An overhead crane's board (kOverheadCraneAxes): the bridge's counter (here its own counter
+// subdevice, as on an NI 660x), its analog output, brake line and runway limit switches are checked
+// at open, read and written where configured; the slew's, which it has not, never. The same fake
+// opened for a tower crane never touches the bridge's.
 BoardConfig overhead_board_config() {
   BoardConfig c;
-  c.bridge_axis = true;
+  c.axes = kOverheadCraneAxes;
   c.counters[index(CounterChannel::bridge_motor)] = {5, 0};
   c.analog_output_channels = {0, 1, 2, 3};
   c.digital_output_bits = {0, 1, 2, 3, 6};
@@ -465,46 +466,53 @@ TEST(ComediBoard, OverheadCraneMapsTheBridgeChannels) {
   EXPECT_EQ(raw[index(CounterChannel::trolley_motor)], 11U);
   EXPECT_EQ(raw[index(CounterChannel::bridge_motor)], 0xABCDEFU);
   const std::vector<Call> reads = state->calls_of("data_read");
-  ASSERT_EQ(reads.size(), 5U);
-  EXPECT_EQ(reads[4].subdevice, 5U);
-  EXPECT_EQ(reads[4].channel, 0U);
+  ASSERT_EQ(reads.size(), 4U);  // trolley, the two swings, the bridge: no slew counter
+  EXPECT_EQ(reads[1].channel, 2U);
+  EXPECT_EQ(reads[3].subdevice, 5U);
+  EXPECT_EQ(reads[3].channel, 0U);
+  EXPECT_EQ(raw[index(CounterChannel::slew_motor)], 0U);
 
   state->calls.clear();
   BoardOutputs outputs;
   outputs.dac_codes = {100U, 200U, 300U, 4000U};
-  outputs.digital_outputs = all_outputs_energized(true);
+  outputs.digital_outputs = (1U << kDigitalOutputCount) - 1U;  // a stray slew brake bit is not written
   board->write_outputs(outputs);
   const std::vector<Call> writes = state->calls_of("data_write");
-  ASSERT_EQ(writes.size(), 4U);
-  EXPECT_EQ(writes[3].channel, 3U);
-  EXPECT_EQ(writes[3].data, 4000U);
+  ASSERT_EQ(writes.size(), 3U);  // trolley, hoist, bridge
+  EXPECT_EQ(writes[1].channel, 2U);
+  EXPECT_EQ(writes[2].channel, 3U);
+  EXPECT_EQ(writes[2].data, 4000U);
   const std::vector<Call> bitfields = state->calls_of("dio_bitfield2");
   ASSERT_EQ(bitfields.size(), 1U);
-  EXPECT_EQ(bitfields[0].write_mask, 0x0FU | (1U << 6));
-  EXPECT_EQ(state->digital_lines[2], 0x0FU | (1U << 6));
+  const unsigned lines = (1U << 0) | (1U << 2) | (1U << 3) | (1U << 6);  // trolley and hoist brakes, enable, bridge brake
+  EXPECT_EQ(bitfields[0].write_mask, lines);
+  EXPECT_EQ(state->digital_lines[2], lines);
   // Only the bridge's brake engaged: its line alone goes to 0, written before the voltages.
   state->calls.clear();
-  outputs.digital_outputs = all_outputs_energized(true) & ~bit(DigitalOutput::brake_release_bridge);
+  outputs.digital_outputs = all_outputs_energized(kOverheadCraneAxes) & ~bit(DigitalOutput::brake_release_bridge);
   board->write_outputs(outputs);
   EXPECT_EQ(state->calls.front().function, "dio_bitfield2");
-  EXPECT_EQ(state->digital_lines[2], 0x0FU);
+  EXPECT_EQ(state->digital_lines[2], lines & ~(1U << 6));
 
   state->digital_lines[3] = 0xFFU & ~(1U << 6);  // active-low: the runway's min switch open
   EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::bridge_min_limit));
   state->digital_lines[3] = 0xFFU & ~(1U << 5);
   EXPECT_EQ(board->read_digital_inputs(), bit(DigitalInput::bridge_max_limit));
   EXPECT_EQ(bit(DigitalInput::bridge_max_limit), 64U);  // SWITCH_BRIDGE_MAX of SensorSample_.limit_switches
+  state->digital_lines[3] = 0x00U;  // every contact open: no slew switch among them
+  EXPECT_EQ(board->read_digital_inputs(), limit_switch_mask(kOverheadCraneAxes) | bit(DigitalInput::emergency_stop));
+  EXPECT_FALSE(contains(board->describe(), "slew_drive")) << board->describe();
 
   // The same board for a tower crane: four counters read, three outputs written, five lines.
   BoardConfig tower = c;
-  tower.bridge_axis = false;
+  tower.axes = kTowerCraneAxes;
   const auto tower_board = open_fake(state, tower);
   state->calls.clear();
   state->counter_values[{5, 0}] = 77U;
   tower_board->read_counters(raw);
   EXPECT_EQ(state->calls_of("data_read").size(), 4U);
   EXPECT_EQ(raw[index(CounterChannel::bridge_motor)], 0U);
-  outputs.digital_outputs = all_outputs_energized(true);  // a stray bridge bit is not written
+  outputs.digital_outputs = (1U << kDigitalOutputCount) - 1U;  // a stray bridge bit is not written
   tower_board->write_outputs(outputs);
   EXPECT_EQ(state->calls_of("data_write").size(), 3U);
   EXPECT_EQ(state->calls_of("dio_bitfield2").back().write_mask, 0x0FU);
@@ -534,7 +542,7 @@ TEST(ComediBoard, OverheadCraneBridgeChannelsAreCheckedAtOpen) {
   message = open_error(state, c);
   EXPECT_TRUE(contains(message, "digital input bridge_max_limit (subdevice 3, channel 9)")) << message;
   // The same out-of-range bridge entries are never looked at on a tower crane.
-  c.bridge_axis = false;
+  c.axes = kTowerCraneAxes;
   c.counters[index(CounterChannel::bridge_motor)] = {0, 4};
   EXPECT_EQ(open_error(state, c), "");
 }

@@ -710,6 +710,42 @@ TEST(SupervisorLimits, SlewRangeAndOverspeed) {
   EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultSlewRange));
 }
 
+// Without a slew (slew_enabled false: a gantry or overhead crane) the slew angle and rate are not
+// looked at (no slew range, approach or overspeed), the slew drive gets 0 V and the slew fields are
+// not validated; the trolley is guarded as before.
+TEST(SupervisorLimits, WithoutASlewItsLimitsAreNotChecked) {
+  sv::SupervisorParams p;
+  p.slew_enabled = false;
+  p.slew_max = p.slew_min;  // would be refused on a tower crane
+  p.slew_braking_deceleration = 0.0;
+  EXPECT_EQ(config_error_message(p), "<no ConfigError thrown>");
+  sv::Supervisor supervisor(p);
+  auto in = healthy_input();
+  in.slew_angle = 5.0;  // beyond a tower crane's slew range
+  sv::SupervisorOutput out;
+  for (int i = 0; i < 3; ++i) out = step(supervisor, in);
+  in.sensor_seq = 1;
+  out = step(supervisor, in);
+  in.sensor_seq = 2;
+  in.slew_angle += 0.05;  // 5 rad/s, twice
+  out = step(supervisor, in);
+  in.sensor_seq = 3;
+  in.slew_angle += 0.05;
+  out = step(supervisor, in);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.warnings & (sv::kWarningSlewApproach | sv::kWarningSpeedLimited), 0U);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_EQ(out.slew_voltage_limit, 0.0);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  in.trolley_position = 1.31;  // the trolley's travel limit still holds
+  EXPECT_EQ(step(supervisor, in).active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyTravel));
+  // The same slew angle on a tower crane is a protective stop.
+  sv::Supervisor tower{sv::SupervisorParams{}};
+  in = healthy_input();
+  in.slew_angle = 5.0;
+  EXPECT_EQ(step(tower, in).active_faults, static_cast<std::uint32_t>(sv::kFaultSlewRange));
+}
+
 TEST(SupervisorLimits, TrolleyOverspeed) {
   std::uint64_t seq = 1;
   auto supervisor = ready_supervisor();

@@ -4,18 +4,22 @@
 // waits until all are matched and alive (the supervisor reports every stage alive), then watches:
 // on Ctrl-C (SIGINT/SIGTERM) or on the death of any stage it stops all of them by pid (SIGTERM,
 // then SIGKILL after a grace period) and exits. Goals are sent by any DDS participant on
-// rt/crane/planner/goal (for example crane_demo, or a ROS 2 node).
+// rt/crane/planner/goal (for example crane_demo, or a ROS 2 node). The crane starts where the
+// configuration's first maneuver starts (inside its travel limits, whichever crane), unless
+// --initial-trolley, --initial-slew or --initial-bridge say otherwise.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/stack/stack_config.hpp"
 
 int main(int argc, char** argv) {
   using namespace crane;
@@ -54,9 +58,11 @@ int main(int argc, char** argv) {
   app.add_flag("--insecure-lan", stack.insecure_lan,
                "allow --lan or --dds-profile without --security: anyone on that network can read and command the crane");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
-  app.add_option("--initial-trolley", stack.initial_trolley_position, "[m] initial trolley position");
-  app.add_option("--initial-slew", stack.initial_slew_angle, "[rad] initial slew angle");
-  app.add_option("--initial-bridge", stack.initial_bridge_position, "[m] initial bridge position (overhead crane)");
+  std::optional<double> initial_trolley, initial_slew, initial_bridge;
+  app.add_option("--initial-trolley", initial_trolley,
+                 "[m] initial trolley position (default: where the configuration's first maneuver starts)");
+  app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle (default: the same)");
+  app.add_option("--initial-bridge", initial_bridge, "[m] initial bridge position (overhead crane; default: the same)");
   app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
   app.add_option("--plant-load-mass-factor", stack.plant_load_mass_factor,
                  "--sim: the simulated load mass is this times the configured one (the controllers assume the "
@@ -78,6 +84,20 @@ int main(int argc, char** argv) {
     runtime::configure_logging("info", "launch");
     std::filesystem::create_directories(log_dir);
     stack.config_path = std::filesystem::absolute(stack.config_path).string();
+    // The whole configuration, validated before any stage starts (each stage would refuse it too).
+    const crane::stack::StackConfig config = crane::stack::load_stack_config(stack.config_path);
+    if (!config.maneuvers.empty()) {
+      const crane::stack::ManeuverConfig& first = config.maneuvers.front();
+      stack.initial_trolley_position = first.initial_trolley_position;
+      stack.initial_slew_angle = first.initial_slew_angle;
+      stack.initial_bridge_position = first.initial_bridge_position;
+    }
+    stack.initial_trolley_position = initial_trolley.value_or(stack.initial_trolley_position);
+    stack.initial_slew_angle = initial_slew.value_or(stack.initial_slew_angle);
+    stack.initial_bridge_position = initial_bridge.value_or(stack.initial_bridge_position);
+    spdlog::info("{} crane ({}), starting at trolley {} m, slew {} rad, bridge {} m", to_string(config.facts.crane_kind),
+                 stack.config_path, stack.initial_trolley_position, stack.initial_slew_angle,
+                 stack.initial_bridge_position);
     stack.log_directory = std::filesystem::absolute(log_dir).string();
     stack.fault_log_path =
         std::filesystem::absolute(fault_log.empty() ? std::filesystem::path(log_dir) / "faults.jsonl"

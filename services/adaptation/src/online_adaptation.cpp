@@ -115,6 +115,12 @@ void validate(const OnlineAdaptationParams& p) {
   common::require_in_range(f + ".min_mass", p.min_mass, 0.0, 1e6);
   common::require_greater(f + ".max_mass", p.max_mass, p.min_mass);
   common::require_finite(f + ".max_mass", p.max_mass);
+  // The configured load must be a payload the estimate may report: [min_mass, max_mass] brackets it.
+  if (p.crane.load_mass < p.min_mass || p.crane.load_mass > p.max_mass) {
+    throw common::ConfigError(f + ".min_mass, max_mass = [" + common::format_value(p.min_mass) + ", " +
+                              common::format_value(p.max_mass) + "] kg is out of range: must contain crane.load_mass = " +
+                              common::format_value(p.crane.load_mass) + " kg");
+  }
   common::require_greater(f + ".friction_relative_bound", p.friction_relative_bound, 0.0);
   common::require_in_range(f + ".friction_relative_bound", p.friction_relative_bound, 0.0, 10.0);
   common::require_greater(f + ".min_friction_factor", p.min_friction_factor, 0.0);

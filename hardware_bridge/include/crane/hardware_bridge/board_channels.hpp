@@ -1,14 +1,13 @@
 #pragma once
 // Channels of the crane's interface board, as in the dissertation's lab setup (H. M. Omar, "Control
-// of Gantry and Tower Cranes", Virginia Tech 2003, section 4.1): four quadrature encoder counters,
-// three analog outputs and a few digital lines; an overhead (bridge) crane adds its bridge axis: a
-// fifth counter, a fourth analog output, a brake line and two runway limit switches.
-//
-// The bridge's channels are the last of each kind, so a crane uses the first N of each
-// (counter_count(), analog_output_count(), digital_output_count(), digital_input_count() of
-// `bridge_axis`): every channel on an overhead crane (crane.kind: overhead), all but the bridge's
-// on a tower or gantry crane, whose configuration has no bridge entries and whose board is never
-// asked for them.
+// of Gantry and Tower Cranes", Virginia Tech 2003, section 4.1): quadrature encoder counters,
+// analog outputs and a few digital lines. Every crane has the trolley's counter, drive, brake line
+// and limit switches, the two swing encoders, the hoist's output and brake line, the drive enable
+// and the emergency stop; a tower crane adds its slew's (counter, drive, brake line, limit
+// switches), an overhead (bridge) crane its bridge's (counter, drive, brake line, runway limit
+// switches), a gantry crane neither (BoardAxes, one per crane.kind: board_axes() of
+// bridge_config.hpp). The configuration of a crane names exactly its channels; the board is never
+// asked for the others (uses()).
 //
 // Digital lines are exchanged with the Board as *logical* words: bit number = the enumerator's
 // value, 1 = active (an output energized, an input pressed / a limit reached). Mapping to the
@@ -77,37 +76,57 @@ inline constexpr std::uint32_t kLimitSwitchMask = 0x6FU;
 [[nodiscard]] constexpr std::uint32_t bit(DigitalOutput line) noexcept { return 1U << static_cast<unsigned>(line); }
 [[nodiscard]] constexpr std::uint32_t bit(DigitalInput line) noexcept { return 1U << static_cast<unsigned>(line); }
 
-/// The channels of each kind a crane uses: the first N (the bridge's are the last of each kind).
-[[nodiscard]] constexpr std::size_t counter_count(bool bridge_axis) noexcept {
-  return bridge_axis ? kCounterCount : kCounterCount - 1;
-}
-[[nodiscard]] constexpr std::size_t analog_output_count(bool bridge_axis) noexcept {
-  return bridge_axis ? kAnalogOutputCount : kAnalogOutputCount - 1;
-}
-[[nodiscard]] constexpr std::size_t digital_output_count(bool bridge_axis) noexcept {
-  return bridge_axis ? kDigitalOutputCount : kDigitalOutputCount - 1;
-}
-[[nodiscard]] constexpr std::size_t digital_input_count(bool bridge_axis) noexcept {
-  return bridge_axis ? kDigitalInputCount : kDigitalInputCount - 2;
-}
-static_assert(index(CounterChannel::bridge_motor) == kCounterCount - 1 &&
-                  index(AnalogOutput::bridge_drive) == kAnalogOutputCount - 1 &&
-                  index(DigitalOutput::brake_release_bridge) == kDigitalOutputCount - 1 &&
-                  index(DigitalInput::bridge_min_limit) == kDigitalInputCount - 2 &&
-                  index(DigitalInput::bridge_max_limit) == kDigitalInputCount - 1,
-              "the bridge's channels are the last of each kind (counter_count() and the others rely on it)");
+/// The axes beside the trolley, the swings and the hoist whose channels a crane's board has.
+struct BoardAxes {
+  bool slew{true};     // tower crane: the slew's counter, drive, brake line and limit switches
+  bool bridge{false};  // overhead crane: the bridge's counter, drive, brake line and runway limit switches
+  friend constexpr bool operator==(BoardAxes, BoardAxes) = default;
+};
+inline constexpr BoardAxes kTowerCraneAxes{true, false};
+inline constexpr BoardAxes kGantryCraneAxes{false, false};
+inline constexpr BoardAxes kOverheadCraneAxes{false, true};
 
-/// Every brake of the crane released and the drives enabled: the first digital_output_count(bridge_axis) bits.
-[[nodiscard]] constexpr std::uint32_t all_outputs_energized(bool bridge_axis) noexcept {
-  return (1U << digital_output_count(bridge_axis)) - 1U;
+/// Whether a crane with `axes` has the channel (the board is asked for it, the configuration names it).
+[[nodiscard]] constexpr bool uses(BoardAxes axes, CounterChannel channel) noexcept {
+  return channel == CounterChannel::slew_motor ? axes.slew : channel == CounterChannel::bridge_motor ? axes.bridge : true;
+}
+[[nodiscard]] constexpr bool uses(BoardAxes axes, AnalogOutput channel) noexcept {
+  return channel == AnalogOutput::slew_drive ? axes.slew : channel == AnalogOutput::bridge_drive ? axes.bridge : true;
+}
+[[nodiscard]] constexpr bool uses(BoardAxes axes, DigitalOutput line) noexcept {
+  return line == DigitalOutput::brake_release_slew     ? axes.slew
+         : line == DigitalOutput::brake_release_bridge ? axes.bridge
+                                                       : true;
+}
+[[nodiscard]] constexpr bool uses(BoardAxes axes, DigitalInput line) noexcept {
+  return line == DigitalInput::slew_min_limit || line == DigitalInput::slew_max_limit       ? axes.slew
+         : line == DigitalInput::bridge_min_limit || line == DigitalInput::bridge_max_limit ? axes.bridge
+                                                                                             : true;
+}
+
+/// Every brake of the crane released and the drives enabled: the bits of the output lines it uses.
+[[nodiscard]] constexpr std::uint32_t all_outputs_energized(BoardAxes axes) noexcept {
+  std::uint32_t word = 0;
+  for (std::size_t i = 0; i < kDigitalOutputCount; ++i) {
+    if (uses(axes, static_cast<DigitalOutput>(i))) word |= 1U << i;
+  }
+  return word;
+}
+/// The brake lines of the crane's travel axes (trolley, slew, bridge: the hoist's is its own).
+[[nodiscard]] constexpr std::uint32_t travel_brake_lines(BoardAxes axes) noexcept {
+  return all_outputs_energized(axes) & ~(bit(DigitalOutput::brake_release_hoist) | bit(DigitalOutput::drive_enable));
 }
 /// Mask of the defined bits of a logical input word.
 inline constexpr std::uint32_t kAllInputsMask = (1U << kDigitalInputCount) - 1U;
 static_assert(kLimitSwitchMask == (kAllInputsMask & ~bit(DigitalInput::emergency_stop)),
               "every input but the emergency stop is a limit switch");
-/// The limit switches a crane has: kLimitSwitchMask without the bridge's on a crane without a bridge.
-[[nodiscard]] constexpr std::uint32_t limit_switch_mask(bool bridge_axis) noexcept {
-  return kLimitSwitchMask & ((1U << digital_input_count(bridge_axis)) - 1U);
+/// The limit switches a crane has: kLimitSwitchMask without the slew's or the bridge's where it has none.
+[[nodiscard]] constexpr std::uint32_t limit_switch_mask(BoardAxes axes) noexcept {
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < kDigitalInputCount; ++i) {
+    if (uses(axes, static_cast<DigitalInput>(i))) mask |= 1U << i;
+  }
+  return mask & kLimitSwitchMask;
 }
 
 /// snake_case names for messages ("trolley_motor", ...); "unknown" for an invalid value.

@@ -7,9 +7,9 @@
 // emulated (shm) board uses only counter_bits: its registers use the logical layout of
 // board_channels.hpp.
 //
-// bridge_axis (true on an overhead crane, crane.kind: overhead) selects which channels exist: the
-// bridge's entries of the arrays below (their last elements) are used, validated and checked
-// against the driver only when it is set (board_channels.hpp, counter_count() and the others).
+// `axes` (board_axes(crane.kind)) selects which channels exist: the slew's entries of the arrays
+// below are used, validated and checked against the driver on a tower crane only, the bridge's on
+// an overhead crane only (board_channels.hpp, uses()).
 
 #include <array>
 
@@ -25,9 +25,9 @@ struct ComediChannel {
 
 struct BoardConfig {
   int counter_bits{24};  // [bit] width of the counter registers (they wrap), in [2, 32]
-  /// The crane has a bridge axis (overhead crane): its counter, analog output, brake line and
-  /// runway limit switches are used. false: they are ignored (tower and gantry cranes).
-  bool bridge_axis{false};
+  /// The slew's channels are used on a tower crane, the bridge's (counter, analog output, brake
+  /// line, runway limit switches) on an overhead crane; elsewhere they are ignored.
+  BoardAxes axes{kTowerCraneAxes};
 
   /// Counter of each encoder, indexed by CounterChannel (some boards have one subdevice per counter).
   std::array<ComediChannel, kCounterCount> counters{{{0, 0}, {0, 1}, {0, 2}, {0, 3}, {0, 4}}};
@@ -46,7 +46,7 @@ struct BoardConfig {
 };
 
 /// Throws common::ConfigError naming the field (prefixed by `prefix`), the value and the bound, for
-/// the channels the crane uses (bridge_axis):
+/// the channels the crane uses (axes):
 /// counter_bits outside [2, 32]; a negative subdevice, channel or range index; a bit outside
 /// [0, 31]; two analog outputs on the same channel; two counters on the same subdevice/channel; two
 /// functions on the same digital bit (inputs and outputs sharing one subdevice included).

@@ -5,11 +5,12 @@
 // actuation gate's, supervisor/actuation_gate.hpp, which the simulated plant applies too: both
 // behave the same under every fault. This adds what is the board's: the hoist speed converted to
 // volts (hoist_speed / hoist_speed_per_volt), every output clamped to its DAC range and quantized,
-// brakes released and drives enabled (all_outputs_energized(bridge_axis)), or the safe outputs (0 V
-// on every analog output, every brake engaged, drives disabled: safe_outputs()). On an overhead
-// crane (bridge_axis) the gated bridge voltage goes to AnalogOutput::bridge_drive like the trolley's
-// and its brake line is released with the others; elsewhere that output stays at 0 V and its
-// brake line at 0. Pure: no clock, no I/O, no threads.
+// brakes released and drives enabled (all_outputs_energized(axes)), or the safe outputs (0 V on
+// every analog output, every brake engaged, drives disabled: safe_outputs()). Only the crane's
+// outputs are driven (BoardAxes): on a tower crane the slew's drive and brake line, on an overhead
+// crane the bridge's (the gated bridge voltage to AnalogOutput::bridge_drive like the trolley's);
+// an output the crane does not have stays at 0 V and its brake line at 0. Pure: no clock, no I/O,
+// no threads.
 //
 // Errors: the constructor throws common::ConfigError naming the field, value and bound. step() and
 // safe_outputs() never throw and never allocate.
@@ -27,7 +28,7 @@ namespace crane::hardware_bridge {
 struct BridgeParams {
   supervisor::ActuationGateParams gate{};  // the actuation gate (the `actuation:` block)
   double hoist_speed_per_volt{0.05};       // [m/s/V] hoist speed per volt of the hoist output, > 0
-  bool bridge_axis{false};                 // overhead crane: drive the bridge's output and brake line
+  BoardAxes axes{kTowerCraneAxes};         // the crane's axes: whose outputs and brake lines are driven
 };
 
 /// Throws common::ConfigError naming the field (the gate's prefixed "actuation", the rest by
@@ -46,7 +47,7 @@ struct BridgeOutput {
   SafeStateReason safe_state_reason{SafeStateReason::no_command_yet};
   bool clamped{false};                // the applied command was limited (supervisor limit or range)
   double applied_trolley_voltage{0.0};  // [V] the voltage of the code written
-  double applied_slew_voltage{0.0};     // [V]
+  double applied_slew_voltage{0.0};     // [V] (tower crane; 0 elsewhere)
   double applied_hoist_speed{0.0};      // [m/s] the hoist output's voltage times hoist_speed_per_volt
   double applied_bridge_voltage{0.0};   // [V] the voltage of the code written (overhead crane; 0 elsewhere)
   bool brakes_engaged{true};
@@ -57,9 +58,9 @@ class BridgeCore {
  public:
   /// `ranges`: the board's analog output ranges (Board::analog_ranges()), indexed by AnalogOutput.
   /// Throws common::ConfigError for invalid params, or a range of a used output
-  /// (analog_output_count(params.bridge_axis)) that is not valid (is_valid) or does not contain
-  /// 0 V (the safe output), naming the channel ("analog_range.slew_drive ..."). The range of an
-  /// unused output (the bridge's on a tower crane) must be valid or default-constructed.
+  /// (uses(params.axes, ...)) that is not valid (is_valid) or does not contain 0 V (the safe
+  /// output), naming the channel ("analog_range.slew_drive ..."). The range of an unused output
+  /// (the bridge's on a tower crane) must be valid or default-constructed.
   BridgeCore(const BridgeParams& params, const std::array<AnalogRange, kAnalogOutputCount>& ranges);
 
   /// One cycle (rules in the file comment). Fills `output` completely. noexcept, no allocation.

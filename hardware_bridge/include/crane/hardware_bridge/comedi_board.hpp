@@ -8,9 +8,10 @@
 //   ComediBoard          the Board: opens the device, checks the configured subdevices, channels and
 //                        bits against what the driver reports, reads the analog output ranges and
 //                        maxdata once, then reads counters and writes codes (converting nothing).
-//                        Only the channels of the crane (BoardConfig::bridge_axis: the bridge's on
-//                        an overhead crane) are checked, read and written; the bridge's counter
-//                        reads 0 and its analog output range is the default one elsewhere.
+//                        Only the channels of the crane (BoardConfig::axes: the slew's on a tower
+//                        crane, the bridge's on an overhead crane) are checked, read and written; a
+//                        counter the crane does not have reads 0 and the range of such an analog
+//                        output is the default one.
 //
 // The counters are read with comedi_data_read (range 0, AREF_GROUND); their counting mode
 // (quadrature x4) is the driver's default or configured outside the bridge (no INSN_CONFIG here).
@@ -143,7 +144,7 @@ class ComediBoard final : public Board {
   unsigned digital_output_mask_{0};  // physical bits of the outputs
   // Logical word of the last successful write; unknown at open, so taken as all energized (the
   // first write of a safe word then writes the digital lines first).
-  std::uint32_t last_digital_outputs_{all_outputs_energized(config_.bridge_axis)};
+  std::uint32_t last_digital_outputs_{all_outputs_energized(config_.axes)};
 };
 
 }  // namespace crane::hardware_bridge

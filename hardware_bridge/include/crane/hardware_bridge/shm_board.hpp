@@ -106,7 +106,7 @@ class ShmBoard final : public Board {
   std::uint32_t counter_mask_;
   std::array<AnalogRange, kAnalogOutputCount> ranges_;
   std::uint64_t answered_tick_{0};  // tick of the counters last read: written as outputs_tick
-  bool bridge_axis_{false};         // BoardConfig::bridge_axis: describe() names the bridge's output
+  BoardAxes axes_{};                // BoardConfig::axes: describe() names the crane's outputs
 };
 
 /// Snapshot of what the driver last wrote (one consistent write_outputs() call).

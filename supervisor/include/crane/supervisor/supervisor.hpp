@@ -143,6 +143,9 @@ struct SupervisorParams {
   double trolley_stop_margin{0.03};      // [m]
   double trolley_approach_speed{0.1};    // [m/s]
   double trolley_max_speed{1.0};         // [m/s]
+  // A tower crane's slew (crane.kind = tower; slew_enabled false elsewhere: no slew limits, no slew
+  // limiter or overspeed, the slew drive's voltage limit 0).
+  bool slew_enabled{true};
   double slew_min{-3.3};             // [rad] hard slew limit
   double slew_max{3.3};              // [rad]
   double slew_approach_margin{0.3};  // [rad]

@@ -65,8 +65,8 @@ struct OnlineAdaptationParams {
   double max_condition{1e4};             // [-] AxisIdentifierParams::max_condition, >= 1
   double solve_period{0.1};              // [s] the estimate is re-solved at most this often, >= T
   double mass_relative_bound{0.05};      // [-] confident while bound <= this x mass, in (0, 1]
-  double min_mass{0.0};                  // [kg] >= 0
-  double max_mass{20.0};                 // [kg] > min_mass
+  double min_mass{0.0};                  // [kg] >= 0, <= crane.load_mass
+  double max_mass{20.0};                 // [kg] > min_mass, >= crane.load_mass
   double friction_relative_bound{0.2};   // [-] a coefficient is released while 2 sigma <= this x value
   double min_friction_factor{0.5};       // [-] safe range of a released coefficient, x configured, in (0, 1]
   double max_friction_factor{2.0};       // [-] >= 1
