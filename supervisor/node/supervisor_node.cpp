@@ -263,7 +263,10 @@ int main(int argc, char** argv) {
         pending_command = false;
         const auto code = command_plain.command;
         const std::string name(protocol::code_name(protocol::SupervisorCommand::kCodes, "COMMAND", code));
-        if (out.command_refused) {
+        if (out.command_refused && out.zone_refusal != supervisor::ZoneRefusal::none) {
+          spdlog::warn("command {} (request {}) refused: {}", name, status_plain.last_request_id,
+                       supervisor::describe(out.zone_refusal, stage.core().params().site, in.command_zone));
+        } else if (out.command_refused) {
           spdlog::warn("command {} (request {}) refused: mode {}, latched faults 0x{:x}, active 0x{:x}, stages "
                        "alive 0x{:x}", name, status_plain.last_request_id, supervisor::mode_name(out.mode),
                        out.latched_faults, out.active_faults, out.stages_alive);

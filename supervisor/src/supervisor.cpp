@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <string_view>
 
@@ -68,7 +69,98 @@ AxisVerdict check_axis(const AxisLimits& a, double position, double velocity) no
   return v;
 }
 
+// The trolley's point at (trolley [m], slew [rad]), horizontal, world frame.
+common::Point2 trolley_point(double trolley, double slew) noexcept {
+  return {trolley * std::cos(slew), trolley * std::sin(slew)};
+}
+
 }  // namespace
+
+ZoneVerdict zone_guard(const SupervisorParams& p, std::uint32_t enabled, const ZoneState& s) noexcept {
+  ZoneVerdict v;
+  const common::Site& site = p.site;
+  if (enabled == 0 || site.zones.empty()) return v;
+  const double length = std::max(s.cable_length, 1e-3);
+  const double w = std::sqrt(p.gravity / length);
+  const auto load = common::load_position(site, s.trolley, s.slew, s.swing_in_plane, s.swing_out_of_plane, length);
+  const common::Point2 load_xy{load[0], load[1]};
+  v.inside = common::intruded_zone(site, enabled, load_xy, load[2], 0.0);
+
+  // The load's swing about the trolley's point: offset u, rate du/dt (the load's velocity minus the
+  // point's), amplitude |u(t)| <= sqrt(|u|^2 + |du/dt|^2 / w^2) (Cauchy-Schwarz on the ellipse).
+  const common::Point2 now = trolley_point(s.trolley, s.slew);
+  const common::Point2 offset{load_xy[0] - now[0], load_xy[1] - now[1]};
+  const double c = std::cos(s.slew), sn = std::sin(s.slew);
+  const common::Point2 point_velocity{s.trolley_velocity * c - s.trolley * s.slew_rate * sn,
+                                      s.trolley_velocity * sn + s.trolley * s.slew_rate * c};
+  const double rate_x = s.load_velocity[0] - point_velocity[0], rate_y = s.load_velocity[1] - point_velocity[1];
+  const double amplitude = std::sqrt(offset[0] * offset[0] + offset[1] * offset[1] + (rate_x * rate_x + rate_y * rate_y) / (w * w));
+
+  // Soft stop: ramp after the shaper's delay; the load about the trolley's rest point within the
+  // swing's amplitude, plus what an unshaped stop excites (the point's speed / w).
+  const double delay = s.stop == SoftStop::shaped ? p.zone_stop_delay_periods * 2.0 * std::numbers::pi / w : 0.0;
+  const auto ramp = [](double speed, double deceleration) { return speed * std::fabs(speed) / (2.0 * deceleration); };
+  const double x_soft = s.trolley + ramp(s.trolley_velocity, p.trolley_braking_deceleration) + s.trolley_velocity * delay;
+  const double g_soft = s.slew + ramp(s.slew_rate, p.slew_braking_deceleration) + s.slew_rate * delay;
+  const common::Point2 soft = trolley_point(x_soft, g_soft);
+  const double excited = s.stop == SoftStop::unshaped ? std::hypot(point_velocity[0], point_velocity[1]) / w : 0.0;
+  if (s.stop == SoftStop::planned) {
+    // The load's offset carried to the rest point, no margin (the planner's paths keep their own).
+    v.limit = common::intruded_zone(site, enabled, {soft[0] + offset[0], soft[1] + offset[1]}, load[2], 0.0);
+    v.approach = v.limit;
+  } else {
+    v.limit = common::intruded_zone(site, enabled, soft, load[2], amplitude + excited);
+    v.approach = common::intruded_zone(site, enabled, soft, load[2], amplitude + excited + p.zone_approach_margin);
+  }
+  v.limit_trolley = v.limit >= 0 && s.trolley_velocity * s.trolley_acceleration > 0.0;
+  v.limit_slew = v.limit >= 0 && s.slew_rate * s.slew_acceleration > 0.0;
+
+  // Brake envelope, while the crane moves (as the travel limiter's "moving toward": a tenth of
+  // the approach speeds; a load at rest beside a zone may stay there).
+  const bool moving = std::fabs(s.trolley_velocity) > 0.1 * std::max(p.trolley_approach_speed, 1e-6) ||
+                      std::fabs(s.slew_rate) > 0.1 * std::max(p.slew_approach_rate, 1e-6);
+  if (moving) {
+    const common::Point2 stop = trolley_point(s.trolley + ramp(s.trolley_velocity, p.trolley_braking_deceleration),
+                                              s.slew + ramp(s.slew_rate, p.slew_braking_deceleration));
+    constexpr int kPhases = 24;
+    for (const common::Point2& centre : {now, stop}) {
+      for (int i = 0; i < kPhases && v.brake < 0; ++i) {
+        const double phase = 2.0 * std::numbers::pi * i / kPhases;
+        const double cp = std::cos(phase), sp = std::sin(phase) / w;
+        const common::Point2 q{centre[0] + offset[0] * cp + s.load_velocity[0] * sp,
+                               centre[1] + offset[1] * cp + s.load_velocity[1] * sp};
+        v.brake = common::intruded_zone(site, enabled, q, load[2], p.zone_brake_margin);
+      }
+    }
+    // Only toward the zone (the trolley's point closer to it at the soft stop's rest than now): a
+    // crane moving away or along it is not stopped (braking would not keep a swinging load out);
+    // in FULLAUTOMATIC only with the ramp-only prediction in the zone (a planned path passing it).
+    if (v.brake >= 0) {
+      const common::Zone& zone = site.zones[static_cast<std::size_t>(v.brake)];
+      const bool toward = common::signed_distance(zone, soft) < common::signed_distance(zone, now);
+      if (!toward || (s.stop == SoftStop::planned && v.approach < 0)) v.brake = -1;
+    }
+  }
+  return v;
+}
+
+ZoneRefusal zone_command_refusal(const common::Site& site, Command command, std::uint8_t zone) noexcept {
+  if (zone >= site.zones.size() || zone >= common::Site::kMaxZones) return ZoneRefusal::no_such_zone;
+  if (command == Command::disable_zone && site.zones[zone].fixed) return ZoneRefusal::fixed;
+  return ZoneRefusal::none;
+}
+
+std::string describe(ZoneRefusal refusal, const common::Site& site, std::uint8_t zone) {
+  switch (refusal) {
+    case ZoneRefusal::none: return "";
+    case ZoneRefusal::no_such_zone:
+      return "no zone " + std::to_string(zone) + ": site.zones has " + std::to_string(site.zones.size());
+    case ZoneRefusal::fixed:
+      return "site.zones[" + std::to_string(zone) + "] (" + site.zones[zone].name +
+             ") is fixed: it stays enforced (switching it off is refused)";
+  }
+  return "";
+}
 
 void validate(const SupervisorParams& p) {
   using common::require_in_range;
@@ -95,6 +187,10 @@ void validate(const SupervisorParams& p) {
   require_in_range("supervisor.sample_period", p.sample_period, 1e-4, 1.0);
   require_in_range("supervisor.expected_sensor_source", p.expected_sensor_source, 0.0, 2.0);
   require_in_range("supervisor.trolley_braking_deceleration", p.trolley_braking_deceleration, 1e-3, 1e3);
+  require_in_range("supervisor.zone_stop_delay_periods", p.zone_stop_delay_periods, 0.0, 3.0);
+  require_in_range("supervisor.zone_approach_margin", p.zone_approach_margin, 0.0, 10.0);
+  require_in_range("supervisor.zone_brake_margin", p.zone_brake_margin, 0.0, 1.0);
+  require_in_range("supervisor.gravity", p.gravity, 0.1, 100.0);
   common::validate(p.site, "site");
 }
 
@@ -122,24 +218,39 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   // Velocities from the sensor stream itself (seq differences), not from the state estimator.
   const bool finite_sensors =
       std::isfinite(in.trolley_position) && std::isfinite(in.slew_angle) && std::isfinite(in.bridge_position);
+  const bool load_valid = std::isfinite(in.cable_length) && std::isfinite(in.swing_in_plane) &&
+                          std::isfinite(in.swing_out_of_plane);
+  const auto load = common::load_position(params_.site, in.trolley_position, in.slew_angle, in.swing_in_plane,
+                                          in.swing_out_of_plane, in.cable_length);
   if (in.sensors_valid && finite_sensors) {
     if (have_previous_sample_ && in.sensor_seq > previous_sensor_seq_) {
       const double dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
-      trolley_velocity_ = (in.trolley_position - previous_trolley_) / dt;
-      slew_rate_ = (in.slew_angle - previous_slew_) / dt;
+      const double trolley_velocity = (in.trolley_position - previous_trolley_) / dt;
+      const double slew_rate = (in.slew_angle - previous_slew_) / dt;
+      trolley_acceleration_ = (trolley_velocity - trolley_velocity_) / dt;
+      slew_acceleration_ = (slew_rate - slew_rate_) / dt;
+      trolley_velocity_ = trolley_velocity;
+      slew_rate_ = slew_rate;
       // Consecutive samples over the speed limit (kOverspeedSamples in the header).
       trolley_overspeed_samples_ = std::fabs(trolley_velocity_) > params_.trolley().max_speed ? trolley_overspeed_samples_ + 1 : 0;
       slew_overspeed_samples_ = std::fabs(slew_rate_) > params_.slew().max_speed ? slew_overspeed_samples_ + 1 : 0;
       bridge_velocity_ = (in.bridge_position - previous_bridge_) / dt;
+      if (load_valid) {
+        load_velocity_ = {(load[0] - previous_load_[0]) / dt, (load[1] - previous_load_[1]) / dt};
+      }
       bridge_overspeed_samples_ = std::fabs(bridge_velocity_) > params_.bridge().max_speed ? bridge_overspeed_samples_ + 1 : 0;
     } else if (!have_previous_sample_ || in.sensor_seq < previous_sensor_seq_) {
       trolley_velocity_ = 0.0;  // first sample, or the sensor writer restarted
       slew_rate_ = 0.0;
+      trolley_acceleration_ = 0.0;
+      slew_acceleration_ = 0.0;
       trolley_overspeed_samples_ = 0;
       slew_overspeed_samples_ = 0;
       bridge_velocity_ = 0.0;
       bridge_overspeed_samples_ = 0;
+      load_velocity_ = {};
     }
+    if (load_valid) previous_load_ = {load[0], load[1]};
     have_previous_sample_ = true;
     previous_sensor_seq_ = in.sensor_seq;
     previous_trolley_ = in.trolley_position;
@@ -188,27 +299,32 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       active |= kFaultSwing;
     }
     if (in.limit_switches != 0) active |= kFaultLimitSwitch;
-    if (zones_enabled_ != 0 && std::isfinite(in.cable_length) && std::isfinite(in.swing_in_plane) &&
-        std::isfinite(in.swing_out_of_plane)) {
-      // The load itself, then where it stops if both drives brake now.
-      const common::Site& site = params_.site;
-      const auto load = common::load_position(site, in.trolley_position, in.slew_angle, in.swing_in_plane,
-                                              in.swing_out_of_plane, in.cable_length);
-      const int inside = common::intruded_zone(site, zones_enabled_, {load[0], load[1]}, load[2], 0.0);
-      const double x_stop = in.trolley_position +
-                            trolley_velocity_ * std::fabs(trolley_velocity_) / (2.0 * params_.trolley_braking_deceleration);
-      const double slew_stop =
-          in.slew_angle + slew_rate_ * std::fabs(slew_rate_) / (2.0 * params_.slew_braking_deceleration);
-      const auto stop = common::load_position(site, x_stop, slew_stop, in.swing_in_plane, in.swing_out_of_plane,
-                                              in.cable_length);
-      const int ahead = common::intruded_zone(site, zones_enabled_, {stop[0], stop[1]}, stop[2], 0.0);
-      if (inside >= 0) {
+    if (zones_enabled_ != 0 && load_valid) {
+      ZoneState state;
+      state.trolley = in.trolley_position;
+      state.trolley_velocity = trolley_velocity_;
+      state.slew = in.slew_angle;
+      state.slew_rate = slew_rate_;
+      state.swing_in_plane = in.swing_in_plane;
+      state.swing_out_of_plane = in.swing_out_of_plane;
+      state.cable_length = in.cable_length;
+      state.load_velocity = load_velocity_;
+      state.stop = operating_mode_ == StatusCodes::OPERATION_MAINTENANCE     ? SoftStop::unshaped
+                   : operating_mode_ == StatusCodes::OPERATION_FULLAUTOMATIC ? SoftStop::planned
+                                                                             : SoftStop::shaped;
+      state.trolley_acceleration = trolley_acceleration_;
+      state.slew_acceleration = slew_acceleration_;
+      const ZoneVerdict zone = zone_guard(params_, zones_enabled_, state);
+      if (zone.inside >= 0 || zone.brake >= 0) {
         active |= kFaultZone;
-        out.zone = inside;
-      } else if (ahead >= 0) {
-        warnings |= kWarningZoneApproach;
-        out.zone = ahead;
+        out.zone = zone.inside >= 0 ? zone.inside : zone.brake;
+      } else if (zone.approach >= 0) {
+        out.zone = zone.approach;
       }
+      if (zone.approach >= 0) warnings |= kWarningZoneApproach;
+      if (zone.limit_trolley) trolley_limit = std::min(trolley_limit, params_.approach_voltage_limit);
+      if (zone.limit_slew) slew_limit = std::min(slew_limit, params_.approach_voltage_limit);
+      if (zone.limit_trolley || zone.limit_slew) warnings |= kWarningSpeedLimited;
     }
     if (params_.expected_sensor_source != 0 && in.sensor_source != params_.expected_sensor_source) {
       active |= kFaultSensorSource;
@@ -251,6 +367,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   latched_ |= active;
 
   bool refused = false;
+  out.zone_refusal = ZoneRefusal::none;
   switch (in.command) {
     case Command::arm:
       // Arming needs a healthy chain and nothing latched (a reset comes first).
@@ -269,7 +386,8 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       break;
     case Command::enable_zone:
     case Command::disable_zone:
-      refused = in.command_zone >= params_.site.zones.size();
+      out.zone_refusal = zone_command_refusal(params_.site, in.command, in.command_zone);
+      refused = out.zone_refusal != ZoneRefusal::none;
       if (!refused) {
         const std::uint32_t bit = 1U << in.command_zone;
         zones_enabled_ = in.command == Command::enable_zone ? (zones_enabled_ | bit) : (zones_enabled_ & ~bit);

@@ -41,8 +41,12 @@ SupervisorParams read_params(config::YamlSection& s, const common::StackFacts& f
   p.arm_on_start = s.flag("arm_on_start");
   p.trolley_braking_deceleration = s.number("trolley_braking_deceleration", 1e-3, 1e3);
   if (p.slew_enabled) p.slew_braking_deceleration = s.number("slew_braking_deceleration", 1e-3, 1e3);
+  p.zone_stop_delay_periods = s.number("zone_stop_delay_periods", 0.0, 3.0);
+  p.zone_approach_margin = s.number("zone_approach_margin", 0.0, 10.0);
+  p.zone_brake_margin = s.number("zone_brake_margin", 0.0, 1.0);
   s.finish();
   p.site = facts.site;
+  p.gravity = facts.crane.gravity;
   validate(p);
   return p;
 }

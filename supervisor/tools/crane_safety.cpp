@@ -10,7 +10,8 @@
 // Exit codes: 0 done (command accepted / status printed), 1 no supervisor answered within
 // --timeout, 2 bad usage, 3 the supervisor refused the command (the reason is in its log: arm needs
 // a healthy chain and no latched fault, reset needs a healthy chain and no active fault, zone needs
-// an index of site.zones).
+// an index of site.zones and disable one that is not fixed). With --config (deploy/crane passes its
+// configuration) a refused zone command names the zone and why (supervisor::zone_command_refusal).
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -23,7 +24,9 @@
 #include <thread>
 #include <vector>
 
+#include "crane/config/config_document.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/supervisor/supervisor.hpp"
 #include "crane/runtime/node_runtime.hpp"
 
 namespace {
@@ -52,6 +55,19 @@ std::string quoted_list(std::uint32_t bits) { return "[" + bit_names("FAULT", bi
 std::string stage_list(std::uint32_t alive, bool want_alive) { return bit_names("STAGE", alive, want_alive, ",", ""); }
 std::string code_name(std::string_view group, std::uint64_t value) {
   return std::string(protocol::code_name(Status::kCodes, group, value));
+}
+
+// Why the supervisor refused a zone command, from the configuration it runs with (the same rule).
+std::string zone_refusal_text(const std::string& config_path, std::uint8_t command, std::uint8_t zone) {
+  if (config_path.empty()) return "zone " + std::to_string(zone) + ": not in site.zones, or fixed (--config names it)";
+  try {
+    const auto site = config::ConfigDocument::load(config_path).facts().site;
+    const auto refusal = supervisor::zone_command_refusal(site, static_cast<supervisor::Command>(command), zone);
+    if (refusal != supervisor::ZoneRefusal::none) return supervisor::describe(refusal, site, zone);
+    return "zone " + std::to_string(zone) + ": " + config_path + " allows it (the supervisor runs another configuration?)";
+  } catch (const std::exception& error) {
+    return "zone " + std::to_string(zone) + ": " + error.what();
+  }
 }
 
 std::string zone_list(std::uint32_t enabled) {
@@ -207,6 +223,8 @@ int main(int argc, char** argv) {
   runtime::add_security_options(app, options);  // identity: the participant's, "operator"
   app.add_option("--timeout", timeout, "[s] longest wait for the supervisor")->check(CLI::Range(0.1, 60.0));
   app.add_flag("--json", json, "status as one JSON object");
+  std::string config_path;
+  app.add_option("--config", config_path, "the stack's configuration (a refused zone command names the zone)");
   CLI11_PARSE(app, argc, argv);
   using Command = protocol::SupervisorCommand;
   std::uint8_t operating_mode = 0, zone = 0;
@@ -319,7 +337,9 @@ int main(int argc, char** argv) {
                     accepted ? "accepted" : "refused", code_name("MODE", status.mode()).c_str(),
                     code_name("OPERATION", status.operating_mode()).c_str(), zone_list(status.zones_enabled()).c_str(),
                     status.brakes_released() ? "released" : "engaged");
-        if (!accepted) {
+        if (!accepted && action == "zone") {
+          std::printf("  %s\n", zone_refusal_text(config_path, zone_command, zone).c_str());
+        } else if (!accepted) {
           std::printf("  latched faults: %s; active: %s; silent stages: %s\n",
                       status.latched_faults() ? fault_list(status.latched_faults()).c_str() : "none",
                       status.active_faults() ? fault_list(status.active_faults()).c_str() : "none",

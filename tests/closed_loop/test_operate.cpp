@@ -11,6 +11,7 @@
 #include <numbers>
 #include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "crane/stack/in_process_stack.hpp"
@@ -249,6 +250,102 @@ TEST(OperatingModes, GoalsAndSpeedsFollowTheModeAndAChangeWhileMovingStopsFirst)
   EXPECT_EQ(s.status().latched_faults, 0U);
 }
 
+// MAINTENANCE (OPC 40020): every operator speed at manual.maintenance_speed_fraction of the rated
+// speed, and no sway control of the operator's speeds (ramp only): the reference stops as soon as
+// its ramp ends, where MANUAL's shaper lets it run on for its length. The stack's feedback
+// anti-swing law is not a planner matter and still runs (docs/operation.md, "Operating modes").
+TEST(OperatingModes, MaintenanceRunsAtTheReducedSpeedWithoutSwayControl) {
+  const auto config = long_jib(lab());
+  const auto& m = config.trajectory_planner.manual;
+  struct Run {
+    double top_speed{0.0};        // [m/s] the reference's largest trolley speed
+    double stop_time{0.0};        // [s] from the release to the reference at rest
+    double residual{0.0};         // [rad] swing 2 s after the reference stopped, for 4 s
+  };
+  const auto run = [&](std::uint8_t mode) {
+    stack::InProcessStack s(config, {});
+    const auto command = set_mode(1, mode);
+    Run r;
+    std::optional<std::uint64_t> stopped;
+    for (std::uint64_t k = 0; k < 2500; ++k) {
+      const auto speed = stick(k, k >= 400 && k < 700 ? 1.0 : 0.0, 0.0);
+      s.step({}, k >= 400 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &command : nullptr);
+      r.top_speed = std::max(r.top_speed, std::abs(s.reference().trolley_velocity));
+      if (k >= 700 && !stopped && !s.planner().under_speed_control()) {
+        stopped = k;
+        r.stop_time = static_cast<double>(k - 700) * 0.01;
+      }
+      if (stopped && k >= *stopped + 200) r.residual = std::max(r.residual, swing_of(s));
+      if (stopped && k >= *stopped + 600) break;
+    }
+    EXPECT_EQ(s.status().operating_mode, mode);
+    EXPECT_EQ(s.status().latched_faults, 0U);
+    EXPECT_TRUE(stopped.has_value());
+    return r;
+  };
+  const Run maintenance = run(Status::OPERATION_MAINTENANCE);
+  const Run manual = run(Status::OPERATION_MANUAL);
+  const double reduced = m.maintenance_speed_fraction * m.trolley.rated_speed;
+  std::printf("full trolley stick 3 s, released: MAINTENANCE top speed %.4f m/s (%.0f %% of rated), reference at rest "
+              "%.2f s after the release, residual swing %.3f deg; MANUAL %.4f m/s, %.2f s, %.3f deg\n",
+              maintenance.top_speed, 100.0 * maintenance.top_speed / m.trolley.rated_speed, maintenance.stop_time,
+              maintenance.residual * kDeg, manual.top_speed, manual.stop_time, manual.residual * kDeg);
+  EXPECT_NEAR(maintenance.top_speed, reduced, 1e-9);
+  EXPECT_NEAR(manual.top_speed, m.trolley.rated_speed, 1e-9);
+  // Ramp only: at rest one ramp (v / a) after the release, give or take the cycles of the
+  // hand-over and the at-rest check; MANUAL's shaper adds its length (ZVD: a swing period, > 2 s).
+  EXPECT_LT(maintenance.stop_time, reduced / m.trolley.acceleration + 0.1);
+  EXPECT_GT(manual.stop_time, m.trolley.rated_speed / m.trolley.acceleration + 1.5);
+}
+
+// SEMIAUTOMATIC: goals are taken, and the operator's stick takes over from a running goal (aborted:
+// manual motion); released, the load stops without swing; a new goal is taken again at rest.
+TEST(OperatingModes, SemiautomaticStickTakesOverFromAGoal) {
+  stack::InProcessStack s(long_jib(lab()), {});
+  const auto semi = set_mode(1, Status::OPERATION_SEMIAUTOMATIC);
+  Request goal;
+  goal.request_id = 1;
+  goal.profile = Request::PROFILE_ZVD;
+  goal.axes = Request::AXIS_TROLLEY;
+  goal.trolley_target = 2.0;
+  Request second = goal;
+  second.request_id = 2;
+  second.trolley_target = 0.5;
+  bool moving = false, taken_over = false, second_arrived = false;
+  std::optional<std::uint64_t> stopped;
+  double at_takeover = 0.0, residual = 0.0, furthest = 0.0;
+  for (std::uint64_t k = 0; k < 5000; ++k) {
+    std::span<const Request> goals;
+    if (k == 100) goals = std::span(&goal, 1);
+    if (stopped && k == *stopped + 600) goals = std::span(&second, 1);
+    // The stick, pulled back at 50 % from cycle 200 (1 s into the goal) to 300, then neutral.
+    const auto speed = stick(k, k >= 200 && k < 300 ? -0.5 : 0.0, 0.0);
+    s.step(goals, k >= 150 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &semi : nullptr);
+    for (const auto& f : s.planner().move_statuses()) {
+      if (f.request_id == 1 && f.result == Feedback::RESULT_MOVING) moving = true;
+      if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED) {
+        taken_over = f.reason == Feedback::REASON_MANUAL_MOTION;
+        at_takeover = s.sensors().trolley_position;
+      }
+      if (f.request_id == 2 && f.result == Feedback::RESULT_ARRIVED) second_arrived = true;
+    }
+    furthest = std::max(furthest, s.sensors().trolley_position);
+    if (k > 300 && !stopped && !s.planner().under_speed_control()) stopped = k;
+    if (stopped && k >= *stopped + 200 && k < *stopped + 600) residual = std::max(residual, swing_of(s));
+    if (second_arrived) break;
+  }
+  std::printf("SEMIAUTOMATIC: goal to 2.0 m taken over by the stick at %.3f m (furthest %.3f m), stopped without swing "
+              "(%.3f deg 2 s after), a second goal then %s\n",
+              at_takeover, furthest, residual * kDeg, second_arrived ? "arrived" : "did not arrive");
+  EXPECT_TRUE(moving) << "the goal was taken in SEMIAUTOMATIC";
+  EXPECT_TRUE(taken_over) << "the stick takes over: the goal is aborted, reason manual motion";
+  EXPECT_LT(furthest, 1.9) << "the goal did not run on to its target";
+  ASSERT_TRUE(stopped.has_value());
+  EXPECT_LT(residual * kDeg, 0.5);
+  EXPECT_TRUE(second_arrived);
+  EXPECT_EQ(s.status().latched_faults, 0U);
+}
+
 // --- No-go zones -----------------------------------------------------------------------------
 
 std::size_t count_from_env(const char* name, std::size_t fallback) {
@@ -273,6 +370,16 @@ stack::StackConfig with_zones() {
   c.trajectory_planner.site = site;
   c.supervisor.site = site;
   return c;
+}
+
+std::string fault_name_list(std::uint32_t faults) {
+  std::string names;
+  for (int bit = 0; bit < 32; ++bit) {
+    if ((faults & (1U << bit)) == 0) continue;
+    if (!names.empty()) names += ",";
+    names += protocol::code_name(Status::kCodes, "FAULT", 1U << bit);
+  }
+  return names;
 }
 
 // The load (the plant's own state, swing included) inside an enabled zone.
@@ -441,6 +548,115 @@ TEST(Zones, SeededRandomManualSessionsNeverPutTheLoadInAZone) {
   EXPECT_GT(max_swing * kDeg, 1.0);   // and did move the crane
 }
 
+
+// The supervisor enforces the zones on its own, from the measured state: the planner's zone guard
+// bypassed (its site has no zones; the supervisor's has), a full stick drives the load straight at
+// the building for 12 s (radially with the trolley, or around with the slew), in MANUAL and in
+// MAINTENANCE (no sway control), and a goal runs straight through it in FULLAUTOMATIC (a printed
+// figure: there the supervisor relies on the planner's paths). The
+// supervisor's warning zone_approach makes the planner stop softly (its only zone reaction left);
+// where that stop overshoots the prediction (a stop begun while the shaped speed still rises) the
+// drives' voltage limit and then the brakes (a protective stop) follow, before the load enters.
+// Then the stick back in neutral and, after a protective stop, a reset (the operator's way out).
+// Every sample: the load (the plant's own state, swing included) outside the zone; at the end the
+// crane at rest, the swing below 0.5 deg.
+TEST(Zones, TheSupervisorAloneKeepsTheLoadOutWhenThePlannerGuardIsBypassed) {
+  auto config = with_zones();
+  const auto site = config.facts.site;
+  config.trajectory_planner.site.zones.clear();  // the planner's guard bypassed
+  const double bearing = std::atan2(0.45, 0.65);  // the building's middle seen from the slew axis
+  struct Case {
+    const char* name;
+    std::uint8_t mode;
+    int axis;  // 0 trolley stick, 1 slew stick, 2 a goal through the building
+  };
+  const Case cases[] = {{"MANUAL, trolley stick", Status::OPERATION_MANUAL, 0},
+                        {"MANUAL, slew stick", Status::OPERATION_MANUAL, 1},
+                        {"MAINTENANCE, trolley stick", Status::OPERATION_MAINTENANCE, 0},
+                        {"MAINTENANCE, slew stick", Status::OPERATION_MAINTENANCE, 1},
+                        {"FULLAUTOMATIC, goal through it", Status::OPERATION_FULLAUTOMATIC, 2}};
+  for (const auto& c : cases) {
+    stack::InProcessOptions options;
+    options.initial_trolley_position = c.axis == 1 ? 0.7 : 0.25;
+    options.initial_slew_angle = c.axis == 1 ? -0.6 : bearing;
+    stack::InProcessStack s(config, options);
+    const auto mode = set_mode(1, c.mode);
+    protocol::SupervisorCommand reset;
+    reset.request_id = 2;
+    reset.command = protocol::SupervisorCommand::COMMAND_RESET;
+    Request goal;
+    goal.request_id = 1;
+    goal.profile = Request::PROFILE_ZV;
+    goal.axes = Request::AXIS_TROLLEY;
+    goal.trolley_target = 1.1;
+    std::size_t inside = 0, warned = 0, limited = 0;
+    double closest = 1e9, moved = 0.0;
+    std::uint32_t faults = 0;
+    std::int64_t quiet = -1;  // the cycle the crane came to rest (-1: not at rest)
+    bool zone_abort = false;
+    std::optional<std::uint64_t> reset_cycle;
+    int resets = 0;
+    for (std::uint64_t k = 0; k < 9000; ++k) {
+      // The stick pushed at the zone for 12 s, then neutral; after a protective stop (from 16 s, at
+      // most once a second), a reset and the stick pulled back at 30 % for 2 s (the operator's way
+      // out: the anti-swing law moving the crane toward the zone with the load swinging beside it
+      // may stop it again), then neutral.
+      const double push = c.axis < 2 && k >= 300 && k < 1500 ? 1.0
+                          : reset_cycle && k >= *reset_cycle + 20 && k < *reset_cycle + 220 ? -0.3 : 0.0;
+      const auto speed = stick(k, c.axis == 0 ? push : 0.0, c.axis == 1 ? push : 0.0);
+      const protocol::SupervisorCommand* command = k == 10 && c.axis < 2 ? &mode : nullptr;
+      if (k >= 1600 && (!reset_cycle || k >= *reset_cycle + 100) && s.status().latched_faults != 0 &&
+          s.status().active_faults == 0) {
+        reset.request_id = static_cast<std::uint32_t>(k);
+        command = &reset;
+        reset_cycle = k;
+        ++resets;
+      }
+      s.step(c.axis == 2 && k == 300 ? std::span(&goal, 1) : std::span<const Request>(),
+             k >= 300 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), command);
+      const auto& p = s.plant().simulator().state();
+      const auto load = common::load_position(site, p.trolley_position, p.slew_angle, p.swing_in_plane,
+                                              p.swing_out_of_plane, p.cable_length);
+      if (load_zone(s, site, s.status().zones_enabled) >= 0) ++inside;
+      closest = std::min(closest, common::signed_distance(site.zones[0], {load[0], load[1]}));
+      moved = std::max(moved, std::abs(c.axis == 1 ? p.slew_angle - options.initial_slew_angle
+                                                   : p.trolley_position - options.initial_trolley_position));
+      if (s.status().warnings & Status::WARNING_ZONE_APPROACH) ++warned;
+      if (s.status().motion_enabled && s.status().trolley_voltage_limit < config.supervisor.voltage_limit) ++limited;
+      faults |= s.status().latched_faults;
+      for (const auto& f : s.planner().move_statuses()) {
+        if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED && f.reason == Feedback::REASON_ZONE) zone_abort = true;
+      }
+      // At rest, after the push: trolley and slew still, the swing below 0.5 deg, brakes released, for 2 s.
+      const bool still = std::abs(p.trolley_velocity) < 1e-3 && std::abs(p.slew_rate) < 1e-3 &&
+                         swing_of(s) * kDeg < 0.5 && s.status().brakes_released;
+      if (!still) quiet = -1;
+      if (k >= 1500 && (!reset_cycle || k >= *reset_cycle + 220) && still && quiet < 0) quiet = static_cast<std::int64_t>(k);
+      if (quiet >= 0 && static_cast<std::int64_t>(k) >= quiet + 200) break;
+    }
+    std::printf("supervisor alone, %s: moved %.3f %s toward the building, the load's closest approach %.3f m, %zu cycles "
+                "warned, %zu with the drives limited, protective stop: %s (%d resets, pulled back), at rest at %.1f s; %zu "
+                "samples inside\n",
+                c.name, moved, c.axis == 1 ? "rad" : "m", closest, warned, limited,
+                faults != 0 ? fault_name_list(faults).c_str() : "none", resets,
+                static_cast<double>(quiet) * 0.01, inside);
+    // In FULLAUTOMATIC the supervisor relies on the planner's paths (supervisor.hpp, zone_guard()):
+    // a goal planned through the zone is a figure here, not a bound.
+    if (c.axis < 2) {
+      EXPECT_EQ(inside, 0U) << c.name;
+      EXPECT_GT(closest, 0.0) << c.name;
+    }
+    // Under operator speeds the warning (the planner's soft stop) comes first; in FULLAUTOMATIC the
+    // supervisor predicts the ramp only (supervisor.hpp, SoftStop::planned): its drive limit or brakes.
+    EXPECT_TRUE(warned > 0 || (c.axis == 2 && (limited > 0 || faults != 0))) << c.name << ": the supervisor saw it";
+    EXPECT_GT(moved, c.axis == 1 ? 0.3 : 0.15) << c.name << ": the crane did drive at the zone";
+    EXPECT_TRUE(faults == 0 || faults == Status::FAULT_ZONE) << c.name << ": " << fault_name_list(faults);
+    EXPECT_GE(quiet, 0) << c.name << ": the load comes to rest";
+    if (c.axis == 2) {
+      EXPECT_TRUE(zone_abort || faults != 0) << "the goal is aborted (the zone, or the protective stop)";
+    }
+  }
+}
 }  // namespace
 
 namespace {

@@ -301,6 +301,17 @@ TEST_F(LabConfigText, BadZonePolygonsAreRefusedNamingTheZone) {
   EXPECT_EQ(config.trajectory_planner.site.zones.size(), 1U);
   EXPECT_EQ(config.supervisor.site.zones.size(), 1U);
   EXPECT_EQ(config.facts.site.zones[0].name, "control desk");
+  EXPECT_FALSE(config.facts.site.zones[0].fixed);
+  // A fixed zone (a building, a neighbour's site) is always enforced: fixed and off is refused;
+  // fixed and on is read as such.
+  message = error_of(edit_line(text_, "site:", "fixed:", "fixed: true").text);
+  EXPECT_TRUE(contains(message, "site.zones[0] (control desk): fixed but not enabled")) << message;
+  const auto fixed = cfg::parse_stack_config(
+      edit_line(edit_line(text_, "site:", "fixed:", "fixed: true").text, "site:", "enabled:", "enabled: true").text,
+      "test.yaml");
+  EXPECT_TRUE(fixed.supervisor.site.zones[0].fixed);
+  message = error_of(edit_line(text_, "site:", "fixed:", "fixed: maybe").text);
+  EXPECT_TRUE(contains(message, "site.zones[0].fixed")) << message;
 }
 
 TEST(LabConfig, MissingFileNamesThePath) {

@@ -12,6 +12,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
@@ -950,4 +951,244 @@ TEST(SupervisorLimits, ValidationNamesTheMarginField) {
   params.slew_approach_rate = 2.5;  // above slew_max_rate 2.0
   EXPECT_NE(config_error_message(params).find("supervisor.slew_approach_rate"), std::string::npos)
       << config_error_message(params);
+}
+
+// --- No-go zones (supervisor.hpp, zone_guard()) ---------------------------------------------
+
+namespace {
+
+// A wall from x = 1.0 m to 1.4 m across the jib at slew 0, up to 10 m; the load at 1 m below a
+// jib at 2 m (height 1 m). Cable 1 m: w = sqrt(9.8) = 3.1305 rad/s, period 2.0071 s.
+sv::SupervisorParams zone_params() {
+  sv::SupervisorParams p;
+  p.trolley_max = 3.0;  // the travel limits far away
+  p.site.jib_height = 2.0;
+  p.site.zones = {{"wall", {{1.0, -0.3}, {1.4, -0.3}, {1.4, 0.3}, {1.0, 0.3}}, 0.0, 10.0, true}};
+  return p;
+}
+
+}  // namespace
+
+sv::Supervisor supervisor_in_mode(const sv::SupervisorParams& p, std::uint8_t mode) {
+  auto supervisor = ready_supervisor(p);
+  auto in = with_command(healthy_input(), sv::Command::set_operating_mode);
+  in.command_operating_mode = mode;
+  EXPECT_EQ(step(supervisor, in).operating_mode, mode);
+  return supervisor;
+}
+
+TEST(SupervisorZones, TheSoftStopPredictionWarnsThenLimitsTheDrivesUnderOperatorSpeeds) {
+  // MANUAL and SEMIAUTOMATIC (the operator's speeds through the manual shaper): at 0.2 m/s the
+  // soft stop rests 0.2^2 / (2 0.9929) + 0.2 * 0.5 * 2.0071 = 0.2222 m ahead.
+  const auto p = zone_params();
+  for (const std::uint8_t mode : {sv::StatusCodes::OPERATION_MANUAL, sv::StatusCodes::OPERATION_SEMIAUTOMATIC}) {
+    auto supervisor = supervisor_in_mode(p, mode);
+    std::uint64_t seq = 1;
+    auto out = trolley_at(supervisor, 0.70, 0.2, seq);  // rests at 0.922 m: 7.8 cm short of the wall
+    EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+    EXPECT_EQ(out.zone, -1);
+    out = trolley_at(supervisor, 0.75, 0.2, seq);  // 0.972 m: within the 5 cm approach margin
+    EXPECT_TRUE(out.warnings & sv::kWarningZoneApproach);
+    EXPECT_FALSE(out.warnings & sv::kWarningSpeedLimited);
+    EXPECT_EQ(out.zone, 0);
+    EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+    // 1.022 m: inside, and the trolley speeding up (from rest to 0.2 m/s in a cycle): its drive may
+    // no longer drive it faster; the slew, at rest, keeps its voltage.
+    out = trolley_at(supervisor, 0.80, 0.2, seq);
+    EXPECT_TRUE(out.warnings & sv::kWarningZoneApproach);
+    EXPECT_TRUE(out.warnings & sv::kWarningSpeedLimited);
+    EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.approach_voltage_limit);
+    EXPECT_DOUBLE_EQ(out.slew_voltage_limit, p.voltage_limit);
+    EXPECT_EQ(out.active_faults, 0U);
+    EXPECT_TRUE(out.brakes_released);
+    // The same place decelerating (0.21 m/s, then 0.2 m/s): the drive keeps its voltage to brake.
+    auto in = healthy_input();
+    in.sensor_seq = seq += 100000;
+    in.trolley_position = 0.80 - 0.0021 - 0.002;
+    step(supervisor, in);
+    in.sensor_seq = ++seq;
+    in.trolley_position = 0.80 - 0.002;
+    step(supervisor, in);
+    in.sensor_seq = ++seq;
+    in.trolley_position = 0.80;
+    out = step(supervisor, in);
+    ++seq;
+    EXPECT_NEAR(out.trolley_velocity, 0.2, 1e-9);
+    EXPECT_TRUE(out.warnings & sv::kWarningZoneApproach);
+    EXPECT_FALSE(out.warnings & sv::kWarningSpeedLimited);
+    EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+    // Slower at the same place: the soft stop fits again (0.05 m/s: rests at 0.851 m).
+    out = trolley_at(supervisor, 0.80, 0.05, seq);
+    EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+    EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+    // Moving away: nothing.
+    out = trolley_at(supervisor, 0.80, -0.2, seq);
+    EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+  }
+  // MAINTENANCE (ramp only, no shaper delay; plus the swing an unshaped stop excites, 0.2 / 3.1305
+  // = 0.0639 m): at 0.80 m the soft stop's load reaches 0.884 m, at 0.87 m 0.954 m (warning).
+  auto maintenance = supervisor_in_mode(p, sv::StatusCodes::OPERATION_MAINTENANCE);
+  std::uint64_t seq = 1;
+  auto out = trolley_at(maintenance, 0.80, 0.2, seq);
+  EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+  out = trolley_at(maintenance, 0.87, 0.2, seq);
+  EXPECT_TRUE(out.warnings & sv::kWarningZoneApproach);
+  // FULLAUTOMATIC (the goal's profile, planned around the zones by the planner): ramp only, no
+  // margin: at 0.80 m nothing where MANUAL warned.
+  auto automatic = ready_supervisor(p);
+  out = trolley_at(automatic, 0.80, 0.2, seq);
+  EXPECT_EQ(out.operating_mode, sv::StatusCodes::OPERATION_FULLAUTOMATIC);
+  EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+}
+
+TEST(SupervisorZones, TheBrakeEnvelopeStopsTheCraneBeforeTheLoadEnters) {
+  // MANUAL. At 0.2 m/s the brakes stop the trolley within 0.0201 m and the load swings on by at
+  // most 0.2 / 3.1305 = 0.0639 m: 0.0840 m ahead; the brake margin is 1 cm.
+  const auto p = zone_params();
+  auto supervisor = supervisor_in_mode(p, sv::StatusCodes::OPERATION_MANUAL);
+  std::uint64_t seq = 1;
+  auto out = trolley_at(supervisor, 0.90, 0.2, seq);  // reaches 0.984 m
+  EXPECT_EQ(out.active_faults, 0U);
+  out = trolley_at(supervisor, 0.91, 0.2, seq);  // reaches 0.994 m: within the margin
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultZone));
+  EXPECT_EQ(out.zone, 0);
+  expect_stopped(out);
+  EXPECT_STREQ(sv::fault_name(out.last_fault), "zone");
+  // At rest beside the wall (inside the margin): no fault of its own, so the reset is taken.
+  auto supervisor2 = supervisor_in_mode(p, sv::StatusCodes::OPERATION_MANUAL);
+  out = trolley_at(supervisor2, 0.985, 0.0, seq);
+  EXPECT_EQ(out.active_faults, 0U);
+  // The swing counts: creeping at 0.02 m/s with the load swung 5 cm ahead of the trolley
+  // (in-plane swing -0.05 rad: the load at x + L sin 0.05): it reaches 0.9402 + 0.0504 m.
+  auto in = healthy_input();
+  in.swing_in_plane = -0.05;
+  in.sensor_seq = seq += 100000;
+  in.trolley_position = 0.94;
+  step(supervisor2, in);
+  in.sensor_seq = ++seq;
+  in.trolley_position = 0.9402;
+  out = step(supervisor2, in);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultZone)) << "the load is 0.99 m out, moving";
+}
+
+TEST(SupervisorZones, AZoneSwitchedOffIsIgnoredAndOnAgainIsEnforced) {
+  auto p = zone_params();
+  auto supervisor = supervisor_in_mode(p, sv::StatusCodes::OPERATION_MANUAL);
+  std::uint64_t seq = 1;
+  auto in = with_command(healthy_input(), sv::Command::disable_zone);
+  in.command_zone = 0;
+  auto out = step(supervisor, in);
+  EXPECT_FALSE(out.command_refused);
+  EXPECT_EQ(out.zones_enabled, 0U);
+  out = trolley_at(supervisor, 0.95, 0.3, seq);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.warnings & (sv::kWarningZoneApproach | sv::kWarningSpeedLimited), 0U);
+  EXPECT_DOUBLE_EQ(out.trolley_voltage_limit, p.voltage_limit);
+  in.command = sv::Command::enable_zone;
+  EXPECT_EQ(step(supervisor, in).zones_enabled, 1U);
+  out = trolley_at(supervisor, 0.95, 0.3, seq);
+  EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultZone));
+  // Off in the configuration: ignored from the start.
+  p.site.zones[0].enabled = false;
+  auto off = ready_supervisor(p);
+  out = trolley_at(off, 0.95, 0.3, seq);
+  EXPECT_EQ(out.active_faults, 0U);
+  EXPECT_EQ(out.zones_enabled, 0U);
+}
+
+// A trolley driven straight at the wall that does not slow down (the planner and the voltage limit
+// ignored; MANUAL and MAINTENANCE in turn): the brakes stop it when the supervisor says so, at once (the largest swing a stop
+// excites), and the load, a linear pendulum with a random free swing, never reaches the wall.
+// Seeded random speeds, cable lengths, swing amplitudes and phases.
+TEST(SupervisorZones, SeededRandomRunsAtTheWallStopBeforeTheLoadEnters) {
+  std::mt19937 rng(kRandomSeed);
+  std::uniform_real_distribution<double> speed(0.05, 0.9), cable(0.4, 1.9), amplitude(0.0, 0.06), phase(0.0, 6.283);
+  constexpr int kRuns = 300;
+  constexpr double dt = 0.01, g = 9.8;
+  double closest = 1e9;
+  int braked = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    auto p = zone_params();
+    const double L = cable(rng);
+    const double w = std::sqrt(g / L);
+    double v = speed(rng);
+    const double a0 = amplitude(rng), ph = phase(rng);
+    double u = a0 * std::cos(ph), ud = -a0 * w * std::sin(ph);  // load offset ahead of the trolley [m]
+    double x = 0.2;
+    auto supervisor = supervisor_in_mode(p, run % 2 == 0 ? sv::StatusCodes::OPERATION_MANUAL
+                                                       : sv::StatusCodes::OPERATION_MAINTENANCE);
+    bool stopped = false;
+    for (std::uint64_t k = 0; k < 1500; ++k) {
+      auto in = healthy_input();
+      in.sensor_seq = 10 + k;
+      in.trolley_position = x;
+      in.cable_length = L;
+      in.swing_in_plane = std::asin(-u / L);  // load x = trolley + u (site.hpp's convention)
+      const auto out = step(supervisor, in);
+      ASSERT_LT(x + u, 1.0) << "run " << run << ": the load entered at cycle " << k << " (v " << v << ", L " << L << ")";
+      closest = std::min(closest, 1.0 - (x + u));
+      if (!stopped && (out.active_faults & sv::kFaultZone) != 0) {
+        stopped = true;
+        ++braked;
+        ud += v;  // the trolley stops at once: the load keeps its speed relative to it
+        v = 0.0;
+      }
+      // Exact step of the free pendulum relative to a trolley at constant speed.
+      const double c = std::cos(w * dt), s = std::sin(w * dt);
+      const double u1 = u * c + ud / w * s;
+      ud = -u * w * s + ud * c;
+      u = u1;
+      x += v * dt;
+    }
+    ASSERT_TRUE(stopped) << "run " << run;
+  }
+  std::printf("%d seeded runs at the wall at 0.05-0.9 m/s: %d braked by the supervisor, the load at least %.1f mm "
+              "short of the wall\n", kRuns, braked, 1e3 * closest);
+  EXPECT_GT(closest, 0.0);
+}
+
+TEST(SupervisorZones, ValidationNamesTheZoneFields) {
+  sv::SupervisorParams params;
+  params.zone_stop_delay_periods = 4.0;
+  EXPECT_NE(config_error_message(params).find("supervisor.zone_stop_delay_periods"), std::string::npos)
+      << config_error_message(params);
+  params = {};
+  params.zone_approach_margin = -0.1;
+  EXPECT_NE(config_error_message(params).find("supervisor.zone_approach_margin"), std::string::npos);
+  params = {};
+  params.zone_brake_margin = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(config_error_message(params).find("supervisor.zone_brake_margin"), std::string::npos);
+}
+
+TEST(SupervisorZones, SwitchingAFixedZoneOffIsRefusedNamingIt) {
+  auto p = zone_params();
+  p.site.zones.push_back({"school yard", {{-1.0, -1.0}, {-0.5, -1.0}, {-0.5, -0.5}}, 0.0, 5.0, true, true});
+  auto supervisor = ready_supervisor(p);
+  auto in = with_command(healthy_input(), sv::Command::disable_zone);
+  in.command_zone = 1;
+  auto out = step(supervisor, in);
+  EXPECT_TRUE(out.command_refused);
+  EXPECT_EQ(out.zone_refusal, sv::ZoneRefusal::fixed);
+  EXPECT_EQ(out.zones_enabled, 3U) << "still enforced";
+  EXPECT_EQ(sv::describe(out.zone_refusal, p.site, 1),
+            "site.zones[1] (school yard) is fixed: it stays enforced (switching it off is refused)");
+  // Enabling it (already on) is taken; the other zone switches as before; an unknown index is named.
+  in.command = sv::Command::enable_zone;
+  out = step(supervisor, in);
+  EXPECT_FALSE(out.command_refused);
+  EXPECT_EQ(out.zone_refusal, sv::ZoneRefusal::none);
+  in.command = sv::Command::disable_zone;
+  in.command_zone = 0;
+  out = step(supervisor, in);
+  EXPECT_FALSE(out.command_refused);
+  EXPECT_EQ(out.zones_enabled, 2U);
+  in.command_zone = 7;
+  out = step(supervisor, in);
+  EXPECT_TRUE(out.command_refused);
+  EXPECT_EQ(out.zone_refusal, sv::ZoneRefusal::no_such_zone);
+  EXPECT_EQ(sv::describe(out.zone_refusal, p.site, 7), "no zone 7: site.zones has 2");
+  // A fixed zone must be enabled: refused at start, naming it.
+  p.site.zones[1].enabled = false;
+  EXPECT_NE(config_error_message(p).find("site.zones[1] (school yard): fixed but not enabled"), std::string::npos)
+      << config_error_message(p);
 }

@@ -75,6 +75,9 @@ void validate(const Site& site, const std::string& prefix) {
     if (std::abs(area2) < 1e-12) throw ConfigError(name + ": polygon has zero area");
     require_finite(name + ".bottom", zone.bottom);
     require_greater(name + ".top", zone.top, zone.bottom);
+    if (zone.fixed && !zone.enabled) {
+      throw ConfigError(name + ": fixed but not enabled: a fixed zone is always enforced (enabled: true)");
+    }
   }
 }
 

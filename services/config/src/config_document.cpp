@@ -60,6 +60,7 @@ common::Site read_site(YamlSection& s) {
     zone.bottom = z.number("bottom", -1.0e3, 1.0e3);
     zone.top = z.number("top", -1.0e3, 1.0e3);
     zone.enabled = z.flag("enabled");
+    zone.fixed = z.flag("fixed");
     z.finish();
     site.zones.push_back(std::move(zone));
   }

@@ -18,11 +18,11 @@ class YamlSection;
 
 namespace crane::supervisor {
 
-/// Reads the `supervisor:` block (every field of SupervisorParams but sample_period, voltage_limit
-/// and expected_sensor_source: the first two from facts, the last from the launch; the slew_* fields
-/// (limits, approach, rate and braking deceleration) on a tower crane only, the bridge_* fields on
-/// an overhead crane only, unknown fields elsewhere; slew_enabled and bridge_enabled from
-/// facts.crane_kind). Throws
+/// Reads the `supervisor:` block (every field of SupervisorParams but sample_period, voltage_limit,
+/// gravity, site and expected_sensor_source: the first four from facts, the last from the launch;
+/// the slew_* fields (limits, approach, rate and braking deceleration) on a tower crane only, the
+/// bridge_* fields on an overhead crane only, unknown fields elsewhere; slew_enabled and
+/// bridge_enabled from facts.crane_kind). Throws
 /// common::ConfigError naming the field, value and bound.
 [[nodiscard]] SupervisorParams read_params(config::YamlSection& block, const common::StackFacts& facts);
 

@@ -34,6 +34,8 @@ struct Zone {
   double bottom{0.0};             // [m] above the ground
   double top{1.0e3};              // [m] above the ground, > bottom
   bool enabled{true};             // enforced from the start (switched at run time by the supervisor)
+  bool fixed{false};              // always enforced (buildings, a neighbour's site): switching it off is
+                                  // refused; needs enabled
 };
 
 struct Site {
@@ -48,7 +50,7 @@ struct Site {
 
 /// Throws ConfigError naming the zone ("site.zones[1] (school yard): ...") when a zone has fewer
 /// than 3 vertices, a non-finite vertex, zero area, two edges that cross (self-intersecting, with
-/// the edges named), bottom >= top; when there are more than kMaxZones zones; when jib_height or
+/// the edges named), bottom >= top, fixed but not enabled; when there are more than kMaxZones zones; when jib_height or
 /// zone_clearance is not finite or negative.
 void validate(const Site& site, const std::string& prefix = "site");
 
