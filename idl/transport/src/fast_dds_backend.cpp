@@ -286,10 +286,10 @@ class FastParticipant final : public ParticipantBackend {
     // Faster detection of vanished participants than the 20 s default; stages are watched by
     // deadline and liveliness anyway. Announced every 100 ms: a participant that joins a running
     // stack (crane_safety estop, crane_move, a monitor) learns of the others at their next
-    // announcement, so the period is what an operator's command waits before it can be sent. With
-    // 1 s, `crane_safety reset` matched the supervisor 89-751 ms after its participant was made (8
-    // runs, loaded machine); with 100 ms, 139-225 ms (12 runs, same load). About 10 participants
-    // times 10 small datagrams a second on the loopback. The LAN profiles set their own period.
+    // announcement, so the period is what an operator's command may wait before it can be sent.
+    // With 1 s, `deploy/crane estop` braked after 1.04-1.14 s in 3 of 10 runs (idle machine); with
+    // 100 ms, 104-224 ms in 10 of 10 (docs/operation.md). About 10 participants times 10 small
+    // datagrams a second on the loopback. The LAN profiles set their own period.
     qos.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(3, 0);
     qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = Duration_t(0, 100'000'000);
     if (!options.profile_file.empty()) {
