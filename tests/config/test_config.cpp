@@ -466,6 +466,30 @@ TEST_F(LabConfigText, ASlewChannelOrLimitMissingOnATowerCraneIsNamed) {
   EXPECT_TRUE(contains(message, "missing field supervisor.slew_braking_deceleration")) << message;
 }
 
+// No-go zones are the tower crane's geometry (trolley along a slewing jib): the lab's site block with
+// its zones on the gantry or the overhead crane is refused naming the field and the crane, not
+// checked at the wrong place.
+TEST(GantryConfig, ZonesOnACraneOtherThanATowerAreRefused) {
+  const std::string lab = read_text(kLabConfig);
+  const auto begin = lab.find("\nsite:");
+  ASSERT_NE(begin, std::string::npos);
+  auto end = begin + 1;
+  do {  // the block runs to the next top-level field
+    end = lab.find('\n', end) + 1;
+  } while (end < lab.size() && (lab[end] == ' ' || lab[end] == '#' || lab[end] == '\n'));
+  const std::string site = lab.substr(begin, end - begin);
+  ASSERT_NE(site.find("zones:"), std::string::npos) << site;
+  for (const char* name : {"gantry_crane.yaml", "overhead_crane.yaml"}) {
+    const std::string text = read_text(std::string(CRANE_SOURCE_DIR) + "/deploy/config/" + name);
+    ASSERT_EQ(text.find("\nsite:"), std::string::npos) << name;
+    const std::string message = error_of(text + site);
+    EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+    EXPECT_TRUE(contains(message, "site.zones: no-go zones are implemented for crane.kind = tower only")) << message;
+    EXPECT_TRUE(contains(message, std::string("this crane is ") + (name[0] == 'g' ? "gantry" : "overhead"))) << message;
+  }
+  EXPECT_NO_THROW(cfg::load_stack_config(kLabConfig));
+}
+
 TEST(OverheadConfig, AMissingBridgeChannelIsNamed) {
   const std::string text = read_text(std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml");
   ASSERT_FALSE(text.empty());

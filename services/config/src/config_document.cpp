@@ -100,6 +100,14 @@ ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
     if (root_["site"]) {
       YamlSection site = document.child("site");
       facts.site = read_site(site);
+      // The zones' geometry (common::load_position, the planner's paths, the supervisor's guard) is
+      // the tower crane's: trolley along the jib, slewing. On another crane a zone would be checked
+      // at the wrong place, so it is refused rather than silently misplaced.
+      if (facts.crane_kind != common::CraneKind::tower && !facts.site.zones.empty()) {
+        throw ConfigError("site.zones: no-go zones are implemented for crane.kind = tower only (this crane is " +
+                          std::string(common::to_string(facts.crane_kind)) +
+                          "): remove the zones or the site block");
+      }
     }
     return facts;
   });
