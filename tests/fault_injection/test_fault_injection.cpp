@@ -12,13 +12,18 @@
 //  - the load's travel after a fault: from the sensor samples the bridge keeps publishing.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +42,7 @@
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
 #include "crane/supervisor/actuation_gate.hpp"
+#include "crane/supervisor/operator_socket.hpp"
 
 namespace {
 // With CRANE_SECURITY set (ctest fault_injection_secured.*: the material of tests/security), every
@@ -240,7 +246,7 @@ class HilStack {
   ::testing::AssertionResult start_move(double target, double speed = 0.3, double timeout = 10.0) {
     tp::msgs::MoveRequest_ goal;
     crane::runtime::stamp_header(goal.header(), 0, crane::runtime::now_stamp());
-    goal.request_id(7);
+    goal.request_id(next_goal_id_++);  // a new goal each call (7 first)
     goal.profile(crane::protocol::MoveRequest::PROFILE_TRAPEZOID);  // (3.43)
     goal.axes(crane::protocol::MoveRequest::AXIS_TROLLEY | crane::protocol::MoveRequest::AXIS_SLEW);
     goal.trolley_target(target);
@@ -288,6 +294,7 @@ class HilStack {
   fs::path dir_;
   std::string board_name_;
   std::uint32_t domain_;
+  std::uint32_t next_goal_id_{7};
   ProcessGroup group_;
   std::map<std::string, pid_t> pids_;
   std::unique_ptr<crane::transport::Participant> participant_;
@@ -650,35 +657,124 @@ TEST(FaultInjection, EmergencyStopInputAndCommandBrakeAtOnce) {
   EXPECT_NE(log.find("\"command\": \"reset\""), std::string::npos) << log;
 }
 
-// The operator's own path, as typed in a shell: `deploy/crane estop` (the script: it never installs
-// or builds, it runs the built crane_safety, which joins the domain, discovers the supervisor and
-// sends the command) in mid-move: the brakes engage, the supervisor is in emergency stop, and the
-// figure from the command's start to the bridge's safe outputs on the board is printed (issue 14
-// asks under 100 ms: 41-145 ms measured, with a rare outlier near 1.1 s when the fresh
-// participant's discovery is slow; a timing target is a figure, not an assertion here). The bound
-// asserted is the functional one: at once, not after a package check and a build (seconds). The
-// script finds this build through CRANE_BUILD_DIR.
+// The operator's own path, as typed in a shell: `deploy/crane estop` in mid-move. The script never
+// installs or builds; it runs crane_operator, which hands the command to the stack's operator relay
+// over a local socket (a participant matched with the supervisor since the stack started), and, with
+// --direct, crane_safety, a participant of its own that must discover the supervisor first. Five
+// stops each way, alternating; the figure is from the command's start to the bridge's safe outputs
+// on the board (issue 14 asks under 100 ms; a timing target is a figure here, not an assertion).
+// Asserted: every stop engages the brakes at once (not after a package check and a build:
+// seconds), the supervisor answers it, and the relay served exactly the relayed ones (its log).
+// The script finds this build through CRANE_BUILD_DIR.
 TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
   HilStack stack("estop_shell", 55);
   ASSERT_TRUE(stack.wait_ready());
-  ASSERT_TRUE(stack.start_move(1.0));
   const std::string domain = " --domain " + std::to_string(stack.domain());
-  const std::string script =
-      "CRANE_BUILD_DIR='" + kBin + "/..' '" + std::string(CRANE_SOURCE_DIR) + "/deploy/crane' estop" + domain + " > /dev/null";
+  const std::string script = "CRANE_BUILD_DIR='" + kBin + "/..' '" + std::string(CRANE_SOURCE_DIR) + "/deploy/crane'";
+  std::vector<double> relayed, direct;
+  constexpr int kStops = 5;
+  for (int i = 0; i < 2 * kStops; ++i) {
+    const bool via_relay = i % 2 == 0;
+    // To the far end of the planner's travel [0.2, 1.1] m from where the last stop left the trolley.
+    const double at = stack.sensors().empty() ? 0.25 : stack.sensors().back().trolley_position();
+    ASSERT_TRUE(stack.start_move(at < 0.65 ? 1.1 : 0.2)) << "stop " << i << " from " << at << " m";
+    stack.run_for(0.5);
+    const std::string command = script + " estop" + domain + (via_relay ? "" : " --direct") + " > /dev/null";
+    const std::int64_t typed_ns = hb::monotonic_time_ns();
+    const int rc = WEXITSTATUS(std::system(command.c_str()));
+    const std::int64_t returned_ns = hb::monotonic_time_ns();
+    stack.run_for(0.3);
+    const auto f = fail_safe_after(stack.monitor().writes(), typed_ns);
+    ASSERT_TRUE(f.first_safe.has_value()) << "no safe outputs after " << command;
+    const double ms = static_cast<double>(f.first_safe->ns - typed_ns) / 1e6;
+    std::printf("[ figure   ] deploy/crane estop%s: brakes engaged %.1f ms after the command started (it returned after "
+                "%.1f ms, having seen the supervisor answer)\n",
+                via_relay ? " (operator relay)" : " --direct (a participant of its own)", ms,
+                static_cast<double>(returned_ns - typed_ns) / 1e6);
+    (via_relay ? relayed : direct).push_back(ms);
+    EXPECT_EQ(rc, 0) << command;
+    ASSERT_TRUE(stack.status().has_value());
+    EXPECT_EQ(stack.status()->mode(), Status::MODE_EMERGENCY_STOP);
+    EXPECT_LT(ms, 3000.0) << "at once: no package check, no build";
+    ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
+    ASSERT_TRUE(stack.wait_ready(10.0)) << "after stop " << i;
+  }
+  const auto summary = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    char text[96];
+    std::snprintf(text, sizeof text, "min %.1f, median %.1f, max %.1f ms", v.front(), v[v.size() / 2], v.back());
+    return std::string(text);
+  };
+  std::printf("[ figure   ] deploy/crane estop to brakes engaged, %d stops each: operator relay %s; a participant of its "
+              "own (--direct) %s\n",
+              kStops, summary(relayed).c_str(), summary(direct).c_str());
+  const auto relay_log = read_file(stack.dir() / "operator_relay.log");
+  std::size_t served = 0;
+  for (auto at = relay_log.find("operator command 'estop'"); at != std::string::npos;
+       at = relay_log.find("operator command 'estop'", at + 1)) {
+    ++served;
+  }
+  EXPECT_EQ(served, static_cast<std::size_t>(kStops)) << relay_log;
+}
+
+// The operator relay's socket against hostile local clients: connections that never send, a
+// request without its newline beyond the size limit, a malformed one; an emergency stop typed
+// meanwhile is served at once, and the malformed requests are answered with exit code 2.
+TEST(FaultInjection, TheOperatorRelayServesAnEstopBesideHostileClients) {
+  HilStack stack("relay_hostile", 56);
+  ASSERT_TRUE(stack.wait_ready());
+  namespace sock = crane::supervisor::operator_socket;
+  const auto connect_relay = [&]() {
+    const int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    const auto name = sock::name(stack.domain());
+    std::memcpy(address.sun_path, name.data(), name.size());
+    const auto size = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + name.size());
+    EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&address), size), 0) << std::strerror(errno);
+    return fd;
+  };
+  const auto reply_of = [](int fd) {
+    std::string reply;
+    char buffer[512];
+    timeval limit{10, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &limit, sizeof limit);
+    for (ssize_t n; (n = read(fd, buffer, sizeof buffer)) > 0;) reply.append(buffer, static_cast<std::size_t>(n));
+    close(fd);
+    return reply;
+  };
+  std::vector<int> silent;
+  for (int i = 0; i < 4; ++i) silent.push_back(connect_relay());
+  const int oversize = connect_relay();
+  const std::string flood(sock::kMaxRequestBytes + 100, 'x');
+  EXPECT_EQ(write(oversize, flood.data(), flood.size()), static_cast<ssize_t>(flood.size()));
+  const int malformed = connect_relay();
+  EXPECT_EQ(write(malformed, "estop\n", 6), 6);  // its argument lacks the NUL
+
+  ASSERT_TRUE(stack.start_move(1.0));
+  stack.run_for(0.5);
+  const std::string script = "CRANE_BUILD_DIR='" + kBin + "/..' '" + std::string(CRANE_SOURCE_DIR) + "/deploy/crane' estop --domain " +
+                             std::to_string(stack.domain()) + " > /dev/null";
   const std::int64_t typed_ns = hb::monotonic_time_ns();
-  const int script_rc = WEXITSTATUS(std::system(script.c_str()));
-  const std::int64_t returned_ns = hb::monotonic_time_ns();
+  EXPECT_EQ(WEXITSTATUS(std::system(script.c_str())), 0);
   stack.run_for(0.3);
   const auto f = fail_safe_after(stack.monitor().writes(), typed_ns);
-  ASSERT_TRUE(f.first_safe.has_value()) << "no safe outputs after " << script;
-  const double script_ms = static_cast<double>(f.first_safe->ns - typed_ns) / 1e6;
-  std::printf("[ figure   ] deploy/crane estop: brakes engaged %.1f ms after the command started (the command "
-              "returned after %.1f ms, having seen the supervisor answer)\n",
-              script_ms, static_cast<double>(returned_ns - typed_ns) / 1e6);
-  EXPECT_EQ(script_rc, 0) << script;
-  ASSERT_TRUE(stack.status().has_value());
+  ASSERT_TRUE(f.first_safe.has_value());
+  const double ms = static_cast<double>(f.first_safe->ns - typed_ns) / 1e6;
+  const auto oversize_reply = reply_of(oversize);
+  const auto malformed_reply = reply_of(malformed);
+  std::printf("[ figure   ] estop beside 4 silent connections and 2 bad requests: brakes engaged %.1f ms after the "
+              "command started; replies: '%s', '%s'\n",
+              ms, oversize_reply.c_str(), malformed_reply.c_str());
   EXPECT_EQ(stack.status()->mode(), Status::MODE_EMERGENCY_STOP);
-  EXPECT_LT(script_ms, 3000.0) << "at once: no package check, no build";
+  EXPECT_EQ(oversize_reply.rfind("2 ", 0), 0U) << oversize_reply;
+  EXPECT_NE(oversize_reply.find("request not read"), std::string::npos) << oversize_reply;
+  EXPECT_EQ(malformed_reply.rfind("2 ", 0), 0U) << malformed_reply;
+  EXPECT_NE(malformed_reply.find("malformed request"), std::string::npos) << malformed_reply;
+  // The silent ones are closed after 5 s without a request: read() sees the end, not a timeout.
+  for (const int fd : silent) EXPECT_EQ(reply_of(fd), "");
+  const auto relay_log = read_file(stack.dir() / "operator_relay.log");
+  EXPECT_NE(relay_log.find("operator command 'estop'"), std::string::npos) << relay_log;
 }
 
 }  // namespace

@@ -225,6 +225,8 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   stack.tracking_controller = std::string(tracking::law_name(choice.tracking));
   stack.tracking_acceleration_feedforward = choice.acceleration_feedforward;
   stack.fault_log_path = (log_dir / "faults.jsonl").string();
+  // The demo is its own operator (op), in a private network namespace no shell reaches: no relay.
+  stack.operator_relay = false;
   // Realtime runs as crane_launch does: the stages on SCHED_FIFO where the system allows it.
   if (options.realtime && launch::probe_realtime(80).empty()) stack.realtime_priority = 70;
   // One emulated board per run, named after this process so parallel demos do not share one.

@@ -19,8 +19,9 @@ bool is_comedi(const std::string& hardware) { return hardware.rfind("comedi:", 0
 }  // namespace
 
 std::vector<std::string> stack_process_names(const StackOptions& o) {
-  std::vector<std::string> names{"supervisor",         "friction_compensation", "tracking", "anti_swing",
-                                 "trajectory_planner", "state_estimator"};
+  std::vector<std::string> names{"supervisor"};
+  if (o.operator_relay) names.push_back("operator_relay");
+  names.insert(names.end(), {"friction_compensation", "tracking", "anti_swing", "trajectory_planner", "state_estimator"});
   if (o.hardware.empty()) {
     names.push_back("plant");
   } else if (is_shm(o.hardware)) {

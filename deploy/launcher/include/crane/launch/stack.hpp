@@ -42,13 +42,16 @@ struct StackOptions {
   std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
                                       // hardware bridge on that board (see the file comment)
   std::string fault_log_path;         // supervisor --fault-log (optional)
+  bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
+                                      // commands (deploy/crane estop, ...) over a local socket to a participant
+                                      // already matched with the supervisor; off: they make a participant each
   int realtime_priority{0};           // > 0: every process --realtime-priority: the sensor writer (plant or
                                       // bridge) this + 10, the supervisor + 5, the chain this (as the
                                       // systemd units); 0: normal priority
 };
 
-/// The processes of the stack in start order: supervisor first, the sensor writer (plant or
-/// hardware_bridge) last; with shm:NAME the plant behind the board comes just before the bridge.
+/// The processes of the stack in start order: supervisor first (then the operator relay, when
+/// options.operator_relay), the sensor writer (plant or hardware_bridge) last; with shm:NAME the plant behind the board comes just before the bridge.
 /// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH.
 std::vector<ProcessSpec> stack_processes(const StackOptions& options);
 
