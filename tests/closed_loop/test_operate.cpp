@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "crane/anti_swing/anti_swing_stage.hpp"
 #include "crane/stack/in_process_stack.hpp"
 #include "crane/stack/stack_config.hpp"
 #include "crane/trajectory_planner/zone_guard.hpp"
@@ -250,10 +251,13 @@ TEST(OperatingModes, GoalsAndSpeedsFollowTheModeAndAChangeWhileMovingStopsFirst)
   EXPECT_EQ(s.status().latched_faults, 0U);
 }
 
-// MAINTENANCE (OPC 40020): every operator speed at manual.maintenance_speed_fraction of the rated
-// speed, and no sway control of the operator's speeds (ramp only): the reference stops as soon as
-// its ramp ends, where MANUAL's shaper lets it run on for its length. The stack's feedback
-// anti-swing law is not a planner matter and still runs (docs/operation.md, "Operating modes").
+// MAINTENANCE (OPC 40020: reduced speeds, no anti-swing): every operator speed at
+// manual.maintenance_speed_fraction of the rated speed, no sway control of the operator's speeds
+// (ramp only: the reference stops as soon as its ramp ends, where MANUAL's shaper lets it run on for
+// its length) and none in the feedback (the anti-swing stage's output is 0 from the supervisor's
+// mode on): the load is left swinging by degrees where MANUAL stops it within 0.5 deg. Then, the load
+// still swinging, the mode back to MANUAL at the worst moment (the law's action at its peak): the
+// feedback fades in over a swing period (no step in the drive) and damps the swing.
 TEST(OperatingModes, MaintenanceRunsAtTheReducedSpeedWithoutSwayControl) {
   const auto config = long_jib(lab());
   const auto& m = config.trajectory_planner.manual;
@@ -261,41 +265,109 @@ TEST(OperatingModes, MaintenanceRunsAtTheReducedSpeedWithoutSwayControl) {
     double top_speed{0.0};        // [m/s] the reference's largest trolley speed
     double stop_time{0.0};        // [s] from the release to the reference at rest
     double residual{0.0};         // [rad] swing 2 s after the reference stopped, for 4 s
+    double largest_action{0.0};   // [-] the anti-swing command's largest action from cycle 20 on
+    // Then MANUAL (MAINTENANCE's run only), the load swinging:
+    double swing_at_switch{0.0};  // [rad] the swing's amplitude (its largest in the 2 s before)
+    double law_step{0.0};         // [V] what the law's action adds to the trolley drive (3.37) at the switch:
+                                  // the step an instant switch would make
+    double fade_change{0.0};      // [V] the trolley drive's largest change in a cycle, the swing period after it
+    double before_change{0.0};    // [V] the same in the swing period before it (tracking alone)
+    double residual_after{0.0};   // [rad] swing from 2 s after the fade, for 4 s
   };
   const auto run = [&](std::uint8_t mode) {
     stack::InProcessStack s(config, {});
+    // The law on the same estimates as the stack's stage, never switched: its action, ungated.
+    anti_swing::AntiSwingStage law(config.anti_swing);
+    protocol::AntiSwingCommand law_action;
     const auto command = set_mode(1, mode);
+    const auto back_to_manual = set_mode(2, Status::OPERATION_MANUAL);
+    const bool then_manual = mode == Status::OPERATION_MAINTENANCE;
     Run r;
-    std::optional<std::uint64_t> stopped;
-    for (std::uint64_t k = 0; k < 2500; ++k) {
+    std::optional<std::uint64_t> stopped, switched;
+    double previous_voltage = 0.0, peak_action = 0.0, swing_before = 0.0;
+    bool switch_now = false;
+    for (std::uint64_t k = 0; k < 5000; ++k) {
       const auto speed = stick(k, k >= 400 && k < 700 ? 1.0 : 0.0, 0.0);
-      s.step({}, k >= 400 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(), k == 10 ? &command : nullptr);
+      s.step({}, k >= 400 ? std::span(&speed, 1) : std::span<const protocol::OperatorSpeed>(),
+             k == 10 ? &command : switch_now ? &back_to_manual : nullptr);
+      EXPECT_NE(law.step(s.estimate(), law_action), common::StepStatus::rejected_nonfinite);
+      const double voltage = s.linear().trolley_voltage;
+      if (k >= 20 && !switched) r.largest_action = std::max(r.largest_action, std::abs(s.anti_swing().trolley_action));
       r.top_speed = std::max(r.top_speed, std::abs(s.reference().trolley_velocity));
-      if (k >= 700 && !stopped && !s.planner().under_speed_control()) {
-        stopped = k;
-        r.stop_time = static_cast<double>(k - 700) * 0.01;
+      if (k >= 700 && !stopped) {
+        if (!s.planner().under_speed_control()) {
+          stopped = k;
+          r.stop_time = static_cast<double>(k - 700) * 0.01;
+        }
       }
-      if (stopped && k >= *stopped + 200) r.residual = std::max(r.residual, swing_of(s));
-      if (stopped && k >= *stopped + 600) break;
+      if (stopped && k >= *stopped + 200 && k < *stopped + 600) r.residual = std::max(r.residual, swing_of(s));
+      if (switch_now) {
+        // The status of cycle k reaches the anti-swing stage at k + 1.
+        switched = k + 1;
+        r.swing_at_switch = swing_before;
+        switch_now = false;
+      }
+      // MANUAL at the law's peak, 6 s after the reference stopped (its peak over the 2 s before).
+      if (then_manual && stopped && !switched && k >= *stopped + 400) {
+        if (k < *stopped + 600) {
+          peak_action = std::max(peak_action, std::abs(law_action.trolley_action));
+          swing_before = std::max(swing_before, swing_of(s));
+        } else {
+          switch_now = std::abs(law_action.trolley_action) >= 0.95 * peak_action;
+        }
+      }
+      if (switched && k == *switched) {
+        const double cable = s.estimate().cable_length;
+        const double period = 2.0 * std::numbers::pi * std::sqrt(cable / config.facts.crane.gravity);
+        r.law_step = std::abs(cable / (period * period) * law_action.trolley_action /
+                              config.tracking.tracking.trolley_drive_gain);
+      }
+      if (stopped && then_manual && !switched && k >= *stopped + 400) {
+        r.before_change = std::max(r.before_change, std::abs(voltage - previous_voltage));
+      }
+      if (switched && k >= *switched && k < *switched + 201) {
+        r.fade_change = std::max(r.fade_change, std::abs(voltage - previous_voltage));
+      }
+      if (switched && k >= *switched + 400) r.residual_after = std::max(r.residual_after, swing_of(s));
+      previous_voltage = voltage;
+      if (stopped && !then_manual && k >= *stopped + 600) break;
+      if (switched && k >= *switched + 800) break;
     }
-    EXPECT_EQ(s.status().operating_mode, mode);
+    EXPECT_EQ(s.status().operating_mode, then_manual ? Status::OPERATION_MANUAL : mode);
     EXPECT_EQ(s.status().latched_faults, 0U);
     EXPECT_TRUE(stopped.has_value());
+    EXPECT_EQ(switched.has_value(), then_manual);
     return r;
   };
   const Run maintenance = run(Status::OPERATION_MAINTENANCE);
   const Run manual = run(Status::OPERATION_MANUAL);
   const double reduced = m.maintenance_speed_fraction * m.trolley.rated_speed;
   std::printf("full trolley stick 3 s, released: MAINTENANCE top speed %.4f m/s (%.0f %% of rated), reference at rest "
-              "%.2f s after the release, residual swing %.3f deg; MANUAL %.4f m/s, %.2f s, %.3f deg\n",
+              "%.2f s after the release, residual swing %.3f deg (largest anti-swing action %.3g); MANUAL %.4f m/s, "
+              "%.2f s, %.3f deg (largest anti-swing action %.3f)\n",
               maintenance.top_speed, 100.0 * maintenance.top_speed / m.trolley.rated_speed, maintenance.stop_time,
-              maintenance.residual * kDeg, manual.top_speed, manual.stop_time, manual.residual * kDeg);
+              maintenance.residual * kDeg, maintenance.largest_action, manual.top_speed, manual.stop_time,
+              manual.residual * kDeg, manual.largest_action);
+  std::printf("then MANUAL with %.3f deg of swing: the trolley drive's largest change in a cycle %.4f V over the fade's "
+              "swing period (%.4f V in the 2 s before, the tracking alone; an instant switch: a step of %.4f V); "
+              "residual swing 2 s after the fade %.3f deg\n",
+              maintenance.swing_at_switch * kDeg, maintenance.fade_change, maintenance.before_change,
+              maintenance.law_step, maintenance.residual_after * kDeg);
   EXPECT_NEAR(maintenance.top_speed, reduced, 1e-9);
   EXPECT_NEAR(manual.top_speed, m.trolley.rated_speed, 1e-9);
   // Ramp only: at rest one ramp (v / a) after the release, give or take the cycles of the
   // hand-over and the at-rest check; MANUAL's shaper adds its length (ZVD: a swing period, > 2 s).
   EXPECT_LT(maintenance.stop_time, reduced / m.trolley.acceleration + 0.1);
   EXPECT_GT(manual.stop_time, m.trolley.rated_speed / m.trolley.acceleration + 1.5);
+  // No sway control at all in MAINTENANCE: the anti-swing action 0, the load left swinging by degrees.
+  EXPECT_EQ(maintenance.largest_action, 0.0);
+  EXPECT_GT(manual.largest_action, 0.0);
+  EXPECT_GT(maintenance.residual * kDeg, 2.0);
+  EXPECT_LT(manual.residual * kDeg, 0.5);
+  // Back in MANUAL the feedback returns without a step and damps the swing.
+  EXPECT_GT(maintenance.swing_at_switch * kDeg, 2.0);
+  EXPECT_LT(maintenance.fade_change, 0.25 * maintenance.law_step);
+  EXPECT_LT(maintenance.residual_after * kDeg, 0.5);
 }
 
 // SEMIAUTOMATIC: goals are taken, and the operator's stick takes over from a running goal (aborted:
@@ -593,6 +665,10 @@ TEST(Zones, TheSupervisorAloneKeepsTheLoadOutWhenThePlannerGuardIsBypassed) {
     double closest = 1e9, moved = 0.0;
     std::uint32_t faults = 0;
     std::int64_t quiet = -1;  // the cycle the crane came to rest (-1: not at rest)
+    double swing_left = 0.0;  // [rad] the largest swing in the 2 s at rest
+    // [rad] MAINTENANCE: the swing's largest angle (both planes together) in the first and the last
+    // 10 s at rest: no damping, a figure.
+    double swing_first = 0.0, swing_last = 0.0;
     bool zone_abort = false;
     std::optional<std::uint64_t> reset_cycle;
     int resets = 0;
@@ -627,19 +703,38 @@ TEST(Zones, TheSupervisorAloneKeepsTheLoadOutWhenThePlannerGuardIsBypassed) {
       for (const auto& f : s.planner().move_statuses()) {
         if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED && f.reason == Feedback::REASON_ZONE) zone_abort = true;
       }
-      // At rest, after the push: trolley and slew still, the swing below 0.5 deg, brakes released, for 2 s.
-      const bool still = std::abs(p.trolley_velocity) < 1e-3 && std::abs(p.slew_rate) < 1e-3 &&
-                         swing_of(s) * kDeg < 0.5 && s.status().brakes_released;
+      // At rest, after the push, for 2 s with the brakes released: trolley and slew still and the
+      // swing below 0.5 deg. MAINTENANCE has no sway control (no anti-swing): the load keeps the
+      // swing the stop left (a figure) and its pull moves the drives about their reference, so
+      // there the reference at rest.
+      const bool still =
+          s.status().brakes_released &&
+          (c.mode == Status::OPERATION_MAINTENANCE
+               ? !s.planner().under_speed_control() && s.reference().trolley_velocity == 0.0 &&
+                     s.reference().slew_rate == 0.0
+               : std::abs(p.trolley_velocity) < 1e-3 && std::abs(p.slew_rate) < 1e-3 && swing_of(s) * kDeg < 0.5);
       if (!still) quiet = -1;
-      if (k >= 1500 && (!reset_cycle || k >= *reset_cycle + 220) && still && quiet < 0) quiet = static_cast<std::int64_t>(k);
-      if (quiet >= 0 && static_cast<std::int64_t>(k) >= quiet + 200) break;
+      if (k >= 1500 && (!reset_cycle || k >= *reset_cycle + 220) && still && quiet < 0) {
+        quiet = static_cast<std::int64_t>(k);
+        swing_left = 0.0;
+      }
+      if (quiet >= 0) swing_left = std::max(swing_left, swing_of(s));
+      const double swing_angle = std::hypot(p.swing_in_plane, p.swing_out_of_plane);
+      if (quiet >= 0 && static_cast<std::int64_t>(k) < quiet + 1000) swing_first = std::max(swing_first, swing_angle);
+      if (k >= 8000) swing_last = std::max(swing_last, swing_angle);
+      // MAINTENANCE runs on to 90 s: the load swinging freely beside the building all that time.
+      if (quiet >= 0 && static_cast<std::int64_t>(k) >= quiet + 200 && c.mode != Status::OPERATION_MAINTENANCE) break;
     }
     std::printf("supervisor alone, %s: moved %.3f %s toward the building, the load's closest approach %.3f m, %zu cycles "
-                "warned, %zu with the drives limited, protective stop: %s (%d resets, pulled back), at rest at %.1f s; %zu "
-                "samples inside\n",
+                "warned, %zu with the drives limited, protective stop: %s (%d resets, pulled back), at rest at %.1f s "
+                "(swing %.2f deg from then to the end); %zu samples inside\n",
                 c.name, moved, c.axis == 1 ? "rad" : "m", closest, warned, limited,
                 faults != 0 ? fault_name_list(faults).c_str() : "none", resets,
-                static_cast<double>(quiet) * 0.01, inside);
+                static_cast<double>(quiet) * 0.01, swing_left * kDeg, inside);
+    if (c.mode == Status::OPERATION_MAINTENANCE) {
+      std::printf("  no sway control: the swing's largest angle %.2f deg in the first 10 s at rest, %.2f deg in the "
+                  "last 10 s (80-90 s)\n", swing_first * kDeg, swing_last * kDeg);
+    }
     // In FULLAUTOMATIC the supervisor relies on the planner's paths (supervisor.hpp, zone_guard()):
     // a goal planned through the zone is a figure here, not a bound.
     if (c.axis < 2) {

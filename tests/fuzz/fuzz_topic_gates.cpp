@@ -168,12 +168,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         }
         break;
       }
-      case 1: {  // rt/crane/state (a foreign writer) -> anti-swing
+      case 1: {  // rt/crane/state (a foreign writer) -> anti-swing, with the latest status (its operating mode)
         protocol::CraneState sample{};
         in.fill(sample);
         if (!gate(estimate, sample)) break;
         protocol::AntiSwingCommand out{};
-        if (anti_swing.step(estimate, out) == crane::common::StepStatus::ok) require_finite(out);
+        if (anti_swing.step(estimate, &status, out) == crane::common::StepStatus::ok) require_finite(out);
         anti_swing_command = out;
         break;
       }
@@ -191,7 +191,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (speeds.size() < 16) speeds.push_back(speed);  // the planner refuses bad speeds itself
         break;
       }
-      case 4: {  // rt/crane/supervisor/status -> the planner's view of the mode and zones
+      case 4: {  // rt/crane/supervisor/status -> the planner's view of the mode and zones, the anti-swing's of the mode
         protocol::SupervisorStatus sample{};
         in.fill(sample);
         (void)gate(status, sample);

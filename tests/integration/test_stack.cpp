@@ -2,8 +2,10 @@
 // Run them inside a private network namespace (deploy/crane test does); otherwise every participant
 // is bound to loopback by default.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <iterator>
@@ -13,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -641,6 +644,136 @@ TEST(Operate, MoveArrivesSettledAndAGoalOutOfRangeIsRefusedNamingTheBound) {
   launcher.stop_all();
 }
 
+// A device unplugged mid-jog stops the load softly (issue 14, manual mode), over DDS with real
+// processes: a realtime stack (the planner's dead man counts its cycles, 10 ms of the wall clock
+// each), MANUAL from crane_safety, `crane_jog --script` (50 Hz) pushing the trolley out at 30 %,
+// killed with SIGKILL 3 s into the motion (the shaped speed steady by then). The planner hears
+// nothing for manual.dead_man_timeout (200 ms) and releases the axes: its reference starts to
+// decelerate (the shaped ramp) between 200 ms less the jog's 20 ms period and 200 ms plus three
+// cycles (the dead man's "longer than": the 21st cycle; the wait for the planner's next cycle;
+// DDS) after the kill. The reference comes to rest, the load with it: its swing 2-6 s after rest
+// < 0.5 deg (the sensors' encoder), and the supervisor raised no fault.
+TEST(Operate, AJogKilledMidMoveStopsTheLoadSoftlyWithinTheDeadManTime) {
+  const fs::path dir = fresh_directory("jog_killed");
+  fs::create_directories(dir / "logs");
+  const unsigned domain = 35;
+  crane::launch::StackOptions options;
+  options.config_path = kConfig;
+  options.binary_directory = kBin;
+  options.log_directory = (dir / "logs").string();
+  options.domain_id = domain;
+  options.lockstep = false;  // the wall clock: the dead man's 200 ms are real time
+  ProcessGroup stack;
+  for (const auto& spec : crane::launch::stack_processes(options)) stack.start(spec);
+
+  crane::transport::ParticipantOptions p;
+  p.name = "jog_test";
+  p.domain_id = domain;
+  crane::transport::Participant participant(p);
+  crane::transport::Wakeup wakeup;
+  auto status_reader = participant.make_recording_reader<tp::SafetyStatus>(&wakeup, 4096);
+  auto reference_reader = participant.make_recording_reader<tp::Reference>(&wakeup, 4096);
+  auto sensors_reader = participant.make_recording_reader<tp::Sensors>(&wakeup, 4096);
+  // Ready: every stage alive, the brakes released and nothing latched, for 1 s. A fault latched
+  // while the stack starts (stage_silent: a loaded machine started a stage late) is reset, as an
+  // operator would, and printed; the faults from the jog on are the test's.
+  tp::msgs::SupervisorStatus_ status;
+  bool ready = false;
+  Clock::time_point ready_since = Clock::now();
+  int resets = 0;
+  const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
+  while (!(ready && Clock::now() > ready_since + std::chrono::seconds(1)) && Clock::now() < ready_deadline) {
+    ASSERT_FALSE(stack.poll().has_value()) << "a stage died during start-up; see " << dir;
+    wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+    if (!status_reader->take_latest(status)) continue;
+    const bool now_ready =
+        status.stages_alive() == Status::STAGES_ALL && status.brakes_released() && status.latched_faults() == 0;
+    if (now_ready && !ready) ready_since = Clock::now();
+    ready = now_ready;
+    if (status.latched_faults() != 0 && status.active_faults() == 0 && resets < 3) {
+      std::printf("[ note     ] start-up fault (latched bits %u) reset\n", status.latched_faults());
+      ++resets;
+      EXPECT_EQ(run_operator_tool(std::to_string(domain), "crane_safety", "reset", dir / "reset.txt"), 0);
+    }
+  }
+  ASSERT_TRUE(ready) << "stack not ready (stages, brakes, no fault) within 30 s; see " << dir;
+  ASSERT_EQ(run_operator_tool(std::to_string(domain), "crane_safety", "mode manual", dir / "mode.txt"), 0)
+      << file_bytes(dir / "mode.txt.err");
+  {
+    std::ofstream script(dir / "stick.csv");
+    script << "t,trolley,slew,hoist\n0,0,0,0\n0.2,0.3,0,0\n30,0,0,0\n";
+  }
+  tp::msgs::Reference_ reference;
+  tp::msgs::SensorSample_ sample;
+  reference_reader->take_latest(reference);  // the samples from before the jog
+  sensors_reader->take_latest(sample);
+  ProcessGroup jog;
+  const pid_t jog_pid = jog.start({"crane_jog", kBin + "/crane_jog",
+                                   {"--domain", std::to_string(domain), "--script", (dir / "stick.csv").string()},
+                                   (dir / "jog.log").string()});
+
+  using crane::runtime::to_nanoseconds;
+  std::optional<std::int64_t> moving, killed, released, at_rest;  // [ns] CLOCK_REALTIME, the headers' clock
+  double speed_at_kill = 0.0, position_at_kill = 0.0, rest_position = 0.0, residual = 0.0;
+  std::uint32_t faults = 0;
+  std::uint64_t swing_samples = 0;
+  const auto deadline = Clock::now() + std::chrono::seconds(40);
+  while (Clock::now() < deadline) {
+    wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+    while (status_reader->take_next(status)) faults |= status.latched_faults() | status.active_faults();
+    while (reference_reader->take_next(reference)) {
+      const std::int64_t stamp = to_nanoseconds(reference.header().stamp());
+      if (!moving && reference.trolley_velocity() > 0.0) moving = stamp;
+      if (moving && !killed && stamp >= *moving + 3'000'000'000LL) {
+        // 3 s into the motion: the jog "unplugged", its pid (this test started it).
+        ASSERT_EQ(::kill(jog_pid, SIGKILL), 0);
+        killed = crane::runtime::now_nanoseconds();
+        speed_at_kill = reference.trolley_velocity();
+        position_at_kill = reference.trolley_position();
+      }
+      // Released: the reference decelerates (its first shaped step down from the steady speed).
+      if (killed && !released && reference.trolley_acceleration() < 0.0) released = stamp;
+      if (released && !at_rest && reference.trolley_velocity() == 0.0 &&
+          reference.phase() != crane::protocol::Reference::PHASE_MOVING) {
+        at_rest = stamp;
+        rest_position = reference.trolley_position();
+      }
+    }
+    while (sensors_reader->take_next(sample)) {
+      const std::int64_t t = to_nanoseconds(sample.header().origin());
+      if (at_rest && t >= *at_rest + 2'000'000'000LL && t < *at_rest + 6'000'000'000LL) {
+        residual = std::max({residual, std::abs(sample.swing_in_plane()), std::abs(sample.swing_out_of_plane())});
+        ++swing_samples;
+      }
+    }
+    if (at_rest && swing_samples > 0 && crane::runtime::now_nanoseconds() > *at_rest + 6'500'000'000LL) break;
+  }
+  ASSERT_TRUE(moving.has_value()) << "the jog never moved the trolley; see " << dir;
+  ASSERT_TRUE(killed.has_value());
+  const auto jog_exit = jog.poll();
+  ASSERT_TRUE(jog_exit.has_value());
+  EXPECT_TRUE(WIFSIGNALED(jog_exit->status) && WTERMSIG(jog_exit->status) == SIGKILL) << jog_exit->describe();
+  ASSERT_TRUE(released.has_value()) << "the planner never released the axes; see " << dir;
+  ASSERT_TRUE(at_rest.has_value()) << "the reference never came to rest; see " << dir;
+  const double release_ms = static_cast<double>(*released - *killed) * 1e-6;
+  const double rest_s = static_cast<double>(*at_rest - *killed) * 1e-9;
+  std::printf("[ figure   ] crane_jog killed (SIGKILL) at trolley %.3f m, %.3f m/s: the reference decelerates %.1f ms "
+              "after the kill (dead man 200 ms), at rest %.2f s after the kill at %.3f m, residual swing %.3f deg 2-6 s "
+              "after rest (%llu samples), supervisor faults %u\n",
+              position_at_kill, speed_at_kill, release_ms, rest_s, rest_position, residual * 180.0 / M_PI,
+              static_cast<unsigned long long>(swing_samples), faults);
+  EXPECT_NEAR(speed_at_kill, 0.3 * 0.4982, 1e-6) << "the shaped speed steady at the kill";
+  EXPECT_GE(release_ms, 200.0 - 20.0) << "released before the dead man's time: by something else";
+  EXPECT_LE(release_ms, 200.0 + 3 * 10.0);
+  EXPECT_GT(swing_samples, 300U);
+  EXPECT_LT(residual * 180.0 / M_PI, 0.5);
+  EXPECT_EQ(faults, 0U) << "supervisor fault; see " << dir;
+  for (const auto& e : stack.stop_all()) EXPECT_TRUE(WIFEXITED(e.status) && WEXITSTATUS(e.status) == 0) << e.describe();
+  status_reader.reset();
+  reference_reader.reset();
+  sensors_reader.reset();
+}
+
 // `deploy/crane launch --config` for the other two cranes (docs/cranes.md): the overhead crane's stack
 // live (lockstep), a diagonal goal (bridge and trolley together, hoisting) from `crane_move --wait
 // --json` arrives settled within the demo's criteria on both axes and in both swing planes, and a
@@ -797,8 +930,8 @@ TEST(Stack, NonFiniteSamplesAreRejectedAndNeverReachADrive) {
     const auto found = stage_of_pid.find(static_cast<int>(d.pid()));
     if (found != stage_of_pid.end()) rejected[found->second] = d.nonfinite_rejected();
   }
-  // Where each rogue stream enters: sensors -> estimator (and supervisor); actuators, safety status
-  // -> plant; linear -> friction compensation; estimate -> planner, anti-swing, tracking, friction
+  // Where each rogue stream enters: sensors -> estimator (and supervisor); actuators -> plant; safety
+  // status -> plant, planner, anti-swing; linear -> friction compensation; estimate -> planner, anti-swing, tracking, friction
   // compensation; goal -> planner; reference, anti-swing action -> tracking; all but the goal and
   // the status -> supervisor.
   for (const auto* stage : {"state_estimator", "plant", "friction_compensation", "trajectory_planner", "anti_swing",

@@ -5,6 +5,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <string>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -144,6 +147,107 @@ TEST(AntiSwingStage, TheLawRegistryNamesAreTheIdlCodes) {
     EXPECT_EQ(out.header.seq, 3U);
   }
   EXPECT_THROW((void)anti_swing::law_from_name("delayed_feedback"), common::ConfigError);
+}
+
+// A free swing at L = 1 m (T = 2 pi sqrt(1 / 9.8) = 2.007 s): 0.1 rad in plane, 0.05 rad out of plane.
+protocol::CraneState swinging(std::uint64_t seq) {
+  auto s = at_rest(seq, 0.6);
+  const double w = std::sqrt(9.8 / 1.0), t = 0.01 * static_cast<double>(seq);
+  s.swing_in_plane = 0.1 * std::sin(w * t);
+  s.swing_in_plane_rate = 0.1 * w * std::cos(w * t);
+  s.swing_out_of_plane = 0.05 * std::cos(w * t);
+  s.swing_out_of_plane_rate = -0.05 * w * std::sin(w * t);
+  return s;
+}
+
+// Every output of the law: actions, reference corrections, the bridge's.
+std::array<double, 9> outputs_of(const protocol::AntiSwingCommand& c) {
+  return {c.trolley_action, c.slew_action, c.trolley_reference_correction, c.trolley_reference_rate_correction,
+          c.slew_reference_correction, c.slew_reference_rate_correction, c.bridge_action, c.bridge_reference_correction,
+          c.bridge_reference_rate_correction};
+}
+
+// MAINTENANCE (OPC 40020: no anti-swing) from the supervisor's status: every law's output fades to
+// exactly 0 within one swing period (fade_periods 1) and stays 0 while the law keeps running; the
+// mode holds when no new status comes and an unknown code changes nothing. Leaving MAINTENANCE at
+// the worst moment (the largest output of the law), the output fades back in: no cycle changes it
+// by more than the law's own largest change in a cycle plus |output| T_s / T, far below the step an
+// instant switch makes, and one swing period later it is the law's to the bit.
+TEST(AntiSwingStage, MaintenanceSwitchesTheFeedbackOffAndLeavingItFadesItBackWithoutAJump) {
+  using Status = protocol::SupervisorStatus;
+  using Law = anti_swing::AntiSwingLaw;
+  constexpr std::uint64_t kCycles = 2500, kEnter = 500;
+  const double period = 2.0 * std::numbers::pi * std::sqrt(1.0 / 9.8), dt = 0.01;
+  const auto fade_cycles = static_cast<std::uint64_t>(std::ceil(period / dt));  // 201
+  for (const Law law : {Law::pd, Law::delay1, Law::delay2, Law::fuzzy}) {
+    const auto name = std::string(anti_swing::law_name(law));
+    anti_swing::AntiSwingStageParams p;
+    p.law = law;
+    p.bridge = true;  // the bridge's outputs (its gantry view: the out-of-plane swing) too
+    anti_swing::AntiSwingStage ungated(p), gated(p);
+    std::vector<std::array<double, 9>> u(kCycles), g(kCycles);
+    std::vector<double> engagement(kCycles);
+    protocol::AntiSwingCommand out;
+    for (std::uint64_t k = 0; k < kCycles; ++k) {
+      ASSERT_NE(ungated.step(swinging(k), out), common::StepStatus::rejected_nonfinite);
+      u[k] = outputs_of(out);
+    }
+    // Back to MANUAL at the largest output between cycles 1400 and 1700: the worst moment.
+    std::uint64_t leave = 1400;
+    const auto largest = [](const std::array<double, 9>& a) {
+      double m = 0.0;
+      for (const double v : a) m = std::max(m, std::abs(v));
+      return m;
+    };
+    for (std::uint64_t k = 1400; k < 1700; ++k) {
+      if (largest(u[k]) > largest(u[leave])) leave = k;
+    }
+    ASSERT_GT(largest(u[leave]), 0.0) << name;
+    Status manual, maintenance, unknown;
+    manual.operating_mode = Status::OPERATION_MANUAL;
+    maintenance.operating_mode = Status::OPERATION_MAINTENANCE;
+    unknown.operating_mode = 99;
+    for (std::uint64_t k = 0; k < kCycles; ++k) {
+      const Status* status = k < kEnter ? &manual : k < leave ? &maintenance : &manual;
+      if (k > kEnter && k < leave && k % 2 == 1) status = nullptr;  // no new status: the mode holds
+      if (k == 900) status = &unknown;
+      ASSERT_NE(gated.step(swinging(k), status, out), common::StepStatus::rejected_nonfinite);
+      g[k] = outputs_of(out);
+      engagement[k] = gated.engagement();
+      if (k == 1000) {
+        EXPECT_EQ(gated.operating_mode(), Status::OPERATION_MAINTENANCE) << name;
+      }
+    }
+    // Before: the law's, to the bit. The fade out: linear, 0 after one swing period.
+    for (std::uint64_t k = 0; k < kEnter; ++k) ASSERT_EQ(g[k], u[k]) << name << " cycle " << k;
+    EXPECT_GT(engagement[kEnter + fade_cycles - 2], 0.0) << name;
+    EXPECT_EQ(engagement[kEnter + fade_cycles - 1], 0.0) << name;
+    for (std::uint64_t k = kEnter + fade_cycles - 1; k < leave; ++k) {
+      for (const double v : g[k]) ASSERT_EQ(v, 0.0) << name << ": MAINTENANCE, cycle " << k;
+    }
+    // Leaving: the largest change in a cycle against the law's own and an instant switch's.
+    std::array<double, 9> jump{}, own{}, amplitude{};
+    for (std::size_t i = 0; i < 9; ++i) {
+      for (std::uint64_t k = leave; k < leave + fade_cycles + 10; ++k) {
+        jump[i] = std::max(jump[i], std::abs(g[k][i] - g[k - 1][i]));
+        own[i] = std::max(own[i], std::abs(u[k][i] - u[k - 1][i]));
+        amplitude[i] = std::max(amplitude[i], std::abs(u[k][i]));
+      }
+      EXPECT_LE(jump[i], own[i] + amplitude[i] * dt / period + 1e-12) << name << " output " << i;
+    }
+    // The output largest at the switch: an instant switch would step it by all of it in one cycle.
+    std::size_t shown = 0;
+    for (std::size_t i = 0; i < 9; ++i) {
+      if (std::abs(u[leave][i]) > std::abs(u[leave][shown])) shown = i;
+    }
+    EXPECT_LT(jump[shown], 0.1 * std::abs(u[leave][shown])) << name << " output " << shown << ": an instant switch";
+    std::printf("%s: leaving MAINTENANCE at cycle %llu (output %zu: %.4f): largest change in a cycle %.5f (the law's "
+                "own %.5f, an instant switch %.4f); the law's output again from cycle %llu\n",
+                name.c_str(), static_cast<unsigned long long>(leave), shown, u[leave][shown], jump[shown], own[shown],
+                std::abs(u[leave][shown]), static_cast<unsigned long long>(leave + fade_cycles - 1));
+    for (std::uint64_t k = leave + fade_cycles - 1; k < kCycles; ++k) ASSERT_EQ(g[k], u[k]) << name << " cycle " << k;
+    EXPECT_EQ(gated.engagement(), 1.0) << name;
+  }
 }
 
 // Masoud's configuration (3.50): the anti-swing command's reference corrections move the reference

@@ -1,5 +1,8 @@
 #include "crane/anti_swing/anti_swing_stage.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "crane/common/protocol_signals.hpp"
@@ -68,6 +71,7 @@ AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFact
   a.delay_gain = s.number("delay_gain", -1000.0, 1000.0);
   a.normalized_delay = s.number("normalized_delay", 1e-3, 5.0);
   a.slew_enabled = s.flag("slew_enabled");
+  p.fade_periods = s.number("fade_periods", 0.1, 10.0);
   s.finish();
   a.sample_period = facts.sample_period;
   a.gravity = facts.crane.gravity;
@@ -78,7 +82,13 @@ AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFact
   return p;
 }
 
-AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params) : law_(params.law), core_(make_core(params)) {
+bool feedback_in_mode(std::uint8_t operating_mode) noexcept {
+  return operating_mode != protocol::SupervisorStatus::OPERATION_MAINTENANCE;
+}
+
+AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params)
+    : law_(params.law), core_(make_core(params)), swing_(params.anti_swing), fade_periods_(params.fade_periods) {
+  common::require_in_range("anti_swing.fade_periods", params.fade_periods, 0.1, 10.0);
   if (params.bridge) {
     AntiSwingStageParams bridge = params;
     bridge.anti_swing.slew_enabled = false;  // the bridge's gantry view has no slew
@@ -103,23 +113,35 @@ AntiSwingStage::Result AntiSwingStage::run(Core& core, const protocol::CraneStat
   return r;
 }
 
-common::StepStatus AntiSwingStage::step(const protocol::CraneState& estimate,
+common::StepStatus AntiSwingStage::step(const protocol::CraneState& estimate, const protocol::SupervisorStatus* status,
                                         protocol::AntiSwingCommand& command) noexcept {
+  using Status = protocol::SupervisorStatus;
   if (!protocol::all_finite(estimate)) return common::StepStatus::rejected_nonfinite;
   const Result r = run(core_, estimate);
   if (r.status == common::StepStatus::rejected_nonfinite) return r.status;
+  if (status != nullptr && status->operating_mode >= Status::OPERATION_MANUAL &&
+      status->operating_mode <= Status::OPERATION_MAINTENANCE) {
+    operating_mode_ = status->operating_mode;
+  }
+  // The share of the law's output moves toward 1 (or 0 in MAINTENANCE) by T_s / (fade_periods T) a
+  // cycle, T the swing period at the measured cable length; it reaches 1 and 0 exactly.
+  const double cable_length = std::clamp(estimate.cable_length, swing_.min_cable_length, swing_.max_cable_length);
+  const double period = 2.0 * std::numbers::pi * std::sqrt(cable_length / swing_.gravity);  // T [s]
+  const double fade = swing_.sample_period / (fade_periods_ * period);
+  engagement_ = feedback_in_mode(operating_mode_) ? std::min(1.0, engagement_ + fade) : std::max(0.0, engagement_ - fade);
+  const double g = engagement_;
   command.controller = static_cast<std::uint8_t>(law_);
-  command.trolley_action = r.action.trolley_action;
-  command.slew_action = r.action.slew_action;
-  command.trolley_reference_correction = r.correction.trolley_position_correction;
-  command.trolley_reference_rate_correction = r.correction.trolley_velocity_correction;
-  command.slew_reference_correction = r.correction.slew_angle_correction;
-  command.slew_reference_rate_correction = r.correction.slew_rate_correction;
+  command.trolley_action = g * r.action.trolley_action;
+  command.slew_action = g * r.action.slew_action;
+  command.trolley_reference_correction = g * r.correction.trolley_position_correction;
+  command.trolley_reference_rate_correction = g * r.correction.trolley_velocity_correction;
+  command.slew_reference_correction = g * r.correction.slew_angle_correction;
+  command.slew_reference_rate_correction = g * r.correction.slew_rate_correction;
   if (bridge_core_) {
     const Result b = run(*bridge_core_, common::bridge_view(estimate));
-    command.bridge_action = b.action.trolley_action;
-    command.bridge_reference_correction = b.correction.trolley_position_correction;
-    command.bridge_reference_rate_correction = b.correction.trolley_velocity_correction;
+    command.bridge_action = g * b.action.trolley_action;
+    command.bridge_reference_correction = g * b.correction.trolley_position_correction;
+    command.bridge_reference_rate_correction = g * b.correction.trolley_velocity_correction;
   }
   common::same_cycle(estimate.header, command.header);
   return r.status;

@@ -96,12 +96,14 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
   if (s.estimator.step(s.sensors, s.estimate) != common::StepStatus::ok) {
     throw std::runtime_error("in-process run: the estimator refused the sensor sample of cycle " + std::to_string(k));
   }
-  // The planner sees the supervisor's status of the previous cycle (none before cycle 1).
-  const trajectory_planner::PlannerCycle cycle{&s.estimate, goals, speeds, k == 0 ? nullptr : &s.gating};
+  // The planner and the anti-swing law see the supervisor's status of the previous cycle (none
+  // before cycle 1): the operating mode.
+  const protocol::SupervisorStatus* previous = k == 0 ? nullptr : &s.gating;
+  const trajectory_planner::PlannerCycle cycle{&s.estimate, goals, speeds, previous};
   if (s.planner.step(cycle, s.reference) != common::StepStatus::ok) {
     throw std::runtime_error("in-process run: the planner did not answer cycle " + std::to_string(k));
   }
-  if (s.anti_swing.step(s.estimate, s.action) == common::StepStatus::rejected_nonfinite) {
+  if (s.anti_swing.step(s.estimate, previous, s.action) == common::StepStatus::rejected_nonfinite) {
     throw std::runtime_error("in-process run: the anti-swing law refused the estimate of cycle " + std::to_string(k));
   }
   (void)s.tracking.step(s.estimate, s.reference, s.action, s.linear);  // 0 V on a refusal, as the node
@@ -125,6 +127,7 @@ const protocol::SensorSample& InProcessStack::sensors() const noexcept { return 
 const protocol::SensorSample& InProcessStack::next_sensors() const noexcept { return stages_->next_sensors; }
 const protocol::CraneState& InProcessStack::estimate() const noexcept { return stages_->estimate; }
 const protocol::Reference& InProcessStack::reference() const noexcept { return stages_->reference; }
+const protocol::AntiSwingCommand& InProcessStack::anti_swing() const noexcept { return stages_->action; }
 const protocol::LinearCommand& InProcessStack::linear() const noexcept { return stages_->linear; }
 const protocol::ActuatorCommand& InProcessStack::actuators() const noexcept { return stages_->actuators; }
 const protocol::SupervisorStatus& InProcessStack::status() const noexcept { return stages_->status; }

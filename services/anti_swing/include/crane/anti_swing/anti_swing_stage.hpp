@@ -11,6 +11,16 @@
 // pd, delay1 and fuzzy use the gains and delay of the `anti_swing:` block, every law the gravity
 // and cable range of the crane (fuzzy and delay2 keep their own dissertation defaults for their
 // gains). A new law: an enumerator here, its case in anti_swing_stage.cpp, its code in the IDL.
+//
+// The operating mode (OPC 40020, from the supervisor's SupervisorStatus.operating_mode): MAINTENANCE
+// is "reduced speeds, no anti-swing", so there the law's output (actions and reference corrections)
+// is 0 and the tracking PD drives alone; in every other mode it is the law's. The law keeps running
+// on the estimate in MAINTENANCE (its delay line stays current), and its share of the command
+// (engagement(): 1 engaged, 0 off) moves between the two linearly over fade_periods swing periods at
+// the measured cable length: no step in the drive voltage when the mode enters or leaves MAINTENANCE
+// with the load swinging. Faded over n swing periods, the command changes per cycle by the law's own
+// change times the share plus at most |action| T_s / (n T): with n = 1 (the configurations') a sixth
+// of what a swing of that amplitude changes the action by itself in a cycle (|action| 2 pi T_s / T).
 
 #include <cstdint>
 #include <optional>
@@ -46,24 +56,46 @@ struct AntiSwingStageParams {
   AntiSwingParams anti_swing{};  // gains, delay, sample period, gravity, cable range (kind follows law)
   bool bridge{false};            // an overhead crane (facts.crane_kind): the same law on the bridge, on its
                                  // gantry view (common::bridge_view), into bridge_action / bridge_reference_*
+  double fade_periods{1.0};      // [swing periods] in [0.1, 10]: the law's output fades out over this many swing
+                                 // periods (2 pi sqrt(L/g), L the measured cable length) when the operating mode
+                                 // enters MAINTENANCE and back in when it leaves it
 };
 
 /// Reads the `anti_swing:` block: controller (a law name), pd_proportional_gain, pd_derivative_gain,
-/// delay_gain [-] in [-1000, 1000], normalized_delay [swing periods] in [1e-3, 5], slew_enabled;
-/// sample period, gravity and cable range from facts. Throws common::ConfigError naming the field.
+/// delay_gain [-] in [-1000, 1000], normalized_delay [swing periods] in [1e-3, 5], slew_enabled,
+/// fade_periods [swing periods] in [0.1, 10]; sample period, gravity and cable range from facts.
+/// Throws common::ConfigError naming the field.
 [[nodiscard]] AntiSwingStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
+
+/// The rule of the operating modes for the feedback: true (the law's output in the command) in every
+/// mode but MAINTENANCE (OPC 40020: "no anti-swing"); an unknown code changes nothing (the caller
+/// keeps the mode it had).
+[[nodiscard]] bool feedback_in_mode(std::uint8_t operating_mode) noexcept;
 
 class AntiSwingStage {
  public:
-  /// Throws common::ConfigError for invalid params (the law's own constructor).
+  /// Throws common::ConfigError for invalid params (the law's own constructor, fade_periods out of
+  /// [0.1, 10]).
   explicit AntiSwingStage(const AntiSwingStageParams& params);
 
-  /// One cycle. ok, or not_ready (a delay line still filling: every action and correction 0, the
-  /// safe value): `command` holds the cycle's output. rejected_nonfinite: nothing written, the law's
-  /// history untouched. Never throws, never allocates.
-  [[nodiscard]] common::StepStatus step(const protocol::CraneState& estimate, protocol::AntiSwingCommand& command) noexcept;
+  /// One cycle. `status`: the supervisor's latest status, for its operating_mode (nullptr: none yet,
+  /// or none new: the mode stays as it was, FULLAUTOMATIC at start; an OPERATION_* code outside
+  /// MANUAL..MAINTENANCE is ignored). ok, or not_ready (a delay line still filling: every action and
+  /// correction 0, the safe value): `command` holds the cycle's output, the law's scaled by
+  /// engagement(). rejected_nonfinite: nothing written, the law's history, the mode and the
+  /// engagement untouched. Never throws, never allocates.
+  [[nodiscard]] common::StepStatus step(const protocol::CraneState& estimate, const protocol::SupervisorStatus* status,
+                                        protocol::AntiSwingCommand& command) noexcept;
+  /// The same without a supervisor status: the operating mode stays as it was.
+  [[nodiscard]] common::StepStatus step(const protocol::CraneState& estimate, protocol::AntiSwingCommand& command) noexcept {
+    return step(estimate, nullptr, command);
+  }
 
   [[nodiscard]] AntiSwingLaw law() const noexcept { return law_; }
+  /// [-] in [0, 1]: the share of the law's output in the last command (1 engaged, 0 off in MAINTENANCE).
+  [[nodiscard]] double engagement() const noexcept { return engagement_; }
+  /// The OPERATION_* code the last step applied.
+  [[nodiscard]] std::uint8_t operating_mode() const noexcept { return operating_mode_; }
 
  private:
   using Core = std::variant<AntiSwing, anti_swing_analysis::FuzzyAntiSwing, anti_swing_analysis::DelayedTrajectoryAntiSwing>;
@@ -78,6 +110,10 @@ class AntiSwingStage {
   AntiSwingLaw law_;
   Core core_;
   std::optional<Core> bridge_core_;
+  AntiSwingParams swing_;  // sample period, gravity, cable range: the fade's swing period
+  double fade_periods_;    // [swing periods]
+  std::uint8_t operating_mode_{protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC};
+  double engagement_{1.0};  // [-]
 };
 
 }  // namespace crane::anti_swing

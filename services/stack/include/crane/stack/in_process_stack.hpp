@@ -6,6 +6,7 @@
 //
 //   cycle k:  plant.sample()  -> estimator -> planner (the goal, waiting for its start cycle)
 //             -> anti-swing -> tracking -> friction compensation -> actuators(k)
+//             (the planner and the anti-swing law with the status of k-1: the operating mode)
 //             -> supervisor(k): every stage fresh, one writer each -> status(k)
 //             -> plant.step(actuators(k), gated by status(k-1); cycle 0 by status(0))
 //
@@ -46,9 +47,10 @@ class InProcessStack {
   InProcessStack& operator=(const InProcessStack&) = delete;
 
   /// One cycle k: the sensors of k through the chain (the planner with these goals, stop requests
-  /// and operator speeds, and the supervisor status of cycle k - 1), the supervisor with
-  /// `command` (nullptr: none), then the plant over [k, k+1) gated by the status of k - 1. Throws
-  /// std::runtime_error naming the cycle when the estimator or the planner refuses its input.
+  /// and operator speeds; the planner and the anti-swing stage with the supervisor status of cycle
+  /// k - 1), the supervisor with `command` (nullptr: none), then the plant over [k, k+1) gated by
+  /// the status of k - 1. Throws std::runtime_error naming the cycle when the estimator or the
+  /// planner refuses its input.
   void step(std::span<const protocol::MoveRequest> goals = {}, std::span<const protocol::OperatorSpeed> speeds = {},
             const protocol::SupervisorCommand* command = nullptr);
 
@@ -57,6 +59,7 @@ class InProcessStack {
   [[nodiscard]] const protocol::SensorSample& next_sensors() const noexcept;  // sampled after it
   [[nodiscard]] const protocol::CraneState& estimate() const noexcept;        // of the last cycle
   [[nodiscard]] const protocol::Reference& reference() const noexcept;
+  [[nodiscard]] const protocol::AntiSwingCommand& anti_swing() const noexcept;  // of the last cycle
   [[nodiscard]] const protocol::LinearCommand& linear() const noexcept;
   [[nodiscard]] const protocol::ActuatorCommand& actuators() const noexcept;
   [[nodiscard]] const protocol::SupervisorStatus& status() const noexcept;
