@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 
 #include "crane/anti_swing/anti_swing.hpp"
@@ -69,10 +70,10 @@ void BM_ControlChainCycle(benchmark::State& state) {
     const auto start = Clock::now();
     (void)estimator.step(m, e);
     (void)anti_swing.step(e, a);
-    tracking::TrackingInput in{e, {}, a.trolley_action, a.slew_action};
+    tracking::TrackingInput in{e, {}, a.trolley_action, a.slew_action, std::nullopt};  // the configured load
     in.reference.trolley.position = 0.6;
     (void)tracking.step(in, t);
-    (void)compensation.step({e, t.command}, f);
+    (void)compensation.step({e, t.command, std::nullopt, std::nullopt}, f);  // the configured friction
     benchmark::DoNotOptimize(f);
     worst = std::max(worst, std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     ++k;
