@@ -398,8 +398,9 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     // arbitration, ambiguity), the one with the lowest delta-BIC when two channels name one. A channel
     // that names the first cause is explained by it (payload_mass_error is fitted on both drives: one
     // cause). Each channel's replay holds the other channels' measured motion, so a cause of one
-    // channel does not enter another's residual (except through the crane's own parameters: the load
-    // mass in both drive rows, the swing's length in the drives' coupling).
+    // channel does not enter another's residual; but the load mass is in both drive rows, and a swing
+    // cause enters the drives' coupling (nominal swing rows), so a swing cause can leave a drive
+    // channel a spurious cause of its own (docs/model_audit.md, "Two causes on different channels").
     const AuditReport* second_channel = nullptr;
     const CandidateReport* second = nullptr;  // the second cause's candidate (ambiguous: the better one)
     for (const auto& channel : report.channels) {
