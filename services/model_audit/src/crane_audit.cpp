@@ -378,16 +378,54 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
   report.nominal_prediction = shown.nominal_prediction;
   report.extended_prediction = shown.extended_prediction;
   report.holdout = shown.holdout;
+  // A cause's parameters as reported; payload_mass_error adds the resulting load_mass.
+  const auto cause_parameters = [&](const CandidateReport& cause) {
+    std::vector<FittedParameter> out = cause.parameters;
+    if (cause.name == "payload_mass_error") {
+      const double dm = cause.parameters.front().value;
+      out.push_back({"load_mass", "kg", crane.load_mass + dm, cause.parameters.front().standard_error});
+    }
+    return out;
+  };
   if (chosen != nullptr) {
     report.cause = chosen->name;
-    report.parameters = chosen->parameters;
+    report.parameters = cause_parameters(*chosen);
     report.extended_nominal = shown.extended_nominal;
-    if (chosen->name == "payload_mass_error") {
-      const double dm = chosen->parameters.front().value;
-      report.parameters.push_back({"load_mass", "kg", crane.load_mass + dm, chosen->parameters.front().standard_error});
-    }
     report.stop_reason = "selected " + chosen->name + " on the " + report.channel +
                          " channel (lowest delta-BIC among qualifying candidates of all channels)";
+    // Second cause, across the channels: the cause another channel names by its own selection (its
+    // residual not white, a qualifying candidate: delta-BIC, held-out gain beyond the floor, held-out
+    // arbitration, ambiguity), the one with the lowest delta-BIC when two channels name one. A channel
+    // that names the first cause is explained by it (payload_mass_error is fitted on both drives: one
+    // cause). Each channel's replay holds the other channels' measured motion, so a cause of one
+    // channel does not enter another's residual; but the load mass is in both drive rows, and a swing
+    // cause enters the drives' coupling (nominal swing rows), so a swing cause can leave a drive
+    // channel a spurious cause of its own (docs/model_audit.md, "Two causes on different channels").
+    const AuditReport* second_channel = nullptr;
+    const CandidateReport* second = nullptr;  // the second cause's candidate (ambiguous: the better one)
+    for (const auto& channel : report.channels) {
+      if (&channel == chosen_channel || channel.cause == "none") continue;
+      const std::vector<std::string> names =
+          channel.cause == "ambiguous" ? channel.ambiguous_with : std::vector<std::string>{channel.cause};
+      if (std::find(names.begin(), names.end(), chosen->name) != names.end()) continue;
+      const auto candidate = std::find_if(channel.candidates.begin(), channel.candidates.end(),
+                                          [&](const CandidateReport& c) { return c.name == names.front(); });
+      if (candidate == channel.candidates.end()) continue;
+      if (second == nullptr || candidate->delta_bic < second->delta_bic) {
+        second = &*candidate;
+        second_channel = &channel;
+      }
+    }
+    if (second != nullptr) {
+      report.second_cause = second_channel->cause;
+      report.second_ambiguous_with = second_channel->ambiguous_with;
+      report.second_parameters = cause_parameters(*second);
+      report.second_channel = second_channel->plant + " " + second_channel->channel;
+      report.stop_reason += "; second cause " + report.second_cause + " on the " + report.second_channel +
+                            " channel (" + second_channel->stop_reason + ")";
+    } else {
+      report.stop_reason += "; no other channel names a second cause";
+    }
   } else {
     report.stop_reason = "no channel has a candidate that earns its parameters (";
     for (const auto& channel : report.channels) {

@@ -353,29 +353,9 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
   return max_input;
 }
 
-HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, double duration,
-                                     const Uniform& uniform, const Uniform& signed_uniform) {
-  HiddenEffectCase out;
-  out.effect = e;
-  CraneTruth truth;
-  truth.crane.load_mass = uniform(1.0, 3.0);
-  truth.crane.cable_length = uniform(0.6, 1.6);
-  common::CraneParameters nominal = truth.crane;
-  const auto axis_truth = [](const common::AxisFriction& f, double gain) {
-    const AxisAuditParameters p = drive_axis_parameters(f, gain);
-    AxisModel m;
-    m.motor_constant = p.motor_constant;
-    m.viscous = p.viscous;
-    m.viscous_asymmetry = p.viscous_asymmetry;
-    m.coulomb = p.coulomb;
-    m.coulomb_asymmetry = p.coulomb_asymmetry;
-    m.stiction = p.stiction;
-    m.stiction_asymmetry = p.stiction_asymmetry;
-    return m;
-  };
-  truth.trolley = axis_truth(truth.crane.trolley_friction, truth.crane.trolley_drive_gain);
-  truth.slew = axis_truth(truth.crane.slew_friction, truth.crane.slew_drive_gain);
-  const double length = duration > 0.0 ? duration : kCreepDuration + 14.0;
+// Draws the magnitude of one crane catalog entry `e` into `truth` (and `nominal` for the payload).
+Drawn draw_crane_effect(const std::string& e, CraneTruth& truth, common::CraneParameters& nominal, double length,
+                        std::uint64_t seed, const Uniform& uniform, const Uniform& signed_uniform) {
   const std::string trolley_prefix = "trolley_";
   const std::string slew_prefix = "slew_";
   Drawn drawn;
@@ -418,10 +398,45 @@ HiddenEffectCase generate_crane_case(const std::string& e, std::uint64_t seed, d
   } else if (e != "none") {
     drawn = draw_pendulum_effect(e, truth.swing, truth.crane.gravity / truth.crane.cable_length, uniform, signed_uniform);
   }
-  out.main_parameter = drawn.parameter;
-  out.main_value = drawn.value;
+  return drawn;
+}
+
+// `effects`: one or two catalog entries (or "none"), drawn in this order.
+HiddenEffectCase generate_crane_case(const std::vector<std::string>& effects, std::uint64_t seed, double duration,
+                                     const Uniform& uniform, const Uniform& signed_uniform) {
+  HiddenEffectCase out;
+  CraneTruth truth;
+  truth.crane.load_mass = uniform(1.0, 3.0);
+  truth.crane.cable_length = uniform(0.6, 1.6);
+  common::CraneParameters nominal = truth.crane;
+  const auto axis_truth = [](const common::AxisFriction& f, double gain) {
+    const AxisAuditParameters p = drive_axis_parameters(f, gain);
+    AxisModel m;
+    m.motor_constant = p.motor_constant;
+    m.viscous = p.viscous;
+    m.viscous_asymmetry = p.viscous_asymmetry;
+    m.coulomb = p.coulomb;
+    m.coulomb_asymmetry = p.coulomb_asymmetry;
+    m.stiction = p.stiction;
+    m.stiction_asymmetry = p.stiction_asymmetry;
+    return m;
+  };
+  truth.trolley = axis_truth(truth.crane.trolley_friction, truth.crane.trolley_drive_gain);
+  truth.slew = axis_truth(truth.crane.slew_friction, truth.crane.slew_drive_gain);
+  const double length = duration > 0.0 ? duration : kCreepDuration + 14.0;
+  const Drawn first = draw_crane_effect(effects.front(), truth, nominal, length, seed, uniform, signed_uniform);
+  out.effect = effects.front();
+  out.main_parameter = first.parameter;
+  out.main_value = first.value;
+  if (effects.size() > 1) {
+    const Drawn second = draw_crane_effect(effects[1], truth, nominal, length, seed, uniform, signed_uniform);
+    out.second_effect = effects[1];
+    out.second_main_parameter = second.parameter;
+    out.second_main_value = second.value;
+  }
   out.nominal = nominal;
-  out.data.source = "generated crane case (seed " + std::to_string(seed) + ", effect " + e + ")";
+  out.data.source = "generated crane case (seed " + std::to_string(seed) + ", effect " + out.effect +
+                    (effects.size() > 1 ? " + " + out.second_effect : std::string()) + ")";
   run_crane(truth, length, seed, &out.data);
   return out;
 }
@@ -436,13 +451,31 @@ HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string
   const auto& catalog = audit_catalog(plant);
   HiddenEffectCase out;
   out.effect = effect;
+  const auto in_catalog = [&](const std::string& name) {
+    return std::find(catalog.begin(), catalog.end(), name) != catalog.end();
+  };
+  if (const std::size_t plus = effect.find('+'); plus != std::string::npos) {  // a pair (crane only)
+    const std::string first = effect.substr(0, plus);
+    const std::string second = effect.substr(plus + 1);
+    if (plant != AuditPlant::crane) throw common::ConfigError("effect: a pair '" + effect + "' is for the crane only");
+    for (const auto& name : {first, second}) {
+      if (!in_catalog(name)) throw common::ConfigError("effect: '" + name + "' (in '" + effect + "') is not in the catalog");
+    }
+    if (first == second) throw common::ConfigError("effect: the pair '" + effect + "' names one entry twice");
+    const std::vector<std::string> extended_rows = {"hook_double_pendulum", "elastic_rope"};
+    if (std::count_if(extended_rows.begin(), extended_rows.end(),
+                      [&](const std::string& name) { return name == first || name == second; }) == 2) {
+      throw common::ConfigError("effect: the pair '" + effect + "': the generator's plant has a hook or an elastic rope, not both");
+    }
+    return generate_crane_case({first, second}, seed, duration, uniform, signed_uniform);
+  }
   if (effect == "random") {
     out.effect = catalog[std::uniform_int_distribution<std::size_t>(0, catalog.size() - 1)(rng)];
-  } else if (effect != "none" && std::find(catalog.begin(), catalog.end(), effect) == catalog.end()) {
+  } else if (effect != "none" && !in_catalog(effect)) {
     throw common::ConfigError("effect: '" + effect + "' is not in the catalog");
   }
   const std::string& e = out.effect;
-  if (plant == AuditPlant::crane) return generate_crane_case(e, seed, duration, uniform, signed_uniform);
+  if (plant == AuditPlant::crane) return generate_crane_case({e}, seed, duration, uniform, signed_uniform);
 
   if (plant == AuditPlant::axis) {
     AxisModel model;

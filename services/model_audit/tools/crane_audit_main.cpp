@@ -4,7 +4,7 @@
 //               [--param NAME=VALUE ...] [--calibrate] [--columns t=COL,u=COL,x=COL ...] [--cause NAME ...]
 //               [--channel position|effort] [--holdout F] [--window S] [--dead-band V] [--max-rate HZ]
 //               [--t-min S] [--t-max S] [--plot] --out DIR
-//   crane_audit generate --model crane|axis|pendulum --effect NAME|none|random --seed N --out FILE.csv
+//   crane_audit generate --model crane|axis|pendulum --effect NAME|none|random|NAME+NAME --seed N --out FILE.csv
 //     Writes a hidden-effect test case (hidden_effect_generator.hpp); the nominal parameters and
 //     the truth go into the comment line.
 //
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::string generate_out;
   generate->add_option("--model", model_name, "crane | axis | pendulum");
-  generate->add_option("--effect", effect, "catalog name, none or random");
+  generate->add_option("--effect", effect, "catalog name, none, random, or (crane) a pair NAME+NAME");
   generate->add_option("--seed", seed, "seed");
   generate->add_option("--out", generate_out, "CSV file")->required();
 
@@ -140,7 +140,11 @@ int main(int argc, char** argv) {
     if (generate->parsed()) {
       const auto c = ma::generate_hidden_effect_case(plant, effect, seed);
       std::string comment = "hidden-effect case: effect " + c.effect + " " + c.main_parameter + "=" +
-                            crane::common::format_value(c.main_value) + "; nominal";
+                            crane::common::format_value(c.main_value) +
+                            (c.second_effect == "none" ? std::string()
+                                                       : " + " + c.second_effect + " " + c.second_main_parameter + "=" +
+                                                             crane::common::format_value(c.second_main_value)) +
+                            "; nominal";
       for (const auto& [k, v] : ma::parameter_values(c.nominal)) comment += " " + k + "=" + crane::common::format_value(v);
       std::ofstream out(generate_out);
       const auto& d = c.data;
@@ -197,7 +201,8 @@ int main(int argc, char** argv) {
       std::cout << "  " << p.name << " = " << p.value << " +- " << p.standard_error << " " << p.unit << '\n';
     }
     if (report.second_cause != "none") {
-      std::cout << "second cause: " << report.second_cause << '\n';
+      std::cout << "second cause: " << report.second_cause
+                << (report.second_channel.empty() ? "" : " (on the " + report.second_channel + " channel)") << '\n';
       for (const auto& p : report.second_parameters) {
         std::cout << "  " << p.name << " = " << p.value << " +- " << p.standard_error << " " << p.unit << '\n';
       }

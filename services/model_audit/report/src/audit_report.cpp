@@ -44,6 +44,7 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
   json["second_cause"] = report.second_cause;
   if (!report.second_ambiguous_with.empty()) json["second_ambiguous_with"] = report.second_ambiguous_with;
   if (report.second_cause != "none") json["second_parameters"] = parameters_json(report.second_parameters);
+  if (!report.second_channel.empty()) json["second_channel"] = report.second_channel;
   json["gain"] = {{"metric", "holdout_rms_" + report.channel + " [" + report.unit + "]"},
                   {"before", number(report.holdout_before)},
                   {"after", number(report.holdout_after)},
@@ -113,7 +114,10 @@ void write_audit_report(const AuditReport& report, const std::filesystem::path& 
       md << "\n";
     }
     if (report.second_cause != "none") {
-      md << "\n**Second cause: `" << report.second_cause << "`** (stepwise, on top of the first)\n\n";
+      md << "\n**Second cause: `" << report.second_cause << "`** ("
+         << (report.second_channel.empty() ? "stepwise, on top of the first"
+                                           : "on the " + report.second_channel + " channel, beside the first")
+         << ")\n\n";
       md << "| parameter | value | std. error | unit |\n|---|---|---|---|\n";
       for (const auto& p : report.second_parameters) {
         md << "| " << p.name << " | " << common::format_value(p.value) << " | " << common::format_value(p.standard_error)

@@ -65,12 +65,19 @@ struct HiddenEffectCase {
   std::string effect{"none"};                 // catalog name or "none"
   std::string main_parameter;                 // name as reported by the audit ("" for none)
   double main_value{0.0};                     // true value of the main parameter
+  // Crane pairs ("A+B"): the second entry, its main parameter and true value ("none", "", 0 else).
+  std::string second_effect{"none"};
+  std::string second_main_parameter;
+  double second_main_value{0.0};
   AuditNominal nominal;                       // nominal model to pass to the audit
   AuditData data;
 };
 
 /// Draws and simulates one case. `effect` = catalog name, "none" (clean), or "random" (uniform over
-/// the plant's catalog). `duration` [s] per axis or crane run or per pendulum swing (0 = default).
+/// the plant's catalog); crane also "A+B", two distinct entries acting together (each drawn in its
+/// range above, A first; not hook_double_pendulum with elastic_rope). `duration` [s] per axis or
+/// crane run or per pendulum swing (0 = default). Throws common::ConfigError for a name not in the
+/// catalog or a pair that is not allowed.
 [[nodiscard]] HiddenEffectCase generate_hidden_effect_case(AuditPlant plant, const std::string& effect,
                                                            std::uint64_t seed, double duration = 0.0);
 

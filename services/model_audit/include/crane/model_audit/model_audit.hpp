@@ -52,6 +52,10 @@
 //    windows of at least 5 s, initial swing state as nuisance; catalog: the pendulum entries.
 //  - combination: the qualifying candidate with the lowest delta-BIC over the channels whose nominal
 //    residual is not white; a candidate must also gain kCraneResolutionQuanta quanta of held-out RMS.
+//    Second cause (cross-channel, no extra fit): the cause that another channel names by its own
+//    selection (residual not white, qualifying, arbitration, ambiguity), the lowest delta-BIC when
+//    two do; a channel that names the first cause (payload_mass_error, fitted on both drives) is
+//    explained by it. The channels stay at one cause each (max_causes 1).
 //    The effort channel as the fitting channel is refused for the crane. With calibrate, each
 //    drive's K_m, b, c are fitted first (the asymmetries and breakaway excess stay as configured)
 //    and the report's nominal gives them back in the configuration's terms (drive gain, volt
@@ -183,7 +187,7 @@ struct AuditOptions {
   // further cause on top of it (the first cause's parameters refitted in every fit), by the same
   // rules (delta-BIC, held-out gain, the floor) against the model with the first cause; stop at
   // "none". In [1, 2]: the axis and pendulum audits go to two causes; the crane's channels stay at
-  // one (their combination picks one cause over the channels).
+  // one (their combination picks the first cause over the channels and a second from another channel).
   int max_causes{2};
   int substeps{4};                  // >= 1, for the non-closed-form entries
   std::size_t max_lag{20};          // [samples] Ljung-Box lags
@@ -232,7 +236,10 @@ struct AuditReport {
   std::vector<FittedParameter> parameters;  // of the cause (refitted with the second cause if any)
   // Stepwise: the second cause found on top of the first ("none": none) and its parameters; the
   // held-out figures, `after` and extended_prediction are then those of the model with both.
+  // Crane: the cause another channel names (cross-channel; its parameters as fitted on that channel,
+  // its held-out figures in `channels`), not a stepwise cause on top of the first.
   std::string second_cause{"none"};           // a catalog name, "none" or "ambiguous"
+  std::string second_channel;                 // crane: the channel of the second cause, e.g. "slew position"
   std::vector<std::string> second_ambiguous_with;  // second_cause "ambiguous": the two it names
   std::vector<FittedParameter> second_parameters;
   std::vector<FittedParameter> nominal;     // nominal model used (calibrated if asked)
