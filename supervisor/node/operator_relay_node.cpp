@@ -9,7 +9,8 @@
 //
 // One thread: Boost.Asio accepts and reads the clients; while an exchange is pending, a 5 ms timer
 // takes the status and estimate samples and advances it (idle, the relay does not wake). A client must be this process's user or root, send
-// its request within 5 s and keep it under operator_socket::kMaxRequestBytes; at most 16 at once.
+// its request within 5 s and keep it under operator_socket::kMaxRequestBytes; at most 16 clients
+// are admitted at once, from connection to answer (a command waits at most its --timeout, 60 s).
 // A client that goes away mid-exchange loses only its reply: a command already written stays written.
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
@@ -76,6 +77,7 @@ class Relay {
     asio::streambuf buffer;
     std::unique_ptr<OperatorExchange> exchange;
     std::string reply;
+    bool counted{false};  // one of the kMaxClients, from admission to its answer
   };
   using ClientPtr = std::shared_ptr<Client>;
 
@@ -103,6 +105,7 @@ class Relay {
       return;
     }
     ++active_;
+    client->counted = true;
     client->request_timer.expires_after(kRequestTimeout);
     client->request_timer.async_wait([client](const boost::system::error_code& error) {
       if (!error) client->socket.close();  // no complete request in time
@@ -110,8 +113,8 @@ class Relay {
     asio::async_read_until(client->socket, client->buffer, '\n',
                            [this, client](const boost::system::error_code& error, std::size_t bytes) {
                              client->request_timer.cancel();
-                             --active_;
                              if (error) {
+                               release(*client);
                                if (error != asio::error::operation_aborted && error != asio::error::eof) {
                                  answer(client, {2, "", "request not read: " + error.message() +
                                                             " (at most " +
@@ -208,7 +211,14 @@ class Relay {
     if (!pending_.empty()) schedule_poll();
   }
 
+  void release(Client& client) {
+    if (!client.counted) return;
+    client.counted = false;
+    --active_;
+  }
+
   void answer(const ClientPtr& client, const supervisor::OperatorOutcome& outcome) {
+    release(*client);
     client->reply = supervisor::operator_socket::reply_header(outcome.exit_code, outcome.out.size(), outcome.err.size()) +
                     outcome.out + outcome.err;
     asio::async_write(client->socket, asio::buffer(client->reply), [client](const boost::system::error_code&, std::size_t) {

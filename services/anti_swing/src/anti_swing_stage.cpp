@@ -71,7 +71,7 @@ AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFact
   a.delay_gain = s.number("delay_gain", -1000.0, 1000.0);
   a.normalized_delay = s.number("normalized_delay", 1e-3, 5.0);
   a.slew_enabled = s.flag("slew_enabled");
-  p.fade_periods = s.number("fade_periods", 0.1, 10.0);
+  p.fade_periods = s.number("fade_periods", kMinFadePeriods, kMaxFadePeriods);
   s.finish();
   a.sample_period = facts.sample_period;
   a.gravity = facts.crane.gravity;
@@ -88,7 +88,7 @@ bool feedback_in_mode(std::uint8_t operating_mode) noexcept {
 
 AntiSwingStage::AntiSwingStage(const AntiSwingStageParams& params)
     : law_(params.law), core_(make_core(params)), swing_(params.anti_swing), fade_periods_(params.fade_periods) {
-  common::require_in_range("anti_swing.fade_periods", params.fade_periods, 0.1, 10.0);
+  common::require_in_range("anti_swing.fade_periods", params.fade_periods, kMinFadePeriods, kMaxFadePeriods);
   if (params.bridge) {
     AntiSwingStageParams bridge = params;
     bridge.anti_swing.slew_enabled = false;  // the bridge's gantry view has no slew

@@ -51,6 +51,10 @@ enum class AntiSwingLaw : std::uint8_t {
 /// The law named `name`; throws common::ConfigError naming `field`, the value and the choices.
 [[nodiscard]] AntiSwingLaw law_from_name(std::string_view name, std::string_view field = "anti_swing.controller");
 
+/// The range of anti_swing.fade_periods [swing periods] (read_params and the stage's constructor).
+inline constexpr double kMinFadePeriods = 0.1;
+inline constexpr double kMaxFadePeriods = 10.0;
+
 struct AntiSwingStageParams {
   AntiSwingLaw law{AntiSwingLaw::delay1};
   AntiSwingParams anti_swing{};  // gains, delay, sample period, gravity, cable range (kind follows law)
