@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <new>
 #include <sstream>
@@ -238,13 +239,31 @@ ShmBoard::ShmBoard(const std::string& name, const BoardConfig& config)
 void ShmBoard::read_counters(std::array<std::uint32_t, kCounterCount>& raw_counts) {
   const ShmBoardLayout& layout = segment_.layout();
   std::array<std::uint32_t, kCounterCount> values{};
+  std::array<std::int64_t, kCounterCount> rates{};
   std::uint64_t tick = 0;
+  std::int64_t due_ns = 0;
+  std::int64_t period_ns = 0;
   const bool consistent = read_consistent(layout.counter_sequence, [&]() noexcept {
-    for (std::size_t i = 0; i < kCounterCount; ++i) values[i] = layout.counters[i].load(std::memory_order_relaxed);
+    for (std::size_t i = 0; i < kCounterCount; ++i) {
+      values[i] = layout.counters[i].load(std::memory_order_relaxed);
+      rates[i] = layout.count_rates[i].load(std::memory_order_relaxed);
+    }
     tick = layout.sample_tick.load(std::memory_order_relaxed);
+    due_ns = layout.sample_time_ns.load(std::memory_order_relaxed);
+    period_ns = layout.sample_period_ns.load(std::memory_order_relaxed);
   });
   if (!consistent) fail(segment_.path(), "the counters stayed mid-update (did the emulator die while writing?)");
-  for (std::size_t i = 0; i < kCounterCount; ++i) raw_counts[i] = values[i] & counter_mask_;
+  // A free-running emulator's counters move on between its samples, along their rates.
+  double elapsed = 0.0;  // [s] since the sample was due, in [0, kMaxCounterExtrapolation periods]
+  if (due_ns > 0 && period_ns > 0) {
+    const double cap = kMaxCounterExtrapolation * static_cast<double>(period_ns);
+    elapsed = std::clamp(static_cast<double>(monotonic_time_ns() - due_ns), 0.0, cap) * 1e-9;
+  }
+  for (std::size_t i = 0; i < kCounterCount; ++i) {
+    const auto advance = static_cast<std::int64_t>(std::llround(static_cast<double>(rates[i]) * elapsed));
+    raw_counts[i] = static_cast<std::uint32_t>(static_cast<std::uint64_t>(values[i]) + static_cast<std::uint64_t>(advance)) &
+                    counter_mask_;
+  }
   answered_tick_ = tick;
 }
 
@@ -349,11 +368,24 @@ ShmBoardEmulator::~ShmBoardEmulator() {
 }
 
 std::uint64_t ShmBoardEmulator::publish_sample(const std::array<std::int64_t, kCounterCount>& encoder_counts) noexcept {
+  return publish_timed_sample(encoder_counts, 0, 0.0);
+}
+
+std::uint64_t ShmBoardEmulator::publish_timed_sample(const std::array<std::int64_t, kCounterCount>& encoder_counts,
+                                                     std::int64_t sample_time_ns, double sample_period) noexcept {
+  const bool timed = sample_time_ns > 0 && std::isfinite(sample_period) && sample_period > 0.0;
   ShmBoardLayout& layout = segment_.layout();
   begin_write(layout.counter_sequence);
   for (std::size_t i = 0; i < kCounterCount; ++i) {
     layout.counters[i].store(counter_register_value(encoder_counts[i], counter_bits_), std::memory_order_relaxed);
+    const double rate = timed && published_ ? static_cast<double>(encoder_counts[i] - last_counts_[i]) / sample_period : 0.0;
+    layout.count_rates[i].store(static_cast<std::int64_t>(std::llround(rate)), std::memory_order_relaxed);
   }
+  layout.sample_time_ns.store(timed ? sample_time_ns : 0, std::memory_order_relaxed);
+  layout.sample_period_ns.store(timed ? static_cast<std::int64_t>(std::llround(sample_period * 1e9)) : 0,
+                                std::memory_order_relaxed);
+  last_counts_ = encoder_counts;
+  published_ = true;
   const std::uint64_t tick = layout.sample_tick.load(std::memory_order_relaxed) + 1U;
   layout.sample_tick.store(tick, std::memory_order_release);  // counters first, then the tick
   end_write(layout.counter_sequence);

@@ -84,16 +84,23 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.facts().sample_period));
   const auto hang_timeout = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(cfg.facts().lockstep_hang_timeout));
-  auto publish = [&] { return board.publish_sample(encoder_counts()); };
+  // Realtime: the board's counters move between the plant's samples as an encoder's do (the bridge
+  // reads them on a timer of its own); lockstep: the bridge reads each sample once, held.
+  auto publish = [&](Clock::time_point due) {
+    if (!realtime) return board.publish_sample(encoder_counts());
+    const auto due_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(due.time_since_epoch()).count();
+    return board.publish_timed_sample(encoder_counts(), due_ns, cfg.facts().sample_period);
+  };
   const auto bit = [](hb::DigitalOutput line) { return 1U << static_cast<unsigned>(line); };
   spdlog::info("behind the emulated board {} ({} clock): counters {} bits, DAC [{}, {}] V", board.segment_path(),
                realtime ? "realtime" : "board-paced lockstep", board.counter_bits(),
                board.analog_range(hb::AnalogOutput::trolley_drive).min_volts,
                board.analog_range(hb::AnalogOutput::trolley_drive).max_volts);
-  std::uint64_t tick = publish();
+  std::uint64_t tick = publish(Clock::now());
   bool answered_once = false;
   auto next_deadline = Clock::now() + period;
   while (!runtime::stop_requested()) {
+    const auto due = next_deadline;  // realtime: when this step is due (steady_clock is CLOCK_MONOTONIC)
     if (realtime) {
       std::this_thread::sleep_until(next_deadline);
       next_deadline += period;
@@ -136,7 +143,7 @@ int run_behind_board(const std::string& board_name, const config::ConfigDocument
     }
     ++counters.cycles;
     counters.last_seq = counters.cycles;
-    tick = publish();
+    tick = publish(due);
     diagnostics.maybe_publish(counters, nullptr);
   }
   runtime::leave_realtime();

@@ -230,6 +230,7 @@ int main(int argc, char** argv) {
     protocol::SupervisorStatus status_plain;
     const auto supervise = [&](Clock::time_point now, const std::array<transport::ReaderHealth, supervisor::kStageCount>& h) {
       supervisor::SupervisorCycle cycle;
+      cycle.realtime = !lockstep;
       for (std::size_t i = 0; i < supervisor::kStageCount; ++i) {
         cycle.stages[i] = watched[i].observe(now, h[i], lockstep, last_sensors.header().seq(), dt);
       }

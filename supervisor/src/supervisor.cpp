@@ -224,7 +224,11 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
                                           in.swing_out_of_plane, in.cable_length);
   if (in.sensors_valid && finite_sensors) {
     if (have_previous_sample_ && in.sensor_seq > previous_sensor_seq_) {
-      const double dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
+      const double nominal_dt = static_cast<double>(in.sensor_seq - previous_sensor_seq_) * params_.sample_period;
+      const double measured_dt = in.sensor_time - previous_sensor_time_;  // NaN without measurement times
+      const double dt = measured_dt >= kMinMeasuredInterval * nominal_dt && measured_dt <= kMaxMeasuredInterval * nominal_dt
+                            ? measured_dt
+                            : nominal_dt;
       const double trolley_velocity = (in.trolley_position - previous_trolley_) / dt;
       const double slew_rate = (in.slew_angle - previous_slew_) / dt;
       trolley_acceleration_ = (trolley_velocity - trolley_velocity_) / dt;
@@ -253,6 +257,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     if (load_valid) previous_load_ = {load[0], load[1]};
     have_previous_sample_ = true;
     previous_sensor_seq_ = in.sensor_seq;
+    previous_sensor_time_ = in.sensor_time;
     previous_trolley_ = in.trolley_position;
     previous_slew_ = in.slew_angle;
     previous_bridge_ = in.bridge_position;

@@ -75,6 +75,11 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.stages = cycle.stages;
   in.sensors_valid = cycle.sensors != nullptr;
   in.sensor_seq = sensors.header.seq;
+  // A hardware bridge stamps a sample when it read the encoders, on cycles that jitter in realtime;
+  // a simulated plant's samples are sample_period apart (and a board-paced bridge's, in lockstep).
+  if (cycle.realtime && sensors.source == protocol::SensorSample::SOURCE_HARDWARE_BRIDGE) {
+    in.sensor_time = static_cast<double>(sensors.header.stamp.sec) + 1e-9 * static_cast<double>(sensors.header.stamp.nanosec);
+  }
   in.sensor_source = sensors.source;
   in.trolley_position = sensors.trolley_position;
   in.slew_angle = sensors.slew_angle;

@@ -99,6 +99,44 @@ TEST(ShmBoard, HoldsTheInitialCountsFromTheStart) {
   for (std::size_t i = 0; i < kCounterCount; ++i) EXPECT_EQ(raw[i], modulo(initial[i], 24)) << i;
 }
 
+// A free-running emulator (the realtime plant): between two samples the driver reads counters
+// advanced along the last step's rate, as an encoder's move between two reads, at most two periods;
+// board-paced samples hold. Without it a driver on its own timer read 0 or 2 plant steps per cycle.
+TEST(ShmBoard, FreeRunningCountersMoveBetweenSamplesAndBoardPacedOnesHold) {
+  const std::string name = unique_name();
+  ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});
+  ShmBoard board(name);
+  constexpr double kPeriod = 0.01;                 // [s]
+  constexpr std::int64_t kPeriodNs = 10'000'000;   // [ns]
+  const std::int64_t now = monotonic_time_ns();
+  // Steps of +1000 counts on the trolley, -300 on the slew (wrapping below 0), every 10 ms.
+  (void)emulator.publish_timed_sample({5000, 100, 0, 0, 0}, now - 2 * kPeriodNs, kPeriod);
+  (void)emulator.publish_timed_sample({6000, -200, 0, 0, 0}, now - kPeriodNs / 2, kPeriod);  // due 5 ms ago
+  std::array<std::uint32_t, kCounterCount> raw{};
+  board.read_counters(raw);
+  const double waited = static_cast<double>(monotonic_time_ns() - now) * 1e-9;  // >= 0, tiny
+  CounterUnwrapper trolley(24), slew(24);
+  const double moved = static_cast<double>(trolley.update(raw[0]) - 6000);
+  EXPECT_GE(moved, 500.0 - 1.0) << "5 ms at 100000 count/s";
+  EXPECT_LE(moved, 500.0 + 1e5 * waited + 1.0);
+  EXPECT_LE(static_cast<double>(slew.update(raw[1]) - (-200)), -150.0 + 1.0) << "5 ms at -30000 count/s";
+  EXPECT_EQ(raw[2], 0U) << "a counter at rest stays";
+  // A plant late by a second: at most two periods of extrapolation (its counters then hold).
+  (void)emulator.publish_timed_sample({7000, -500, 0, 0, 0}, monotonic_time_ns() - 1'000'000'000, kPeriod);
+  board.read_counters(raw);
+  EXPECT_EQ(trolley.update(raw[0]), 7000 + 2000);
+  EXPECT_EQ(slew.update(raw[1]), -500 - 600);
+  // Board-paced lockstep (publish_sample): held exactly, whatever the time.
+  (void)emulator.publish_sample({8000, -800, 0, 0, 0});
+  board.read_counters(raw);
+  EXPECT_EQ(trolley.update(raw[0]), 8000);
+  EXPECT_EQ(slew.update(raw[1]), -800);
+  // A bad period publishes held counters.
+  (void)emulator.publish_timed_sample({9000, -800, 0, 0, 0}, monotonic_time_ns() - kPeriodNs, 0.0);
+  board.read_counters(raw);
+  EXPECT_EQ(trolley.update(raw[0]), 9000);
+}
+
 TEST(ShmBoard, OutputsReachTheEmulatorWithTickCountAndTime) {
   const std::string name = unique_name();
   ShmBoardEmulator emulator = ShmBoardEmulator::create(name, common::CraneParameters{});

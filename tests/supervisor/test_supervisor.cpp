@@ -16,6 +16,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "crane/common/validation.hpp"
 #include "crane/supervisor/supervisor.hpp"
@@ -770,6 +771,43 @@ TEST(SupervisorLimits, TrolleyOverspeed) {
   const auto out = sample(-0.0101);
   EXPECT_EQ(out.active_faults, static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed));
   expect_stopped(out);
+}
+
+// A hardware bridge's cycles jitter: a 0.9 m/s move read at 12.1, 11.5 and 6.5 ms intervals (the
+// secured fault-injection stack's samples 427-430) is 1.07 and 1.04 m/s over the nominal 10 ms, two
+// samples over 1.0 m/s: a spurious overspeed. Over the measured intervals it is 0.9 m/s; a true
+// 1.05 m/s read with the same jitter is still an overspeed; a clock step falls back to the nominal.
+TEST(SupervisorLimits, TrolleyOverspeedOverTheMeasuredIntervals) {
+  const double intervals[] = {0.010, 0.010, 0.0121, 0.0115, 0.0065, 0.010, 0.010};
+  std::vector<double> velocity;  // [m/s] the supervisor's, per sample of the last run
+  const auto run = [&](double speed, bool measured, double clock_step = 0.0) {
+    auto supervisor = ready_supervisor();
+    auto in = healthy_input();
+    std::uint64_t seq = 200000;
+    double t = 1000.0;  // [s] any epoch
+    std::uint32_t faults = 0;
+    velocity.clear();
+    for (int k = 0; k < 7; ++k) {
+      t += intervals[k];
+      in.sensor_seq = seq++;
+      in.trolley_position = 0.3 + speed * (t - 1000.0);
+      in.sensor_time = measured ? t + (k >= 3 ? clock_step : 0.0) : std::numeric_limits<double>::quiet_NaN();
+      const auto out = step(supervisor, in);
+      faults |= out.active_faults;
+      velocity.push_back(out.trolley_velocity);
+    }
+    return faults;
+  };
+  EXPECT_EQ(run(0.9, false), static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed)) << "over the nominal intervals";
+  EXPECT_NEAR(velocity[3], 0.9 * 0.0115 / 0.010, 1e-9);
+  EXPECT_EQ(run(0.9, true), 0U) << "over the measured intervals";
+  for (std::size_t k = 1; k < velocity.size(); ++k) EXPECT_NEAR(velocity[k], 0.9, 1e-6) << k;
+  EXPECT_EQ(run(1.05, true), static_cast<std::uint32_t>(sv::kFaultTrolleyOverspeed)) << "a true overspeed";
+  // The clock stepped by 1 s before sample 3: that interval falls back to the nominal 10 ms, the
+  // next ones are measured again.
+  EXPECT_EQ(run(0.9, true, 1.0), 0U);
+  EXPECT_NEAR(velocity[3], 0.9 * 0.0115 / 0.010, 1e-9) << "the nominal interval";
+  EXPECT_NEAR(velocity[4], 0.9, 1e-6) << "measured again";
 }
 
 // An overhead crane's bridge (bridge_enabled): guarded like the trolley, with its own faults,

@@ -34,6 +34,10 @@ inline constexpr std::chrono::microseconds kShmPollInterval{50};
 /// naming NAME otherwise.
 [[nodiscard]] std::string shm_segment_path(const std::string& name);
 
+/// How far [sample periods] a driver advances the counters of a free-running emulator past the
+/// time its last sample was due (ShmBoard::read_counters): a plant late by more holds its counters.
+inline constexpr double kMaxCounterExtrapolation = 2.0;
+
 /// CLOCK_MONOTONIC now [ns] (the clock of ShmBoardLayout::last_output_write_ns; the same clock as
 /// std::chrono::steady_clock on Linux).
 [[nodiscard]] std::int64_t monotonic_time_ns() noexcept;
@@ -78,8 +82,11 @@ class ShmBoard final : public Board {
   explicit ShmBoard(const std::string& name, const BoardConfig& config = {});
 
   /// Seqlock read of the counter registers; also remembers the sample_tick they belong to (the tick
-  /// the next write_outputs() answers). Throws BoardError if the emulator stays mid-update for
-  /// more than ~10 ms (it died while writing).
+  /// the next write_outputs() answers). From a free-running emulator (publish_timed_sample) each
+  /// register is advanced along its published rate by the time since the sample was due, at most
+  /// kMaxCounterExtrapolation sample periods: the counters move between two samples as an
+  /// encoder's do. Throws BoardError if the emulator stays mid-update for more than ~10 ms (it
+  /// died while writing).
   void read_counters(std::array<std::uint32_t, kCounterCount>& raw_counts) override;
   /// Seqlock write of codes (clamped to maxdata), digital word, outputs_tick (the tick of the last
   /// read_counters()/wait_for_sample()), write count + 1 and the CLOCK_MONOTONIC time. noexcept in
@@ -140,6 +147,16 @@ class ShmBoardEmulator {
   /// Publishes one sample: each register = counter_register_value(count, counter_bits), then
   /// sample_tick + 1 (release). Returns the new tick. Single writer (one emulator per segment).
   std::uint64_t publish_sample(const std::array<std::int64_t, kCounterCount>& encoder_counts) noexcept;
+  /// A free-running (realtime) emulator's sample: as publish_sample(), plus `sample_time_ns` [ns,
+  /// CLOCK_MONOTONIC], when the step that produced it was due, and each counter's rate [count/s],
+  /// its change since the previous published sample over `sample_period` [s]. The driver then
+  /// reads counters that move between samples (ShmBoard::read_counters). Without it a driver on
+  /// its own timer, in phase with the plant's, reads 0 or 2 of the plant's steps in one of its
+  /// cycles and differentiates 0 or twice the speed (the supervisor's overspeed fault at 1.03
+  /// m/s on a 0.5 m/s move, tests/fault_injection). `sample_period` <= 0 or non-finite publishes
+  /// held counters (rates 0), as publish_sample().
+  std::uint64_t publish_timed_sample(const std::array<std::int64_t, kCounterCount>& encoder_counts,
+                                     std::int64_t sample_time_ns, double sample_period) noexcept;
   [[nodiscard]] std::uint64_t sample_tick() const noexcept;
 
   /// Waits (polling every kShmPollInterval) until the driver's outputs answer `tick`
@@ -170,6 +187,8 @@ class ShmBoardEmulator {
   bool owns_segment_{false};
   int counter_bits_{0};
   std::array<AnalogRange, kAnalogOutputCount> ranges_{};
+  std::array<std::int64_t, kCounterCount> last_counts_{};  // the counts last published (the rates' base)
+  bool published_{false};                                  // a sample was published by this emulator
 };
 
 }  // namespace crane::hardware_bridge

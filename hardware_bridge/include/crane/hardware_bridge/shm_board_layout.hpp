@@ -29,7 +29,7 @@
 namespace crane::hardware_bridge {
 
 inline constexpr std::uint32_t kShmBoardMagic = 0x43524E42U;  // "CRNB"
-inline constexpr std::uint32_t kShmBoardVersion = 2U;  // 2: the bridge axis (a fifth counter, a fourth DAC)
+inline constexpr std::uint32_t kShmBoardVersion = 3U;  // 2: the bridge axis; 3: counter rates of a free-running emulator
 inline constexpr const char* kShmSegmentPrefix = "/crane_board_";
 
 struct ShmBoardLayout {
@@ -46,6 +46,12 @@ struct ShmBoardLayout {
   alignas(64) std::atomic<std::uint64_t> counter_sequence;        // seqlock: odd while writing
   std::array<std::atomic<std::uint32_t>, kCounterCount> counters;  // raw registers, (count & mask)
   std::atomic<std::uint64_t> sample_tick;     // samples published so far (0: none yet)
+  // A free-running (realtime) emulator also publishes when its sample was due and each counter's
+  // rate, so that the driver reads counters that move between samples as a real encoder's do
+  // (ShmBoardEmulator::publish_timed_sample); 0 in board-paced lockstep: the counters hold.
+  std::array<std::atomic<std::int64_t>, kCounterCount> count_rates;  // [count/s]
+  std::atomic<std::int64_t> sample_time_ns;    // [ns] CLOCK_MONOTONIC time the sample was due (0: held)
+  std::atomic<std::int64_t> sample_period_ns;  // [ns] the emulator's sample period (0: held)
   std::atomic<std::uint32_t> digital_inputs;  // logical input word, bit(DigitalInput) = active
   std::atomic<std::uint32_t> emulator_closed; // 1 once the emulator has shut down
 

@@ -39,11 +39,16 @@
 //    slew's friction alone hardly slows it) and the warning speed_limited; (3) the brake envelope (where the load can swing if the brakes stop the
 //    crane now) within zone_brake_margin of the zone while the crane moves, or the load measured
 //    inside one: protective stop (fault zone, brakes), before the load enters.
-// The axis velocities are differentiated here from the sensor samples (seq and positions), not
-// taken from the state estimator: the supervisor does not trust the control processes.
+// The axis velocities are differentiated here from the sensor samples, not taken from the state
+// estimator: the supervisor does not trust the control processes. The interval between two samples
+// is their measurement times' difference when the input gives them (SupervisorInput::sensor_time: a
+// hardware bridge in realtime, whose cycles jitter: a read 2 ms late is a 20 % faster velocity over
+// the nominal 10 ms), within [kMinMeasuredInterval, kMaxMeasuredInterval] x the nominal one, and
+// their seq difference x sample_period otherwise (a simulated plant's samples are exactly that).
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "crane/common/site.hpp"
@@ -142,6 +147,10 @@ struct AxisLimits {
 /// whose plant updates its counters once per step on its own timer: 1.28 m/s for one sample, then
 /// 0.09, during a 0.64 m/s move). A real overspeed lasts longer; the trip comes one cycle later.
 inline constexpr int kOverspeedSamples = 2;
+/// Bounds of a measured interval between two sensor samples, as fractions of the nominal one (seq
+/// difference x sample_period); outside them (a clock step, a sample reordered) the nominal is used.
+inline constexpr double kMinMeasuredInterval = 0.25;
+inline constexpr double kMaxMeasuredInterval = 4.0;
 
 struct SupervisorParams {
   double trolley_min{0.05};          // [m] hard travel limit
@@ -241,6 +250,8 @@ struct SupervisorInput {
   std::array<StageObservation, kStageCount> stages{};
   bool sensors_valid{false};          // a sensor sample has been received (limits are checked only then)
   std::uint64_t sensor_seq{0};        // cycle number of the latest sensor sample
+  double sensor_time{std::numeric_limits<double>::quiet_NaN()};  // [s] when its positions were measured, any
+                                      // epoch; NaN: the samples are sample_period apart per seq
   std::uint8_t sensor_source{0};      // SensorSample_.source
   double trolley_position{0.0};       // [m] from the latest sensor sample
   double slew_angle{0.0};             // [rad]
@@ -382,6 +393,7 @@ class Supervisor {
   // Velocity from successive sensor samples.
   bool have_previous_sample_{false};
   std::uint64_t previous_sensor_seq_{0};
+  double previous_sensor_time_{std::numeric_limits<double>::quiet_NaN()};  // [s] SupervisorInput::sensor_time
   double previous_trolley_{0.0};
   double previous_slew_{0.0};
   double trolley_velocity_{0.0};

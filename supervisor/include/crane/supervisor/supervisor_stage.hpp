@@ -37,6 +37,7 @@ struct SupervisorCycle {
   bool nonfinite_seen{false};                           // a watched sample was rejected since the last cycle
   std::uint32_t nonfinite_rejected{0};                  // samples rejected since start (carried in the status)
   const protocol::SupervisorCommand* command{nullptr};  // at most one operator command per cycle
+  bool realtime{false};  // wall-clock cycles: a hardware bridge's sample stamp is when it read the encoders
 };
 
 class SupervisorStage {
