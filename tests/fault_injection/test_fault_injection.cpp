@@ -756,7 +756,9 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
       ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
       ASSERT_TRUE(stack.wait_ready(10.0)) << "after the protective stop before stop " << i;
     }
-    const std::string command = script + " estop" + domain + (via_relay ? "" : " --direct") + " > /dev/null";
+    // --direct: a fresh participant; secured, its handshakes take seconds on a loaded machine before
+    // it sees the supervisor's answer (the brakes engage sooner: the figure).
+    const std::string command = script + " estop" + domain + (via_relay ? "" : " --direct --timeout 15") + " > /dev/null";
     const std::int64_t typed_ns = hb::monotonic_time_ns();
     const int rc = WEXITSTATUS(std::system(command.c_str()));
     const std::int64_t returned_ns = hb::monotonic_time_ns();
