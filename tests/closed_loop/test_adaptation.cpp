@@ -91,52 +91,102 @@ TEST(Adaptation, PayloadMassWithinFivePercentWithinThreeSecondsOfMotion) {
   EXPECT_GT(run.bound.back(), 0.0);
 }
 
-// Settle time, trolley overshoot and residual swing of a maneuver: the configured plant, the heavy
-// plant with the configured mass, the heavy plant with the online estimate.
+// Settle time, trolley overshoot, residual swing and final position error of a maneuver, on a plant
+// carrying `plant_factor` x the lab's 2.0 kg, configured with `configured_factor` x 2.0 kg.
 struct Row {
-  double settle{0.0};      // [s] NaN: never
-  double overshoot{0.0};   // [mm] trolley beyond its target
-  double residual{0.0};    // [deg]
+  double settle{0.0};          // [s] NaN: never
+  double overshoot{0.0};       // [mm] trolley beyond its target
+  double residual{0.0};        // [deg]
   double position_error{0.0};  // [mm]
 };
+struct RowCase {
+  double plant_factor{1.0};
+  double configured_factor{1.0};
+  bool adaptation{false};      // the online estimate (state_estimator.adaptation.enabled)
+  bool adapt_friction{true};   // adaptation.adapt_friction: false, the payload mass only
+  bool after_learning{false};  // measured after the learning move (learning_move below)
+};
 
-Row run_row(const std::string& controller, const std::string& maneuver_name, double load_factor, bool adaptation) {
-  const StackConfig cfg = lab(adaptation);
+// The move made first when a row is measured after one: the combined maneuver backwards, to where the
+// measured maneuver starts (a slewing move: the load is identified by the slew, (3.32), not by a
+// trolley move alone). delay1 makes it with half the slew's limits: at full limits its slew passed
+// 2 rad/s there and the supervisor stopped it (slew_overspeed); the gain schedule with full ones.
+ManeuverConfig learning_move(const StackConfig& cfg, const ManeuverConfig& measured, const std::string& controller) {
+  ManeuverConfig back = maneuver(cfg, "combined");
+  back.name = "combined backwards";
+  back.initial_trolley_position = back.trolley_target;
+  back.initial_slew_angle = back.slew_target;
+  back.trolley_target = measured.initial_trolley_position;
+  back.slew_target = measured.initial_slew_angle;
+  if (controller == "delay1") {
+    back.slew_max_velocity *= 0.5;
+    back.slew_max_acceleration *= 0.5;
+  }
+  return back;
+}
+
+Row run_row(const std::string& controller, const std::string& maneuver_name, const RowCase& c) {
+  StackConfig cfg = lab(c.adaptation);
+  cfg.state_estimator.adaptation.adapt_friction = c.adapt_friction;
+  cfg.facts.crane.load_mass *= c.configured_factor;
   const ManeuverConfig& m = maneuver(cfg, maneuver_name);
   crane::stack::InProcessRun run;
   run.maneuver = m;
   run.controller = crane::stack::choose_controller(controller, m, false);
   run.profile = controller.rfind("gain_scheduling", 0) == 0 ? crane::protocol::MoveRequest::PROFILE_STEP
                                                             : crane::protocol::MoveRequest::PROFILE_TRAPEZOID;
-  run.mismatch.load_mass_factor = load_factor;
+  run.mismatch.load_mass_factor = c.plant_factor;
+  if (c.after_learning) run.first_move = learning_move(cfg, m, controller);
   const auto result = crane::stack::run_in_process(cfg, run);
   Row r;
   r.settle = result.metrics.settle_time;
   r.residual = result.metrics.residual_swing * 180.0 / 3.14159265358979323846;
   r.position_error = 1e3 * result.metrics.final_position_error;
   const double direction = m.trolley_target > m.initial_trolley_position ? 1.0 : -1.0;
-  for (const auto& c : result.records) r.overshoot = std::max(r.overshoot, 1e3 * direction * (c.x - m.trolley_target));
+  for (const auto& rec : result.records) r.overshoot = std::max(r.overshoot, 1e3 * direction * (rec.x - m.trolley_target));
   return r;
 }
 
+// The heavy plant (3.0 kg) with the configured 2.0 kg, with the online estimate, and configured
+// right (3.0 kg: what a perfect estimate gives), against the nominal 2.0 kg plant: the first move
+// from rest, and a move after the learning move. Asserted, after the learning move: with the payload
+// mass estimate (adapt_friction false) every figure is at least as close to the nominal load's as
+// without it (the criterion). With friction adaptation too, the trolley step's settle time
+// moves away (printed, docs/architecture.md "Online estimation": the released friction, not the load).
 TEST(Adaptation, GainSchedulingAndTrackingWithTheEstimateAgainstTheNominalLoad) {
-  std::printf("%-24s %-9s %-28s %8s %13s %15s %11s\n", "controller", "maneuver", "plant / model", "settle_s",
+  std::printf("%-24s %-9s %-44s %8s %13s %15s %11s\n", "controller", "maneuver", "plant / model", "settle_s",
               "overshoot_mm", "resid_swing_deg", "pos_err_mm");
   for (const std::string controller : {"gain_scheduling_partial", "delay1"}) {
     const std::string m = controller == "delay1" ? "combined" : "trolley";
-    const Row nominal = run_row(controller, m, 1.0, false);
-    const Row configured = run_row(controller, m, kHeavy, false);
-    const Row estimated = run_row(controller, m, kHeavy, true);
     const auto print = [&](const char* label, const Row& r) {
-      std::printf("%-24s %-9s %-28s %8.2f %13.2f %15.3f %11.2f\n", controller.c_str(), m.c_str(), label, r.settle,
+      std::printf("%-24s %-9s %-44s %8.2f %13.2f %15.3f %11.2f\n", controller.c_str(), m.c_str(), label, r.settle,
                   r.overshoot, r.residual, r.position_error);
     };
-    print("2.0 kg / configured 2.0 kg", nominal);
-    print("3.0 kg / configured 2.0 kg", configured);
-    print("3.0 kg / online estimate", estimated);
-    // With the estimate the run is at least as close to the nominal-load figures as without it.
-    EXPECT_LE(std::abs(estimated.residual - nominal.residual), std::abs(configured.residual - nominal.residual) + 1e-3)
-        << controller;
+    for (const bool after : {false, true}) {
+      const Row nominal = run_row(controller, m, {1.0, 1.0, false, true, after});
+      const Row configured = run_row(controller, m, {kHeavy, 1.0, false, true, after});
+      const Row estimated = run_row(controller, m, {kHeavy, 1.0, true, true, after});
+      const Row mass_only = run_row(controller, m, {kHeavy, 1.0, true, false, after});
+      const Row known = run_row(controller, m, {1.0, kHeavy, false, true, after});
+      print(after ? "2.0 kg / 2.0 kg, after learning" : "2.0 kg / configured 2.0 kg", nominal);
+      print(after ? "3.0 kg / 2.0 kg, after learning" : "3.0 kg / configured 2.0 kg", configured);
+      print(after ? "3.0 kg / estimate, after learning" : "3.0 kg / online estimate", estimated);
+      print(after ? "3.0 kg / mass estimate only, after learning" : "3.0 kg / mass estimate only", mass_only);
+      print(after ? "3.0 kg / 3.0 kg, after learning" : "3.0 kg / configured 3.0 kg", known);
+      if (!after) {
+        EXPECT_LE(std::abs(estimated.residual - nominal.residual), std::abs(configured.residual - nominal.residual) + 1e-3)
+            << controller;
+        continue;
+      }
+      ASSERT_TRUE(std::isfinite(nominal.settle) && std::isfinite(mass_only.settle)) << controller;
+      EXPECT_LE(std::abs(mass_only.settle - nominal.settle), std::abs(configured.settle - nominal.settle) + 1e-9)
+          << controller;
+      EXPECT_LE(std::abs(mass_only.residual - nominal.residual), std::abs(configured.residual - nominal.residual) + 1e-3)
+          << controller;
+      EXPECT_LE(std::abs(mass_only.position_error - nominal.position_error),
+                std::abs(configured.position_error - nominal.position_error) + 1e-3)
+          << controller;
+    }
   }
 }
 

@@ -268,8 +268,8 @@ void OnlineAdaptation::step(const AdaptationInput& in, AdaptationEstimate& out) 
 
 void OnlineAdaptation::release_axis(const AxisIdentifier& id, const common::AxisFriction& configured,
                                     bool limit_cycle, common::AxisFriction& in_use) noexcept {
-  if (limit_cycle) {
-    in_use = configured;  // the fallback (header)
+  if (limit_cycle || !params_.adapt_friction) {
+    in_use = configured;  // the fallback (header), or the payload mass only
     return;
   }
   const AxisIdentification& s = id.identification();

@@ -143,23 +143,55 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   options.friction_compensation = run.friction_compensation;
   options.controller = run.controller;
   options.mismatch = run.mismatch;
-  options.initial_trolley_position = m.initial_trolley_position;
-  options.initial_slew_angle = m.initial_slew_angle;
-  options.initial_bridge_position = m.initial_bridge_position;
+  const ManeuverConfig& from = run.first_move ? *run.first_move : m;  // where the crane starts
+  options.initial_trolley_position = from.initial_trolley_position;
+  options.initial_slew_angle = from.initial_slew_angle;
+  options.initial_bridge_position = from.initial_bridge_position;
   InProcessStack stack(cfg, options);
-
-  const protocol::MoveRequest goal = move_request(m, cfg.facts, run.request_id, run.profile, run.start_cycle);
   const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
+
+  std::uint64_t k = 0;  // cycles stepped
+  std::uint64_t start_cycle = run.start_cycle;
+  if (run.first_move) {
+    const ManeuverConfig& f = *run.first_move;
+    if (f.trolley_target != m.initial_trolley_position || f.slew_target != m.initial_slew_angle ||
+        f.bridge_target != m.initial_bridge_position) {
+      throw std::invalid_argument("run_in_process: the first move " + f.name + " does not end where " + m.name + " starts");
+    }
+    if (m.cable_length_target != cfg.facts.crane.cable_length || f.cable_length_target != cfg.facts.crane.cable_length) {
+      throw std::invalid_argument("run_in_process: a first move with hoisting (" + f.name + ", " + m.name + ")");
+    }
+    const protocol::MoveRequest first =
+        move_request(f, cfg.facts, run.request_id, protocol::MoveRequest::PROFILE_TRAPEZOID, start_cycle);
+    const auto first_cycles = static_cast<std::uint64_t>(std::llround(f.duration / dt));
+    for (; k <= start_cycle + first_cycles; ++k) {
+      stack.step(k == 0 ? std::span(&first, 1) : std::span<const protocol::MoveRequest>());
+      for (const auto& outcome : stack.planner().goal_outcomes()) {
+        if (outcome.status != trajectory_planner::GoalStatus::accepted) {
+          throw std::runtime_error("in-process run: the first move was refused: " +
+                                   std::string(trajectory_planner::goal_status_name(outcome.status)));
+        }
+      }
+    }
+    if (stack.status().latched_faults != 0) {
+      throw std::runtime_error("in-process run: the supervisor latched faults (FAULT_* bits) " + std::to_string(stack.status().latched_faults) +
+                               " in the first move " + f.name);
+    }
+    start_cycle += k;
+  }
+  const std::uint64_t goal_cycle = k;  // the measured move's request arrives at this cycle
+  const std::uint32_t request_id = run.first_move ? run.request_id + 1 : run.request_id;  // the planner takes newer ids
+  const protocol::MoveRequest goal = move_request(m, cfg.facts, request_id, run.profile, start_cycle);
 
   InProcessResult result;
   result.swing_period = swing_period(m, cfg.facts);
   result.records.reserve(static_cast<std::size_t>(cycles_needed + 1));
   bool started = false;
   std::uint64_t start_seq = 0;
-  for (std::uint64_t k = 0;; ++k) {
+  for (;; ++k) {
     // The goal arrives while the crane rests (over DDS: a few cycles after the stack is ready) and
     // waits in the planner for its start cycle.
-    stack.step(k == 0 ? std::span(&goal, 1) : std::span<const protocol::MoveRequest>());
+    stack.step(k == goal_cycle ? std::span(&goal, 1) : std::span<const protocol::MoveRequest>());
     for (const auto& outcome : stack.planner().goal_outcomes()) {
       if (outcome.status != trajectory_planner::GoalStatus::accepted) {
         throw std::runtime_error("in-process run: move request refused at cycle " + std::to_string(k) + ": " +
@@ -176,7 +208,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
                                          &reference, &stack.linear(), &stack.actuators()));
       if (stack.next_sensors().brakes_engaged) ++result.braked_cycles;
       if (k == start_seq + cycles_needed) break;
-    } else if (k > run.start_cycle + 10) {
+    } else if (k > start_cycle + 10) {
       throw std::runtime_error("in-process run: the move did not start by cycle " + std::to_string(k));
     }
   }

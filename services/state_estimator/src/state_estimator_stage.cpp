@@ -24,6 +24,7 @@ adaptation::OnlineAdaptationParams read_adaptation(config::YamlSection s, const 
   a.mass_relative_bound = s.number("mass_relative_bound", 1e-4, 1.0);
   a.min_mass = s.number("min_mass", 0.0, 1e6);
   a.max_mass = s.number("max_mass", 0.0, 1e6);
+  a.adapt_friction = s.flag("adapt_friction");
   a.friction_relative_bound = s.number("friction_relative_bound", 1e-4, 10.0);
   a.min_friction_factor = s.number("min_friction_factor", 1e-3, 1.0);
   a.max_friction_factor = s.number("max_friction_factor", 1.0, 100.0);

@@ -67,6 +67,8 @@ struct OnlineAdaptationParams {
   double mass_relative_bound{0.05};      // [-] confident while bound <= this x mass, in (0, 1]
   double min_mass{0.0};                  // [kg] >= 0, <= crane.load_mass
   double max_mass{20.0};                 // [kg] > min_mass, >= crane.load_mass
+  bool adapt_friction{true};             // false: the payload mass only, the compensation keeps the configured
+                                         // friction (the regression still solves it: printed, never released)
   double friction_relative_bound{0.2};   // [-] a coefficient is released while 2 sigma <= this x value
   double min_friction_factor{0.5};       // [-] safe range of a released coefficient, x configured, in (0, 1]
   double max_friction_factor{2.0};       // [-] >= 1

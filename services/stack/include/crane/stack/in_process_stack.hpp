@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -80,6 +81,12 @@ struct InProcessRun {
   plant::PlantMismatch mismatch{};
   std::uint64_t start_cycle{kMoveStartCycle};  // the move request's header.seq (> 0)
   std::uint32_t request_id{1};
+  // A move made first, unmeasured, from its initial positions (where the crane starts) to its
+  // targets, which must be the maneuver's start, with its own limits and a trapezoid profile (the
+  // maneuver's duration); then the maneuver, measured: a move after one with the same load, what
+  // the online estimate has learnt from (docs/architecture.md, "Online estimation"). Neither may
+  // hoist. std::invalid_argument otherwise.
+  std::optional<ManeuverConfig> first_move;
 };
 
 struct InProcessResult {
