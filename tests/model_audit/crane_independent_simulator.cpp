@@ -90,7 +90,10 @@ struct DriveTruth {
   double inertia{1.0};  // M_drive [kg] or J_o [kg m^2]: force per volt = inertia * gain
   double viscous_positive{0.0}, viscous_negative{0.0};  // [V s/m]
   double coulomb_positive{0.0}, coulomb_negative{0.0};  // [V]
-  double static_positive{0.0}, static_negative{0.0};    // [V]
+  // Breakaway excess over the Coulomb level [V] per direction, from the configuration (max(static,
+  // Coulomb) - Coulomb): the catalog's nominal Delta_s +- dDelta_s, kept when an entry moves the
+  // Coulomb level (audit_models.hpp).
+  double static_excess_positive{0.0}, static_excess_negative{0.0};
   double stiction{0.0};           // [V] added breakaway level
   double stribeck_level{0.0};     // [V]
   double stribeck_velocity{0.03};  // [m/s]
@@ -113,9 +116,7 @@ struct DriveTruth {
   }
   // Largest drive [V] held at rest toward s.
   [[nodiscard]] double breakaway(int s, double x) const {
-    const double c = s > 0 ? coulomb_positive : coulomb_negative;
-    const double st = s > 0 ? static_positive : static_negative;
-    return coulomb(s, x) + std::max(0.0, st - c) + stribeck_level + stiction;
+    return coulomb(s, x) + (s > 0 ? static_excess_positive : static_excess_negative) + stribeck_level + stiction;
   }
   // Effective drive [V] of the command u [V].
   [[nodiscard]] double drive(double u) const {
@@ -502,8 +503,8 @@ DriveTruth drive_truth(const common::AxisFriction& f, double gain, double inerti
   d.viscous_negative = f.viscous_negative;
   d.coulomb_positive = f.coulomb_positive;
   d.coulomb_negative = f.coulomb_negative;
-  d.static_positive = f.static_positive;
-  d.static_negative = f.static_negative;
+  d.static_excess_positive = std::max(0.0, f.static_positive - f.coulomb_positive);
+  d.static_excess_negative = std::max(0.0, f.static_negative - f.coulomb_negative);
   return d;
 }
 

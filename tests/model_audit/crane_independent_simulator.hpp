@@ -22,7 +22,8 @@
 // Drives: F_x = M_drive K_mx (1 + g) S(D(u(t - tau))) - M_drive K_mx f_x, likewise T_gamma with
 // J_o K_mgamma (f in volt equivalents: max(0, c_s + slope x) + stribeck + b_s |v|). A drive at rest
 // is held (q''_i = 0, its row's constraint force is the friction that holds it) while that force is
-// within its breakaway level; a step in which a sliding drive's rate changes sign is cut at the
+// within its breakaway level (the Coulomb level, the configuration's static excess over it, the
+// Stribeck level and an injected stiction); a step in which a sliding drive's rate changes sign is cut at the
 // reversal (the drive rests there and the rest rule decides).
 // Sensors: encoder counts of the lab crane (trolley 1.59 um, slew 17.5 urad, swing 0.26 mrad),
 // Gaussian noise of 0.3 count, read as the nearest count; the swing encoders read the plant's
