@@ -560,6 +560,47 @@ TEST(CraneAudit, TwoCausesOnDifferentChannelsAreBothNamed) {
   EXPECT_GE(both, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(cases))));
 }
 
+// Two simultaneous causes on one drive channel: the crane's second cause stepwise on the first's own
+// channel (crane_audit.cpp). Seeds 9600 + i; case i: two distinct trolley entries (even i) or two
+// distinct slew entries (odd i), drawn uniformly (std::mt19937_64(seed)), both magnitudes in the
+// generator's ranges. Env CRANE_AUDIT_SAME_CHANNEL_CASES (default 1), CRANE_AUDIT_SAME_CHANNEL_FIRST.
+TEST(CraneAudit, TwoCausesOnOneDriveChannelAreBothNamed) {
+  const std::size_t first = env_cases("CRANE_AUDIT_SAME_CHANNEL_FIRST", 0);
+  const std::size_t cases = env_cases("CRANE_AUDIT_SAME_CHANNEL_CASES", 1);
+  const CraneEntries entries = crane_entries();
+  std::size_t both = 0;
+  std::size_t one = 0;
+  for (std::size_t i = first; i < first + cases; ++i) {
+    const std::uint64_t seed = 9600 + i;
+    std::mt19937_64 rng(seed);
+    const auto& list = i % 2 == 0 ? entries.trolley : entries.slew;
+    const auto pick = [&] { return list[std::uniform_int_distribution<std::size_t>(0, list.size() - 1)(rng)]; };
+    const std::string a = pick();
+    std::string b = pick();
+    while (b == a) b = pick();
+    const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, a + "+" + b, seed);
+    ma::AuditOptions options;
+    options.nominal = c.nominal;
+    const auto report = ma::run_audit(c.data, options);
+    const auto named = [&](const std::string& name) {
+      const auto in = [&](const std::vector<std::string>& v) { return std::find(v.begin(), v.end(), name) != v.end(); };
+      return report.cause == name || report.second_cause == name || in(report.ambiguous_with) ||
+             in(report.second_ambiguous_with);
+    };
+    const int found = (named(a) ? 1 : 0) + (named(b) ? 1 : 0);
+    both += found == 2 ? 1 : 0;
+    one += found == 1 ? 1 : 0;
+    std::printf("same-channel case %zu seed %llu: %s %s=%g + %s %s=%g -> %s + %s (%s)%s\n", i,
+                static_cast<unsigned long long>(seed), a.c_str(), c.main_parameter.c_str(), c.main_value, b.c_str(),
+                c.second_main_parameter.c_str(), c.second_main_value, report.cause.c_str(), report.second_cause.c_str(),
+                report.second_channel.empty() ? "-" : report.second_channel.c_str(),
+                found == 2 ? "" : found == 1 ? "  [one]" : "  [none]");
+  }
+  std::printf("crane pairs on one drive channel: both named %zu/%zu, one %zu, none %zu\n", both, cases, one,
+              cases - both - one);
+  EXPECT_GE(both, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(cases))));
+}
+
 // The cross-channel second cause invents nothing: clean recordings (seeds 9800 + i) give none with
 // no second cause; single-cause recordings (seeds 9900 + i, entry 9 i modulo the catalog, as the
 // crane hidden-effect test steps) are counted: right first cause, and a spurious second cause

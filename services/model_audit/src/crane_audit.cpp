@@ -247,15 +247,22 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
   const auto& drive_catalog = audit_catalog(AuditPlant::axis);
   const auto drive_channel = [&](const std::string& prefix, const std::vector<double>& input,
                                  const std::vector<double>& position, const DriveCoupling& coupling,
-                                 double drive_inertia, const common::AxisFriction& friction,
-                                 double gain) -> std::optional<AuditReport> {
+                                 double drive_inertia, const common::AxisFriction& friction, double gain,
+                                 int max_causes) -> std::optional<AuditReport> {
     bool requested = false;
     AuditOptions axis_options = options;
     axis_options.causes = channel_causes(options.causes, prefix, drive_catalog, true, requested);
     if (!requested) return std::nullopt;
+    if (max_causes > 1) {
+      // A second cause on this drive alone is not payload_mass_error: the load is in both drive rows
+      // (a payload error the other drive does not show is another cause's echo).
+      if (axis_options.causes.empty()) axis_options.causes = drive_catalog;
+      std::erase(axis_options.causes, std::string("payload_mass_error"));
+      if (axis_options.causes.empty()) return std::nullopt;  // (an empty list would mean the whole catalog)
+    }
     axis_options.nominal = drive_axis_parameters(friction, gain);
     axis_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
-    axis_options.max_causes = 1;  // one cause per channel (the combination picks one)
+    axis_options.max_causes = max_causes;  // 1 first (the combination picks one), 2 for a second on it
     axis_options.every_grid_start = true;
     AuditData axis_data;
     axis_data.source = data.source;
@@ -279,20 +286,25 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       for (auto& p : candidate.parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
     }
     for (auto& p : channel.extended_nominal) p.unit = slew ? slew_unit(p.unit) : p.unit;
+    for (auto& p : channel.second_parameters) p.unit = slew ? slew_unit(p.unit) : p.unit;
     const auto prefixed = [&](const std::string& name) { return name == "payload_mass_error" ? name : prefix + name; };
     if (channel.cause != "none" && channel.cause != "ambiguous") channel.cause = prefixed(channel.cause);
     for (auto& name : channel.ambiguous_with) name = prefixed(name);
-    if (options.calibrate) calibrate_drive(prefix, channel.nominal, std::get<AxisAuditParameters>(axis_options.nominal));
+    if (channel.second_cause != "none" && channel.second_cause != "ambiguous") channel.second_cause = prefixed(channel.second_cause);
+    for (auto& name : channel.second_ambiguous_with) name = prefixed(name);
+    if (options.calibrate && max_causes == 1) calibrate_drive(prefix, channel.nominal, std::get<AxisAuditParameters>(axis_options.nominal));
     return channel;
   };
-  if (auto c = drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
-                             crane.trolley_friction, crane.trolley_drive_gain)) {
-    report.channels.push_back(std::move(*c));
-  }
-  if (auto c = drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, slew_coupling, crane.jib_inertia,
-                             crane.slew_friction, crane.slew_drive_gain)) {
-    report.channels.push_back(std::move(*c));
-  }
+  const auto trolley_channel = [&](int max_causes) {
+    return drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
+                         crane.trolley_friction, crane.trolley_drive_gain, max_causes);
+  };
+  const auto slew_channel = [&](int max_causes) {
+    return drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, slew_coupling, crane.jib_inertia,
+                         crane.slew_friction, crane.slew_drive_gain, max_causes);
+  };
+  if (auto c = trolley_channel(1)) report.channels.push_back(std::move(*c));
+  if (auto c = slew_channel(1)) report.channels.push_back(std::move(*c));
 
   // Swing.
   {
@@ -416,14 +428,33 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
         second_channel = &channel;
       }
     }
-    if (second != nullptr) {
+    // No other channel names one: a second cause on the first's own drive channel, stepwise there
+    // (its residual with the first cause still not white; the channel audited again with two causes,
+    // kept when its first is the crane's). The swing channel stays at one cause.
+    std::optional<AuditReport> stepwise;
+    const bool drive = chosen_channel->plant == "trolley" || chosen_channel->plant == "slew";
+    const bool white_after = chosen_channel->after.whiteness.lags > 0 && chosen_channel->after.whiteness.p_value >= 0.05;
+    if (second == nullptr && drive && !white_after && options.max_causes > 1 && chosen->name != "payload_mass_error") {
+      stepwise = chosen_channel->plant == "trolley" ? trolley_channel(options.max_causes) : slew_channel(options.max_causes);
+      if (stepwise && stepwise->cause == chosen->name && stepwise->second_cause != "none") {
+        report.second_cause = stepwise->second_cause;
+        report.second_ambiguous_with = stepwise->second_ambiguous_with;
+        report.second_parameters = stepwise->second_parameters;
+        report.second_channel = chosen_channel->plant + " " + chosen_channel->channel;
+        report.stop_reason += "; second cause " + report.second_cause + " on the same " + report.second_channel +
+                              " channel, stepwise (" + stepwise->stop_reason + ")";
+      } else {
+        stepwise.reset();
+      }
+    }
+    if (!stepwise && second != nullptr) {
       report.second_cause = second_channel->cause;
       report.second_ambiguous_with = second_channel->ambiguous_with;
       report.second_parameters = cause_parameters(*second);
       report.second_channel = second_channel->plant + " " + second_channel->channel;
       report.stop_reason += "; second cause " + report.second_cause + " on the " + report.second_channel +
                             " channel (" + second_channel->stop_reason + ")";
-    } else {
+    } else if (!stepwise) {
       report.stop_reason += "; no other channel names a second cause";
     }
   } else {

@@ -55,7 +55,10 @@
 //    Second cause (cross-channel, no extra fit): the cause that another channel names by its own
 //    selection (residual not white, qualifying, arbitration, ambiguity), the lowest delta-BIC when
 //    two do; a channel that names the first cause (payload_mass_error, fitted on both drives) is
-//    explained by it. The channels stay at one cause each (max_causes 1).
+//    explained by it. When no other channel names one and the first is a drive's (not
+//    payload_mass_error), that drive channel is audited again stepwise (max_causes) for a second on
+//    the same channel, without payload_mass_error (a payload error shows on both drives), kept when
+//    its first cause is the crane's. The swing channel stays at one cause.
 //    The effort channel as the fitting channel is refused for the crane. With calibrate, each
 //    drive's K_m, b, c are fitted first (the asymmetries and breakaway excess stay as configured)
 //    and the report's nominal gives them back in the configuration's terms (drive gain, volt
