@@ -109,8 +109,9 @@ struct RowCase {
 
 // The move made first when a row is measured after one: the combined maneuver backwards, to where the
 // measured maneuver starts (a slewing move: the load is identified by the slew, (3.32), not by a
-// trolley move alone). delay1 makes it with half the slew's limits: at full limits its slew passed
-// 2 rad/s there and the supervisor stopped it (slew_overspeed); the gain schedule with full ones.
+// trolley move alone). delay1 makes it with half the slew's limits: at full limits, the trolley moving
+// in, its slew lagged the reference by 0.18 rad and caught up at 2.03 rad/s, and the supervisor
+// stopped it (slew_overspeed; architecture.md); the gain schedule with full ones.
 ManeuverConfig learning_move(const StackConfig& cfg, const ManeuverConfig& measured, const std::string& controller) {
   ManeuverConfig back = maneuver(cfg, "combined");
   back.name = "combined backwards";
