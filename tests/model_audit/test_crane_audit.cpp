@@ -24,6 +24,7 @@
 #include "crane/model_audit/model_audit.hpp"
 #include "crane/plant/crane_simulator.hpp"
 #include "audit_test_files.hpp"
+#include "audit_test_report.hpp"
 
 #if !defined(CRANE_AUDIT_EXECUTABLE) || !defined(CRANE_LAB_CONFIG)
 #error "CRANE_AUDIT_EXECUTABLE and CRANE_LAB_CONFIG must name crane_audit and the lab configuration"
@@ -50,6 +51,7 @@ void expect_refused(const fs::path& path, const std::string& needle) {
   ma::test::expect_refused(path, ma::AuditPlant::crane, needle);
 }
 
+using ma::test::env_count;
 using ma::test::run_tool;
 using ma::test::write_file;
 
@@ -317,10 +319,6 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
   }
 }
 
-std::size_t env_cases(const char* name, std::size_t fallback) {
-  const char* text = std::getenv(name);
-  return text != nullptr ? static_cast<std::size_t>(std::strtoul(text, nullptr, 10)) : fallback;
-}
 
 // The wind and hook entries on recordings of the project's plant simulator with its own options
 // (plant.wind: a steady force; plant.hook: the hook as a double pendulum, integrated by CVODE over
@@ -332,15 +330,15 @@ std::size_t env_cases(const char* name, std::size_t fallback) {
 // recording audited with these entries in the catalog), CRANE_AUDIT_PLANT_FIRST (first case index,
 // for shards).
 TEST(CraneAudit, PlantSimulatorWindHookAndOffsetAreNamed) {
-  const std::size_t cases = env_cases("CRANE_AUDIT_PLANT_CASES", 3);
-  const std::size_t clean = env_cases("CRANE_AUDIT_PLANT_CLEAN", 0);
+  const std::size_t cases = env_count("CRANE_AUDIT_PLANT_CASES", 3);
+  const std::size_t clean = env_count("CRANE_AUDIT_PLANT_CLEAN", 0);
   const char* entries[] = {"wind_force", "hook_double_pendulum", "encoder_offset"};
   std::size_t effect_cases = 0;
   std::size_t right = 0;
   std::size_t clean_cases = 0;
   std::size_t clean_none = 0;
   std::size_t within = 0;
-  for (std::size_t i = env_cases("CRANE_AUDIT_PLANT_FIRST", 0); i < cases + clean; ++i) {
+  for (std::size_t i = env_count("CRANE_AUDIT_PLANT_FIRST", 0); i < cases + clean; ++i) {
     const std::uint64_t seed = 4700 + i;
     std::mt19937_64 rng(seed);
     const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
@@ -436,12 +434,12 @@ TEST(CraneAudit, PlantSimulatorWithTheLabsElasticRopeGivesNone) {
 // elastic_rope with e_r within 10 %, not the cable length error its static stretch also is. Env
 // CRANE_AUDIT_ROPE_CASES (default 2), CRANE_AUDIT_ROPE_CLEAN (default 0), CRANE_AUDIT_ROPE_FIRST.
 TEST(CraneAudit, PlantSimulatorElasticRopeIsNamed) {
-  const std::size_t cases = env_cases("CRANE_AUDIT_ROPE_CASES", 2);
-  const std::size_t clean = env_cases("CRANE_AUDIT_ROPE_CLEAN", 0);
+  const std::size_t cases = env_count("CRANE_AUDIT_ROPE_CASES", 2);
+  const std::size_t clean = env_count("CRANE_AUDIT_ROPE_CLEAN", 0);
   std::size_t right = 0;
   std::size_t within = 0;
   std::size_t clean_none = 0;
-  const std::size_t first = env_cases("CRANE_AUDIT_ROPE_FIRST", 0);
+  const std::size_t first = env_count("CRANE_AUDIT_ROPE_FIRST", 0);
   for (std::size_t i = first; i < cases + clean; ++i) {
     const std::uint64_t seed = 4800 + i;
     std::mt19937_64 rng(seed);
@@ -511,20 +509,58 @@ CraneEntries crane_entries() {
   return out;
 }
 
+// Cases of two simultaneous causes: a generator pair "A+B" audited; both named, one, none. A name
+// counts when it is the cause or the second cause, or one of an ambiguous pair reported for either
+// (the data cannot separate the two: the single-cause tests' rule); those are counted apart too.
+struct PairTally {
+  std::size_t cases{0}, both{0}, one{0}, none{0}, via_ambiguous{0};
+
+  void audit(const char* kind, std::size_t i, std::uint64_t seed, const std::string& a, const std::string& b) {
+    const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, a + "+" + b, seed);
+    ASSERT_EQ(c.effect, a);
+    ASSERT_EQ(c.second_effect, b);
+    ma::AuditOptions options;
+    options.nominal = c.nominal;
+    const auto report = ma::run_audit(c.data, options);
+    const auto in = [](const std::vector<std::string>& v, const std::string& name) {
+      return std::find(v.begin(), v.end(), name) != v.end();
+    };
+    const auto exact = [&](const std::string& name) { return report.cause == name || report.second_cause == name; };
+    const auto named = [&](const std::string& name) {
+      return exact(name) || in(report.ambiguous_with, name) || in(report.second_ambiguous_with, name);
+    };
+    const int found = (named(a) ? 1 : 0) + (named(b) ? 1 : 0);
+    ++cases;
+    both += found == 2 ? 1 : 0;
+    one += found == 1 ? 1 : 0;
+    none += found == 0 ? 1 : 0;
+    via_ambiguous += found == 2 && !(exact(a) && exact(b)) ? 1 : 0;
+    std::printf("%s case %zu seed %llu: %s %s=%g + %s %s=%g -> %s + %s (%s)%s\n", kind, i,
+                static_cast<unsigned long long>(seed), a.c_str(), c.main_parameter.c_str(), c.main_value, b.c_str(),
+                c.second_main_parameter.c_str(), c.second_main_value, report.cause.c_str(), report.second_cause.c_str(),
+                report.second_channel.empty() ? "-" : report.second_channel.c_str(),
+                found == 2 ? "" : found == 1 ? "  [one]" : "  [none]");
+  }
+  // Prints the tally under `title` and expects both named in >= 90 % of the cases (issue 17).
+  void expect_both_named(const char* title) const {
+    std::printf("%s: both named %zu/%zu (%zu of them through an ambiguous pair), one %zu, none %zu\n", title, both, cases,
+                via_ambiguous, one, none);
+    EXPECT_GE(both, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(cases))));
+  }
+};
+
 // Issue 17 item 5 on the crane: two simultaneous causes on different channels, the cross-channel
 // second cause (model_audit.hpp, "combination"). Generator pairs "A+B" (hidden_effect_generator.hpp),
 // seeds 9700 + i, both magnitudes drawn in the generator's ranges; case i: kind i % 4 = a trolley
 // entry + a slew entry, a trolley entry + a swing entry, a slew entry + a swing entry,
-// payload_mass_error + a swing entry; the entries drawn uniformly (std::mt19937_64(seed)). Counts
-// the cases where {cause, second_cause} is the pair (both), where one of them is, and where none is.
+// payload_mass_error + a swing entry; the entries drawn uniformly (std::mt19937_64(seed)). Counted by
+// PairTally.
 // Env CRANE_AUDIT_PAIR_CASES (default 2), CRANE_AUDIT_PAIR_FIRST (first case index, for shards).
 TEST(CraneAudit, TwoCausesOnDifferentChannelsAreBothNamed) {
-  const std::size_t first = env_cases("CRANE_AUDIT_PAIR_FIRST", 0);
-  const std::size_t cases = env_cases("CRANE_AUDIT_PAIR_CASES", 2);
+  const std::size_t first = env_count("CRANE_AUDIT_PAIR_FIRST", 0);
+  const std::size_t cases = env_count("CRANE_AUDIT_PAIR_CASES", 2);
   const CraneEntries entries = crane_entries();
-  std::size_t both = 0;
-  std::size_t one = 0;
-  std::size_t none = 0;
+  PairTally tally;
   for (std::size_t i = first; i < first + cases; ++i) {
     const std::uint64_t seed = 9700 + i;
     std::mt19937_64 rng(seed);
@@ -539,25 +575,9 @@ TEST(CraneAudit, TwoCausesOnDifferentChannelsAreBothNamed) {
       case 2: a = pick(entries.slew); b = pick(entries.swing); break;
       default: a = "payload_mass_error"; b = pick(entries.swing); break;
     }
-    const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, a + "+" + b, seed);
-    ASSERT_EQ(c.effect, a);
-    ASSERT_EQ(c.second_effect, b);
-    ma::AuditOptions options;
-    options.nominal = c.nominal;
-    const auto report = ma::run_audit(c.data, options);
-    const auto named = [&](const std::string& name) { return report.cause == name || report.second_cause == name; };
-    const int found = (named(a) ? 1 : 0) + (named(b) ? 1 : 0);
-    both += found == 2 ? 1 : 0;
-    one += found == 1 ? 1 : 0;
-    none += found == 0 ? 1 : 0;
-    std::printf("pair case %zu seed %llu: %s %s=%g + %s %s=%g -> %s + %s (%s)%s\n", i,
-                static_cast<unsigned long long>(seed), a.c_str(), c.main_parameter.c_str(), c.main_value, b.c_str(),
-                c.second_main_parameter.c_str(), c.second_main_value, report.cause.c_str(), report.second_cause.c_str(),
-                report.second_channel.empty() ? "-" : report.second_channel.c_str(),
-                found == 2 ? "" : found == 1 ? "  [one]" : "  [none]");
+    tally.audit("pair", i, seed, a, b);
   }
-  std::printf("crane pairs on different channels: both named %zu/%zu, one %zu, none %zu\n", both, cases, one, none);
-  EXPECT_GE(both, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(cases))));
+  tally.expect_both_named("crane pairs on different channels");
 }
 
 // Two simultaneous causes on one drive channel: the crane's second cause stepwise on the first's own
@@ -565,11 +585,10 @@ TEST(CraneAudit, TwoCausesOnDifferentChannelsAreBothNamed) {
 // distinct slew entries (odd i), drawn uniformly (std::mt19937_64(seed)), both magnitudes in the
 // generator's ranges. Env CRANE_AUDIT_SAME_CHANNEL_CASES (default 1), CRANE_AUDIT_SAME_CHANNEL_FIRST.
 TEST(CraneAudit, TwoCausesOnOneDriveChannelAreBothNamed) {
-  const std::size_t first = env_cases("CRANE_AUDIT_SAME_CHANNEL_FIRST", 0);
-  const std::size_t cases = env_cases("CRANE_AUDIT_SAME_CHANNEL_CASES", 1);
+  const std::size_t first = env_count("CRANE_AUDIT_SAME_CHANNEL_FIRST", 0);
+  const std::size_t cases = env_count("CRANE_AUDIT_SAME_CHANNEL_CASES", 1);
   const CraneEntries entries = crane_entries();
-  std::size_t both = 0;
-  std::size_t one = 0;
+  PairTally tally;
   for (std::size_t i = first; i < first + cases; ++i) {
     const std::uint64_t seed = 9600 + i;
     std::mt19937_64 rng(seed);
@@ -578,27 +597,9 @@ TEST(CraneAudit, TwoCausesOnOneDriveChannelAreBothNamed) {
     const std::string a = pick();
     std::string b = pick();
     while (b == a) b = pick();
-    const auto c = ma::generate_hidden_effect_case(ma::AuditPlant::crane, a + "+" + b, seed);
-    ma::AuditOptions options;
-    options.nominal = c.nominal;
-    const auto report = ma::run_audit(c.data, options);
-    const auto named = [&](const std::string& name) {
-      const auto in = [&](const std::vector<std::string>& v) { return std::find(v.begin(), v.end(), name) != v.end(); };
-      return report.cause == name || report.second_cause == name || in(report.ambiguous_with) ||
-             in(report.second_ambiguous_with);
-    };
-    const int found = (named(a) ? 1 : 0) + (named(b) ? 1 : 0);
-    both += found == 2 ? 1 : 0;
-    one += found == 1 ? 1 : 0;
-    std::printf("same-channel case %zu seed %llu: %s %s=%g + %s %s=%g -> %s + %s (%s)%s\n", i,
-                static_cast<unsigned long long>(seed), a.c_str(), c.main_parameter.c_str(), c.main_value, b.c_str(),
-                c.second_main_parameter.c_str(), c.second_main_value, report.cause.c_str(), report.second_cause.c_str(),
-                report.second_channel.empty() ? "-" : report.second_channel.c_str(),
-                found == 2 ? "" : found == 1 ? "  [one]" : "  [none]");
+    tally.audit("same-channel", i, seed, a, b);
   }
-  std::printf("crane pairs on one drive channel: both named %zu/%zu, one %zu, none %zu\n", both, cases, one,
-              cases - both - one);
-  EXPECT_GE(both, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(cases))));
+  tally.expect_both_named("crane pairs on one drive channel");
 }
 
 // The cross-channel second cause invents nothing: clean recordings (seeds 9800 + i) give none with
@@ -607,8 +608,8 @@ TEST(CraneAudit, TwoCausesOnOneDriveChannelAreBothNamed) {
 // (printed, not asserted). Env CRANE_AUDIT_SINGLE_CASES (default 1), CRANE_AUDIT_SINGLE_CLEAN
 // (default 1).
 TEST(CraneAudit, CleanRecordingsGiveNoSecondCauseAndSingleCausesAreCounted) {
-  const std::size_t cases = env_cases("CRANE_AUDIT_SINGLE_CASES", 1);
-  const std::size_t clean = env_cases("CRANE_AUDIT_SINGLE_CLEAN", 1);
+  const std::size_t cases = env_count("CRANE_AUDIT_SINGLE_CASES", 1);
+  const std::size_t clean = env_count("CRANE_AUDIT_SINGLE_CLEAN", 1);
   const auto& catalog = ma::audit_catalog(ma::AuditPlant::crane);
   std::size_t right = 0;
   std::size_t spurious = 0;

@@ -17,9 +17,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <string>
 
+#include "audit_test_report.hpp"
 #include "crane/model_audit/model_audit.hpp"
 #include "crane_independent_simulator.hpp"
 
@@ -28,11 +30,7 @@ namespace mt = crane::model_audit::test;
 
 namespace {
 
-std::size_t env_count(const char* name, std::size_t fallback) {
-  const char* text = std::getenv(name);
-  if (text == nullptr || *text == '\0') return fallback;
-  return static_cast<std::size_t>(std::strtoul(text, nullptr, 10));
-}
+using crane::model_audit::test::env_count;
 
 std::string reported_name(const ma::AuditReport& report) {
   std::string reported = report.cause;
@@ -44,41 +42,23 @@ std::string reported_name(const ma::AuditReport& report) {
   return reported;
 }
 
-void print_candidates(const ma::AuditReport& report) {
+void print_report(const ma::AuditReport& report) {
   for (const auto& channel : report.channels) {
     std::printf("    channel %-16s cause %-28s training %.4g, held-out %.4g %s, Ljung-Box p %.3g\n",
                 channel.channel.c_str(), channel.cause.c_str(), channel.before.train_rms, channel.holdout_before,
                 channel.unit.c_str(), channel.before.whiteness.p_value);
-    for (std::size_t i = 0; i < channel.candidates.size() && i < 2; ++i) {
-      const auto& c = channel.candidates[i];
-      std::printf("      %-32s dBIC %10.1f held-out %.4g (%+.1f %%)%s\n", c.name.c_str(), c.delta_bic, c.holdout_rms,
-                  c.holdout_gain_percent, c.qualifies ? " qualifies" : "");
-    }
+    mt::print_candidates(channel, 2, 34);
   }
-  for (std::size_t i = 0; i < report.candidates.size() && i < 4; ++i) {
-    const auto& c = report.candidates[i];
-    std::printf("    %-34s dBIC %10.1f held-out %.4g (%+.1f %%)%s", c.name.c_str(), c.delta_bic, c.holdout_rms,
-                c.holdout_gain_percent, c.qualifies ? " qualifies" : "");
-    for (const auto& p : c.parameters) std::printf(" %s=%.4g", p.name.c_str(), p.value);
-    std::printf("\n");
-  }
+  mt::print_candidates(report, 4, 34);
 }
 
 // CRANE_AUDIT_INDEPENDENT_DUMP=DIR: each case also as DIR/independent_crane_SEED.csv (the crane
-// columns t,u_x,u_gamma,x,gamma,phi,theta,L), for crane_audit.
+// columns of read_audit_data), for crane_audit.
 void dump(const mt::IndependentCraneCase& c, std::uint64_t seed) {
   const char* dir = std::getenv("CRANE_AUDIT_INDEPENDENT_DUMP");
   if (dir == nullptr || *dir == '\0') return;
-  const std::string path = std::string(dir) + "/independent_crane_" + std::to_string(seed) + ".csv";
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return;
-  std::fprintf(f, "t,u_x,u_gamma,x,gamma,phi,theta,L\n");
-  const auto& d = c.data;
-  for (std::size_t k = 0; k < d.time.size(); ++k) {
-    std::fprintf(f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", d.time[k], d.input[k], d.slew_input[k], d.output[k],
-                 d.slew_angle[k], d.swing_in_plane[k], d.swing_out_of_plane[k], d.cable_length[k]);
-  }
-  std::fclose(f);
+  std::ofstream out(std::string(dir) + "/independent_crane_" + std::to_string(seed) + ".csv");
+  ma::write_audit_data(out, c.data, ma::AuditPlant::crane);
 }
 
 }  // namespace
@@ -109,7 +89,7 @@ TEST(IndependentSimulator, CraneAuditNamesEveryCauseAndInventsNothing) {
       ++clean_cases;
       clean_none += report.cause == "none" ? 1 : 0;
       std::printf("  clean seed %llu: %s\n", static_cast<unsigned long long>(seed), reported.c_str());
-      print_candidates(report);
+      print_report(report);
       continue;
     }
     ++effect_cases;
@@ -125,7 +105,7 @@ TEST(IndependentSimulator, CraneAuditNamesEveryCauseAndInventsNothing) {
     std::printf("  %-40s seed %llu: %s  %s true %.5g fitted %.5g (%+.1f %%)\n", cause.c_str(),
                 static_cast<unsigned long long>(seed), reported.c_str(), c.main_parameter.c_str(), c.main_value, fitted,
                 100.0 * (fitted - c.main_value) / std::abs(c.main_value));
-    if (!right) print_candidates(report);
+    if (!right) print_report(report);
   }
   std::printf("\ncrane (independent simulator): right cause %d/%d (%.1f %%, of which %d ambiguous naming the truth); "
               "clean none %d/%d; a second cause in %d\n",

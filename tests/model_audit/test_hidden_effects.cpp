@@ -17,17 +17,14 @@
 #include <vector>
 
 #include "crane/model_audit/hidden_effect_generator.hpp"
+#include "audit_test_report.hpp"
 #include "crane/model_audit/model_audit.hpp"
 
 namespace ma = crane::model_audit;
 
 namespace {
 
-std::size_t env_count(const char* name, std::size_t fallback) {
-  const char* text = std::getenv(name);
-  if (text == nullptr || *text == '\0') return fallback;
-  return static_cast<std::size_t>(std::strtoul(text, nullptr, 10));
-}
+using crane::model_audit::test::env_count;
 
 struct Tally {
   std::map<std::string, std::map<std::string, int>> confusion;  // truth -> reported -> count

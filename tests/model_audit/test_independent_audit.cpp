@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <random>
@@ -24,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "audit_test_report.hpp"
 #include "crane/model_audit/model_audit.hpp"
 #include "independent_simulator.hpp"
 
@@ -32,11 +34,7 @@ namespace mt = crane::model_audit::test;
 
 namespace {
 
-std::size_t env_count(const char* name, std::size_t fallback) {
-  const char* text = std::getenv(name);
-  if (text == nullptr || *text == '\0') return fallback;
-  return static_cast<std::size_t>(std::strtoul(text, nullptr, 10));
-}
+using crane::model_audit::test::env_count;
 
 struct Tally {
   std::map<std::string, std::map<std::string, int>> confusion;
@@ -62,33 +60,19 @@ void print(const std::string& title, const Tally& tally, const std::vector<std::
 }
 
 // The three best candidates of a missed case (delta-BIC, held-out RMS and gain, parameters).
-void print_candidates(const ma::AuditReport& report) {
+void print_report(const ma::AuditReport& report) {
   std::printf("    nominal held-out RMS %.4g %s, Ljung-Box p %.3g\n", report.holdout_before, report.unit.c_str(),
               report.before.whiteness.p_value);
-  for (std::size_t i = 0; i < report.candidates.size() && i < 4; ++i) {
-    const auto& c = report.candidates[i];
-    std::printf("    %-28s dBIC %10.1f held-out %.4g (%+.1f %%)%s", c.name.c_str(), c.delta_bic, c.holdout_rms,
-                c.holdout_gain_percent, c.qualifies ? " qualifies" : "");
-    for (const auto& p : c.parameters) std::printf(" %s=%.4g", p.name.c_str(), p.value);
-    std::printf("\n");
-  }
+  mt::print_candidates(report);
 }
 
-// CRANE_AUDIT_INDEPENDENT_DUMP=DIR: each case also as DIR/independent_SEED.csv (t,u,x,theta,segment),
-// for crane_audit.
+// CRANE_AUDIT_INDEPENDENT_DUMP=DIR: each case also as DIR/independent_SEED.csv (t,u,x or
+// t,theta,segment: the columns of read_audit_data), for crane_audit.
 void dump(const mt::IndependentCase& c, std::uint64_t seed) {
   const char* dir = std::getenv("CRANE_AUDIT_INDEPENDENT_DUMP");
   if (dir == nullptr || *dir == '\0') return;
-  const std::string path = std::string(dir) + "/independent_" + std::to_string(seed) + ".csv";
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return;
-  const bool axis = !c.data.input.empty();
-  std::fprintf(f, axis ? "t,u,x\n" : "t,theta,segment\n");
-  for (std::size_t k = 0; k < c.data.time.size(); ++k) {
-    if (axis) std::fprintf(f, "%.6f,%.9g,%.9g\n", c.data.time[k], c.data.input[k], c.data.output[k]);
-    else std::fprintf(f, "%.6f,%.9g,%g\n", c.data.time[k], c.data.output[k], c.data.segment.empty() ? 0.0 : c.data.segment[k]);
-  }
-  std::fclose(f);
+  std::ofstream out(std::string(dir) + "/independent_" + std::to_string(seed) + ".csv");
+  ma::write_audit_data(out, c.data, c.data.input.empty() ? ma::AuditPlant::pendulum : ma::AuditPlant::axis);
 }
 
 std::string reported_name(const ma::AuditReport& report) {
@@ -137,7 +121,7 @@ Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_case
       tally.clean_none += report.cause == "none" ? 1 : 0;
       if (report.cause != "none") {
         std::printf("  clean seed %llu reported %s\n", static_cast<unsigned long long>(seed), reported.c_str());
-        print_candidates(report);
+        print_report(report);
       }
       continue;
     }
@@ -154,7 +138,7 @@ Tally run(ma::AuditPlant plant, std::size_t effect_cases, std::size_t clean_case
     } else {
       std::printf("  missed: %s seed %llu reported %s (%s)\n", cause.c_str(), static_cast<unsigned long long>(seed),
                   reported.c_str(), report.stop_reason.c_str());
-      print_candidates(report);
+      print_report(report);
     }
   }
   return tally;
@@ -200,7 +184,7 @@ TEST(IndependentSimulator, LongLargeAmplitudeSwingWithCoulombPivotFrictionIsName
     const auto report = ma::run_audit(c.data, options);
     std::printf("long swing%s: cause %s (%s)\n", calibrate ? " (--calibrate)" : "", report.cause.c_str(),
                 report.stop_reason.c_str());
-    print_candidates(report);
+    print_report(report);
     EXPECT_EQ(report.cause, "pendulum_coulomb_damping");
     for (const auto& p : report.parameters) {
       if (p.name == "coulomb_damping") {
@@ -241,7 +225,7 @@ void expect_pairs_found(ma::AuditPlant plant, std::size_t default_cases, std::ui
                   static_cast<unsigned long long>(seed), reported_name(report).c_str(), report.stop_reason.c_str());
       for (const auto& p : report.parameters) std::printf("    first: %s = %.4g\n", p.name.c_str(), p.value);
       for (const auto& p : report.second_parameters) std::printf("    second: %s = %.4g\n", p.name.c_str(), p.value);
-      print_candidates(report);
+      print_report(report);
       missed[catalog[a] + "+" + catalog[b]] += 1;
     }
   }
@@ -278,7 +262,7 @@ TEST(IndependentSimulator, EncoderOffsetOfZeroPointEightDegreesOnOneFreeSwingIsN
     options.nominal = nominal;
     const auto report = ma::run_audit(data, options);
     std::printf("one free swing, offset %.4f rad: %s (%s)\n", offset, reported_name(report).c_str(), report.stop_reason.c_str());
-    print_candidates(report);
+    print_report(report);
     if (offset == 0.0) {
       EXPECT_EQ(report.cause, "none");
     } else {

@@ -85,14 +85,51 @@ void validate(const AuditOptions& options) {
   if (options.substeps < 1) throw common::ConfigError("substeps = " + std::to_string(options.substeps) + " must be >= 1");
 }
 
+namespace {
+
+// The crane's CSV columns (read_audit_data, write_audit_data), in file order.
+const std::vector<std::string>& crane_columns() {
+  static const std::vector<std::string> columns{"t", "u_x", "u_gamma", "x", "gamma", "phi", "theta", "L"};
+  return columns;
+}
+
+}  // namespace
+
+void write_audit_data(std::ostream& out, const AuditData& data, AuditPlant plant,
+                      const std::vector<std::string>& comment_lines) {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  const auto add = [&](const std::string& name, const std::vector<double>& column) {
+    if (column.size() != data.time.size()) {
+      throw DataError("write_audit_data: column '" + name + "' has " + std::to_string(column.size()) +
+                      " samples, the time " + std::to_string(data.time.size()));
+    }
+    names.push_back(name);
+    columns.push_back(column);
+  };
+  add("t", data.time);
+  if (plant == AuditPlant::axis) {
+    add("u", data.input);
+    add("x", data.output);
+  } else if (plant == AuditPlant::crane) {
+    const std::vector<const std::vector<double>*> crane{&data.input,          &data.slew_input,         &data.output,
+                                                        &data.slew_angle,     &data.swing_in_plane,     &data.swing_out_of_plane,
+                                                        &data.cable_length};
+    for (std::size_t i = 0; i < crane.size(); ++i) add(crane_columns()[i + 1], *crane[i]);
+  } else {
+    add("theta", data.output);
+    if (!data.segment.empty()) add("segment", data.segment);
+  }
+  write_time_series_csv(out, comment_lines, names, columns);
+}
+
 AuditData read_audit_data(const std::filesystem::path& file, AuditPlant plant, const std::string& columns,
                           double max_rate, std::size_t minimum_samples) {
   CsvReadOptions read;
   read.mapping = parse_column_mapping(columns);
-  const std::vector<std::string> crane_columns{"t", "u_x", "u_gamma", "x", "gamma", "phi", "theta", "L"};
   const std::vector<std::string> allowed = plant == AuditPlant::axis       ? std::vector<std::string>{"t", "u", "x"}
                                            : plant == AuditPlant::pendulum ? std::vector<std::string>{"t", "theta", "x", "segment"}
-                                                                           : crane_columns;
+                                                                           : crane_columns();
   for (const auto& [canonical, file_column] : read.mapping.entries) {
     if (std::find(allowed.begin(), allowed.end(), canonical) == allowed.end()) {
       throw common::ConfigError("columns: unknown canonical name '" + canonical + "' (expected " + detail::join(allowed) + ")");
@@ -100,7 +137,7 @@ AuditData read_audit_data(const std::filesystem::path& file, AuditPlant plant, c
   }
   read.required_columns = plant == AuditPlant::axis       ? std::vector<std::string>{"t", "u", "x"}
                           : plant == AuditPlant::pendulum ? std::vector<std::string>{"t", "theta"}
-                                                          : crane_columns;
+                                                          : crane_columns();
   read.time_column = "t";
   read.minimum_samples = minimum_samples;
   const TimeSeries series = read_time_series_csv(file, read);

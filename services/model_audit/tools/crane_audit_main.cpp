@@ -147,16 +147,7 @@ int main(int argc, char** argv) {
                             "; nominal";
       for (const auto& [k, v] : ma::parameter_values(c.nominal)) comment += " " + k + "=" + crane::common::format_value(v);
       std::ofstream out(generate_out);
-      const auto& d = c.data;
-      if (plant == ma::AuditPlant::axis) {
-        ma::write_time_series_csv(out, {comment}, {"t", "u", "x"}, {d.time, d.input, d.output});
-      } else if (plant == ma::AuditPlant::crane) {
-        ma::write_time_series_csv(out, {comment}, {"t", "u_x", "u_gamma", "x", "gamma", "phi", "theta", "L"},
-                                  {d.time, d.input, d.slew_input, d.output, d.slew_angle, d.swing_in_plane,
-                                   d.swing_out_of_plane, d.cable_length});
-      } else {
-        ma::write_time_series_csv(out, {comment}, {"t", "theta", "segment"}, {c.data.time, c.data.output, c.data.segment});
-      }
+      ma::write_audit_data(out, c.data, plant, {comment});
       std::cout << comment << '\n';
       return 0;
     }

@@ -137,6 +137,13 @@ struct AuditData {
                                         const std::string& columns, double max_rate,
                                         std::size_t minimum_samples = 50);
 
+/// Writes `data` as the CSV read_audit_data() reads with its default columns: axis t, u, x; pendulum
+/// t, theta and segment (when data.segment is set); crane t, u_x, u_gamma, x, gamma, phi, theta, L;
+/// `comment_lines` first (write_time_series_csv). Throws DataError if the stream fails or a column
+/// of the plant is missing or shorter than data.time (naming it).
+void write_audit_data(std::ostream& out, const AuditData& data, AuditPlant plant,
+                      const std::vector<std::string>& comment_lines = {});
+
 /// Resolution floor of the crane channels (AuditOptions::min_holdout_gain_quanta): the coupled model
 /// replayed from 100 Hz samples leaves a systematic residual of one to three encoder counts on clean
 /// data (the coupling is held per sample; it grows with the load mass), which the BIC alone
