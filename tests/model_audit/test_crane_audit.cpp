@@ -583,9 +583,11 @@ TEST(CraneAudit, TwoCausesOnDifferentChannelsAreBothNamed) {
 // Two simultaneous causes on one drive channel: the crane's second cause stepwise on the first's own
 // channel (crane_audit.cpp). Seeds 9600 + i; case i: two distinct trolley entries (even i) or two
 // distinct slew entries (odd i), drawn uniformly (std::mt19937_64(seed)), both magnitudes in the
-// generator's ranges. Env CRANE_AUDIT_SAME_CHANNEL_CASES (default 1), CRANE_AUDIT_SAME_CHANNEL_FIRST.
+// generator's ranges. Env CRANE_AUDIT_SAME_CHANNEL_CASES (default 1), CRANE_AUDIT_SAME_CHANNEL_FIRST
+// (default 11: slew stiction and a viscous asymmetry, where the crane's lowest delta-BIC takes
+// slew_stribeck alone and the channel's pair, with another first cause, wins on joint delta-BIC).
 TEST(CraneAudit, TwoCausesOnOneDriveChannelAreBothNamed) {
-  const std::size_t first = env_count("CRANE_AUDIT_SAME_CHANNEL_FIRST", 0);
+  const std::size_t first = env_count("CRANE_AUDIT_SAME_CHANNEL_FIRST", 11);
   const std::size_t cases = env_count("CRANE_AUDIT_SAME_CHANNEL_CASES", 1);
   const CraneEntries entries = crane_entries();
   PairTally tally;

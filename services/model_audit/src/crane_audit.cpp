@@ -163,6 +163,21 @@ std::string slew_unit(const std::string& unit) {
   return out;
 }
 
+// The joint delta-BIC of a channel's causes against its nominal: its first step's plus its second
+// step's (an ambiguous cause by its better name; "none" adds nothing).
+double pair_delta_bic(const AuditReport& report) {
+  const auto step = [](const std::vector<CandidateReport>& candidates, const std::string& cause,
+                       const std::vector<std::string>& ambiguous_with) {
+    const std::string& name = cause == "ambiguous" && !ambiguous_with.empty() ? ambiguous_with.front() : cause;
+    for (const auto& candidate : candidates) {
+      if (candidate.name == name) return candidate.delta_bic;
+    }
+    return 0.0;
+  };
+  return step(report.candidates, report.cause, report.ambiguous_with) +
+         step(report.second_candidates, report.second_cause, report.second_ambiguous_with);
+}
+
 }  // namespace
 
 AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) {
@@ -292,6 +307,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     for (auto& name : channel.ambiguous_with) name = prefixed(name);
     if (channel.second_cause != "none" && channel.second_cause != "ambiguous") channel.second_cause = prefixed(channel.second_cause);
     for (auto& name : channel.second_ambiguous_with) name = prefixed(name);
+    for (auto& candidate : channel.second_candidates) candidate.name = prefixed(candidate.name);
     if (options.calibrate && max_causes == 1) calibrate_drive(prefix, channel.nominal, std::get<AxisAuditParameters>(axis_options.nominal));
     return channel;
   };
@@ -429,14 +445,34 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       }
     }
     // No other channel names one: a second cause on the first's own drive channel, stepwise there
-    // (its residual with the first cause still not white; the channel audited again with two causes,
-    // kept when its first is the crane's). The swing channel stays at one cause.
+    // (its residual with the first cause still not white; the channel audited again with two causes).
+    // The pair is kept when its first is the crane's, or when its joint delta-BIC (first step plus
+    // second step) is lower than the crane's first cause alone: the channel's own selection (held-out
+    // arbitration, its search over first causes for the pair) may take another first, and with two
+    // causes the best single fit is often neither (the rule of kStepwiseBicFraction). The cause, its
+    // parameters and the held-out figures are then the pair's. The swing channel stays at one cause.
     std::optional<AuditReport> stepwise;
     const bool drive = chosen_channel->plant == "trolley" || chosen_channel->plant == "slew";
     const bool white_after = chosen_channel->after.whiteness.lags > 0 && chosen_channel->after.whiteness.p_value >= 0.05;
     if (second == nullptr && drive && !white_after && options.max_causes > 1 && chosen->name != "payload_mass_error") {
       stepwise = chosen_channel->plant == "trolley" ? trolley_channel(options.max_causes) : slew_channel(options.max_causes);
-      if (stepwise && stepwise->cause == chosen->name && stepwise->second_cause != "none") {
+      const double joint = stepwise ? pair_delta_bic(*stepwise) : 0.0;
+      const bool same_first = stepwise && (stepwise->cause == chosen->name ||
+                                           (stepwise->cause == "ambiguous" && stepwise->ambiguous_with.front() == chosen->name));
+      if (stepwise && stepwise->second_cause != "none" && (same_first || joint < chosen->delta_bic)) {
+        if (!same_first) {
+          report.stop_reason = "selected " + stepwise->cause + " on the " + report.channel +
+                               " channel, the first of the pair with the lowest joint delta-BIC (" + common::format_value(joint) +
+                               ", against " + common::format_value(chosen->delta_bic) + " for " + chosen->name + " alone)";
+        }
+        report.cause = stepwise->cause;
+        report.ambiguous_with = stepwise->ambiguous_with;
+        report.parameters = stepwise->parameters;
+        report.extended_nominal = stepwise->extended_nominal;
+        report.after = stepwise->after;
+        report.holdout_after = stepwise->holdout_after;
+        report.holdout_percent = stepwise->holdout_percent;
+        report.extended_prediction = stepwise->extended_prediction;
         report.second_cause = stepwise->second_cause;
         report.second_ambiguous_with = stepwise->second_ambiguous_with;
         report.second_parameters = stepwise->second_parameters;
