@@ -81,6 +81,11 @@ CraneMotion crane_motion(const AuditData& data, double sample_time) {
 // I_i = M_eff,ii and C_i = b_eff,i + M_eff,ij a_j (the other drive's measured acceleration). The swing
 // rows do not depend on the load mass and the drive rows are affine in it, so I and C are affine in
 // m: I = I(0) + m dI, C = C(0) + m dC.
+// With a swing cause in `effects` (the swing channel's cause, crane_swing.hpp) the swing rows
+// are the swing replay's: the encoder offset taken off phi, the cable length scaled by (1 + e), the
+// damping terms added to the swing accelerations, and the wind's generalized force (its share of
+// the drive rows does not depend on the load mass, so it is added to C(0)). A hook or an elastic
+// rope is not in this coupling (their rigging and stretch states are not measured).
 struct DriveCoupling {
   std::vector<double> inertia;           // at the nominal load mass
   std::vector<double> inertia_per_mass;
@@ -88,7 +93,8 @@ struct DriveCoupling {
   std::vector<double> force_per_mass;
 };
 
-std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion) {
+std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion,
+                                                      const SwingEffects& effects = {}) {
   common::CraneParameters massless = crane;
   massless.load_mass = 0.0;
   common::CraneParameters unit = crane;
@@ -103,22 +109,40 @@ std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParame
     c->force.resize(n);
     c->force_per_mass.resize(n);
   }
+  const double scale = 1.0 + effects.length_error;
+  const bool wind = effects.wind_force_x != 0.0 || effects.wind_force_y != 0.0;
   for (std::size_t k = 0; k < n; ++k) {
+    plant::ModelState state = motion.state[k];
+    state.position[plant::kInPlaneSwingIndex] -= effects.encoder_offset;
+    const plant::HoistMotion& measured_hoist = motion.hoist[k];
+    const plant::HoistMotion hoist{measured_hoist.cable_length * scale, measured_hoist.cable_length_rate * scale,
+                                   measured_hoist.cable_length_acceleration * scale};
     plant::CoordinateMatrix mass0;
     plant::CoordinateMatrix mass1;
     plant::CoordinateVector bias0;
     plant::CoordinateVector bias1;
-    model0.compute_dynamics(motion.state[k], motion.hoist[k], mass0, bias0);
-    model1.compute_dynamics(motion.state[k], motion.hoist[k], mass1, bias1);
+    model0.compute_dynamics(state, hoist, mass0, bias0);
+    model1.compute_dynamics(state, hoist, mass1, bias1);
     const Eigen::Vector2d a(motion.acceleration[k][plant::kTrolleyIndex], motion.acceleration[k][plant::kSlewIndex]);
-    const SwingElimination e0 = eliminate_swing(mass0, bias0);
-    const SwingElimination e1 = eliminate_swing(mass1, bias1);
+    const Eigen::Vector2d damping = swing_damping(effects, state.velocity[plant::kInPlaneSwingIndex],
+                                                  state.velocity[plant::kOutOfPlaneSwingIndex]);
+    const SwingElimination e0 = eliminate_swing(mass0, bias0, damping);
+    const SwingElimination e1 = eliminate_swing(mass1, bias1, damping);
+    Eigen::Vector2d wind_share = Eigen::Vector2d::Zero();  // [N, N m]
+    if (wind) {
+      plant::ExtendedState extended;
+      extended.position.head<plant::kNumCoordinates>() = state.position;
+      extended.velocity.head<plant::kNumCoordinates>() = state.velocity;
+      const plant::CoordinateVector force =
+          wind_generalized_force(model1, effects, extended, hoist).head<plant::kNumCoordinates>();
+      wind_share = eliminate_swing(mass1, bias1 - force, damping).drive_bias - e1.drive_bias;
+    }
     const Eigen::Matrix2d inertia[2] = {e0.drive_inertia, e1.drive_inertia};
     const Eigen::Vector2d bias[2] = {e0.drive_bias, e1.drive_bias};
     for (int i = 0; i < 2; ++i) {
       DriveCoupling& c = i == 0 ? out.first : out.second;
-      const double force0 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i);
-      const double force1 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i);
+      const double force0 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i) + wind_share(i);
+      const double force1 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i) + wind_share(i);
       c.inertia_per_mass[k] = inertia[1](i, i) - inertia[0](i, i);
       c.force_per_mass[k] = force1 - force0;
       c.inertia[k] = inertia[0](i, i) + crane.load_mass * c.inertia_per_mass[k];
@@ -163,19 +187,22 @@ std::string slew_unit(const std::string& unit) {
   return out;
 }
 
+// The delta-BIC of one step's cause among its candidates (an ambiguous cause by its better name;
+// "none" adds nothing).
+double step_delta_bic(const std::vector<CandidateReport>& candidates, const std::string& cause,
+                      const std::vector<std::string>& ambiguous_with) {
+  const std::string& name = cause == "ambiguous" && !ambiguous_with.empty() ? ambiguous_with.front() : cause;
+  for (const auto& candidate : candidates) {
+    if (candidate.name == name) return candidate.delta_bic;
+  }
+  return 0.0;
+}
+
 // The joint delta-BIC of a channel's causes against its nominal: its first step's plus its second
-// step's (an ambiguous cause by its better name; "none" adds nothing).
+// step's.
 double pair_delta_bic(const AuditReport& report) {
-  const auto step = [](const std::vector<CandidateReport>& candidates, const std::string& cause,
-                       const std::vector<std::string>& ambiguous_with) {
-    const std::string& name = cause == "ambiguous" && !ambiguous_with.empty() ? ambiguous_with.front() : cause;
-    for (const auto& candidate : candidates) {
-      if (candidate.name == name) return candidate.delta_bic;
-    }
-    return 0.0;
-  };
-  return step(report.candidates, report.cause, report.ambiguous_with) +
-         step(report.second_candidates, report.second_cause, report.second_ambiguous_with);
+  return step_delta_bic(report.candidates, report.cause, report.ambiguous_with) +
+         step_delta_bic(report.second_candidates, report.second_cause, report.second_ambiguous_with);
 }
 
 }  // namespace
@@ -201,7 +228,8 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     smoothed.swing_in_plane = zero_phase_low_pass(data.swing_in_plane, kSwingCutoff, 1.0 / sample_time);
     smoothed.swing_out_of_plane = zero_phase_low_pass(data.swing_out_of_plane, kSwingCutoff, 1.0 / sample_time);
   }
-  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, crane_motion(smoothed, sample_time));
+  const CraneMotion smoothed_motion = crane_motion(smoothed, sample_time);
+  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, smoothed_motion);
 
   AuditReport report;
   report.plant = "crane";
@@ -311,19 +339,19 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     if (options.calibrate && max_causes == 1) calibrate_drive(prefix, channel.nominal, std::get<AxisAuditParameters>(axis_options.nominal));
     return channel;
   };
-  const auto trolley_channel = [&](int max_causes) {
-    return drive_channel(kTrolleyPrefix, data.input, data.output, trolley_coupling, crane.trolley_drive_mass,
+  const auto trolley_channel = [&](int max_causes, const DriveCoupling& coupling) {
+    return drive_channel(kTrolleyPrefix, data.input, data.output, coupling, crane.trolley_drive_mass,
                          crane.trolley_friction, crane.trolley_drive_gain, max_causes);
   };
-  const auto slew_channel = [&](int max_causes) {
-    return drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, slew_coupling, crane.jib_inertia,
+  const auto slew_channel = [&](int max_causes, const DriveCoupling& coupling) {
+    return drive_channel(kSlewPrefix, data.slew_input, data.slew_angle, coupling, crane.jib_inertia,
                          crane.slew_friction, crane.slew_drive_gain, max_causes);
   };
-  if (auto c = trolley_channel(1)) report.channels.push_back(std::move(*c));
-  if (auto c = slew_channel(1)) report.channels.push_back(std::move(*c));
+  if (auto c = trolley_channel(1, trolley_coupling)) report.channels.push_back(std::move(*c));
+  if (auto c = slew_channel(1, slew_coupling)) report.channels.push_back(std::move(*c));
 
-  // Swing.
-  {
+  // Swing: one cause first (max_causes 1), two for a second on it.
+  const auto swing_channel = [&](int max_causes) -> std::optional<AuditReport> {
     bool requested = false;
     AuditOptions swing_options = options;
     std::vector<std::string> swing_catalog;  // the pendulum entries and the crane-only swing entries
@@ -337,22 +365,59 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     swing_options.nominal = swing_nominal;
     swing_options.window_duration = std::max(options.window_duration, kSwingWindow);
     swing_options.min_holdout_gain_quanta = kCraneResolutionQuanta;
-    swing_options.max_causes = 1;
+    swing_options.max_causes = max_causes;
     swing_options.calibrate = false;  // nothing of its own to calibrate (above)
-    if (requested) {
-      std::vector<double> measured(2 * n);
-      for (std::size_t k = 0; k < n; ++k) {
-        measured[2 * k] = data.swing_in_plane[k];
-        measured[2 * k + 1] = data.swing_out_of_plane[k];
+    if (!requested) return std::nullopt;
+    std::vector<double> measured(2 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+      measured[2 * k] = data.swing_in_plane[k];
+      measured[2 * k + 1] = data.swing_out_of_plane[k];
+    }
+    AuditData swing_data;
+    swing_data.source = data.source;
+    swing_data.time = data.time;
+    swing_data.output = data.swing_in_plane;
+    validate(swing_options);
+    const SwingAudit swing(swing_data, std::make_shared<const plant::TowerCraneModel>(crane), swing_drive_motion(motion),
+                           std::move(measured), mean_length, crane.gravity, swing_options);
+    return run_channel_audit(swing, swing_options);
+  };
+  if (auto c = swing_channel(1)) report.channels.push_back(std::move(*c));
+
+  // The swing channel's cause in the drives' coupling: with the nominal swing rows a swing cause is
+  // also an error of the drives' generalized forces, which a drive entry takes up (an encoder offset
+  // is a constant force on the trolley, as a Coulomb asymmetry is). So when the swing channel names
+  // a cause, the drives that named one are audited again with it in their coupling (crane_coupling;
+  // not the hook or the elastic rope, whose extra states are not measured). A drive cause does not
+  // enter the swing channel's replay (it holds the measured drive motion), so the swing's cause is
+  // not the echo of a drive's.
+  std::string recoupled;
+  const auto swing_report = std::find_if(report.channels.begin(), report.channels.end(),
+                                         [](const AuditReport& c) { return c.plant == "swing"; });
+  if (swing_report != report.channels.end() && swing_report->cause != "none") {
+    const std::string& name = swing_report->cause == "ambiguous" ? swing_report->ambiguous_with.front() : swing_report->cause;
+    const auto entry = std::find_if(pendulum_catalog().begin(), pendulum_catalog().end(),
+                                    [&](const PendulumCause& c) { return name == c.name; });
+    const auto candidate = std::find_if(swing_report->candidates.begin(), swing_report->candidates.end(),
+                                        [&](const CandidateReport& c) { return c.name == name; });
+    const bool drive_named = std::any_of(report.channels.begin(), report.channels.end(), [](const AuditReport& c) {
+      return (c.plant == "trolley" || c.plant == "slew") && c.cause != "none";
+    });
+    if (drive_named && entry != pendulum_catalog().end() && candidate != swing_report->candidates.end() &&
+        entry->extra_nuisance == 0 && name != "elastic_rope") {
+      std::vector<double> values;
+      for (const auto& p : candidate->parameters) values.push_back(p.value);
+      SwingEffects effects;
+      entry->apply_swing(values.data(), effects);
+      const auto [trolley, slew] = crane_coupling(crane, smoothed_motion, effects);
+      for (auto& channel : report.channels) {
+        if (channel.cause == "none" || (channel.plant != "trolley" && channel.plant != "slew")) continue;
+        auto again = channel.plant == "trolley" ? trolley_channel(1, trolley) : slew_channel(1, slew);
+        if (!again) continue;
+        recoupled += "; the " + channel.plant + " channel, which named " + channel.cause + ", audited again with the swing's " +
+                     name + " in its coupling: " + again->cause;
+        channel = std::move(*again);
       }
-      AuditData swing_data;
-      swing_data.source = data.source;
-      swing_data.time = data.time;
-      swing_data.output = data.swing_in_plane;
-      validate(swing_options);
-      const SwingAudit swing(swing_data, std::make_shared<const plant::TowerCraneModel>(crane), swing_drive_motion(motion),
-                             std::move(measured), mean_length, crane.gravity, swing_options);
-      report.channels.push_back(run_channel_audit(swing, swing_options));
     }
   }
 
@@ -420,7 +485,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     report.parameters = cause_parameters(*chosen);
     report.extended_nominal = shown.extended_nominal;
     report.stop_reason = "selected " + chosen->name + " on the " + report.channel +
-                         " channel (lowest delta-BIC among qualifying candidates of all channels)";
+                         " channel (lowest delta-BIC among qualifying candidates of all channels)" + recoupled;
     // Second cause, across the channels: the cause another channel names by its own selection (its
     // residual not white, a qualifying candidate: delta-BIC, held-out gain beyond the floor, held-out
     // arbitration, ambiguity), the one with the lowest delta-BIC when two channels name one. A channel
@@ -444,22 +509,35 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
         second_channel = &channel;
       }
     }
-    // No other channel names one: a second cause on the first's own drive channel, stepwise there
-    // (its residual with the first cause still not white; the channel audited again with two causes).
+    // A second cause stepwise on the first cause's own channel (its residual with the first cause
+    // still not white; the channel audited again with two causes):
+    // - a drive's first cause (not payload_mass_error), when no other channel names a second: a drive
+    //   cause does not enter the other channels' replays (each holds the others' measured motion);
+    // - a swing cause, also against another channel's second: a swing cause enters the drives'
+    //   coupling (nominal swing rows) and can leave a drive a spurious cause, so the swing channel's
+    //   own second is kept when its step's delta-BIC is lower than the other channel's cause.
     // The pair is kept when its first is the crane's, or when its joint delta-BIC (first step plus
     // second step) is lower than the crane's first cause alone: the channel's own selection (held-out
     // arbitration, its search over first causes for the pair) may take another first, and with two
     // causes the best single fit is often neither (the rule of kStepwiseBicFraction). The cause, its
-    // parameters and the held-out figures are then the pair's. The swing channel stays at one cause.
+    // parameters and the held-out figures are then the pair's.
     std::optional<AuditReport> stepwise;
+    std::string stepwise_note;  // why the stepwise pair was not kept
     const bool drive = chosen_channel->plant == "trolley" || chosen_channel->plant == "slew";
+    const bool swing = chosen_channel->plant == "swing";
     const bool white_after = chosen_channel->after.whiteness.lags > 0 && chosen_channel->after.whiteness.p_value >= 0.05;
-    if (second == nullptr && drive && !white_after && options.max_causes > 1 && chosen->name != "payload_mass_error") {
-      stepwise = chosen_channel->plant == "trolley" ? trolley_channel(options.max_causes) : slew_channel(options.max_causes);
+    if (!white_after && options.max_causes > 1 &&
+        ((drive && second == nullptr && chosen->name != "payload_mass_error") || swing)) {
+      stepwise = swing                                  ? swing_channel(options.max_causes)
+                 : chosen_channel->plant == "trolley" ? trolley_channel(options.max_causes, trolley_coupling)
+                                                       : slew_channel(options.max_causes, slew_coupling);
       const double joint = stepwise ? pair_delta_bic(*stepwise) : 0.0;
       const bool same_first = stepwise && (stepwise->cause == chosen->name ||
                                            (stepwise->cause == "ambiguous" && stepwise->ambiguous_with.front() == chosen->name));
-      if (stepwise && stepwise->second_cause != "none" && (same_first || joint < chosen->delta_bic)) {
+      const bool beats_other = second == nullptr ||
+                               (stepwise && step_delta_bic(stepwise->second_candidates, stepwise->second_cause,
+                                                           stepwise->second_ambiguous_with) < second->delta_bic);
+      if (stepwise && stepwise->second_cause != "none" && (same_first || joint < chosen->delta_bic) && beats_other) {
         if (!same_first) {
           report.stop_reason = "selected " + stepwise->cause + " on the " + report.channel +
                                " channel, the first of the pair with the lowest joint delta-BIC (" + common::format_value(joint) +
@@ -479,9 +557,21 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
         report.second_channel = chosen_channel->plant + " " + chosen_channel->channel;
         report.stop_reason += "; second cause " + report.second_cause + " on the same " + report.second_channel +
                               " channel, stepwise (" + stepwise->stop_reason + ")";
+        if (second != nullptr) {
+          report.stop_reason += "; instead of " + second_channel->cause + " on the " + second_channel->plant + " " +
+                                second_channel->channel + " channel (delta-BIC " + common::format_value(second->delta_bic) + ")";
+        }
       } else {
+        if (stepwise) {
+          stepwise_note = "; stepwise on the " + chosen_channel->plant + " channel: " +
+                          (stepwise->second_cause == "none" ? stepwise->stop_reason
+                                                            : "its pair " + stepwise->cause + " + " + stepwise->second_cause +
+                                                                  " not kept (joint delta-BIC " + common::format_value(joint) + ")");
+        }
         stepwise.reset();
       }
+    } else if ((drive || swing) && white_after) {
+      stepwise_note = "; the " + chosen_channel->plant + " residual with the first cause is white";
     }
     if (!stepwise && second != nullptr) {
       report.second_cause = second_channel->cause;
@@ -489,9 +579,9 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       report.second_parameters = cause_parameters(*second);
       report.second_channel = second_channel->plant + " " + second_channel->channel;
       report.stop_reason += "; second cause " + report.second_cause + " on the " + report.second_channel +
-                            " channel (" + second_channel->stop_reason + ")";
+                            " channel (" + second_channel->stop_reason + ")" + stepwise_note;
     } else if (!stepwise) {
-      report.stop_reason += "; no other channel names a second cause";
+      report.stop_reason += "; no other channel names a second cause" + stepwise_note;
     }
   } else {
     report.stop_reason = "no channel has a candidate that earns its parameters (";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <string_view>
 
 namespace crane::model_audit::detail {
 
@@ -112,6 +113,8 @@ struct SwingSeries {
   double sample_time{0.0};
   int substeps{1};
   const PendulumCause* cause{nullptr};  // nullptr: the nominal model
+  const PendulumCause* first{nullptr};  // second step: the first cause (its parameters first)
+  std::size_t first_count{0};
 };
 
 namespace {
@@ -177,11 +180,12 @@ Problem pendulum_problem(const std::shared_ptr<PendulumSeries>& s, const std::ve
 
 
 
-// The swing channel has no base parameters: the candidate's parameter comes first.
+// The swing channel has no base parameters of its own: the candidate's parameters come first, after
+// the first cause's in a second step.
 SwingEffects swing_effects(const SwingSeries& s, const std::vector<double>& full) {
   SwingEffects e;
-  if (full.empty() || s.cause == nullptr) return e;
-  s.cause->apply_swing(full.data(), e);
+  if (s.first != nullptr && full.size() >= s.first_count) s.first->apply_swing(full.data(), e);
+  if (s.cause != nullptr && full.size() > s.first_count) s.cause->apply_swing(full.data() + s.first_count, e);
   return e;
 }
 
@@ -197,7 +201,8 @@ Problem crane_swing_problem(const std::shared_ptr<SwingSeries>& s, double window
     const std::size_t count = std::min(length, n - first);
     problem.windows.push_back({2 * first, 2 * count, first >= holdout_start ? 0 : 2 * count});
   }
-  const std::size_t extra = s->cause != nullptr ? s->cause->extra_nuisance : 0;
+  const std::size_t extra = (s->cause != nullptr ? s->cause->extra_nuisance : 0) +
+                            (s->first != nullptr ? s->first->extra_nuisance : 0);  // (one hook at most)
   problem.nuisance_size = 4 + extra;
   problem.initial_nuisance = [s, extra](const Window& w, double* out) {
     std::vector<double> phi(w.count / 2);
@@ -339,7 +344,38 @@ SwingAudit::SwingAudit(const AuditData& data, std::shared_ptr<const plant::Tower
 
 SwingAudit::~SwingAudit() = default;
 
-std::vector<Candidate> SwingAudit::candidates() const { return candidates_of(scales_, true); }
+std::vector<std::size_t> SwingAudit::nominal_free(bool) const {
+  std::vector<std::size_t> free(base_.size());
+  for (std::size_t i = 0; i < free.size(); ++i) free[i] = i;
+  return free;
+}
+
+std::vector<Candidate> SwingAudit::candidates() const {
+  auto list = candidates_of(scales_, true);
+  if (series_->first != nullptr) {
+    // The replay's extended rows: a hook or an elastic rope, not both (replay_crane_swing).
+    const auto extended = [](const PendulumCause& e) {
+      return std::string_view(e.name) == "hook_double_pendulum" || std::string_view(e.name) == "elastic_rope";
+    };
+    std::erase_if(list, [&](const Candidate& c) {
+      const auto& entry = pendulum_catalog()[c.entry];
+      return &entry == series_->first || (extended(entry) && extended(*series_->first));
+    });
+  }
+  return list;
+}
+
+std::unique_ptr<ChannelAudit> SwingAudit::with_first_cause(const Candidate& first, const std::vector<double>& full) const {
+  if (series_->first != nullptr) return nullptr;  // two causes at most
+  auto next = std::make_unique<SwingAudit>(*this);
+  next->base_.assign(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(first.parameters.size()));
+  next->base_specs_ = first.parameters;
+  auto s = std::make_shared<SwingSeries>(*series_);
+  s->first = &pendulum_catalog()[first.entry];
+  s->first_count = first.parameters.size();
+  next->series_ = std::move(s);
+  return next;
+}
 
 Problem SwingAudit::problem(const Candidate* candidate) const {
   auto s = std::make_shared<SwingSeries>(*series_);

@@ -99,14 +99,22 @@ class SwingAudit final : public ChannelAudit {
   [[nodiscard]] std::size_t samples() const override { return data_.time.size(); }
   [[nodiscard]] std::size_t residuals_per_sample() const override { return 2; }
   [[nodiscard]] double sample_time() const override { return sample_time_; }
-  [[nodiscard]] const std::vector<double>& base() const override { return no_base_; }
-  [[nodiscard]] const std::vector<ParameterSpec>& base_specs() const override { return no_specs_; }
-  [[nodiscard]] std::vector<std::size_t> nominal_free(bool) const override { return {}; }
+  [[nodiscard]] const std::vector<double>& base() const override { return base_; }
+  [[nodiscard]] const std::vector<ParameterSpec>& base_specs() const override { return base_specs_; }
+  /// No base parameters of its own (the cable length is measured); in a second step the first
+  /// cause's parameters are the base and are refitted in every fit.
+  [[nodiscard]] std::vector<std::size_t> nominal_free(bool) const override;
+  /// The swing catalog; in a second step without the first cause, and without the other extended
+  /// row (the replay has a hook or an elastic rope, not both).
   [[nodiscard]] std::vector<Candidate> candidates() const override;
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
-  [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_base_; }
+  [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_input_; }
   [[nodiscard]] double quantum() const override;
   [[nodiscard]] double measured(std::size_t k) const override;
+  /// The second step (stepwise, two causes at most): the replay with `first` applied, its fitted
+  /// values the base.
+  [[nodiscard]] std::unique_ptr<ChannelAudit> with_first_cause(const Candidate& first,
+                                                               const std::vector<double>& full) const override;
 
  private:
   const AuditData& data_;
@@ -114,9 +122,10 @@ class SwingAudit final : public ChannelAudit {
   double holdout_fraction_;
   double window_duration_;
   SwingScales scales_;
-  std::vector<double> no_base_;
-  std::vector<ParameterSpec> no_specs_;
-  std::shared_ptr<const SwingSeries> series_;
+  std::vector<double> base_;  // empty, or the first cause's parameters in a second step
+  std::vector<ParameterSpec> base_specs_;
+  std::vector<double> no_input_;
+  std::shared_ptr<const SwingSeries> series_;  // the nominal series (the first cause in a second step)
 };
 
 }  // namespace crane::model_audit::detail

@@ -58,7 +58,11 @@
 //    explained by it. When no other channel names one and the first is a drive's (not
 //    payload_mass_error), that drive channel is audited again stepwise (max_causes) for a second on
 //    the same channel, without payload_mass_error (a payload error shows on both drives), kept when
-//    its first cause is the crane's. The swing channel stays at one cause.
+//    its first cause is the crane's or its joint delta-BIC (first plus second step) is lower than
+//    the crane's first cause alone (then the pair's first replaces it). When the first is a swing
+//    cause, the swing channel is audited again stepwise by the same rule even when a drive names a
+//    second (a swing cause enters the drives' coupling, which uses the nominal swing rows): its own
+//    second is kept when its step's delta-BIC is lower than the drive's cause.
 //    The effort channel as the fitting channel is refused for the crane. With calibrate, each
 //    drive's K_m, b, c are fitted first (the asymmetries and breakaway excess stay as configured)
 //    and the report's nominal gives them back in the configuration's terms (drive gain, volt
@@ -196,8 +200,10 @@ struct AuditOptions {
   // Stepwise (issue 17): after the first cause, while the residual is still not white, look for a
   // further cause on top of it (the first cause's parameters refitted in every fit), by the same
   // rules (delta-BIC, held-out gain, the floor) against the model with the first cause; stop at
-  // "none". In [1, 2]: the axis and pendulum audits go to two causes; the crane's channels stay at
-  // one (their combination picks the first cause over the channels and a second from another channel).
+  // "none". In [1, 2]: the axis and pendulum audits go to two causes; the crane's combination picks
+  // the first cause over its channels and a second from another channel, or stepwise on the first
+  // cause's own channel (a drive's when no other channel names one; the swing's against the other
+  // channels' by delta-BIC) (docs/model_audit.md).
   int max_causes{2};
   int substeps{4};                  // >= 1, for the non-closed-form entries
   std::size_t max_lag{20};          // [samples] Ljung-Box lags
@@ -247,7 +253,8 @@ struct AuditReport {
   // Stepwise: the second cause found on top of the first ("none": none) and its parameters; the
   // held-out figures, `after` and extended_prediction are then those of the model with both.
   // Crane: the cause another channel names (cross-channel; its parameters as fitted on that channel,
-  // its held-out figures in `channels`), not a stepwise cause on top of the first.
+  // its held-out figures in `channels`), or a stepwise cause on the first cause's own channel
+  // (`second_channel` the same; the held-out figures are then those of the pair).
   std::string second_cause{"none"};           // a catalog name, "none" or "ambiguous"
   std::string second_channel;                 // crane: the channel of the second cause, e.g. "slew position"
   std::vector<std::string> second_ambiguous_with;  // second_cause "ambiguous": the two it names
