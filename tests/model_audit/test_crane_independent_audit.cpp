@@ -50,6 +50,7 @@ void print_report(const ma::AuditReport& report) {
     mt::print_candidates(channel, 2, 34);
   }
   mt::print_candidates(report, 4, 34);
+  std::printf("    stop reason: %s\n", report.stop_reason.c_str());
 }
 
 // CRANE_AUDIT_INDEPENDENT_DUMP=DIR: each case also as DIR/independent_crane_SEED.csv (the crane
@@ -105,7 +106,7 @@ TEST(IndependentSimulator, CraneAuditNamesEveryCauseAndInventsNothing) {
     std::printf("  %-40s seed %llu: %s  %s true %.5g fitted %.5g (%+.1f %%)\n", cause.c_str(),
                 static_cast<unsigned long long>(seed), reported.c_str(), c.main_parameter.c_str(), c.main_value, fitted,
                 100.0 * (fitted - c.main_value) / std::abs(c.main_value));
-    if (!right) print_report(report);
+    if (!right || report.second_cause != "none") print_report(report);
   }
   std::printf("\ncrane (independent simulator): right cause %d/%d (%.1f %%, of which %d ambiguous naming the truth); "
               "clean none %d/%d; a second cause in %d\n",
