@@ -404,7 +404,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
       return (c.plant == "trolley" || c.plant == "slew") && c.cause != "none";
     });
     if (drive_named && entry != pendulum_catalog().end() && candidate != swing_report->candidates.end() &&
-        entry->extra_nuisance == 0 && name != "elastic_rope") {
+        !extends_swing_state(*entry)) {
       std::vector<double> values;
       for (const auto& p : candidate->parameters) values.push_back(p.value);
       SwingEffects effects;

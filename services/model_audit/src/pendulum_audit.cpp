@@ -95,6 +95,10 @@ const std::vector<PendulumCause>& pendulum_catalog() {
   return catalog;
 }
 
+bool extends_swing_state(const PendulumCause& cause) {
+  return std::string_view(cause.name) == "hook_double_pendulum" || std::string_view(cause.name) == "elastic_rope";
+}
+
 struct PendulumSeries {
   std::vector<double> theta;
   std::vector<double> trolley_acceleration;
@@ -353,13 +357,9 @@ std::vector<std::size_t> SwingAudit::nominal_free(bool) const {
 std::vector<Candidate> SwingAudit::candidates() const {
   auto list = candidates_of(scales_, true);
   if (series_->first != nullptr) {
-    // The replay's extended rows: a hook or an elastic rope, not both (replay_crane_swing).
-    const auto extended = [](const PendulumCause& e) {
-      return std::string_view(e.name) == "hook_double_pendulum" || std::string_view(e.name) == "elastic_rope";
-    };
     std::erase_if(list, [&](const Candidate& c) {
       const auto& entry = pendulum_catalog()[c.entry];
-      return &entry == series_->first || (extended(entry) && extended(*series_->first));
+      return &entry == series_->first || (extends_swing_state(entry) && extends_swing_state(*series_->first));
     });
   }
   return list;

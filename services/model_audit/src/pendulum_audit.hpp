@@ -40,6 +40,11 @@ struct PendulumCause {
 /// The pendulum catalog in catalog order.
 [[nodiscard]] const std::vector<PendulumCause>& pendulum_catalog();
 
+/// An entry that extends the crane swing replay by states the encoders do not measure (the hook's
+/// rigging, the rope's stretch): one of them at a time (replay_crane_swing), and not in the drives'
+/// coupling.
+[[nodiscard]] bool extends_swing_state(const PendulumCause& cause);
+
 struct PendulumSeries;
 struct SwingSeries;
 
