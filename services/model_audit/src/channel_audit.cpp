@@ -71,8 +71,10 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
   const double holdout_nominal = report.before.holdout_rms;
   const double quantum = channel.quantum();
   // Practical-significance floor of the held-out gain [channel unit].
-  const double floor = std::max(options.min_holdout_gain_quanta * quantum,
-                                options.min_holdout_gain_resolutions * channel.resolution());
+  const double resolution_floor = std::max(options.min_holdout_gain_quanta * quantum,
+                                           options.min_holdout_gain_resolutions * channel.resolution());
+  const double relative_floor = channel.second_step_gain_fraction() * holdout_nominal;
+  const double floor = relative_floor > 0.0 ? std::min(resolution_floor, relative_floor) : resolution_floor;
   constexpr double kRestartQuanta = 2.0;  // every_grid_start: restart above this training RMS [quanta]
 
   // Candidates.
@@ -294,6 +296,9 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
                               ? " and >= " + common::format_value(options.min_holdout_gain_quanta) + " quanta of " +
                                     common::format_value(quantum) + " " + report.unit
                               : std::string()) +
+                         (relative_floor > 0.0 ? ", or " + common::format_value(100.0 * channel.second_step_gain_fraction()) +
+                                                     " % of the held-out RMS left by the first cause"
+                                               : std::string()) +
                          ")";
   }
 
@@ -303,27 +308,31 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
   // the best delta-BIC are tried as the first too (with several causes every single-cause fit is
   // wrong, and the best single one need not be one of them), and the pair with the lowest joint
   // delta-BIC is kept (model_audit.hpp).
+  // An ambiguous first cause (twin) goes on too: the pair found from the pick keeps the ambiguity of
+  // its first, a pair from another first (the twin among them) or one whose second is the twin
+  // resolves it.
   std::optional<AuditReport> second;
   std::string second_note;
-  if (options.max_causes > 1 && chosen >= 0 && twin < 0 && !white) {
-    const auto step_two = [&](std::size_t c) -> std::optional<AuditReport> {
-      const ResidualSummary after = summarize(fits[c], summary_input, options.max_lag);
-      if (after.whiteness.lags > 0 && after.whiteness.p_value >= 0.05) return std::nullopt;
-      const auto next = channel.with_first_cause(candidates[c], fits[c].full);
-      if (!next) return std::nullopt;
-      AuditOptions step = options;
-      step.max_causes = options.max_causes - 1;
-      return run_channel_audit(*next, step);
-    };
-    // A second step that names a cause, or two that share a signature (ambiguous).
-    const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none"; };
-    const auto joint_bic = [&](std::size_t c, const AuditReport& r) {
-      const std::string& name = r.cause == "ambiguous" ? r.ambiguous_with.front() : r.cause;
-      for (const auto& e : r.candidates) {
-        if (e.name == name) return report.candidates[c].delta_bic + e.delta_bic;
-      }
-      return report.candidates[c].delta_bic;
-    };
+  const auto step_two = [&](std::size_t c) -> std::optional<AuditReport> {
+    const ResidualSummary after = summarize(fits[c], summary_input, options.max_lag);
+    if (after.whiteness.lags > 0 && after.whiteness.p_value >= 0.05) return std::nullopt;
+    const auto next = channel.with_first_cause(candidates[c], fits[c].full);
+    if (!next) return std::nullopt;
+    AuditOptions step = options;
+    step.max_causes = options.max_causes - 1;
+    return run_channel_audit(*next, step);
+  };
+  // A second step that names a cause, or two that share a signature (ambiguous).
+  const auto named = [](const std::optional<AuditReport>& r) { return r && r->cause != "none"; };
+  const auto joint_bic = [&](std::size_t c, const AuditReport& r) {
+    const std::string& name = r.cause == "ambiguous" ? r.ambiguous_with.front() : r.cause;
+    for (const auto& e : r.candidates) {
+      if (e.name == name) return report.candidates[c].delta_bic + e.delta_bic;
+    }
+    return report.candidates[c].delta_bic;
+  };
+  if (options.max_causes > 1 && chosen >= 0 && !white) {
+    const std::ptrdiff_t picked = chosen;
     const auto first = static_cast<std::size_t>(chosen);
     second = step_two(first);
     double best_joint = report.candidates[first].delta_bic;
@@ -353,6 +362,42 @@ AuditReport run_channel_audit(const ChannelAudit& channel, const AuditOptions& o
       chosen = static_cast<std::ptrdiff_t>(c);
       second = std::move(alternative);
       second_note.clear();
+    }
+    if (twin >= 0 && second) {
+      const std::string& twin_name = report.candidates[static_cast<std::size_t>(twin)].name;
+      const bool twin_second = second->cause == twin_name ||
+                               std::find(second->ambiguous_with.begin(), second->ambiguous_with.end(), twin_name) !=
+                                   second->ambiguous_with.end();
+      if (chosen != picked || twin_second) twin = -1;
+    }
+  } else if (options.max_causes > 1 && chosen < 0 && !white && channel.pairs_without_single()) {
+    // No single cause earns its parameters, where each of two causes alone can leave the held-out
+    // RMS above the floor (ChannelAudit::pairs_without_single): the best first causes by delta-BIC
+    // each get a second step, and the pair with the lowest joint delta-BIC is kept when together
+    // they lower the held-out RMS by the floor and the held-out gain.
+    std::vector<std::size_t> firsts;
+    for (std::size_t c = 0; c < report.candidates.size(); ++c) {
+      if (report.candidates[c].fitted && report.candidates[c].delta_bic < -options.bic_threshold) firsts.push_back(c);
+    }
+    std::sort(firsts.begin(), firsts.end(),
+              [&](std::size_t x, std::size_t y) { return report.candidates[x].delta_bic < report.candidates[y].delta_bic; });
+    if (firsts.size() > kStepwiseAlternatives + 1) firsts.resize(kStepwiseAlternatives + 1);
+    double best_joint = -options.bic_threshold;
+    for (const std::size_t c : firsts) {
+      auto pair = step_two(c);
+      if (!named(pair)) continue;
+      const double gain = holdout_nominal - pair->holdout_after;
+      if (gain < floor || 100.0 * gain < options.min_holdout_gain_percent * holdout_nominal) continue;
+      if (joint_bic(c, *pair) >= best_joint) continue;
+      best_joint = joint_bic(c, *pair);
+      chosen = static_cast<std::ptrdiff_t>(c);
+      second = std::move(pair);
+    }
+    if (second) {
+      arbitration = "; no single cause earns its parameters, the pair does: the lowest joint delta-BIC (" +
+                    common::format_value(best_joint) + ") among the first " + std::to_string(firsts.size()) +
+                    " causes by delta-BIC, held-out RMS " + common::format_value(holdout_nominal) + " -> " +
+                    common::format_value(second->holdout_after) + " " + report.unit;
     }
   }
 

@@ -55,6 +55,17 @@ class ChannelAudit {
   /// The sensor's resolution for the practical-significance floor: quantum or noise, the larger
   /// (measurement_resolution(); default: quantum()).
   [[nodiscard]] virtual double resolution() const { return quantum(); }
+  /// In a second step (with_first_cause), the fraction [-] in [0, 1) of the held-out RMS left by
+  /// the first cause whose removal passes the practical-significance floor even when it is below
+  /// the floor (0: the floor alone). For a channel whose clean residual is its sensor's noise (no
+  /// systematic part a second cause could take up), where the first cause can leave less than the
+  /// floor and a second cause that halves it is still plainly there (SwingAudit).
+  [[nodiscard]] virtual double second_step_gain_fraction() const { return 0.0; }
+  /// Whether a pair of causes is looked for when no single cause earns its parameters (the
+  /// residual not white, max_causes > 1): the best first causes by delta-BIC each get a second
+  /// step, and the pair is kept when together they pass the floor (run_channel_audit). False by
+  /// default; for a channel whose clean residual is its sensor's noise (SwingAudit).
+  [[nodiscard]] virtual bool pairs_without_single() const { return false; }
   /// Measured value at sample k for the plots (the channel's first residual of the sample).
   [[nodiscard]] virtual double measured(std::size_t k) const = 0;
 

@@ -72,86 +72,6 @@ CraneMotion crane_motion(const AuditData& data, double sample_time) {
   return m;
 }
 
-// Coupling of the drive axes (inverse dynamics of the full model with the measured motion). The
-// swing accelerations are not differentiated twice (the swing encoders' quanta would give several
-// rad/s^2 of noise): the swing rows of TowerCraneModel give them from the drive accelerations,
-// s'' = -M_ss^-1 (M_sa a'' + bias_s), so the drive rows become M_eff a'' + b_eff = (F_x, T_gamma) with
-//   M_eff = M_aa - M_as M_ss^-1 M_sa,  b_eff = bias_a - M_as M_ss^-1 bias_s
-// at the measured positions and (central-difference) rates. Drive i: I_i a_i + C_i with the inertia
-// I_i = M_eff,ii and C_i = b_eff,i + M_eff,ij a_j (the other drive's measured acceleration). The swing
-// rows do not depend on the load mass and the drive rows are affine in it, so I and C are affine in
-// m: I = I(0) + m dI, C = C(0) + m dC.
-// With a swing cause in `effects` (the swing channel's cause, crane_swing.hpp) the swing rows
-// are the swing replay's: the encoder offset taken off phi, the cable length scaled by (1 + e), the
-// damping terms added to the swing accelerations, and the wind's generalized force (its share of
-// the drive rows does not depend on the load mass, so it is added to C(0)). A hook or an elastic
-// rope is not in this coupling (their rigging and stretch states are not measured).
-struct DriveCoupling {
-  std::vector<double> inertia;           // at the nominal load mass
-  std::vector<double> inertia_per_mass;
-  std::vector<double> force;
-  std::vector<double> force_per_mass;
-};
-
-std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion,
-                                                      const SwingEffects& effects = {}) {
-  common::CraneParameters massless = crane;
-  massless.load_mass = 0.0;
-  common::CraneParameters unit = crane;
-  unit.load_mass = 1.0;
-  const plant::TowerCraneModel model0(massless);
-  const plant::TowerCraneModel model1(unit);
-  const std::size_t n = motion.state.size();
-  std::pair<DriveCoupling, DriveCoupling> out;
-  for (auto* c : {&out.first, &out.second}) {
-    c->inertia.resize(n);
-    c->inertia_per_mass.resize(n);
-    c->force.resize(n);
-    c->force_per_mass.resize(n);
-  }
-  const double scale = 1.0 + effects.length_error;
-  const bool wind = effects.wind_force_x != 0.0 || effects.wind_force_y != 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    plant::ModelState state = motion.state[k];
-    state.position[plant::kInPlaneSwingIndex] -= effects.encoder_offset;
-    const plant::HoistMotion& measured_hoist = motion.hoist[k];
-    const plant::HoistMotion hoist{measured_hoist.cable_length * scale, measured_hoist.cable_length_rate * scale,
-                                   measured_hoist.cable_length_acceleration * scale};
-    plant::CoordinateMatrix mass0;
-    plant::CoordinateMatrix mass1;
-    plant::CoordinateVector bias0;
-    plant::CoordinateVector bias1;
-    model0.compute_dynamics(state, hoist, mass0, bias0);
-    model1.compute_dynamics(state, hoist, mass1, bias1);
-    const Eigen::Vector2d a(motion.acceleration[k][plant::kTrolleyIndex], motion.acceleration[k][plant::kSlewIndex]);
-    const Eigen::Vector2d damping = swing_damping(effects, state.velocity[plant::kInPlaneSwingIndex],
-                                                  state.velocity[plant::kOutOfPlaneSwingIndex]);
-    const SwingElimination e0 = eliminate_swing(mass0, bias0, damping);
-    const SwingElimination e1 = eliminate_swing(mass1, bias1, damping);
-    Eigen::Vector2d wind_share = Eigen::Vector2d::Zero();  // [N, N m]
-    if (wind) {
-      plant::ExtendedState extended;
-      extended.position.head<plant::kNumCoordinates>() = state.position;
-      extended.velocity.head<plant::kNumCoordinates>() = state.velocity;
-      const plant::CoordinateVector force =
-          wind_generalized_force(model1, effects, extended, hoist).head<plant::kNumCoordinates>();
-      wind_share = eliminate_swing(mass1, bias1 - force, damping).drive_bias - e1.drive_bias;
-    }
-    const Eigen::Matrix2d inertia[2] = {e0.drive_inertia, e1.drive_inertia};
-    const Eigen::Vector2d bias[2] = {e0.drive_bias, e1.drive_bias};
-    for (int i = 0; i < 2; ++i) {
-      DriveCoupling& c = i == 0 ? out.first : out.second;
-      const double force0 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i) + wind_share(i);
-      const double force1 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i) + wind_share(i);
-      c.inertia_per_mass[k] = inertia[1](i, i) - inertia[0](i, i);
-      c.force_per_mass[k] = force1 - force0;
-      c.inertia[k] = inertia[0](i, i) + crane.load_mass * c.inertia_per_mass[k];
-      c.force[k] = force0 + crane.load_mass * c.force_per_mass[k];
-    }
-  }
-  return out;
-}
-
 // Drive motion held over [t_k, t_k+1) for the swing replay: position and rates at t_k, the
 // acceleration of the interval (mean of the second differences at k and k+1).
 std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
@@ -169,6 +89,92 @@ std::vector<DriveMotion> swing_drive_motion(const CraneMotion& m) {
     d.cable_length = m.hoist[k].cable_length;
     d.cable_length_rate = m.hoist[k].cable_length_rate;
     d.cable_length_acceleration = m.hoist[k].cable_length_acceleration;
+  }
+  return out;
+}
+
+// Coupling of the drive axes (inverse dynamics of the full model with the measured motion). The
+// swing accelerations are not differentiated twice (the swing encoders' quanta would give several
+// rad/s^2 of noise): the swing rows of TowerCraneModel give them from the drive accelerations,
+// s'' = -M_ss^-1 (M_sa a'' + bias_s), so the drive rows become M_eff a'' + b_eff = (F_x, T_gamma) with
+//   M_eff = M_aa - M_as M_ss^-1 M_sa,  b_eff = bias_a - M_as M_ss^-1 bias_s
+// at the measured positions and (central-difference) rates. Drive i: I_i a_i + C_i with the inertia
+// I_i = M_eff,ii and C_i = b_eff,i + M_eff,ij a_j (the other drive's measured acceleration). The swing
+// rows do not depend on the load mass and the drive rows are affine in it, so I and C are affine in
+// m: I = I(0) + m dI, C = C(0) + m dC (evaluated at two masses).
+// With a swing cause in `effects` (the swing channel's cause, crane_swing.hpp) the swing rows
+// are the swing replay's: the encoder offset taken off phi, the cable length scaled by (1 + e), the
+// damping terms added to the swing accelerations, and the wind's generalized force (its share of
+// the drive rows does not depend on the load mass). With a hook or an elastic rope the rows are the
+// extended model's (hooked_model, roped_model: the hook's and the load's masses, the rope's
+// stiffness and damping all scale with the suspended mass, so the affinity holds), and the states
+// the encoders do not measure (the rigging's angles, the stretch) are those of follow_swing(): the
+// model's response to the measured cable angles, from rest at the first sample.
+struct DriveCoupling {
+  std::vector<double> inertia;           // at the nominal load mass
+  std::vector<double> inertia_per_mass;
+  std::vector<double> force;
+  std::vector<double> force_per_mass;
+};
+
+std::pair<DriveCoupling, DriveCoupling> crane_coupling(const common::CraneParameters& crane, const CraneMotion& motion,
+                                                      double sample_time, const SwingEffects& effects = {}) {
+  const std::size_t n = motion.state.size();
+  const bool hooked = effects.rigging_length > 0.0;
+  const bool extended = hooked || effects.rope_stretch_ratio > 0.0;
+  // The models at the suspended masses 1 and 2 kg (the extended ones split or scale with it).
+  common::CraneParameters one = crane;
+  one.load_mass = 1.0;
+  common::CraneParameters two = crane;
+  two.load_mass = 2.0;
+  const plant::TowerCraneModel model[2] = {
+      extended ? (hooked ? hooked_model(one, effects) : roped_model(one, effects)) : plant::TowerCraneModel(one),
+      extended ? (hooked ? hooked_model(two, effects) : roped_model(two, effects)) : plant::TowerCraneModel(two)};
+  // The unmeasured states along the record (with a hook or a rope).
+  std::vector<SwingState> swing(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const plant::ModelState& q = motion.state[k];
+    swing[k] = {q.position[plant::kInPlaneSwingIndex] - effects.encoder_offset, q.velocity[plant::kInPlaneSwingIndex],
+                q.position[plant::kOutOfPlaneSwingIndex], q.velocity[plant::kOutOfPlaneSwingIndex]};
+  }
+  if (extended) {
+    swing = follow_swing(plant::TowerCraneModel(crane), effects, swing_drive_motion(motion), swing, sample_time);
+  }
+  std::pair<DriveCoupling, DriveCoupling> out;
+  for (auto* c : {&out.first, &out.second}) {
+    c->inertia.resize(n);
+    c->inertia_per_mass.resize(n);
+    c->force.resize(n);
+    c->force_per_mass.resize(n);
+  }
+  const double scale = 1.0 + effects.length_error;
+  for (std::size_t k = 0; k < n; ++k) {
+    plant::ExtendedState state;
+    state.position.head<plant::kNumCoordinates>() = motion.state[k].position;
+    state.velocity.head<plant::kNumCoordinates>() = motion.state[k].velocity;
+    state.position[plant::kInPlaneSwingIndex] = swing[k].in_plane;
+    state.position[plant::kRiggingInPlaneIndex] = swing[k].rigging_in_plane;
+    state.velocity[plant::kRiggingInPlaneIndex] = swing[k].rigging_in_plane_rate;
+    state.position[plant::kRiggingOutOfPlaneIndex] = swing[k].rigging_out_of_plane;
+    state.velocity[plant::kRiggingOutOfPlaneIndex] = swing[k].rigging_out_of_plane_rate;
+    const plant::HoistMotion& measured_hoist = motion.hoist[k];
+    const plant::HoistMotion hoist{measured_hoist.cable_length * scale, measured_hoist.cable_length_rate * scale,
+                                   measured_hoist.cable_length_acceleration * scale};
+    const Eigen::Vector2d a(motion.acceleration[k][plant::kTrolleyIndex], motion.acceleration[k][plant::kSlewIndex]);
+    const Eigen::Vector2d damping = swing_damping(effects, swing[k].in_plane_rate, swing[k].out_of_plane_rate);
+    const HookedSwingElimination e[2] = {eliminate_swing_at(model[0], effects, state, hoist, damping),
+                                         eliminate_swing_at(model[1], effects, state, hoist, damping)};
+    const Eigen::Matrix2d inertia[2] = {e[0].drive_inertia, e[1].drive_inertia};
+    const Eigen::Vector2d bias[2] = {e[0].drive_bias, e[1].drive_bias};
+    for (int i = 0; i < 2; ++i) {
+      DriveCoupling& c = i == 0 ? out.first : out.second;
+      const double force1 = bias[0](i) + inertia[0](i, 1 - i) * a(1 - i);  // at 1 kg
+      const double force2 = bias[1](i) + inertia[1](i, 1 - i) * a(1 - i);  // at 2 kg
+      c.inertia_per_mass[k] = inertia[1](i, i) - inertia[0](i, i);
+      c.force_per_mass[k] = force2 - force1;
+      c.inertia[k] = inertia[0](i, i) + (crane.load_mass - 1.0) * c.inertia_per_mass[k];
+      c.force[k] = force1 + (crane.load_mass - 1.0) * c.force_per_mass[k];
+    }
   }
   return out;
 }
@@ -229,7 +235,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     smoothed.swing_out_of_plane = zero_phase_low_pass(data.swing_out_of_plane, kSwingCutoff, 1.0 / sample_time);
   }
   const CraneMotion smoothed_motion = crane_motion(smoothed, sample_time);
-  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, smoothed_motion);
+  const auto [trolley_coupling, slew_coupling] = crane_coupling(crane, smoothed_motion, sample_time);
 
   AuditReport report;
   report.plant = "crane";
@@ -388,7 +394,7 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
   // also an error of the drives' generalized forces, which a drive entry takes up (an encoder offset
   // is a constant force on the trolley, as a Coulomb asymmetry is). So when the swing channel names
   // a cause, the drives that named one are audited again with it in their coupling (crane_coupling;
-  // not the hook or the elastic rope, whose extra states are not measured). A drive cause does not
+  // a hook's rigging or a rope's stretch followed from the measured cable angles). A drive cause does not
   // enter the swing channel's replay (it holds the measured drive motion), so the swing's cause is
   // not the echo of a drive's.
   std::string recoupled;
@@ -403,13 +409,12 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     const bool drive_named = std::any_of(report.channels.begin(), report.channels.end(), [](const AuditReport& c) {
       return (c.plant == "trolley" || c.plant == "slew") && c.cause != "none";
     });
-    if (drive_named && entry != pendulum_catalog().end() && candidate != swing_report->candidates.end() &&
-        !extends_swing_state(*entry)) {
+    if (drive_named && entry != pendulum_catalog().end() && candidate != swing_report->candidates.end()) {
       std::vector<double> values;
       for (const auto& p : candidate->parameters) values.push_back(p.value);
       SwingEffects effects;
       entry->apply_swing(values.data(), effects);
-      const auto [trolley, slew] = crane_coupling(crane, smoothed_motion, effects);
+      const auto [trolley, slew] = crane_coupling(crane, smoothed_motion, sample_time, effects);
       for (auto& channel : report.channels) {
         if (channel.cause == "none" || (channel.plant != "trolley" && channel.plant != "slew")) continue;
         auto again = channel.plant == "trolley" ? trolley_channel(1, trolley) : slew_channel(1, slew);
@@ -419,6 +424,17 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
         channel = std::move(*again);
       }
     }
+  }
+
+  // Two causes on the swing channel where neither alone earns its parameters (each leaves the
+  // held-out RMS above the floor; SwingAudit::pairs_without_single): the swing channel audited
+  // again with max_causes, its pair kept below (when its joint delta-BIC beats the crane's first
+  // cause). The drives' causes are then the pair's echo in their coupling.
+  std::optional<AuditReport> swing_pair;
+  if (options.max_causes > 1 && swing_report != report.channels.end() && swing_report->cause == "none" &&
+      !(swing_report->before.whiteness.lags > 0 && swing_report->before.whiteness.p_value >= 0.05)) {
+    auto pair = swing_channel(options.max_causes);
+    if (pair && pair->cause != "none" && pair->second_cause != "none") swing_pair = std::move(pair);
   }
 
   // The nominal as used: the configuration's, with the calibrated drives if asked.
@@ -456,21 +472,25 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     if (a.fitted != b.fitted) return a.fitted;
     return a.fitted && a.delta_bic < b.delta_bic;
   });
+  // The report shows one channel's residuals and series.
+  const auto show = [&report](const AuditReport& shown) {
+    report.channel = shown.plant + " " + shown.channel;
+    report.unit = shown.unit;
+    report.before = shown.before;
+    report.after = shown.after;
+    report.holdout_before = shown.holdout_before;
+    report.holdout_after = shown.holdout_after;
+    report.holdout_percent = shown.holdout_percent;
+    report.effort_holdout_before = shown.effort_holdout_before;
+    report.effort_holdout_after = shown.effort_holdout_after;
+    report.time = shown.time;
+    report.measured = shown.measured;
+    report.nominal_prediction = shown.nominal_prediction;
+    report.extended_prediction = shown.extended_prediction;
+    report.holdout = shown.holdout;
+  };
   const AuditReport& shown = chosen_channel != nullptr ? *chosen_channel : report.channels.front();
-  report.channel = shown.plant + " " + shown.channel;
-  report.unit = shown.unit;
-  report.before = shown.before;
-  report.after = shown.after;
-  report.holdout_before = shown.holdout_before;
-  report.holdout_after = shown.holdout_after;
-  report.holdout_percent = shown.holdout_percent;
-  report.effort_holdout_before = shown.effort_holdout_before;
-  report.effort_holdout_after = shown.effort_holdout_after;
-  report.time = shown.time;
-  report.measured = shown.measured;
-  report.nominal_prediction = shown.nominal_prediction;
-  report.extended_prediction = shown.extended_prediction;
-  report.holdout = shown.holdout;
+  show(shown);
   // A cause's parameters as reported; payload_mass_error adds the resulting load_mass.
   const auto cause_parameters = [&](const CandidateReport& cause) {
     std::vector<FittedParameter> out = cause.parameters;
@@ -590,6 +610,26 @@ AuditReport run_crane_audit(const AuditData& data, const AuditOptions& options) 
     }
     report.stop_reason.resize(report.stop_reason.size() - 2);
     report.stop_reason += ")";
+  }
+  if (swing_pair && (chosen == nullptr || pair_delta_bic(*swing_pair) < chosen->delta_bic)) {
+    const AuditReport& pair = *swing_pair;
+    const std::string replaced =
+        chosen == nullptr ? std::string()
+                          : "; instead of " + report.cause + (report.second_cause == "none" ? "" : " + " + report.second_cause) +
+                                " (delta-BIC " + common::format_value(chosen->delta_bic) + " for " + chosen->name +
+                                ", an echo of the swing's causes in the drives' coupling)";
+    show(pair);
+    report.cause = pair.cause;
+    report.ambiguous_with = pair.ambiguous_with;
+    report.parameters = pair.parameters;
+    report.extended_nominal = pair.extended_nominal;
+    report.second_cause = pair.second_cause;
+    report.second_ambiguous_with = pair.second_ambiguous_with;
+    report.second_parameters = pair.second_parameters;
+    report.second_channel = report.channel;
+    report.stop_reason = "two causes on the " + report.channel + " channel, neither alone earning its parameters (joint delta-BIC " +
+                         common::format_value(pair_delta_bic(pair)) + "): " + pair.stop_reason + replaced;
+    *swing_report = std::move(*swing_pair);
   }
   if (!calibration_notes.empty()) {
     calibration_notes.resize(calibration_notes.size() - 2);

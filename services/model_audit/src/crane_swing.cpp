@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 namespace crane::model_audit {
 
@@ -68,6 +69,36 @@ HookedSwingElimination eliminate_hooked_swing(const plant::ExtendedMatrix& mass,
   e.drive_inertia = m_aa + m_as * e.swing_gain;
   e.drive_bias = b_a + m_as * e.swing_free;
   return e;
+}
+
+HookedSwingElimination eliminate_swing_at(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                          const plant::ExtendedState& state, const plant::HoistMotion& hoist,
+                                          const Eigen::Vector2d& swing_extra) noexcept {
+  if (model.coordinate_count() > plant::kNumCoordinates) {
+    plant::ExtendedMatrix mass;
+    plant::ExtendedVector bias;
+    model.compute_extended_dynamics(state, hoist, mass, bias);
+    bias -= wind_generalized_force(model, effects, state, hoist);
+    return eliminate_hooked_swing(mass, bias, swing_extra);
+  }
+  plant::ModelState q;
+  q.position = state.position.head<plant::kNumCoordinates>();
+  q.velocity = state.velocity.head<plant::kNumCoordinates>();
+  plant::CoordinateMatrix mass;
+  plant::CoordinateVector bias;
+  model.compute_dynamics(q, hoist, mass, bias);
+  if (effects.wind_force_x != 0.0 || effects.wind_force_y != 0.0) {
+    bias -= wind_generalized_force(model, effects, state, hoist).head<plant::kNumCoordinates>();
+  }
+  const SwingElimination e = eliminate_swing(mass, bias, swing_extra);
+  HookedSwingElimination out;
+  out.swing_gain.setZero();
+  out.swing_gain.topRows<2>() = e.swing_gain;
+  out.swing_free.setZero();
+  out.swing_free.head<2>() = e.swing_free;
+  out.drive_inertia = e.drive_inertia;
+  out.drive_bias = e.drive_bias;
+  return out;
 }
 
 plant::TowerCraneModel hooked_model(const common::CraneParameters& suspended, const SwingEffects& effects) {
@@ -176,76 +207,56 @@ Eigen::Vector4d hooked_acceleration(const plant::TowerCraneModel& model, const S
 
 }  // namespace
 
-void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
-                        std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,
-                        SwingState initial, int substeps, std::span<double> out) noexcept {
-  assert(first + count <= motion.size());
-  assert(out.size() >= 2 * count);
-  const bool hooked = effects.rigging_length > 0.0;
-  const bool roped = !hooked && effects.rope_stretch_ratio > 0.0;
-  // The hooked or roped model allocates nothing per step; it is built once per replay (noexcept:
-  // the clamped hook and rope parameters are within the model's bounds). Both go through the
-  // extended rows (slots 4 and 5: the rigging's angles, or the stretch and an unused slot).
-  const std::optional<plant::TowerCraneModel> hook =
-      hooked  ? std::optional<plant::TowerCraneModel>(hooked_model(model.parameters(), effects))
-      : roped ? std::optional<plant::TowerCraneModel>(roped_model(model.parameters(), effects))
-              : std::nullopt;
-  const bool extended = hook.has_value();
-  int steps = substeps < 1 ? 1 : substeps;
-  const double first_length = motion[first].cable_length * (1.0 + effects.length_error);
-  if (roped) {
-    // The load's bounce on the rope, sqrt(k / m) = sqrt(g / (e_r L)): h omega <= 0.3 as for the hook.
-    const double omega = std::sqrt(hook->parameters().gravity /
-                                   (std::clamp(effects.rope_stretch_ratio, kMinRopeStretchRatio, kMaxRopeStretchRatio) *
-                                    first_length));
-    if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
-  }
-  if (hooked) {
-    // The rigging's mode is fast for a short rigging or a light hook: at least as many RK4 steps as
-    // keep h omega_2 <= 0.3 (omega_2 of the double pendulum at rest, at the first sample's length).
-    const common::CraneParameters& p = hook->parameters();
-    const double omega = plant::double_pendulum_frequencies(first_length, hook->hook().rigging_length, hook->hook().hook_mass,
-                                                            p.load_mass, p.gravity)
-                             .second;
-    if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
-  }
-  const double h = sample_time / steps;
-  SwingVector state;
-  state << initial.in_plane, initial.in_plane_rate, initial.out_of_plane, initial.out_of_plane_rate,
-      initial.rigging_in_plane, initial.rigging_in_plane_rate, initial.rigging_out_of_plane,
-      initial.rigging_out_of_plane_rate;
-  if (roped) {  // the stretch at rest under the load's weight, e_r L, not moving; slot 5 unused
-    state.tail<4>() << hook->parameters().load_mass * hook->parameters().gravity * first_length /
-                           hook->rope().axial_stiffness,
-        0.0, 0.0, 0.0;
-  }
-  const auto derivative = [&](const SwingVector& s, const DriveMotion& d) {
-    SwingVector k = SwingVector::Zero();
-    k(0) = s(1);
-    k(2) = s(3);
-    if (extended) {
-      const Eigen::Vector4d a = hooked_acceleration(*hook, effects, s, d);
-      k(1) = a(0);
-      k(3) = a(1);
-      k(4) = s(5);
-      k(5) = a(2);
-      k(6) = s(7);
-      k(7) = a(3);
-    } else {
-      const SwingState single{s(0), s(1), s(2), s(3)};
-      swing_acceleration(model, effects, single, d, k(1), k(3));
+namespace {
+
+// One sample of the swing replay: classical RK4 with the drive and hoist motion held (the trolley
+// position and the slew angle following their held rates and accelerations within the sample), the
+// hooked or roped model built once (noexcept: the clamped hook and rope parameters are within the
+// model's bounds; both go through the extended rows, slots 4 and 5: the rigging's angles, or the
+// stretch and an unused slot).
+class SwingStepper {
+ public:
+  SwingStepper(const plant::TowerCraneModel& model, const SwingEffects& effects, double first_length, double sample_time,
+               int substeps)
+      : model_(model), effects_(effects) {
+    const bool hooked = effects.rigging_length > 0.0;
+    const bool roped = !hooked && effects.rope_stretch_ratio > 0.0;
+    if (hooked) extended_.emplace(hooked_model(model.parameters(), effects));
+    if (roped) extended_.emplace(roped_model(model.parameters(), effects));
+    int steps = substeps < 1 ? 1 : substeps;
+    if (roped) {
+      // The load's bounce on the rope, sqrt(k / m) = sqrt(g / (e_r L)): h omega <= 0.3 as for the hook.
+      const double omega = std::sqrt(extended_->parameters().gravity /
+                                     (std::clamp(effects.rope_stretch_ratio, kMinRopeStretchRatio, kMaxRopeStretchRatio) *
+                                      first_length));
+      if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
+      static_stretch_ = extended_->parameters().load_mass * extended_->parameters().gravity * first_length /
+                        extended_->rope().axial_stiffness;
     }
-    return k;
-  };
-  for (std::size_t i = 0; i < count; ++i) {
-    out[2 * i] = state(0) + effects.encoder_offset;
-    out[2 * i + 1] = state(2);
-    if (i + 1 == count) break;
-    const DriveMotion& held = motion[first + i];
+    if (hooked) {
+      // The rigging's mode is fast for a short rigging or a light hook: at least as many RK4 steps as
+      // keep h omega_2 <= 0.3 (omega_2 of the double pendulum at rest, at the first sample's length).
+      const common::CraneParameters& p = extended_->parameters();
+      const double omega = plant::double_pendulum_frequencies(first_length, extended_->hook().rigging_length,
+                                                              extended_->hook().hook_mass, p.load_mass, p.gravity)
+                               .second;
+      if (std::isfinite(omega)) steps = std::max(steps, static_cast<int>(std::ceil(omega * sample_time / 0.3)));
+    }
+    steps_ = steps;
+    h_ = sample_time / steps;
+  }
+
+  // The rope's stretch at rest under the load's weight at the first sample's length [m] (0 without a rope).
+  [[nodiscard]] double static_stretch() const noexcept { return static_stretch_; }
+
+  // Advances `state` over one sample with `held`; false (the state left at its last step inside the
+  // domain) when a step leaves the model's domain: a fit may try parameters or initial states far from the data, so a
+  // swing beyond 1.5 rad (the model is singular at pi/2) or a non-finite state is held where it
+  // was, and the prediction stays finite (and far from the data).
+  bool advance(SwingVector& state, const DriveMotion& held) const noexcept {
     DriveMotion d = held;
-    for (int step = 0; step < steps; ++step) {
-      // The trolley position and the slew angle follow their held rates and accelerations within
-      // the sample.
+    const double h = h_;
+    for (int step = 0; step < steps_; ++step) {
       const double tau = step * h;
       d.trolley_position = held.trolley_position + held.trolley_velocity * tau + 0.5 * held.trolley_acceleration * tau * tau;
       d.trolley_velocity = held.trolley_velocity + held.trolley_acceleration * tau;
@@ -266,16 +277,92 @@ void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects&
       const SwingVector k3 = derivative(state + 0.5 * h * k2, mid);
       const SwingVector k4 = derivative(state + h * k3, end);
       const SwingVector next = state + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-      // A fit may try parameters or initial states far from the data: a swing beyond 1.5 rad (the
-      // model is singular at pi/2) or a non-finite state is held where it was, so that the
-      // prediction stays finite (and far from the data).
       if (!next.allFinite() || std::abs(next(0)) > 1.5 || std::abs(next(2)) > 1.5 || std::abs(next(4)) > 1.5 ||
           std::abs(next(6)) > 1.5) {
-        break;
+        return false;
       }
       state = next;
     }
+    return true;
   }
+
+ private:
+  SwingVector derivative(const SwingVector& s, const DriveMotion& d) const noexcept {
+    SwingVector k = SwingVector::Zero();
+    k(0) = s(1);
+    k(2) = s(3);
+    if (extended_) {
+      const Eigen::Vector4d a = hooked_acceleration(*extended_, effects_, s, d);
+      k(1) = a(0);
+      k(3) = a(1);
+      k(4) = s(5);
+      k(5) = a(2);
+      k(6) = s(7);
+      k(7) = a(3);
+    } else {
+      const SwingState single{s(0), s(1), s(2), s(3)};
+      swing_acceleration(model_, effects_, single, d, k(1), k(3));
+    }
+    return k;
+  }
+
+  const plant::TowerCraneModel& model_;
+  const SwingEffects& effects_;
+  std::optional<plant::TowerCraneModel> extended_;
+  double static_stretch_{0.0};
+  int steps_{1};
+  double h_{0.0};
+};
+
+}  // namespace
+
+void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                        std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,
+                        SwingState initial, int substeps, std::span<double> out) noexcept {
+  assert(first + count <= motion.size());
+  assert(out.size() >= 2 * count);
+  const bool roped = effects.rigging_length <= 0.0 && effects.rope_stretch_ratio > 0.0;
+  const SwingStepper stepper(model, effects, motion[first].cable_length * (1.0 + effects.length_error), sample_time,
+                             substeps);
+  SwingVector state;
+  state << initial.in_plane, initial.in_plane_rate, initial.out_of_plane, initial.out_of_plane_rate,
+      initial.rigging_in_plane, initial.rigging_in_plane_rate, initial.rigging_out_of_plane,
+      initial.rigging_out_of_plane_rate;
+  if (roped) state.tail<4>() << stepper.static_stretch(), 0.0, 0.0, 0.0;  // at rest under the load's weight; slot 5 unused
+  for (std::size_t i = 0; i < count; ++i) {
+    out[2 * i] = state(0) + effects.encoder_offset;
+    out[2 * i + 1] = state(2);
+    if (i + 1 == count) break;
+    (void)stepper.advance(state, motion[first + i]);  // a step out of the domain: held where it was
+  }
+}
+
+std::vector<SwingState> follow_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                     std::span<const DriveMotion> motion, std::span<const SwingState> cable,
+                                     double sample_time) {
+  assert(cable.size() == motion.size());
+  std::vector<SwingState> out(cable.begin(), cable.end());
+  const bool hooked = effects.rigging_length > 0.0;
+  const bool roped = !hooked && effects.rope_stretch_ratio > 0.0;
+  if (out.empty() || (!hooked && !roped)) return out;
+  const SwingStepper stepper(model, effects, motion.front().cable_length * (1.0 + effects.length_error), sample_time, 1);
+  // At rest at the first sample: the rigging hanging on the cable's line, or the rope stretched by
+  // the load's weight.
+  SwingVector extended;
+  extended << cable[0].in_plane, 0.0, cable[0].out_of_plane, 0.0, 0.0, 0.0, 0.0, 0.0;
+  if (hooked) extended.tail<4>() << cable[0].in_plane, 0.0, cable[0].out_of_plane, 0.0;
+  if (roped) extended.tail<4>() << stepper.static_stretch(), 0.0, 0.0, 0.0;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    out[k].rigging_in_plane = extended(4);
+    out[k].rigging_in_plane_rate = extended(5);
+    out[k].rigging_out_of_plane = extended(6);
+    out[k].rigging_out_of_plane_rate = extended(7);
+    if (k + 1 == out.size()) break;
+    SwingVector state = extended;
+    state.head<4>() << cable[k].in_plane, cable[k].in_plane_rate, cable[k].out_of_plane, cable[k].out_of_plane_rate;
+    if (stepper.advance(state, motion[k])) extended.tail<4>() = state.tail<4>();
+  }
+  return out;
 }
 
 }  // namespace crane::model_audit

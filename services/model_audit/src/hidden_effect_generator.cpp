@@ -290,41 +290,17 @@ std::pair<double, double> run_crane(const CraneTruth& truth, double duration, st
       // Swing rows eliminated (with the swing entries' damping and the wind's generalized force):
       // s'' = S a'' + s0, M_eff a'' + b_eff = Q; s = (phi, theta) or, with the hook, (phi, theta, phi2, theta2).
       const Eigen::Vector2d damping = swing_damping(truth.swing, swing.in_plane_rate, swing.out_of_plane_rate);
-      Eigen::Matrix<double, 4, 2> swing_gain = Eigen::Matrix<double, 4, 2>::Zero();
-      Eigen::Vector4d swing_free = Eigen::Vector4d::Zero();
-      Eigen::Matrix2d m_eff;
-      Eigen::Vector2d b_eff;
       plant::ExtendedState extended;
       extended.position << trolley.position, swing.in_plane, slew.position, swing.out_of_plane, swing.rigging_in_plane,
           swing.rigging_out_of_plane;
       extended.velocity << trolley.velocity, swing.in_plane_rate, slew.velocity, swing.out_of_plane_rate,
           swing.rigging_in_plane_rate, swing.rigging_out_of_plane_rate;
-      if (extended_rows) {
-        plant::ExtendedMatrix mass;
-        plant::ExtendedVector bias;
-        hook->compute_extended_dynamics(extended, hoist, mass, bias);
-        bias -= wind_generalized_force(*hook, truth.swing, extended, hoist);
-        const HookedSwingElimination e = eliminate_hooked_swing(mass, bias, damping);
-        swing_gain = e.swing_gain;
-        swing_free = e.swing_free;
-        m_eff = e.drive_inertia;
-        b_eff = e.drive_bias;
-      } else {
-        plant::ModelState q;
-        q.position = extended.position.head<plant::kNumCoordinates>();
-        q.velocity = extended.velocity.head<plant::kNumCoordinates>();
-        plant::CoordinateMatrix mass;
-        plant::CoordinateVector bias;
-        model.compute_dynamics(q, hoist, mass, bias);
-        if (truth.swing.wind_force_x != 0.0 || truth.swing.wind_force_y != 0.0) {
-          bias -= wind_generalized_force(model, truth.swing, extended, hoist).head<plant::kNumCoordinates>();
-        }
-        const SwingElimination e = eliminate_swing(mass, bias, damping);
-        swing_gain.topRows<2>() = e.swing_gain;
-        swing_free.head<2>() = e.swing_free;
-        m_eff = e.drive_inertia;
-        b_eff = e.drive_bias;
-      }
+      const HookedSwingElimination e =
+          eliminate_swing_at(extended_rows ? *hook : model, truth.swing, extended, hoist, damping);
+      const Eigen::Matrix<double, 4, 2>& swing_gain = e.swing_gain;
+      const Eigen::Vector4d& swing_free = e.swing_free;
+      const Eigen::Matrix2d& m_eff = e.drive_inertia;
+      const Eigen::Vector2d& b_eff = e.drive_bias;
       // Each drive with its own effective inertia; the small cross term from the other drive's
       // acceleration of the previous substep.
       const double ratio_x = truth.crane.trolley_drive_mass / m_eff(0, 0);

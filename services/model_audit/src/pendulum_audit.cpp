@@ -385,6 +385,12 @@ Problem SwingAudit::problem(const Candidate* candidate) const {
 
 double SwingAudit::quantum() const { return resolution_quantum(series_->measured, 2); }
 
+bool SwingAudit::pairs_without_single() const { return series_->first == nullptr; }
+
+double SwingAudit::second_step_gain_fraction() const {
+  return series_->first != nullptr ? kSwingSecondStepGainFraction : 0.0;
+}
+
 double SwingAudit::measured(std::size_t k) const { return series_->measured[2 * k]; }
 
 }  // namespace crane::model_audit::detail

@@ -35,6 +35,7 @@
 
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "crane/plant/tower_crane_model.hpp"
 
@@ -118,6 +119,14 @@ struct HookedSwingElimination {
                                                             const plant::ExtendedVector& bias,
                                                             const Eigen::Vector2d& swing_extra) noexcept;
 
+/// The swing eliminated at one state of `model` (its swing rows: four with a hook or a rope, whose
+/// models have 6 or 5 coordinates, else two, the other rows of swing_gain and swing_free zero), with
+/// the wind's generalized force of `effects` in the bias and `swing_extra` [rad/s^2] (the catalog's
+/// damping, swing_damping()) added to phi'' and theta''. `state`: every coordinate of `model`.
+[[nodiscard]] HookedSwingElimination eliminate_swing_at(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                                        const plant::ExtendedState& state, const plant::HoistMotion& hoist,
+                                                        const Eigen::Vector2d& swing_extra) noexcept;
+
 /// The model with the hook of `effects` (rigging_length clamped to [kMinRiggingLength,
 /// kMaxRiggingLength], hook_mass_share to [kMinHookMassShare, kMaxHookMassShare]): `suspended`'s
 /// load_mass M (> 0; 1 kg when not) split into the hook's s M and the load's (1 - s) M. Allocates.
@@ -155,5 +164,21 @@ void swing_acceleration(const plant::TowerCraneModel& model, const SwingEffects&
 void replay_crane_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
                         std::span<const DriveMotion> motion, double sample_time, std::size_t first, std::size_t count,
                         SwingState initial, int substeps, std::span<double> out) noexcept;
+
+/// The swing states the encoders do not measure, along a record whose cable angles are measured:
+/// with a hook (effects.rigging_length > 0) the rigging's angles and rates; with an elastic rope
+/// (no hook) the stretch [m] and its rate [m/s] in rigging_in_plane and rigging_in_plane_rate.
+/// `cable[k]` is the cable's state at sample k (phi without the encoder offset, theta, their rates;
+/// its rigging fields are ignored); the result is `cable` with the extended fields filled. They start
+/// at rest at the first sample (the rigging on the cable's line, the rope stretched by the load's
+/// weight) and are carried from sample to sample by one sample of the replay's integration
+/// (replay_crane_swing, the same model) started from the measured cable state, so the cable's part
+/// never drifts from the measurement (an observer that injects the measured cable state; the
+/// extended part follows the model's response to it). Without a hook or a rope: `cable` unchanged.
+/// `model` as for replay_crane_swing. Preconditions (asserted): cable.size() == motion.size().
+/// Allocates the result.
+[[nodiscard]] std::vector<SwingState> follow_swing(const plant::TowerCraneModel& model, const SwingEffects& effects,
+                                                   std::span<const DriveMotion> motion, std::span<const SwingState> cable,
+                                                   double sample_time);
 
 }  // namespace crane::model_audit

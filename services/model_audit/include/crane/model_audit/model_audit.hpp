@@ -16,7 +16,12 @@
 // curve with v_s <= c T / 2 is stiction on sampled data). Else "none". The audit stops at once
 // ("none") when the nominal residual is already white (Ljung-Box p >= 0.05). Stepwise
 // (max_causes): while the residual with the cause is not white, a second cause by the same rules
-// against the model with the first (second_cause).
+// against the model with the first (second_cause); an ambiguous first goes on too (a pair from its
+// twin, or with its twin as the second, resolves the ambiguity). On the crane's swing channel a
+// second cause also passes the floor when it halves the held-out RMS left by the first
+// (kSwingSecondStepGainFraction in src/pendulum_audit.hpp), and when no single cause earns its
+// parameters the best three by delta-BIC are tried as the first of a pair, kept when the pair
+// together passes the floor (each of two causes alone can miss it).
 //
 // Channels (what the residual is):
 //  - position (axis) / angle (pendulum): output error. The record is cut into windows (axis:
@@ -59,10 +64,14 @@
 //    payload_mass_error), that drive channel is audited again stepwise (max_causes) for a second on
 //    the same channel, without payload_mass_error (a payload error shows on both drives), kept when
 //    its first cause is the crane's or its joint delta-BIC (first plus second step) is lower than
-//    the crane's first cause alone (then the pair's first replaces it). When the first is a swing
-//    cause, the swing channel is audited again stepwise by the same rule even when a drive names a
-//    second (a swing cause enters the drives' coupling, which uses the nominal swing rows): its own
-//    second is kept when its step's delta-BIC is lower than the drive's cause.
+//    the crane's first cause alone (then the pair's first replaces it). When the swing channel
+//    names a cause, the drives that named one are audited again with it in their coupling (a hook's
+//    rigging and a rope's stretch followed from the measured cable angles, follow_swing in
+//    crane_swing.hpp). When the first is a swing cause, the swing channel is audited again
+//    stepwise by the same rule even when a drive names a second: its own second is kept when its
+//    step's delta-BIC is lower than the drive's cause. When the swing channel names none but its
+//    residual is not white, it is audited again for a pair (above), which replaces the crane's
+//    causes when its joint delta-BIC is lower than the crane's first.
 //    The effort channel as the fitting channel is refused for the crane. With calibrate, each
 //    drive's K_m, b, c are fitted first (the asymmetries and breakaway excess stay as configured)
 //    and the report's nominal gives them back in the configuration's terms (drive gain, volt
