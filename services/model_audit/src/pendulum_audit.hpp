@@ -123,7 +123,8 @@ class SwingAudit final : public ChannelAudit {
   [[nodiscard]] Problem problem(const Candidate* candidate) const override;
   [[nodiscard]] const std::vector<double>& correlation_input() const override { return no_input_; }
   [[nodiscard]] double quantum() const override;
-  /// True in a first step (kSwingSecondStepGainFraction: the clean swing residual is its encoders' noise).
+  /// True in a first step: a swing cause alone can miss the floor beside a second one, and the
+  /// clean swing residual is its encoders' noise, no systematic part for a spurious pair to take up.
   [[nodiscard]] bool pairs_without_single() const override;
   /// kSwingSecondStepGainFraction in a second step.
   [[nodiscard]] double second_step_gain_fraction() const override;
