@@ -47,13 +47,6 @@ ModelState to_model_state(const PlantState& s, PlantKind kind) {
   return m;
 }
 
-IntegratorSettings integrator_settings(const SimulatorParameters& p) {
-  IntegratorSettings settings;
-  settings.relative_tolerance = p.relative_tolerance;
-  settings.absolute_tolerance = p.absolute_tolerance;
-  return settings;
-}
-
 // Friction and brake of the second drive axis: the slew's (tower), the bridge's (overhead); a gantry
 // has none, its held slot gets a 1 N static friction that nothing ever loads (so it stays stuck).
 AxisFrictionModel second_axis_friction(const SimulatorParameters& p, const CraneDynamics& model) {
@@ -90,10 +83,10 @@ const SimulatorParameters& CraneSimulator::validated(const SimulatorParameters& 
   common::validate(p.crane, "simulator.crane");  // the cable range (the hoist's) included
   if (p.kind == PlantKind::overhead) common::validate(p.bridge, "simulator.bridge");
   common::require_in_range("simulator.sample_period", p.sample_period, 1e-6, 1.0);
-  common::require_greater("simulator.relative_tolerance", p.relative_tolerance, 0.0);
-  common::require_in_range("simulator.relative_tolerance", p.relative_tolerance, 0.0, 1e-2);
-  common::require_greater("simulator.absolute_tolerance", p.absolute_tolerance, 0.0);
-  common::require_in_range("simulator.absolute_tolerance", p.absolute_tolerance, 0.0, 1e-2);
+  common::require_greater("simulator.integrator.relative_tolerance", p.integrator.relative_tolerance, 0.0);
+  common::require_in_range("simulator.integrator.relative_tolerance", p.integrator.relative_tolerance, 0.0, 1e-2);
+  common::require_greater("simulator.integrator.absolute_tolerance", p.integrator.absolute_tolerance, 0.0);
+  common::require_in_range("simulator.integrator.absolute_tolerance", p.integrator.absolute_tolerance, 0.0, 1e-2);
   common::require_in_range("simulator.brake_holding_factor", p.brake_holding_factor, 0.0, 1e6);
   common::require_greater("simulator.hoist_max_acceleration", p.hoist_max_acceleration, 0.0);
   validate(p.hook, "plant.hook.");
@@ -128,7 +121,7 @@ CraneSimulator::CraneSimulator(const SimulatorParameters& parameters)
                                     parameters_.brake_holding_factor *
                                         model_->drive_force_per_volt(DriveAxis::trolley) * parameters_.crane.dac_range,
                                     "simulator.crane.trolley_friction"),
-                  second_axis_friction(parameters_, *model_), integrator_settings(parameters_)),
+                  second_axis_friction(parameters_, *model_), parameters_.integrator),
       wind_(parameters_.wind, parameters_.sample_period) {
   reset(parameters_.initial_state);
 }

@@ -37,8 +37,9 @@ SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts
   p.bridge = facts.bridge;
   p.crane = facts.crane;
   p.sample_period = facts.sample_period;
-  p.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
-  p.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
+  p.integrator.method = parse_integration_method(s.text("integrator"), s.field("integrator"));
+  p.integrator.relative_tolerance = s.number("relative_tolerance", 1e-14, 1e-3);
+  p.integrator.absolute_tolerance = s.number("absolute_tolerance", 1e-16, 1e-3);
   p.brake_holding_factor = s.number("brake_holding_factor", 1.0, 1000.0);
   p.hoist_max_acceleration = s.number("hoist_max_acceleration", 1e-3, 100.0);
   if (p.kind == PlantKind::tower) {  // elsewhere plant.hook, plant.wind and plant.rope are unknown fields
@@ -131,14 +132,14 @@ void PlantStage::remember_measurement() noexcept {
 
 common::StepStatus PlantStage::step(const supervisor::GateInput& input) noexcept {
   gate_.step(input, gate_output_);
-  DriveInput drive;  // default: 0 V, brakes engaged
-  drive.trolley_voltage = gate_output_.drive.trolley_voltage;
-  drive.slew_voltage = gate_output_.drive.slew_voltage;
-  drive.bridge_voltage = gate_output_.drive.bridge_voltage;
-  drive.hoist_speed = gate_output_.drive.hoist_speed;
-  drive.brakes_engaged = gate_output_.brakes_engaged;
+  drive_ = DriveInput{};  // 0 V, brakes engaged, then the gate's output
+  drive_.trolley_voltage = gate_output_.drive.trolley_voltage;
+  drive_.slew_voltage = gate_output_.drive.slew_voltage;
+  drive_.bridge_voltage = gate_output_.drive.bridge_voltage;
+  drive_.hoist_speed = gate_output_.drive.hoist_speed;
+  drive_.brakes_engaged = gate_output_.brakes_engaged;
   if (changed_friction_ && cycle_ == mismatch_.friction_change_cycle) simulator_.set_friction(*changed_friction_);
-  const auto status = simulator_.step(drive);
+  const auto status = simulator_.step(drive_);
   ++cycle_;
   remember_measurement();
   return status;

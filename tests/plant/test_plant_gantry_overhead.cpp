@@ -356,8 +356,8 @@ TEST(OverheadCrane, SmallSwingPeriodsWithBothDrivesFree) {
 TEST(OverheadCrane, SimulatedWithTheBridgeHeldMatchesTheSimulatedGantry) {
   SimulatorParameters gantry_params = frictionless(PlantKind::gantry, 2.0);
   gantry_params.crane.trolley_friction = common::CraneParameters{}.trolley_friction;
-  gantry_params.relative_tolerance = 1e-10;
-  gantry_params.absolute_tolerance = 1e-12;
+  gantry_params.integrator.relative_tolerance = 1e-10;
+  gantry_params.integrator.absolute_tolerance = 1e-12;
   gantry_params.initial_state.cable_length = 2.0;
   SimulatorParameters overhead_params = gantry_params;
   overhead_params.kind = PlantKind::overhead;

@@ -241,8 +241,8 @@ SimulatorParameters frictionless(double relative_tolerance, double absolute_tole
   SimulatorParameters p;
   p.crane.trolley_friction = {};
   p.crane.slew_friction = {};
-  p.relative_tolerance = relative_tolerance;
-  p.absolute_tolerance = absolute_tolerance;
+  p.integrator.relative_tolerance = relative_tolerance;
+  p.integrator.absolute_tolerance = absolute_tolerance;
   p.initial_state.trolley_position = 0.5;
   p.initial_state.trolley_velocity = 0.2;
   p.initial_state.swing_in_plane = 0.3;

@@ -12,7 +12,7 @@
 #include "crane/common/validation.hpp"
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/plant/tower_crane_model.hpp"
-#include "crane/plant/cvode_integrator.hpp"
+#include "crane/plant/hybrid_integrator.hpp"
 
 namespace crane::plant {
 namespace {
@@ -31,8 +31,8 @@ TEST(Configuration, BadParametersThrowNamingTheField) {
   p.sample_period = 0.0;
   expect_config_error(p, "simulator.sample_period");
   p = {};
-  p.relative_tolerance = std::nan("");
-  expect_config_error(p, "simulator.relative_tolerance");
+  p.integrator.relative_tolerance = std::nan("");
+  expect_config_error(p, "simulator.integrator.relative_tolerance");
   p = {};
   p.crane.load_mass = -1.0;
   expect_config_error(p, "simulator.crane.load_mass");
@@ -59,7 +59,7 @@ TEST(Sampling, LandsExactlyOnEverySampleTimeAcrossEvents) {
   common::CraneParameters crane;
   const TowerCraneModel model(crane);
   const double torque_per_volt = crane.jib_inertia * crane.slew_drive_gain;
-  CvodeIntegrator integrator(model,
+  HybridIntegrator integrator(model,
                              AxisFrictionModel(crane.trolley_friction, crane.trolley_drive_mass * crane.trolley_drive_gain, 0.0),
                              AxisFrictionModel(crane.slew_friction, torque_per_volt, 0.0), IntegratorSettings{});
   ModelState s;

@@ -148,6 +148,12 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   options.initial_slew_angle = from.initial_slew_angle;
   options.initial_bridge_position = from.initial_bridge_position;
   InProcessStack stack(cfg, options);
+  InProcessResult result;
+  const auto trace = [&] {
+    if (!run.record_plant) return;
+    result.plant_inputs.push_back(stack.plant().drive_input());
+    result.plant_states.push_back(stack.plant().simulator().state());
+  };
   const auto cycles_needed = static_cast<std::uint64_t>(std::llround(m.duration / dt));
 
   std::uint64_t k = 0;  // cycles stepped
@@ -166,6 +172,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
     const auto first_cycles = static_cast<std::uint64_t>(std::llround(f.duration / dt));
     for (; k <= start_cycle + first_cycles; ++k) {
       stack.step(k == 0 ? std::span(&first, 1) : std::span<const protocol::MoveRequest>());
+      trace();
       for (const auto& outcome : stack.planner().goal_outcomes()) {
         if (outcome.status != trajectory_planner::GoalStatus::accepted) {
           throw std::runtime_error("in-process run: the first move was refused: " +
@@ -183,7 +190,6 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   const std::uint32_t request_id = run.first_move ? run.request_id + 1 : run.request_id;  // the planner takes newer ids
   const protocol::MoveRequest goal = move_request(m, cfg.facts, request_id, run.profile, start_cycle);
 
-  InProcessResult result;
   result.swing_period = swing_period(m, cfg.facts);
   result.records.reserve(static_cast<std::size_t>(cycles_needed + 1));
   bool started = false;
@@ -192,6 +198,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
     // The goal arrives while the crane rests (over DDS: a few cycles after the stack is ready) and
     // waits in the planner for its start cycle.
     stack.step(k == goal_cycle ? std::span(&goal, 1) : std::span<const protocol::MoveRequest>());
+    trace();
     for (const auto& outcome : stack.planner().goal_outcomes()) {
       if (outcome.status != trajectory_planner::GoalStatus::accepted) {
         throw std::runtime_error("in-process run: move request refused at cycle " + std::to_string(k) + ": " +
@@ -216,6 +223,8 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   result.plant_step_failures = stack.plant_step_failures();
   result.friction_events = stack.plant().simulator().friction_event_count();
   result.latched_faults = stack.status().latched_faults;
+  result.integrator_work = stack.plant().simulator().integrator_work();
+  if (run.record_plant) result.plant_parameters = stack.plant().simulator().parameters();
   result.metrics = evaluate(result.records, m);
   return result;
 }

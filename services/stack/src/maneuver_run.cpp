@@ -143,16 +143,30 @@ std::string table_header(bool bridge) {
   return bridge ? std::string(b) + " bridge_err_mm" : std::string(b);
 }
 
+std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& m, double period, bool bridge) {
+  constexpr double kDegrees = 180.0 / std::numbers::pi;
+  std::vector<PrintedFigure> f{
+      {"settle_s", m.settle_time, 2},
+      {"settle_T", m.settle_time / period, 2},
+      {"pos_err_mm", m.final_position_error * 1e3, 2},
+      {"slew_err_mrad", m.final_slew_error * 1e3, 2},
+      {"max_swing_deg", m.max_swing * kDegrees, 2},
+      {"resid_swing_deg", m.residual_swing * kDegrees, 3},
+      {"max_V", m.max_voltage, 2},
+  };
+  if (bridge) f.push_back({"bridge_err_mm", m.final_bridge_error * 1e3, 2});
+  return f;
+}
+
 std::string table_row(const std::string& maneuver, bool friction_compensation, const ManeuverMetrics& m,
                       double period, bool bridge) {
+  const auto f = printed_figures(m, period, bridge);
+  const auto text = [&](std::size_t i) { return format_number(f[i].value, f[i].decimals); };
   char b[256];
   std::snprintf(b, sizeof(b), "%-13s %-9s %9s %7s %10s %11s %10s %12s %8s", maneuver.c_str(),
-                friction_compensation ? "comp_on" : "comp_off", format_number(m.settle_time, 2).c_str(),
-                format_number(m.settle_time / period, 2).c_str(), format_number(m.final_position_error * 1e3, 2).c_str(),
-                format_number(m.final_slew_error * 1e3, 2).c_str(), format_number(m.max_swing * 180 / std::numbers::pi, 2).c_str(),
-                format_number(m.residual_swing * 180 / std::numbers::pi, 3).c_str(), format_number(m.max_voltage, 2).c_str());
-  if (bridge) return std::string(b) + " " + std::string(13 - std::min<std::size_t>(13, format_number(m.final_bridge_error * 1e3, 2).size()), ' ') +
-                     format_number(m.final_bridge_error * 1e3, 2);
+                friction_compensation ? "comp_on" : "comp_off", text(0).c_str(), text(1).c_str(), text(2).c_str(),
+                text(3).c_str(), text(4).c_str(), text(5).c_str(), text(6).c_str());
+  if (bridge) return std::string(b) + " " + std::string(13 - std::min<std::size_t>(13, text(7).size()), ' ') + text(7);
   return b;
 }
 

@@ -13,6 +13,17 @@
 //   crane_sim bench --config FILE [--cases N]
 //       speed figures measured in one run: the demo maneuvers on one core (x real time), and a
 //       sweep of N cases on 1 thread and on every core (the ratio);
+//   crane_sim converge --config FILE [--maneuver M ...] [--reference-integrator M --reference-rtol R]
+//       the convergence study (convergence_study.hpp): every demo run at the configured integrator
+//       and at the reference; each printed figure at both, the integration error (same inputs) and
+//       the closed-loop difference; exit 1 when a printed figure differs by more than half its last
+//       printed digit;
+//   crane_sim integrators --config FILE [--maneuver M ...]
+//       the integrators compared on the demo runs' drive inputs (open loop, the plant alone): for
+//       each method and tolerance the error against the reference, the right-hand sides and the
+//       wall time per simulated second (docs/integration.md);
+//   (demo, sweep, bench, converge and integrators take --integrator M [--rtol R --atol A]: the
+//   plant's integrator instead of the configuration's plant.integrator)
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -31,6 +42,7 @@
 #include <sstream>
 #include <thread>
 
+#include "crane/stack/convergence_study.hpp"
 #include "crane/stack/gantry_gain_study.hpp"
 #include "crane/stack/in_process_stack.hpp"
 
@@ -48,7 +60,26 @@ struct Selection {
   std::vector<std::string> maneuvers;
   std::string compensation{"both"};
   bool acceleration_feedforward{false};
+  std::string integrator;  // empty: the configuration's plant.integrator
+  double rtol{0.0};        // 0: the configuration's
+  double atol{0.0};
 };
+
+// The configuration with the command line's integrator, if any.
+stack::StackConfig load_config(const Selection& s) {
+  auto cfg = stack::load_stack_config(s.config_path);
+  if (!s.integrator.empty()) cfg.plant.integrator.method = plant::parse_integration_method(s.integrator, "--integrator");
+  if (s.rtol > 0.0) cfg.plant.integrator.relative_tolerance = s.rtol;
+  if (s.atol > 0.0) cfg.plant.integrator.absolute_tolerance = s.atol;
+  return cfg;
+}
+
+std::string integrator_label(const plant::IntegratorSettings& i) {
+  char b[128];
+  std::snprintf(b, sizeof(b), "%s rtol %.0e atol %.0e", std::string(plant::integration_method_name(i.method)).c_str(),
+                i.relative_tolerance, i.absolute_tolerance);
+  return b;
+}
 
 std::vector<stack::ManeuverConfig> selected_maneuvers(const stack::StackConfig& cfg, const std::vector<std::string>& names) {
   std::vector<stack::ManeuverConfig> out;
@@ -83,11 +114,11 @@ struct DemoRun {
   stack::InProcessResult result;
 };
 
-std::vector<DemoRun> run_demo(const stack::StackConfig& cfg, const Selection& s, double& wall_seconds) {
+// The demo's runs: every selected maneuver with friction compensation on and off (as selected).
+std::vector<stack::InProcessRun> demo_runs(const stack::StackConfig& cfg, const Selection& s) {
   const std::string controller = default_controller(s);
-  std::vector<DemoRun> runs;
+  std::vector<stack::InProcessRun> runs;
   std::uint32_t request_id = 1;
-  const auto start = Clock::now();
   for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
     for (const bool compensation : {true, false}) {
       if ((compensation && s.compensation == "off") || (!compensation && s.compensation == "on")) continue;
@@ -97,8 +128,17 @@ std::vector<DemoRun> run_demo(const stack::StackConfig& cfg, const Selection& s,
       run.controller = stack::choose_controller(controller, m, s.acceleration_feedforward);
       run.profile = profile_of(controller, s);
       run.request_id = request_id++;
-      runs.push_back({m, compensation, stack::run_in_process(cfg, run)});
+      runs.push_back(run);
     }
+  }
+  return runs;
+}
+
+std::vector<DemoRun> run_demo(const stack::StackConfig& cfg, const Selection& s, double& wall_seconds) {
+  std::vector<DemoRun> runs;
+  const auto start = Clock::now();
+  for (const auto& run : demo_runs(cfg, s)) {
+    runs.push_back({run.maneuver, run.friction_compensation, stack::run_in_process(cfg, run)});
   }
   wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return runs;
@@ -111,7 +151,7 @@ double simulated_seconds(const stack::StackConfig& cfg, const std::vector<DemoRu
 }
 
 int demo(const Selection& s, const std::string& out_dir) {
-  const auto cfg = stack::load_stack_config(s.config_path);
+  const auto cfg = load_config(s);
   double wall = 0.0;
   const auto runs = run_demo(cfg, s, wall);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
@@ -128,8 +168,9 @@ int demo(const Selection& s, const std::string& out_dir) {
                 stack::table_row(r.maneuver.name, r.compensation, r.result.metrics, r.result.swing_period, bridge).c_str());
   }
   const double simulated = simulated_seconds(cfg, runs);
-  std::printf("\nspeed: %.1f s simulated in %.3f s on one core (%.0fx real time), controller %s, %zu runs\n", simulated,
-              wall, simulated / wall, default_controller(s).c_str(), runs.size());
+  std::printf("\nspeed: %.1f s simulated in %.3f s on one core (%.0fx real time), controller %s, %zu runs, plant %s\n",
+              simulated, wall, simulated / wall, default_controller(s).c_str(), runs.size(),
+              integrator_label(cfg.plant.integrator).c_str());
   int failures = 0;
   for (const auto& r : runs) {
     if (r.result.plant_step_failures != 0) {
@@ -268,7 +309,7 @@ unsigned default_jobs() { return std::max(1U, std::thread::hardware_concurrency(
 
 int sweep(const Selection& s, const std::string& controllers_text, int grid, int random, unsigned seed, unsigned jobs,
           const std::string& out_dir, const std::string& plot_script, const std::string& python) {
-  const auto cfg = stack::load_stack_config(s.config_path);
+  const auto cfg = load_config(s);
   const auto maneuvers = selected_maneuvers(cfg, s.maneuvers.empty() ? std::vector<std::string>{"trolley"} : s.maneuvers);
   if (maneuvers.size() != 1) throw std::invalid_argument("sweep: give one --maneuver");
   const auto controllers = split_list(controllers_text);
@@ -321,19 +362,45 @@ int sweep(const Selection& s, const std::string& controllers_text, int grid, int
 // ---------------------------------------------------------------------------------------------
 // bench
 
-int bench(const Selection& s, int cases) {
-  const auto cfg = stack::load_stack_config(s.config_path);
-  // 1. The demo maneuvers, one core, three repetitions: the best (the machine's own noise aside).
+// The integrator the plant had before the measured choice (docs/integration.md): CVODE BDF with a
+// dense difference-quotient Jacobian, rtol 1e-8, atol 1e-10.
+plant::IntegratorSettings former_integrator() {
+  plant::IntegratorSettings former;
+  former.method = plant::IntegrationMethod::bdf;
+  former.relative_tolerance = 1e-8;
+  former.absolute_tolerance = 1e-10;
+  return former;
+}
+
+// [x real time] of the demo maneuvers on one core, the best of `repeats` (the machine's own noise aside).
+double demo_speed(const stack::StackConfig& cfg, const Selection& s, int repeats, double& simulated) {
   double best = 1e300;
-  double simulated = 0.0;
-  for (int repeat = 0; repeat < 3; ++repeat) {
+  for (int repeat = 0; repeat < repeats; ++repeat) {
     double wall = 0.0;
     const auto runs = run_demo(cfg, s, wall);
     simulated = simulated_seconds(cfg, runs);
     best = std::min(best, wall);
   }
-  std::printf("demo maneuvers, one core: %.1f s simulated in %.3f s: %.0fx real time (best of 3)\n", simulated, best,
-              simulated / best);
+  return simulated / best;
+}
+
+int bench(const Selection& s, int cases) {
+  const auto cfg = load_config(s);
+  // 1. The demo maneuvers, one core, with the configured integrator and with the former one, in
+  // turns in the same run.
+  stack::StackConfig former = cfg;
+  former.plant.integrator = former_integrator();
+  double simulated = 0.0;
+  double speed = 0.0, former_speed = 0.0;
+  for (int round = 0; round < 3; ++round) {
+    speed = std::max(speed, demo_speed(cfg, s, 1, simulated));
+    former_speed = std::max(former_speed, demo_speed(former, s, 1, simulated));
+  }
+  std::printf("demo maneuvers, one core: %.1f s simulated: %.0fx real time with the plant's %s (best of 3)\n", simulated,
+              speed, integrator_label(cfg.plant.integrator).c_str());
+  std::printf("demo maneuvers, one core: %.1f s simulated: %.0fx real time with the former %s (best of 3)\n", simulated,
+              former_speed, integrator_label(former.plant.integrator).c_str());
+  std::printf("speed-up over the former integrator: %.2fx\n", speed / former_speed);
   // 2. A sweep on 1 thread and on every core, the same cases.
   const auto maneuvers = selected_maneuvers(cfg, {"trolley"});
   const auto all = sweep_cases({default_controller(s)}, 0, cases, 7);
@@ -349,6 +416,102 @@ int bench(const Selection& s, int cases) {
                 jobs == 1 ? "" : "s", sim, wall, sim / wall);
   }
   std::printf("sweep speed-up on %u cores: %.2fx (ideal %ux)\n", cores, one / many, cores);
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// converge, integrators
+
+std::string figure_text(double value, int decimals) { return stack::format_number(value, decimals); }
+
+int converge(const Selection& s, const plant::IntegratorSettings& reference) {
+  const auto cfg = load_config(s);
+  std::printf("convergence study: %s against the reference %s\n", integrator_label(cfg.plant.integrator).c_str(),
+              integrator_label(reference).c_str());
+  const auto cases = stack::run_convergence_study(cfg, demo_runs(cfg, s), reference);
+  int disagreements = 0;
+  for (const auto& c : cases) {
+    std::printf("\n%s %s  (friction events %ld / %ld; steps %ld, right-hand sides %ld, root functions %ld, restarts %ld)\n",
+                c.maneuver.c_str(), c.friction_compensation ? "comp_on" : "comp_off", c.friction_events,
+                c.reference_friction_events, c.work.steps, c.work.right_hand_sides, c.work.root_evaluations,
+                c.work.restarts);
+    std::printf("  %-16s %12s %12s %12s %s\n", "figure", "settings", "reference", "difference", "agrees");
+    for (const auto& f : c.figures) {
+      const double difference = f.at_settings - f.at_reference;
+      std::printf("  %-16s %12s %12s %12.3g %s\n", f.name.c_str(), figure_text(f.at_settings, f.decimals + 3).c_str(),
+                  figure_text(f.at_reference, f.decimals + 3).c_str(), std::isfinite(difference) ? difference : 0.0,
+                  f.agrees() ? "yes" : "NO");
+      if (!f.agrees()) ++disagreements;
+    }
+    const auto show = [](const char* what, const stack::StateDifference& d) {
+      std::printf("  %-38s position %.2e m, angle %.2e rad, velocity %.2e m/s, rate %.2e rad/s\n", what, d.position,
+                  d.angle, d.velocity, d.angular_rate);
+    };
+    show("integration error (same inputs):", c.integration_error);
+    show("closed-loop difference (stack re-run):", c.closed_loop_difference);
+  }
+  std::printf("\n%zu runs, %d printed figures differ from the reference by more than half their last digit\n",
+              cases.size(), disagreements);
+  return disagreements == 0 ? 0 : 1;
+}
+
+int integrators(const Selection& s) {
+  const auto cfg = load_config(s);
+  // The drive inputs of the demo runs (closed loop at the configured settings), replayed open loop.
+  struct Recorded {
+    plant::SimulatorParameters parameters;
+    std::vector<plant::DriveInput> inputs;
+    std::vector<plant::PlantState> reference;
+  };
+  std::vector<Recorded> recorded;
+  double simulated = 0.0;
+  const auto reference = stack::reference_integrator_settings();
+  for (auto run : demo_runs(cfg, s)) {
+    run.record_plant = true;
+    auto result = stack::run_in_process(cfg, run);
+    Recorded r{result.plant_parameters, std::move(result.plant_inputs), {}};
+    plant::SimulatorParameters p = r.parameters;
+    p.integrator = reference;
+    r.reference = stack::replay_plant(p, r.inputs);
+    simulated += static_cast<double>(r.inputs.size()) * cfg.facts.sample_period;
+    recorded.push_back(std::move(r));
+  }
+  std::printf("the plant alone on the drive inputs of %zu demo runs (%.1f s simulated), against %s\n", recorded.size(),
+              simulated, integrator_label(reference).c_str());
+  std::printf("%-15s %8s %12s %12s %12s %14s %12s %12s\n", "method", "rtol", "max_pos_m", "max_angle_rad", "max_vel",
+              "rhs_per_s", "us_per_s", "x_real_time");
+  for (const auto method : {plant::IntegrationMethod::bdf, plant::IntegrationMethod::adams,
+                            plant::IntegrationMethod::dormand_prince, plant::IntegrationMethod::verner}) {
+    for (const double rtol : {1e-6, 1e-7, 1e-8, 1e-9, 1e-10}) {
+      stack::StateDifference worst;
+      long evaluations = 0;
+      double wall = 0.0;
+      for (const auto& r : recorded) {
+        plant::SimulatorParameters p = r.parameters;
+        p.integrator.method = method;
+        p.integrator.relative_tolerance = rtol;
+        p.integrator.absolute_tolerance = rtol * 1e-2;
+        plant::CraneSimulator simulator(p);
+        std::vector<plant::PlantState> states;
+        states.reserve(r.inputs.size());
+        const auto start = Clock::now();
+        for (const auto& input : r.inputs) {
+          (void)simulator.step(input);
+          states.push_back(simulator.state());
+        }
+        wall += std::chrono::duration<double>(Clock::now() - start).count();
+        const auto work = simulator.integrator_work();
+        evaluations += work.right_hand_sides + work.root_evaluations;
+        const auto d = stack::max_state_difference(states, r.reference);
+        worst.position = std::max(worst.position, d.position);
+        worst.angle = std::max(worst.angle, d.angle);
+        worst.velocity = std::max({worst.velocity, d.velocity, d.angular_rate});
+      }
+      std::printf("%-15s %8.0e %12.2e %12.2e %12.2e %14.0f %12.1f %12.0f\n",
+                  std::string(plant::integration_method_name(method)).c_str(), rtol, worst.position, worst.angle,
+                  worst.velocity, static_cast<double>(evaluations) / simulated, wall / simulated * 1e6, simulated / wall);
+    }
+  }
   return 0;
 }
 
@@ -387,6 +550,10 @@ int main(int argc, char** argv) {
     cmd->add_option("--maneuver", s.maneuvers, "maneuver names (default: all; sweep: trolley)");
     cmd->add_flag("--acceleration-feedforward", s.acceleration_feedforward,
                   "tracking adds the reference acceleration (beyond the dissertation)");
+    cmd->add_option("--integrator", s.integrator,
+                    "the plant's integrator: dormand_prince | verner | adams | bdf (default: the config's)");
+    cmd->add_option("--rtol", s.rtol, "the plant's relative tolerance (default: the config's)")->check(CLI::Range(1e-14, 1e-3));
+    cmd->add_option("--atol", s.atol, "the plant's absolute tolerance (default: the config's)")->check(CLI::Range(1e-16, 1e-3));
   };
   auto* demo_cmd = app.add_subcommand("demo", "the demo maneuvers: crane_demo's table and CSV files, in one process");
   common_options(demo_cmd);
@@ -419,6 +586,18 @@ int main(int argc, char** argv) {
   int cases = 40;
   bench_cmd->add_option("--cases", cases, "sweep cases of the scaling figure")->check(CLI::Range(1, 100000));
 
+  auto* converge_cmd = app.add_subcommand("converge", "the convergence study: the demo runs at the plant's settings and at a reference");
+  common_options(converge_cmd);
+  auto reference = stack::reference_integrator_settings();
+  std::string reference_method{plant::integration_method_name(reference.method)};
+  converge_cmd->add_option("--reference-integrator", reference_method, "the reference's method (default bdf)");
+  converge_cmd->add_option("--reference-rtol", reference.relative_tolerance, "the reference's rtol (default 1e-12)")
+      ->check(CLI::Range(1e-14, 1e-3));
+  converge_cmd->add_option("--reference-atol", reference.absolute_tolerance, "the reference's atol (default 1e-14)")
+      ->check(CLI::Range(1e-16, 1e-3));
+  auto* integrators_cmd = app.add_subcommand("integrators", "the integrators compared on the demo runs' inputs (the plant alone)");
+  common_options(integrators_cmd);
+
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
   gantry_cmd->add_option("--K", full_forward_gain, "forward gain K [V/m] of the full-state law (Figure 3.8), > 0")
@@ -432,6 +611,11 @@ int main(int argc, char** argv) {
       return sweep(s, controllers, grid, random, seed, jobs, out_dir, plot_script, python);
     }
     if (*bench_cmd) return bench(s, cases);
+    if (*converge_cmd) {
+      reference.method = plant::parse_integration_method(reference_method, "--reference-integrator");
+      return converge(s, reference);
+    }
+    if (*integrators_cmd) return integrators(s);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

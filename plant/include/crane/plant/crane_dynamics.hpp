@@ -1,6 +1,6 @@
 #pragma once
 // The rigid-body model interface the plant integrates: one per crane kind (tower, gantry, overhead),
-// all in the same four-slot coordinate layout so that one integrator (cvode_integrator.hpp), one
+// all in the same four-slot coordinate layout so that one integrator (hybrid_integrator.hpp), one
 // friction model per drive axis (axis_friction.hpp) and one drives-and-sensors model serve them all.
 //
 // Coordinates q (SI), by slot:

@@ -8,7 +8,7 @@
 //        (2.27) on a tower crane, F_y = M_y K_my V_y on an overhead crane's bridge, none on a gantry
 //     -> the crane's model (crane_dynamics.hpp: TowerCraneModel (2.11)-(2.16), GantryCraneModel
 //        (2.5)-(2.6), OverheadCraneModel) with stick-slip friction (3.1)-(3.3) and brakes
-//        (axis_friction.hpp), integrated by CVODE with event location (cvode_integrator.hpp)
+//        (axis_friction.hpp), integrated by CVODE with event location (hybrid_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
 // Options of the tower crane, each off by default (beyond the dissertation): the hook as a double
 // pendulum (HookParameters, tower_crane_model.hpp), wind on the load (WindParameters, wind.hpp) and
@@ -21,7 +21,7 @@
 #include "crane/common/crane_parameters.hpp"
 #include "crane/common/crane_signals.hpp"
 #include "crane/plant/axis_friction.hpp"
-#include "crane/plant/cvode_integrator.hpp"
+#include "crane/plant/hybrid_integrator.hpp"
 #include "crane/plant/drives_and_sensors.hpp"
 #include "crane/plant/crane_dynamics.hpp"
 #include "crane/plant/tower_crane_model.hpp"
@@ -74,8 +74,7 @@ struct SimulatorParameters {
   common::CraneParameters crane{};
   common::BridgeParameters bridge{};   // overhead crane only
   double sample_period{0.01};          // [s] in (0, 1]
-  double relative_tolerance{1e-8};     // [-] CVODE rtol in (0, 1e-2]
-  double absolute_tolerance{1e-10};    // [SI] CVODE atol in (0, 1e-2]
+  IntegratorSettings integrator{};     // method; rtol and atol [-] in (0, 1e-2] (hybrid_integrator.hpp)
   double brake_holding_factor{20.0};   // [-] brake holding force / drive force at full DAC range, >= 0
   double hoist_max_acceleration{0.5};  // [m/s^2] > 0
   HookParameters hook{};               // tower crane only: the hook as a double pendulum (off by default)
@@ -128,6 +127,8 @@ class CraneSimulator {
 
   [[nodiscard]] long friction_event_count() const noexcept { return integrator_.friction_event_count(); }
   [[nodiscard]] long integrator_failure_count() const noexcept { return integrator_.solver_failure_count(); }
+  /// The integrator's work since construction (steps, right-hand sides, restarts).
+  [[nodiscard]] IntegratorWork integrator_work() const noexcept { return integrator_.work(); }
   [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return integrator_.last_friction_event(); }
   [[nodiscard]] AxisMode axis_mode(FrictionAxis axis) const noexcept { return integrator_.mode(axis); }
 
@@ -148,7 +149,7 @@ class CraneSimulator {
   SimulatorParameters parameters_;
   std::unique_ptr<const CraneDynamics> model_;
   DrivesAndSensors sensors_;
-  CvodeIntegrator integrator_;
+  HybridIntegrator integrator_;
   WindForce wind_;
   PlantState state_{};
   std::int64_t sample_index_{0};

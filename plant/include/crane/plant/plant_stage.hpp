@@ -47,7 +47,8 @@ struct PlantStageParams {
   PlantMismatch mismatch{};
 };
 
-/// Reads the `plant:` block (relative_tolerance, absolute_tolerance [-] in [1e-16, 1e-3],
+/// Reads the `plant:` block (integrator: a method name of hybrid_integrator.hpp; relative_tolerance
+/// [-] in [1e-14, 1e-3], absolute_tolerance [-] in [1e-16, 1e-3],
 /// brake_holding_factor [-] in [1, 1000], hoist_max_acceleration [m/s^2] in [1e-3, 100]); the
 /// crane, its kind (crane.kind) and bridge (crane.bridge), sample period from facts; the initial state at rest with the crane's cable length. The
 /// gate's params are read from `actuation:` by supervisor::read_actuation_params. Throws
@@ -71,6 +72,8 @@ class PlantStage {
 
   [[nodiscard]] std::uint64_t cycle() const noexcept { return cycle_; }
   [[nodiscard]] const supervisor::GateOutput& gate_output() const noexcept { return gate_output_; }
+  /// What the simulator held over the last cycle (the gate's output as drive input).
+  [[nodiscard]] const DriveInput& drive_input() const noexcept { return drive_; }
   [[nodiscard]] const supervisor::ActuationGate& gate() const noexcept { return gate_; }
   [[nodiscard]] const CraneSimulator& simulator() const noexcept { return simulator_; }
   [[nodiscard]] const PlantMismatch& mismatch() const noexcept { return mismatch_; }
@@ -82,6 +85,7 @@ class PlantStage {
   CraneSimulator simulator_;
   supervisor::ActuationGate gate_;
   supervisor::GateOutput gate_output_{};
+  DriveInput drive_{};
   double cable_length_reading_factor_{1.0};
   std::uint64_t cycle_{0};
   std::array<common::CraneMeasurement, kMaxSensorDelay + 1> measurements_{};  // ring, by cycle

@@ -87,6 +87,9 @@ struct InProcessRun {
   // the online estimate has learnt from (docs/architecture.md, "Online estimation"). Neither may
   // hoist. std::invalid_argument otherwise.
   std::optional<ManeuverConfig> first_move;
+  // Keep the plant's drive input and true state of every cycle (InProcessResult::plant_inputs,
+  // plant_states): the convergence study's replay (convergence_study.hpp).
+  bool record_plant{false};
 };
 
 struct InProcessResult {
@@ -98,6 +101,13 @@ struct InProcessResult {
   std::uint64_t plant_step_failures{0};
   long friction_events{0};
   std::uint32_t latched_faults{0};   // the supervisor's at the end
+  plant::IntegratorWork integrator_work;  // the plant's integrator over the whole run
+  // With InProcessRun::record_plant, from cycle 0 (rest and a first move included): the input the
+  // plant held over cycle k (after the actuation gate) and its true state at the end of it, and
+  // the plant's parameters (the mismatch applied; its initial state is the state before cycle 0).
+  std::vector<plant::DriveInput> plant_inputs;
+  std::vector<plant::PlantState> plant_states;
+  plant::SimulatorParameters plant_parameters;
 };
 
 /// Runs `run` on `config`. Throws std::runtime_error naming the cycle when the goal is refused or

@@ -76,8 +76,22 @@ void write_csv(std::ostream& out, const std::vector<CycleRecord>& records, bool 
 /// The figures of merit of the recorded move (throws std::invalid_argument when empty).
 [[nodiscard]] ManeuverMetrics evaluate(const std::vector<CycleRecord>& records, const ManeuverConfig& maneuver);
 
+/// One printed figure of a table row: its column, value in the printed unit (NaN: never reached)
+/// and decimals. The decimals are those the convergence study justifies (docs/integration.md):
+/// the plant's numerical error at the configured integrator settings stays below half a unit of
+/// the last one on every demo maneuver (tests/integration ConvergenceStudy.*).
+struct PrintedFigure {
+  const char* name;
+  double value;
+  int decimals;
+};
+/// The row's figures in the table's order (settle_s, settle_T, pos_err_mm, slew_err_mrad,
+/// max_swing_deg, resid_swing_deg, max_V[, bridge_err_mm]).
+[[nodiscard]] std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& metrics, double swing_period,
+                                                         bool bridge = false);
+
 /// The table (README, crane_demo, crane_sim): header line and one row per run, numbers rounded as
-/// printed ("-" for a settle time never reached).
+/// printed ("-" for a settle time never reached): printed_figures.
 /// `bridge` (an overhead crane): a column bridge_err_mm follows.
 [[nodiscard]] std::string table_header(bool bridge = false);
 [[nodiscard]] std::string table_row(const std::string& maneuver, bool friction_compensation,

@@ -1,14 +1,16 @@
-#include "crane/plant/cvode_integrator.hpp"
+#include "crane/plant/hybrid_integrator.hpp"
 
 #include <Eigen/LU>
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
 
+#include <arkode/arkode_erkstep.h>
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include "crane/common/validation.hpp"
 
@@ -20,6 +22,10 @@ namespace {
 // then L and L_dot (cable_length_index(), cable_length_rate_index()).
 constexpr int kPositionOffset = 0;
 
+// solver_evolve()'s outcomes besides a failure (< 0).
+constexpr int kReachedEnd = 0;
+constexpr int kRootFound = 2;
+
 // Generalized coordinate of each friction axis.
 constexpr std::array<int, kNumFrictionAxes> kAxisCoordinate{kTrolleyIndex, kSlewIndex};
 
@@ -30,12 +36,40 @@ AxisMode slipping(int direction) {
 }
 
 void check(int flag, const char* what) {
-  if (flag != CV_SUCCESS) throw std::runtime_error(std::string("CvodeIntegrator: ") + what + " failed");
+  // CV_SUCCESS and ARK_SUCCESS are both 0.
+  if (flag != 0) throw std::runtime_error(std::string("HybridIntegrator: ") + what + " failed");
+}
+
+constexpr std::array<std::pair<IntegrationMethod, std::string_view>, 4> kMethodNames{{
+    {IntegrationMethod::dormand_prince, "dormand_prince"},
+    {IntegrationMethod::verner, "verner"},
+    {IntegrationMethod::adams, "adams"},
+    {IntegrationMethod::bdf, "bdf"},
+}};
+
+ARKODE_ERKTableID butcher_table(IntegrationMethod method) {
+  return method == IntegrationMethod::verner ? ARKODE_VERNER_8_5_6 : ARKODE_DORMAND_PRINCE_7_4_5;
 }
 
 }  // namespace
 
-CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
+std::string_view integration_method_name(IntegrationMethod method) noexcept {
+  for (const auto& [m, name] : kMethodNames) {
+    if (m == method) return name;
+  }
+  return "unknown";
+}
+
+IntegrationMethod parse_integration_method(std::string_view name, std::string_view field) {
+  std::string allowed;
+  for (const auto& [m, n] : kMethodNames) {
+    if (n == name) return m;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(n);
+  }
+  throw common::ConfigError(std::string(field) + " = '" + std::string(name) + "' is not one of " + allowed);
+}
+
+HybridIntegrator::HybridIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
                                  const AxisFrictionModel& slew_friction, const IntegratorSettings& settings)
     : model_(model.clone()),
       coordinates_(model_->coordinate_count()),
@@ -50,26 +84,48 @@ CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionM
 
   y_ = N_VNew_Serial(state_size_, context_);
   y_saved_ = N_VNew_Serial(state_size_, context_);
-  jacobian_ = SUNDenseMatrix(state_size_, state_size_, context_);
-  cvode_memory_ = CVodeCreate(CV_BDF, context_);
-  if (y_ == nullptr || y_saved_ == nullptr || jacobian_ == nullptr || cvode_memory_ == nullptr) {
+  if (y_ == nullptr || y_saved_ == nullptr) {
     release();
-    throw std::runtime_error("CvodeIntegrator: SUNDIALS allocation failed");
+    throw std::runtime_error("HybridIntegrator: SUNDIALS allocation failed");
   }
   N_VConst(0.0, y_);
   NV_Ith_S(y_, cable_length_index()) = model_->parameters().cable_length;
-  linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);
   try {
-    if (linear_solver_ == nullptr) throw std::runtime_error("CvodeIntegrator: SUNLinSol_Dense failed");
-    check(CVodeSetErrHandlerFn(cvode_memory_, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
-    check(CVodeInit(cvode_memory_, &CvodeIntegrator::right_hand_side, 0.0, y_), "CVodeInit");
-    check(CVodeSStolerances(cvode_memory_, settings.relative_tolerance, settings.absolute_tolerance),
-          "CVodeSStolerances");
-    check(CVodeSetUserData(cvode_memory_, this), "CVodeSetUserData");
-    check(CVodeSetLinearSolver(cvode_memory_, linear_solver_, jacobian_), "CVodeSetLinearSolver");
-    check(CVodeRootInit(cvode_memory_, kNumFrictionAxes, &CvodeIntegrator::root_functions), "CVodeRootInit");
-    check(CVodeSetNoInactiveRootWarn(cvode_memory_), "CVodeSetNoInactiveRootWarn");
-    check(CVodeSetMaxNumSteps(cvode_memory_, settings.max_steps_per_advance), "CVodeSetMaxNumSteps");
+    if (explicit_runge_kutta()) {
+      arkode_memory_ = ERKStepCreate(&HybridIntegrator::right_hand_side, 0.0, y_, context_);
+      if (arkode_memory_ == nullptr) throw std::runtime_error("HybridIntegrator: ERKStepCreate failed");
+      check(ERKStepSetErrHandlerFn(arkode_memory_, silent_error_handler, nullptr), "ERKStepSetErrHandlerFn");
+      check(ERKStepSetTableNum(arkode_memory_, butcher_table(settings.method)), "ERKStepSetTableNum");
+      check(ERKStepSStolerances(arkode_memory_, settings.relative_tolerance, settings.absolute_tolerance),
+            "ERKStepSStolerances");
+      check(ERKStepSetUserData(arkode_memory_, this), "ERKStepSetUserData");
+      check(ERKStepRootInit(arkode_memory_, kNumFrictionAxes, &HybridIntegrator::root_functions), "ERKStepRootInit");
+      check(ERKStepSetNoInactiveRootWarn(arkode_memory_), "ERKStepSetNoInactiveRootWarn");
+      check(ERKStepSetMaxNumSteps(arkode_memory_, settings.max_steps_per_advance), "ERKStepSetMaxNumSteps");
+    } else {
+      const bool bdf = settings.method == IntegrationMethod::bdf;
+      cvode_memory_ = CVodeCreate(bdf ? CV_BDF : CV_ADAMS, context_);
+      if (cvode_memory_ == nullptr) throw std::runtime_error("HybridIntegrator: CVodeCreate failed");
+      check(CVodeSetErrHandlerFn(cvode_memory_, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
+      check(CVodeInit(cvode_memory_, &HybridIntegrator::right_hand_side, 0.0, y_), "CVodeInit");
+      check(CVodeSStolerances(cvode_memory_, settings.relative_tolerance, settings.absolute_tolerance),
+            "CVodeSStolerances");
+      check(CVodeSetUserData(cvode_memory_, this), "CVodeSetUserData");
+      if (bdf) {
+        jacobian_ = SUNDenseMatrix(state_size_, state_size_, context_);
+        if (jacobian_ == nullptr) throw std::runtime_error("HybridIntegrator: SUNDenseMatrix failed");
+        linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);
+        if (linear_solver_ == nullptr) throw std::runtime_error("HybridIntegrator: SUNLinSol_Dense failed");
+        check(CVodeSetLinearSolver(cvode_memory_, linear_solver_, jacobian_), "CVodeSetLinearSolver");
+      } else {
+        nonlinear_solver_ = SUNNonlinSol_FixedPoint(y_, 0, context_);
+        if (nonlinear_solver_ == nullptr) throw std::runtime_error("HybridIntegrator: SUNNonlinSol_FixedPoint failed");
+        check(CVodeSetNonlinearSolver(cvode_memory_, nonlinear_solver_), "CVodeSetNonlinearSolver");
+      }
+      check(CVodeRootInit(cvode_memory_, kNumFrictionAxes, &HybridIntegrator::root_functions), "CVodeRootInit");
+      check(CVodeSetNoInactiveRootWarn(cvode_memory_), "CVodeSetNoInactiveRootWarn");
+      check(CVodeSetMaxNumSteps(cvode_memory_, settings.max_steps_per_advance), "CVodeSetMaxNumSteps");
+    }
   } catch (...) {
     release();
     throw;
@@ -78,22 +134,26 @@ CvodeIntegrator::CvodeIntegrator(const CraneDynamics& model, const AxisFrictionM
   reset(0.0, rest, model_->parameters().cable_length, 0.0);
 }
 
-CvodeIntegrator::~CvodeIntegrator() { release(); }
+HybridIntegrator::~HybridIntegrator() { release(); }
 
-void CvodeIntegrator::release() noexcept {
+void HybridIntegrator::release() noexcept {
+  if (arkode_memory_ != nullptr) ERKStepFree(&arkode_memory_);
   if (cvode_memory_ != nullptr) CVodeFree(&cvode_memory_);
+  if (nonlinear_solver_ != nullptr) SUNNonlinSolFree(nonlinear_solver_);
   if (linear_solver_ != nullptr) SUNLinSolFree(linear_solver_);
   if (jacobian_ != nullptr) SUNMatDestroy(jacobian_);
   if (y_saved_ != nullptr) N_VDestroy(y_saved_);
   if (y_ != nullptr) N_VDestroy(y_);
+  arkode_memory_ = nullptr;
   cvode_memory_ = nullptr;
+  nonlinear_solver_ = nullptr;
   linear_solver_ = nullptr;
   jacobian_ = nullptr;
   y_saved_ = nullptr;
   y_ = nullptr;
 }
 
-void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
+void HybridIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes, double* y_dot,
                                std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
   if (coordinates_ == kMaxCoordinates) {
     evaluate_with<kMaxCoordinates>(y, modes, y_dot, driving_force);
@@ -107,7 +167,7 @@ void CvodeIntegrator::evaluate(const double* y, const std::array<AxisMode, kNumF
 // N = 4: the model's compute_dynamics (the single pendulum); N = 6 (a hook) and N = 5 (an elastic
 // rope, the first five of the extended rows): compute_extended_dynamics. The same arithmetic in all.
 template <int N>
-void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes,
+void HybridIntegrator::evaluate_with(const double* y, const std::array<AxisMode, kNumFrictionAxes>& modes,
                                     double* y_dot, std::array<double, kNumFrictionAxes>& driving_force) const noexcept {
   using Matrix = Eigen::Matrix<double, N, N>;
   using Vector = Eigen::Matrix<double, N, 1>;
@@ -181,8 +241,9 @@ void CvodeIntegrator::evaluate_with(const double* y, const std::array<AxisMode, 
   y_dot[2 * N + 1] = hoist.cable_length_acceleration;
 }
 
-int CvodeIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* user_data) {
-  const auto* self = static_cast<const CvodeIntegrator*>(user_data);
+int HybridIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* user_data) {
+  auto* self = static_cast<HybridIntegrator*>(user_data);
+  ++self->right_hand_side_count_;
   std::array<double, kNumFrictionAxes> driving{};
   self->evaluate(N_VGetArrayPointer(y), self->modes_, N_VGetArrayPointer(y_dot), driving);
   for (int i = 0; i < self->state_size_; ++i) {
@@ -191,8 +252,9 @@ int CvodeIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* u
   return 0;
 }
 
-int CvodeIntegrator::root_functions(double, N_Vector y, double* g, void* user_data) {
-  const auto* self = static_cast<const CvodeIntegrator*>(user_data);
+int HybridIntegrator::root_functions(double, N_Vector y, double* g, void* user_data) {
+  auto* self = static_cast<HybridIntegrator*>(user_data);
+  ++self->root_evaluation_count_;
   const double* values = N_VGetArrayPointer(y);
   std::array<double, kNumFrictionAxes> driving{};
   self->evaluate(values, self->modes_, nullptr, driving);
@@ -206,7 +268,7 @@ int CvodeIntegrator::root_functions(double, N_Vector y, double* g, void* user_da
   return 0;
 }
 
-void CvodeIntegrator::set_mode(int axis, AxisMode mode) noexcept {
+void HybridIntegrator::set_mode(int axis, AxisMode mode) noexcept {
   if (modes_[axis] == mode) return;
   const bool counts_as_event = mode == AxisMode::stuck || modes_[axis] == AxisMode::stuck;
   modes_[axis] = mode;
@@ -215,7 +277,7 @@ void CvodeIntegrator::set_mode(int axis, AxisMode mode) noexcept {
   last_event_ = FrictionEvent{time_, static_cast<FrictionAxis>(axis), mode};
 }
 
-void CvodeIntegrator::settle_modes() noexcept {
+void HybridIntegrator::settle_modes() noexcept {
   double* y = N_VGetArrayPointer(y_);
   // A few passes: a mode change of one axis changes the driving force on the other.
   for (int pass = 0; pass < 2 * kNumFrictionAxes + 1; ++pass) {
@@ -252,7 +314,7 @@ void CvodeIntegrator::settle_modes() noexcept {
   }
 }
 
-void CvodeIntegrator::reset(double time, const ModelState& state, double cable_length,
+void HybridIntegrator::reset(double time, const ModelState& state, double cable_length,
                             double cable_length_rate) noexcept {
   ExtendedState extended;
   extended.position.head<kNumCoordinates>() = state.position;
@@ -260,7 +322,7 @@ void CvodeIntegrator::reset(double time, const ModelState& state, double cable_l
   reset(time, extended, cable_length, cable_length_rate);
 }
 
-void CvodeIntegrator::reset(double time, const ExtendedState& state, double cable_length,
+void HybridIntegrator::reset(double time, const ExtendedState& state, double cable_length,
                             double cable_length_rate) noexcept {
   time_ = time;
   double* y = N_VGetArrayPointer(y_);
@@ -281,7 +343,7 @@ void CvodeIntegrator::reset(double time, const ExtendedState& state, double cabl
   needs_reinit_ = true;
 }
 
-void CvodeIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
+void HybridIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
                                    const AxisFrictionModel& slew_friction) noexcept {
   trolley_friction_ = trolley_friction;
   slew_friction_ = slew_friction;
@@ -293,7 +355,7 @@ void CvodeIntegrator::set_friction(const AxisFrictionModel& trolley_friction,
   needs_reinit_ = true;
 }
 
-IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput& input) noexcept {
+IntegrationStatus HybridIntegrator::advance_to(double end_time, const SampleInput& input) noexcept {
   if (!std::isfinite(end_time) || !(end_time > time_) || !std::isfinite(input.trolley_drive_force) ||
       !std::isfinite(input.slew_drive_torque) || !std::isfinite(input.cable_length_acceleration) ||
       !std::isfinite(input.load_force_x) || !std::isfinite(input.load_force_y)) {
@@ -319,22 +381,18 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
   int events = 0;
   while (time_ < end_time) {
     if (needs_reinit_) {
-      if (CVodeReInit(cvode_memory_, time_, y_) != CV_SUCCESS) {
+      if (!solver_restart()) {
         status = IntegrationStatus::solver_failure;
         break;
       }
       needs_reinit_ = false;
     }
-    if (CVodeSetStopTime(cvode_memory_, end_time) != CV_SUCCESS) {
-      status = IntegrationStatus::solver_failure;
-      break;
-    }
     double reached = time_;
-    const int flag = CVode(cvode_memory_, end_time, y_, &reached, CV_NORMAL);
-    if (flag == CV_ROOT_RETURN) {
+    const int flag = solver_evolve(end_time, reached);
+    if (flag == kRootFound) {
       time_ = reached;
       int found[kNumFrictionAxes] = {0, 0};
-      CVodeGetRootInfo(cvode_memory_, found);
+      solver_root_info(found);
       double* y = N_VGetArrayPointer(y_);
       std::array<double, kNumFrictionAxes> driving{};
       evaluate(y, modes_, nullptr, driving);
@@ -358,7 +416,7 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
       }
       continue;
     }
-    if (flag == CV_TSTOP_RETURN || flag == CV_SUCCESS) {
+    if (flag == kReachedEnd) {
       time_ = end_time;
       break;
     }
@@ -375,7 +433,74 @@ IntegrationStatus CvodeIntegrator::advance_to(double end_time, const SampleInput
   return status;
 }
 
-ExtendedState CvodeIntegrator::extended_state() const noexcept {
+bool HybridIntegrator::solver_restart() noexcept {
+  bank_counters();
+  ++banked_work_.restarts;
+  if (arkode_memory_ != nullptr) {
+    // A one-step method keeps nothing across a restart but its step size: start where it was (the
+    // first restart estimates one).
+    double step = 0.0;
+    if (banked_work_.restarts > 1 && ERKStepGetCurrentStep(arkode_memory_, &step) != ARK_SUCCESS) step = 0.0;
+    if (ERKStepReInit(arkode_memory_, &HybridIntegrator::right_hand_side, time_, y_) != ARK_SUCCESS) return false;
+    return ERKStepSetInitStep(arkode_memory_, std::isfinite(step) ? std::abs(step) : 0.0) == ARK_SUCCESS;
+  }
+  return CVodeReInit(cvode_memory_, time_, y_) == CV_SUCCESS;
+}
+
+int HybridIntegrator::solver_evolve(double end_time, double& reached) noexcept {
+  if (arkode_memory_ != nullptr) {
+    if (ERKStepSetStopTime(arkode_memory_, end_time) != ARK_SUCCESS) return -1;
+    const int flag = ERKStepEvolve(arkode_memory_, end_time, y_, &reached, ARK_NORMAL);
+    if (flag == ARK_ROOT_RETURN) return kRootFound;
+    if (flag == ARK_TSTOP_RETURN || flag == ARK_SUCCESS) return kReachedEnd;
+    return flag < 0 ? flag : -1;
+  }
+  if (CVodeSetStopTime(cvode_memory_, end_time) != CV_SUCCESS) return -1;
+  const int flag = CVode(cvode_memory_, end_time, y_, &reached, CV_NORMAL);
+  if (flag == CV_ROOT_RETURN) return kRootFound;
+  if (flag == CV_TSTOP_RETURN || flag == CV_SUCCESS) return kReachedEnd;
+  return flag < 0 ? flag : -1;
+}
+
+void HybridIntegrator::solver_root_info(int* found) noexcept {
+  if (arkode_memory_ != nullptr) {
+    ERKStepGetRootInfo(arkode_memory_, found);
+  } else {
+    CVodeGetRootInfo(cvode_memory_, found);
+  }
+}
+
+IntegratorWork HybridIntegrator::solver_counters() const noexcept {
+  IntegratorWork run;
+  if (arkode_memory_ != nullptr) {
+    if (ERKStepGetNumSteps(arkode_memory_, &run.steps) != ARK_SUCCESS) run.steps = 0;
+  } else {
+    if (CVodeGetNumSteps(cvode_memory_, &run.steps) != CV_SUCCESS) run.steps = 0;
+    if (linear_solver_ != nullptr && CVodeGetNumLinSolvSetups(cvode_memory_, &run.jacobian_setups) != CV_SUCCESS) {
+      run.jacobian_setups = 0;
+    }
+  }
+  return run;
+}
+
+void HybridIntegrator::bank_counters() noexcept {
+  // Both solvers zero their counters at a re-initialisation: add them up before it.
+  const IntegratorWork run = solver_counters();
+  banked_work_.steps += run.steps;
+  banked_work_.jacobian_setups += run.jacobian_setups;
+}
+
+IntegratorWork HybridIntegrator::work() const noexcept {
+  const IntegratorWork run = solver_counters();
+  IntegratorWork w = banked_work_;
+  w.steps += run.steps;
+  w.jacobian_setups += run.jacobian_setups;
+  w.right_hand_sides = right_hand_side_count_;
+  w.root_evaluations = root_evaluation_count_;
+  return w;
+}
+
+ExtendedState HybridIntegrator::extended_state() const noexcept {
   const double* y = N_VGetArrayPointer(y_);
   ExtendedState state;
   for (int j = 0; j < coordinates_; ++j) {
@@ -388,7 +513,7 @@ ExtendedState CvodeIntegrator::extended_state() const noexcept {
   return state;
 }
 
-ModelState CvodeIntegrator::state() const noexcept {
+ModelState HybridIntegrator::state() const noexcept {
   const double* y = N_VGetArrayPointer(y_);
   ModelState state;
   for (int j = 0; j < kNumCoordinates; ++j) {
@@ -401,11 +526,11 @@ ModelState CvodeIntegrator::state() const noexcept {
   return state;
 }
 
-double CvodeIntegrator::cable_length() const noexcept { return NV_Ith_S(y_, cable_length_index()); }
+double HybridIntegrator::cable_length() const noexcept { return NV_Ith_S(y_, cable_length_index()); }
 
-double CvodeIntegrator::cable_length_rate() const noexcept { return NV_Ith_S(y_, cable_length_rate_index()); }
+double HybridIntegrator::cable_length_rate() const noexcept { return NV_Ith_S(y_, cable_length_rate_index()); }
 
-double CvodeIntegrator::holding_force(FrictionAxis axis) const noexcept {
+double HybridIntegrator::holding_force(FrictionAxis axis) const noexcept {
   const int a = index(axis);
   if (modes_[a] != AxisMode::stuck) return 0.0;
   std::array<double, kNumFrictionAxes> driving{};

@@ -1,6 +1,12 @@
 #pragma once
-// Hybrid integrator of a crane (any CraneDynamics: tower, gantry, overhead) with stick-slip friction: a RAII wrapper around SUNDIALS 6.4
-// CVODE (BDF, dense SUNMatrix + dense SUNLinearSolver, Jacobian by CVODE's difference quotients).
+// Hybrid integrator of a crane (any CraneDynamics: tower, gantry, overhead) with stick-slip friction: a RAII wrapper around one
+// SUNDIALS 6.4 solver, chosen by IntegratorSettings::method (plant.integrator in the config):
+//   dormand_prince  ARKODE ERKStep, Dormand-Prince 5(4) (ARKODE_DORMAND_PRINCE_7_4_5), the default;
+//   verner          ARKODE ERKStep, Verner 6(5) (ARKODE_VERNER_8_5_6);
+//   adams           CVODE Adams-Moulton (orders 1-12) with fixed-point iteration;
+//   bdf             CVODE BDF (orders 1-5), Newton with a dense SUNMatrix + dense SUNLinearSolver and
+//                   CVODE's difference-quotient Jacobian.
+// The choice and its figures: docs/integration.md (the convergence study and the comparison).
 //
 // State y (10, or 14 for a model with a hook): q = (x, phi, second axis, theta[, phi2, theta2]),
 // q_dot, L, L_dot. Model: a CraneDynamics
@@ -18,19 +24,24 @@
 //                   coordinates move under the reduced equations and the friction force that holds
 //                   the axis follows from the eliminated row. Root function is the stick margin
 //                   (holding limit minus driving force); at its zero crossing the axis breaks away.
-// Events are located by CVodeRootInit root finding, then the mode switches and CVODE is
-// re-initialised (CVodeReInit) at the event time. A changed input (ZOH step) also re-initialises.
+// Events are located by the solver's root finding (CVodeRootInit, ERKStepRootInit), then the mode
+// switches and the solver restarts at the event time. A changed input (a ZOH step at a sample
+// boundary) also restarts it: no step ever integrates across a discontinuity of the right-hand
+// side. An explicit Runge-Kutta restart keeps the step size the solver had reached (one-step
+// methods carry no other history); a multistep (CVODE) restart begins again at order 1.
 //
-// Every advance lands exactly on the requested end time (CV_NORMAL with CVodeSetStopTime).
+// Every advance lands exactly on the requested end time (a stop time at the end of each advance).
 // advance_to() is noexcept and allocation-free (all N_Vectors and matrices are created in the
 // constructor); the constructor throws std::runtime_error if SUNDIALS cannot allocate.
 
 #include <array>
 #include <memory>
+#include <string_view>
 
 #include <sundials/sundials_context.hpp>
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
+#include <sundials/sundials_nonlinearsolver.h>
 #include <sundials/sundials_nvector.h>
 
 #include "crane/plant/axis_friction.hpp"
@@ -57,17 +68,38 @@ struct SampleInput {
   bool operator==(const SampleInput&) const = default;
 };
 
+/// The solver of IntegratorSettings::method (the header's comment lists what each is).
+enum class IntegrationMethod : int { dormand_prince, verner, adams, bdf };
+
+/// The config's name of `method` ("dormand_prince", "verner", "adams", "bdf").
+[[nodiscard]] std::string_view integration_method_name(IntegrationMethod method) noexcept;
+/// The method named `name`; throws common::ConfigError naming `field`, the value and the names allowed.
+[[nodiscard]] IntegrationMethod parse_integration_method(std::string_view name, std::string_view field);
+
 struct IntegratorSettings {
-  double relative_tolerance{1e-8};   // [-] CVODE rtol, > 0
-  double absolute_tolerance{1e-10};  // [SI of each state] CVODE atol, > 0
-  long max_steps_per_advance{100000};  // CVODE mxstep
+  // The default: measured (docs/integration.md): every printed figure of every demo maneuver of
+  // the three crane kinds agrees with the reference, at 2300x real time for the in-process demo.
+  IntegrationMethod method{IntegrationMethod::dormand_prince};
+  double relative_tolerance{1e-9};   // [-] rtol, > 0
+  double absolute_tolerance{1e-11};  // [SI of each state] atol, > 0
+  long max_steps_per_advance{100000};  // the solver's mxstep
   int max_events_per_advance{1000};    // friction events per advance before giving up
+};
+
+/// Work done by the solver since construction (each restart included).
+struct IntegratorWork {
+  long steps{0};                 // accepted steps
+  long right_hand_sides{0};      // evaluations of the dynamics by the solver (stages, Jacobians by difference
+                                 // quotients); root-function evaluations not included
+  long root_evaluations{0};      // evaluations of the root functions (each evaluates the dynamics once)
+  long restarts{0};              // re-initialisations: input changes and friction events
+  long jacobian_setups{0};       // linear-solver setups (bdf only)
 };
 
 enum class [[nodiscard]] IntegrationStatus {
   ok,
   invalid_request,   // end time not after the current time, or non-finite input
-  solver_failure,    // CVODE failed; the state was restored to the start of the advance
+  solver_failure,    // the solver failed; the state was restored to the start of the advance
   too_many_events,   // event storm; the state was restored to the start of the advance
 };
 
@@ -78,17 +110,17 @@ struct FrictionEvent {
   AxisMode new_mode{AxisMode::stuck};
 };
 
-class CvodeIntegrator {
+class HybridIntegrator {
  public:
   /// Copies the model (CraneDynamics::clone) and frictions. Throws common::ConfigError for invalid settings (field names
   /// prefixed "integrator."), std::runtime_error if SUNDIALS fails to allocate.
-  CvodeIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
-                  const AxisFrictionModel& slew_friction, const IntegratorSettings& settings);
-  ~CvodeIntegrator();
-  CvodeIntegrator(const CvodeIntegrator&) = delete;
-  CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
-  CvodeIntegrator(CvodeIntegrator&&) = delete;
-  CvodeIntegrator& operator=(CvodeIntegrator&&) = delete;
+  HybridIntegrator(const CraneDynamics& model, const AxisFrictionModel& trolley_friction,
+                   const AxisFrictionModel& slew_friction, const IntegratorSettings& settings);
+  ~HybridIntegrator();
+  HybridIntegrator(const HybridIntegrator&) = delete;
+  HybridIntegrator& operator=(const HybridIntegrator&) = delete;
+  HybridIntegrator(HybridIntegrator&&) = delete;
+  HybridIntegrator& operator=(HybridIntegrator&&) = delete;
 
   /// Sets time [s], state and hoist (L [m] > 0, L_dot [m/s]); friction modes are decided from the
   /// state (velocity sign, or stick/breakaway at zero velocity) under the current input.
@@ -122,6 +154,9 @@ class CvodeIntegrator {
   [[nodiscard]] long friction_event_count() const noexcept { return friction_event_count_; }
   [[nodiscard]] long solver_failure_count() const noexcept { return solver_failure_count_; }
   [[nodiscard]] FrictionEvent last_friction_event() const noexcept { return last_event_; }
+  [[nodiscard]] const IntegratorSettings& settings() const noexcept { return settings_; }
+  /// The solver's counters summed over its restarts. noexcept.
+  [[nodiscard]] IntegratorWork work() const noexcept;
 
  private:
   static int index(FrictionAxis axis) noexcept { return static_cast<int>(axis); }
@@ -140,6 +175,14 @@ class CvodeIntegrator {
   int cable_length_rate_index() const noexcept { return 2 * coordinates_ + 1; }
   void settle_modes() noexcept;
   void release() noexcept;
+  bool explicit_runge_kutta() const noexcept { return settings_.method <= IntegrationMethod::verner; }
+  // The solver's part: restart at (time_, y_), integrate toward end_time (returns the SUNDIALS flag,
+  // normalized: 0 reached end_time, 2 a root, < 0 failure), and which roots were found.
+  bool solver_restart() noexcept;
+  int solver_evolve(double end_time, double& reached) noexcept;
+  void solver_root_info(int* found) noexcept;
+  IntegratorWork solver_counters() const noexcept;  // steps and setups of the solver's run since its last restart
+  void bank_counters() noexcept;
   void set_mode(int axis, AxisMode mode) noexcept;
   const AxisFrictionModel& friction(int axis) const noexcept { return axis == 0 ? trolley_friction_ : slew_friction_; }
 
@@ -155,7 +198,12 @@ class CvodeIntegrator {
   N_Vector y_saved_{nullptr};
   SUNMatrix jacobian_{nullptr};
   SUNLinearSolver linear_solver_{nullptr};
-  void* cvode_memory_{nullptr};
+  SUNNonlinearSolver nonlinear_solver_{nullptr};  // adams: fixed-point iteration
+  void* cvode_memory_{nullptr};                   // adams, bdf
+  void* arkode_memory_{nullptr};                  // the explicit Runge-Kutta methods
+  IntegratorWork banked_work_{};                  // counters of the solver's runs before its last restart
+  long right_hand_side_count_{0};
+  long root_evaluation_count_{0};
 
   double time_{0.0};
   SampleInput input_{};
