@@ -31,8 +31,10 @@
 // methods carry no other history); a multistep (CVODE) restart begins again at order 1.
 //
 // Every advance lands exactly on the requested end time (a stop time at the end of each advance).
-// advance_to() is noexcept and allocation-free (all N_Vectors and matrices are created in the
-// constructor); the constructor throws std::runtime_error if SUNDIALS cannot allocate.
+// advance_to() is noexcept and, with every method but bdf, allocation-free (all N_Vectors and
+// matrices are created in the constructor; tests/plant/test_plant_allocation.cpp counts). bdf
+// allocates at each linear-solver setup (CVODE's difference-quotient Jacobian clones a vector
+// header). The constructor throws std::runtime_error if SUNDIALS cannot allocate.
 
 #include <array>
 #include <memory>
