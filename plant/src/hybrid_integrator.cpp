@@ -18,7 +18,7 @@ namespace crane::plant {
 
 namespace {
 
-// Layout of the CVODE state vector: positions from 0, velocities from coordinates_ (velocity_offset()),
+// Layout of the state vector: positions from 0, velocities from coordinates_ (velocity_offset()),
 // then L and L_dot (cable_length_index(), cable_length_rate_index()).
 constexpr int kPositionOffset = 0;
 
@@ -247,7 +247,7 @@ int HybridIntegrator::right_hand_side(double, N_Vector y, N_Vector y_dot, void* 
   std::array<double, kNumFrictionAxes> driving{};
   self->evaluate(N_VGetArrayPointer(y), self->modes_, N_VGetArrayPointer(y_dot), driving);
   for (int i = 0; i < self->state_size_; ++i) {
-    if (!std::isfinite(NV_Ith_S(y_dot, i))) return 1;  // recoverable: CVODE retries with a smaller step
+    if (!std::isfinite(NV_Ith_S(y_dot, i))) return 1;  // recoverable: the solver retries with a smaller step
   }
   return 0;
 }

@@ -26,7 +26,7 @@ const crane::stack::StackConfig& lab() {
   return cfg;
 }
 
-// One 10 ms sample of the nonlinear plant (CVODE with friction events), driven by a voltage that
+// One 10 ms sample of the nonlinear plant (the configured integrator with friction events), driven by a voltage that
 // reverses every 0.5 s so the trolley keeps sticking and slipping.
 void BM_PlantSample(benchmark::State& state) {
   plant::SimulatorParameters p;

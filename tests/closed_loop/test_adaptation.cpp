@@ -1,6 +1,6 @@
 // The online payload mass and friction estimation (crane::adaptation in the state estimator stage)
 // in closed loop: every stage object and the plant, in one process, lockstep (deterministic: no
-// seed needed, the plant's CVODE run is the same every time). The plant differs from the
+// seed needed, the plant's integration is the same every time). The plant differs from the
 // configuration (plant::PlantMismatch): it carries 3.0 kg where the configuration says 2.0 kg, or
 // its friction rises by 50 % on both drives in the middle of a run.
 #include <gtest/gtest.h>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "crane/common/protocol_signals.hpp"
+#include "crane/plant/drives_and_sensors.hpp"
 #include "crane/stack/in_process_stack.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
@@ -184,8 +185,12 @@ TEST(Adaptation, GainSchedulingAndTrackingWithTheEstimateAgainstTheNominalLoad) 
           << controller;
       EXPECT_LE(std::abs(mass_only.residual - nominal.residual), std::abs(configured.residual - nominal.residual) + 1e-3)
           << controller;
+      // The final error is read by the trolley's encoder: a difference within one count (7.9 um)
+      // is which count the friction compensation's dither ends on, not the load (the convergence
+      // study, docs/integration.md: an integration error of 1e-7 m moved such figures by a count).
+      const double count_mm = 1e3 * crane::plant::DrivesAndSensors(lab(true).facts.crane).trolley_resolution();
       EXPECT_LE(std::abs(mass_only.position_error - nominal.position_error),
-                std::abs(configured.position_error - nominal.position_error) + 1e-3)
+                std::abs(configured.position_error - nominal.position_error) + count_mm + 1e-9)
           << controller;
     }
   }

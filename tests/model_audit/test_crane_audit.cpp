@@ -250,7 +250,7 @@ TEST(CraneAudit, CalibrateRecoversTheDrivesAndStillFindsAWrongPayload) {
   EXPECT_NEAR(fitted_mass, truth.load_mass, 0.1 * truth.load_mass);
 }
 
-// A recording of the project's own plant simulator (plant::CraneSimulator: CVODE with exact
+// A recording of the project's own plant simulator (plant::CraneSimulator: SUNDIALS with exact
 // stick-slip event location, the DAC and the encoders; an integrator independent of the audit's
 // and of the generator's) under a PD on each drive, 18 s at 100 Hz, the generator's sines without
 // its creep phase. The recorder reports the middle of each encoder count (the simulator's counts
@@ -322,7 +322,7 @@ TEST(CraneAudit, PlantSimulatorRecordingGivesNoneAndAWrongPayloadIsFound) {
 
 
 // The wind and hook entries on recordings of the project's plant simulator with its own options
-// (plant.wind: a steady force; plant.hook: the hook as a double pendulum, integrated by CVODE over
+// (plant.wind: a steady force; plant.hook: the hook as a double pendulum, integrated by SUNDIALS over
 // six coordinates), seeded random magnitudes in the generator's ranges (hidden_effect_generator.hpp),
 // load 1-3 kg and cable 0.6-1.6 m drawn per case. Case i: wind_force, hook_double_pendulum and
 // encoder_offset in turn (the offset tests the other direction: wind must not take it), then clean
@@ -411,7 +411,7 @@ TEST(CraneAudit, PlantSimulatorWindHookAndOffsetAreNamed) {
 }
 
 // The elastic rope (plant.rope: the load on a spring of stiffness EA / L in series with the cable,
-// integrated by CVODE over five coordinates) with its catalog entry elastic_rope (the static stretch
+// integrated by SUNDIALS over five coordinates) with its catalog entry elastic_rope (the static stretch
 // ratio e_r = m g / EA). The lab's rope (EA = 2e5 N: e_r = 1e-4) is below the audit's resolution
 // floor: a recording of the plant simulator with it is clean (none), started at the static stretch
 // as the plant stage does.

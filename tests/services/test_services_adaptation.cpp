@@ -143,7 +143,7 @@ TEST(AxisIdentifier, InvalidParamsNameTheField) {
 
 // The trolley of the lab crane (section 4.2) under a PD on a sinusoidal reference, with stick-slip
 // friction (3.1)-(3.3) and a linear pendulum, integrated here by explicit Euler at 0.1 ms (an
-// integrator independent of the plant's CVODE model); encoders quantized like the lab crane's
+// integrator independent of the plant's SUNDIALS model); encoders quantized like the lab crane's
 // motor encoder (2000 lines x 4 through 0.5 in/rev), the drive's 13-bit DAC over +-10 V.
 struct AxisRun {
   double load_mass{3.0};            // [kg] the truth

@@ -579,7 +579,7 @@ int main(int argc, char** argv) {
       line("floor: DDS one-way (ping-pong / 2)", j["floor_one_way"]);
       if (j.contains("p99_ratio_to_floor")) std::printf("end-to-end p99 / floor p99 = %.2f\n", j["p99_ratio_to_floor"].get<double>());
       if (j.contains("plant_step")) {
-        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us\n", "plant step (CVODE, one cycle)",
+        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us\n", "plant step (integrator, one cycle)",
                     j["plant_step"]["p50"].get<double>(), j["plant_step"]["p99"].get<double>(),
                     j["plant_step"]["max"].get<double>());
       }

@@ -304,7 +304,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   result.startup_s = std::chrono::duration<double>(ready_time - run_start).count();
 
   // 2. Send the move. In lockstep it starts at a fixed cycle, not at the wall-clock moment the goal
-  //    arrives: the crane rests before it, but the estimator's filters and CVODE's step history at
+  //    arrives: the crane rests before it, but the estimator's filters and the integrator's step size at
   //    rest differ in the last bits from one cycle to the next, so only the same start cycle gives
   //    the same run to the last bit. The stack is ready after a few cycles; should it be later, the
   //    start moves (and the run is repeatable only with runs that moved it alike). A goal that

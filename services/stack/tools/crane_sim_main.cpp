@@ -249,7 +249,7 @@ std::vector<SweepCase> sweep_cases(const std::vector<std::string>& controllers, 
   return cases;
 }
 
-// Runs every case on `jobs` threads (each run is independent: its own stages and CVODE instance).
+// Runs every case on `jobs` threads (each run is independent: its own stages and integrator).
 std::vector<SweepRow> run_sweep(const stack::StackConfig& cfg, const Selection& s, const stack::ManeuverConfig& maneuver,
                                 const std::vector<SweepCase>& cases, unsigned jobs) {
   std::vector<SweepRow> rows(cases.size());

@@ -8,7 +8,7 @@
 //        (2.27) on a tower crane, F_y = M_y K_my V_y on an overhead crane's bridge, none on a gantry
 //     -> the crane's model (crane_dynamics.hpp: TowerCraneModel (2.11)-(2.16), GantryCraneModel
 //        (2.5)-(2.6), OverheadCraneModel) with stick-slip friction (3.1)-(3.3) and brakes
-//        (axis_friction.hpp), integrated by CVODE with event location (hybrid_integrator.hpp)
+//        (axis_friction.hpp), integrated by SUNDIALS with event location (hybrid_integrator.hpp)
 //     -> encoders (quadrature counts) -> SimulatorOutput.
 // Options of the tower crane, each off by default (beyond the dissertation): the hook as a double
 // pendulum (HookParameters, tower_crane_model.hpp), wind on the load (WindParameters, wind.hpp) and
