@@ -67,7 +67,7 @@ TEST_P(StepAllocation, StepsAllocateNothing) {
 INSTANTIATE_TEST_SUITE_P(Integrators, StepAllocation,
                          ::testing::Values(IntegrationMethod::dormand_prince, IntegrationMethod::verner,
                                            IntegrationMethod::adams),
-                         [](const auto& info) { return std::string(integration_method_name(info.param)); });
+                         [](const auto& method) { return std::string(integration_method_name(method.param)); });
 
 }  // namespace
 }  // namespace crane::plant
