@@ -633,3 +633,19 @@ TEST_F(LabConfigText, PlantRopeIsOffAndValidatedLikeTheRest) {
   EXPECT_TRUE(on.plant.rope.enabled);
   EXPECT_NEAR(on.plant.initial_state.rope_stretch, 2.0 * 9.8 * 1.0 / 2.0e5, 1e-15);
 }
+
+// plant.integrator names one of the integrators (hybrid_integrator.hpp); the configs carry the
+// code's default, and another name or a missing field is refused naming the field.
+TEST_F(LabConfigText, PlantIntegratorIsTheDefaultAndValidated) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_EQ(c.plant.integrator.method, crane::plant::IntegratorSettings{}.method);
+  EXPECT_DOUBLE_EQ(c.plant.integrator.relative_tolerance, crane::plant::IntegratorSettings{}.relative_tolerance);
+  EXPECT_DOUBLE_EQ(c.plant.integrator.absolute_tolerance, crane::plant::IntegratorSettings{}.absolute_tolerance);
+  auto message = error_of(edit_line(text_, "plant:", "integrator:", "integrator: rk4").text);
+  EXPECT_TRUE(starts_with(message, "test.yaml: ")) << message;
+  EXPECT_TRUE(contains(message, "plant.integrator = 'rk4' is not one of dormand_prince, verner, adams, bdf")) << message;
+  message = error_of(edit_line(text_, "plant:", "integrator:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field plant.integrator")) << message;
+  const auto bdf = cfg::parse_stack_config(edit_line(text_, "plant:", "integrator:", "integrator: bdf").text, "test.yaml");
+  EXPECT_EQ(bdf.plant.integrator.method, crane::plant::IntegrationMethod::bdf);
+}
