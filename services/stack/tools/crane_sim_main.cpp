@@ -24,6 +24,11 @@
 //       wall time per simulated second (docs/integration.md);
 //   (demo, sweep, bench, converge and integrators take --integrator M [--rtol R --atol A]: the
 //   plant's integrator instead of the configuration's plant.integrator)
+//   crane_sim bound --config FILE [--maneuver M ...] [--intervals N] [--out DIR]
+//       the minimum time T* of each demo maneuver on the plant's nonlinear model (maneuver_bound.hpp,
+//       docs/optimal_control.md): T* on N and on 2N intervals (their difference: the
+//       discretization's), the linear profile's time, IPOPT's iterations and solve time, the largest
+//       drive voltage and swing; --out writes bound.csv and <maneuver>_bound.csv (the trajectory);
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -38,6 +43,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -45,6 +51,7 @@
 #include "crane/stack/convergence_study.hpp"
 #include "crane/stack/gantry_gain_study.hpp"
 #include "crane/stack/in_process_stack.hpp"
+#include "crane/stack/maneuver_bound.hpp"
 
 namespace {
 
@@ -424,6 +431,62 @@ int bench(const Selection& s, int cases) {
 
 std::string figure_text(double value, int decimals) { return stack::format_number(value, decimals); }
 
+void write_bound_trajectory(const fs::path& path, const optimal_control::MinimumTimeResult& r) {
+  std::ofstream out(path);
+  out << "t,x,phi,gamma,theta,x_dot,phi_dot,gamma_dot,theta_dot,L,L_dot,a_x,a_gamma,a_L,V_x,V_gamma\n";
+  out.precision(10);
+  for (const auto& n : r.nodes) {
+    out << n.time;
+    for (int i = 0; i < plant::kNumCoordinates; ++i) out << ',' << n.state.position[i];
+    for (int i = 0; i < plant::kNumCoordinates; ++i) out << ',' << n.state.velocity[i];
+    out << ',' << n.cable_length << ',' << n.cable_length_rate << ',' << n.trolley_acceleration << ','
+        << n.second_acceleration << ',' << n.hoist_acceleration << ',' << n.trolley_voltage << ','
+        << n.second_voltage << '\n';
+  }
+}
+
+int bound(const Selection& s, int intervals, const std::string& out_dir) {
+  const auto cfg = load_config(s);
+  if (!out_dir.empty()) fs::create_directories(out_dir);
+  std::ofstream summary;
+  if (!out_dir.empty()) {
+    summary.open(fs::path(out_dir) / "bound.csv");
+    summary << "maneuver,T_star,T_star_refined,linear_profile,intervals,iterations,solve_seconds,max_voltage,max_swing_deg\n";
+  }
+  std::printf("minimum time on the nonlinear model (%s crane; IPOPT, trapezoidal collocation)\n",
+              common::to_string(cfg.facts.crane_kind));
+  std::printf("%-14s %9s %11s %9s %9s %6s %8s %8s %10s\n", "maneuver", "T* [s]", "T*(2N) [s]", "change", "linear [s]",
+              "iter", "solve s", "max |V|", "max swing");
+  int failures = 0;
+  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+    const auto coarse = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, intervals));
+    const auto fine = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, 2 * intervals));
+    double max_voltage = 0.0;
+    double max_swing = 0.0;
+    for (const auto& n : fine.nodes) {
+      max_voltage = std::max({max_voltage, std::abs(n.trolley_voltage), std::abs(n.second_voltage)});
+      max_swing = std::max({max_swing, std::abs(n.state.position[plant::kInPlaneSwingIndex]),
+                            std::abs(n.state.position[plant::kOutOfPlaneSwingIndex])});
+    }
+    if (!coarse.solved || !fine.solved) {
+      std::printf("%-14s not solved: %s (N), %s (2N)\n", m.name.c_str(), coarse.status.c_str(), fine.status.c_str());
+      ++failures;
+      continue;
+    }
+    const double change = (fine.duration - coarse.duration) / coarse.duration;
+    std::printf("%-14s %9.4f %11.4f %8.2f%% %9.4f %6d %8.2f %8.2f %8.2f deg\n", m.name.c_str(), coarse.duration,
+                fine.duration, 100.0 * change, coarse.initial_guess_duration, fine.iterations, fine.solve_seconds,
+                max_voltage, max_swing * 180.0 / std::numbers::pi);
+    if (!out_dir.empty()) {
+      summary << m.name << ',' << coarse.duration << ',' << fine.duration << ',' << coarse.initial_guess_duration << ','
+              << 2 * intervals << ',' << fine.iterations << ',' << fine.solve_seconds << ',' << max_voltage << ','
+              << max_swing * 180.0 / std::numbers::pi << '\n';
+      write_bound_trajectory(fs::path(out_dir) / (m.name + "_bound.csv"), fine);
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}
+
 int converge(const Selection& s, const plant::IntegratorSettings& reference) {
   const auto cfg = load_config(s);
   std::printf("convergence study: %s against the reference %s\n", integrator_label(cfg.plant.integrator).c_str(),
@@ -598,6 +661,12 @@ int main(int argc, char** argv) {
   auto* integrators_cmd = app.add_subcommand("integrators", "the integrators compared on the demo runs' inputs (the plant alone)");
   common_options(integrators_cmd);
 
+  auto* bound_cmd = app.add_subcommand("bound", "the minimum time of each maneuver on the nonlinear model (IPOPT)");
+  common_options(bound_cmd);
+  int intervals = 100;
+  bound_cmd->add_option("--intervals", intervals, "collocation intervals N (also solved on 2N)")->check(CLI::Range(4, 1000));
+  bound_cmd->add_option("--out", out_dir, "write bound.csv and <maneuver>_bound.csv here");
+
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
   gantry_cmd->add_option("--K", full_forward_gain, "forward gain K [V/m] of the full-state law (Figure 3.8), > 0")
@@ -616,6 +685,7 @@ int main(int argc, char** argv) {
       return converge(s, reference);
     }
     if (*integrators_cmd) return integrators(s);
+    if (*bound_cmd) return bound(s, intervals, out_dir);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

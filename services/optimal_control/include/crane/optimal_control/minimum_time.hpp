@@ -1,0 +1,117 @@
+#pragma once
+// The minimum time of a rest-to-rest crane maneuver on the plant's own nonlinear model, and the
+// trajectory (states and inputs) that reaches it: the bound every controller is measured against
+// (docs/optimal_control.md).
+//
+// Problem (the plant's equations, crane_dynamics.hpp, in every coordinate the model has):
+//   minimize T  subject to
+//     M(q, L) q'' + b(q, q', L, L', L'') = Q,  Q = (F_trolley, 0, F_second, 0[, 0, 0])
+//     drive axes (slots 0 and 2): q'' = the inputs a_trolley, a_second;  hoist: L'' = a_hoist
+//     passive coordinates (the swings, a hook's rigging, a rope's stretch): from the model, Q = 0
+//     drive voltage V = F / force_per_volt + friction(q') in [-voltage_limit, voltage_limit]
+//       (friction: the plant's Coulomb + viscous law (3.1) in volt-equivalents, direction
+//       dependent, its sign smoothed over friction_smoothing_speed; static friction is not a
+//       constraint of a moving axis)
+//     |a| <= max_acceleration, |q'| <= max_speed, position within [min_position, max_position]
+//       per axis; |swing| <= max_swing on every swing coordinate
+//     rest at both ends: every velocity and every swing 0, the drive axes and the cable at the
+//       maneuver's start and target; a drive axis whose start equals its target may move in
+//       between (the slew's bound uses the trolley against the centripetal swing), the hoist not.
+// Transcription: direct collocation, trapezoidal rule on `intervals` equal intervals of T/N, the
+// inputs piecewise linear (J. T. Betts, "Practical Methods for Optimal Control Using Nonlinear
+// Programming", SIAM 2010, section 4.5). Solved by IPOPT (A. Waechter, L. T. Biegler, Math.
+// Program. 106, 2006) with a limited-memory Hessian. The constraint Jacobian is exact in its
+// structure and differentiates the model's own equations at each node by central differences
+// (the model is a virtual double-precision interface, not templated on a scalar type, so neither
+// automatic differentiation nor a second, hand-derived copy of the equations: one model; step
+// 1e-6 scaled by the variable, truncation error about 1e-10 relative).
+//
+// The initial guess: each drive axis and the hoist on the linear time-optimal swing-free profile
+// (trajectory_planner/time_optimal_profile.hpp), the swings at 0.
+//
+// Errors: solve_minimum_time throws common::ConfigError naming the field, the value and the bound
+// for a problem that is malformed (a non-finite or non-positive limit, a start or target outside
+// its axis's range, intervals outside [4, 2000]); a problem IPOPT does not solve is returned with
+// `solved == false` and IPOPT's status in `status` (never an exception).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crane/common/crane_parameters.hpp"
+#include "crane/plant/crane_dynamics.hpp"
+
+namespace crane::optimal_control {
+
+/// Range and rated limits of one axis [m, m/s, m/s^2] or [rad, rad/s, rad/s^2].
+struct AxisRange {
+  double start{0.0};             // position at t = 0
+  double target{0.0};            // position at t = T
+  double min_position{-1e3};     // the axis stays within [min_position, max_position]
+  double max_position{1e3};
+  double max_speed{1.0};         // |q'| <= max_speed, > 0
+  double max_acceleration{1.0};  // |q''| <= max_acceleration, > 0
+};
+
+struct MinimumTimeProblem {
+  /// The plant's model (make_crane_dynamics); cloned by the solver.
+  std::shared_ptr<const plant::CraneDynamics> model;
+  AxisRange trolley;                  // slot 0 [m]
+  AxisRange second;                   // slot 2: slew [rad] (tower) or bridge [m] (overhead); a model whose
+                                      // second axis has no drive (gantry) keeps it at 0 whatever is set here
+  AxisRange hoist;                    // the cable length L [m]; start == target: no hoisting
+  common::AxisFriction trolley_friction;  // volt-equivalents (3.1)-(3.3)
+  common::AxisFriction second_friction;   // the slew's (tower) or the bridge's (overhead)
+  double voltage_limit{10.0};         // [V] |V| of each drive, > 0
+  double max_swing{0.6};              // [rad] |phi|, |theta| (and a hook's rigging angles), > 0
+  double friction_smoothing_speed{1e-3};  // [m/s or rad/s] sign(v) ~ tanh(v / this), > 0
+  int intervals{100};                 // collocation intervals N, in [4, 2000]
+  double input_smoothing{1e-5};       // [s] w in [0, 1]: the objective is T + w sum over the intervals and inputs
+                                      // of ((a_k+1 - a_k) / max_acceleration)^2. It picks one of the equally fast
+                                      // inputs where an axis has slack (without it IPOPT wanders on the overhead
+                                      // crane's long moves); 1e-5 changes T* by < 1e-4 s on the demo maneuvers
+                                      // (docs/optimal_control.md)
+  double tolerance{1e-8};             // IPOPT's tol
+  int max_iterations{3000};
+};
+
+/// One node of the trajectory.
+struct TrajectoryNode {
+  double time{0.0};                       // [s]
+  plant::ExtendedState state;             // q, q' in the model's slots (crane_dynamics.hpp)
+  double cable_length{1.0};               // [m] L
+  double cable_length_rate{0.0};          // [m/s]
+  double trolley_acceleration{0.0};       // [m/s^2] the input a_trolley
+  double second_acceleration{0.0};        // [rad/s^2 or m/s^2]
+  double hoist_acceleration{0.0};         // [m/s^2]
+  double trolley_voltage{0.0};            // [V] drive voltage with friction (the feedforward)
+  double second_voltage{0.0};             // [V]
+};
+
+struct MinimumTimeResult {
+  bool solved{false};
+  std::string status;                     // IPOPT's return status, e.g. "Solve_Succeeded"
+  double duration{0.0};                   // [s] T*
+  std::vector<TrajectoryNode> nodes;      // intervals + 1 nodes, t = k T / N
+  int iterations{0};
+  double solve_seconds{0.0};              // [s] wall time of IPOPT
+  double max_defect{0.0};                 // largest collocation defect at the solution [SI]
+  double initial_guess_duration{0.0};     // [s] the linear profiles' duration the solve started from
+};
+
+/// Validates `problem` (see the header's Errors) and solves it.
+[[nodiscard]] MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem);
+
+/// Validates `problem`; throws common::ConfigError naming the field, the value and the bound.
+void validate(const MinimumTimeProblem& problem);
+
+/// The trajectory between nodes: states and inputs linear in time (the trapezoidal rule's own
+/// interpolation of the inputs; the states to the same order). `time` [s] is clamped to [0, T].
+[[nodiscard]] TrajectoryNode sample(const MinimumTimeResult& result, double time);
+
+/// Drive voltage [V] of one axis at speed `velocity` for a drive force `force` [N or N m]:
+/// force / force_per_volt + the smoothed friction of the header, in volt-equivalents.
+[[nodiscard]] double drive_voltage(double force, double force_per_volt, double velocity,
+                                   const common::AxisFriction& friction, double smoothing_speed) noexcept;
+
+}  // namespace crane::optimal_control

@@ -1,0 +1,593 @@
+#include "crane/optimal_control/minimum_time.hpp"
+
+#include <IpIpoptApplication.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "crane/common/validation.hpp"
+#include "crane/trajectory_planner/time_optimal_profile.hpp"
+#include "crane/trajectory_planner/trapezoid_profile.hpp"
+
+namespace crane::optimal_control {
+
+namespace {
+
+using plant::ExtendedMatrix;
+using plant::ExtendedState;
+using plant::ExtendedVector;
+using plant::HoistMotion;
+using plant::kSlewIndex;
+using plant::kTrolleyIndex;
+
+constexpr double kInfinity = 1e19;  // IPOPT's default nlp_upper_bound_inf
+constexpr int kInputs = 3;          // a_trolley, a_second, a_hoist
+constexpr int kMaxNodeVariables = 2 * plant::kMaxCoordinates + 2 + kInputs;
+
+// The variables of one node: q (n), q' (n), L, L', then the inputs.
+struct Layout {
+  int n{4};            // the model's coordinates
+  int states{10};      // 2 n + 2
+  int stride{13};      // states + inputs
+  int nodes{101};      // N + 1
+  int voltages{2};     // drives with a voltage row (1 on a gantry)
+  [[nodiscard]] int position(int i) const { return i; }
+  [[nodiscard]] int velocity(int i) const { return n + i; }
+  [[nodiscard]] int cable_length() const { return 2 * n; }
+  [[nodiscard]] int cable_rate() const { return 2 * n + 1; }
+  [[nodiscard]] int input(int j) const { return states + j; }
+  [[nodiscard]] int duration_index() const { return nodes * stride; }
+  [[nodiscard]] int variable_count() const { return nodes * stride + 1; }
+  [[nodiscard]] int defect_rows() const { return (nodes - 1) * states; }
+  [[nodiscard]] int constraint_count() const { return defect_rows() + nodes * voltages; }
+};
+
+using NodeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxNodeVariables, 1>;
+using NodeJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxNodeVariables, kMaxNodeVariables>;
+
+bool second_axis_driven(const plant::CraneDynamics& model) {
+  return model.drive_force_per_volt(plant::DriveAxis::second) > 0.0;
+}
+
+// The dynamics at one node: the state derivative (q', q'', L', L'') and the drive voltages.
+class NodeDynamics {
+ public:
+  NodeDynamics(const MinimumTimeProblem& problem, const Layout& layout)
+      : model_(problem.model->clone()),
+        layout_(layout),
+        trolley_friction_(problem.trolley_friction),
+        second_friction_(problem.second_friction),
+        smoothing_(problem.friction_smoothing_speed),
+        trolley_force_per_volt_(model_->drive_force_per_volt(plant::DriveAxis::trolley)),
+        second_force_per_volt_(model_->drive_force_per_volt(plant::DriveAxis::second)) {}
+
+  // z: the node's variables (states then inputs); derivative: states rows; voltage: layout.voltages.
+  void evaluate(const double* z, NodeVector& derivative, NodeVector& voltage) const {
+    const int n = layout_.n;
+    ExtendedState s;
+    for (int i = 0; i < n; ++i) {
+      s.position[i] = z[layout_.position(i)];
+      s.velocity[i] = z[layout_.velocity(i)];
+    }
+    const HoistMotion hoist{z[layout_.cable_length()], z[layout_.cable_rate()], z[layout_.input(2)]};
+    ExtendedMatrix mass;
+    ExtendedVector bias;
+    model_->compute_extended_dynamics(s, hoist, mass, bias);
+
+    // Passive rows: M_PP q''_P = -(b_P + M_PA a_A), Q_P = 0.
+    ExtendedVector acceleration = ExtendedVector::Zero();
+    acceleration[kTrolleyIndex] = z[layout_.input(0)];
+    acceleration[kSlewIndex] = z[layout_.input(1)];
+    int passive[plant::kMaxCoordinates];
+    int p = 0;
+    for (int i = 0; i < n; ++i) {
+      if (i != kTrolleyIndex && i != kSlewIndex) passive[p++] = i;
+    }
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, plant::kMaxCoordinates, plant::kMaxCoordinates> mpp(p, p);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, plant::kMaxCoordinates, 1> rhs(p);
+    for (int r = 0; r < p; ++r) {
+      rhs[r] = -bias[passive[r]] - mass(passive[r], kTrolleyIndex) * acceleration[kTrolleyIndex] -
+               mass(passive[r], kSlewIndex) * acceleration[kSlewIndex];
+      for (int c = 0; c < p; ++c) mpp(r, c) = mass(passive[r], passive[c]);
+    }
+    const auto solution = mpp.partialPivLu().solve(rhs).eval();
+    for (int r = 0; r < p; ++r) acceleration[passive[r]] = solution[r];
+
+    derivative.resize(layout_.states);
+    for (int i = 0; i < n; ++i) {
+      derivative[layout_.position(i)] = s.velocity[i];
+      derivative[layout_.velocity(i)] = acceleration[i];
+    }
+    derivative[layout_.cable_length()] = hoist.cable_length_rate;
+    derivative[layout_.cable_rate()] = hoist.cable_length_acceleration;
+
+    // Drive rows: Q_A = M_A. q'' + b_A.
+    voltage.resize(layout_.voltages);
+    const double trolley_force = mass.row(kTrolleyIndex).head(n).dot(acceleration.head(n)) + bias[kTrolleyIndex];
+    voltage[0] = drive_voltage(trolley_force, trolley_force_per_volt_, s.velocity[kTrolleyIndex], trolley_friction_,
+                               smoothing_);
+    if (layout_.voltages > 1) {
+      const double second_force = mass.row(kSlewIndex).head(n).dot(acceleration.head(n)) + bias[kSlewIndex];
+      voltage[1] = drive_voltage(second_force, second_force_per_volt_, s.velocity[kSlewIndex], second_friction_,
+                                 smoothing_);
+    }
+  }
+
+  // Central differences of evaluate() over the node's variables (header: step 1e-6 scaled).
+  void jacobian(const double* z, NodeJacobian& derivative_jacobian, NodeJacobian& voltage_jacobian) const {
+    const int width = layout_.stride;
+    derivative_jacobian.resize(layout_.states, width);
+    voltage_jacobian.resize(layout_.voltages, width);
+    double perturbed[kMaxNodeVariables];
+    std::copy(z, z + width, perturbed);
+    NodeVector f_plus, f_minus, v_plus, v_minus;
+    for (int j = 0; j < width; ++j) {
+      const double step = 1e-6 * (1.0 + std::abs(z[j]));
+      perturbed[j] = z[j] + step;
+      evaluate(perturbed, f_plus, v_plus);
+      perturbed[j] = z[j] - step;
+      evaluate(perturbed, f_minus, v_minus);
+      perturbed[j] = z[j];
+      derivative_jacobian.col(j) = (f_plus - f_minus) / (2.0 * step);
+      voltage_jacobian.col(j) = (v_plus - v_minus) / (2.0 * step);
+    }
+  }
+
+ private:
+  std::unique_ptr<plant::CraneDynamics> model_;
+  Layout layout_;
+  common::AxisFriction trolley_friction_;
+  common::AxisFriction second_friction_;
+  double smoothing_;
+  double trolley_force_per_volt_;
+  double second_force_per_volt_;
+};
+
+// The nonlinear program of the header for IPOPT.
+class MinimumTimeProgram final : public Ipopt::TNLP {
+ public:
+  MinimumTimeProgram(const MinimumTimeProblem& problem, const Layout& layout, std::vector<double> initial_guess)
+      : problem_(problem),
+        layout_(layout),
+        dynamics_(problem, layout),
+        initial_(std::move(initial_guess)),
+        input_scale_{problem.trolley.max_acceleration, problem.second.max_acceleration, problem.hoist.max_acceleration} {}
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g, Ipopt::Index& nnz_h_lag,
+                    IndexStyleEnum& index_style) override {
+    n = layout_.variable_count();
+    m = layout_.constraint_count();
+    nnz_jac_g = (layout_.nodes - 1) * layout_.states * (2 * layout_.stride + 1) +
+                layout_.nodes * layout_.voltages * layout_.stride;
+    nnz_h_lag = 0;
+    index_style = C_STYLE;
+    return true;
+  }
+
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index m, Ipopt::Number* g_l,
+                       Ipopt::Number* g_u) override {
+    std::fill(x_l, x_l + n, -kInfinity);
+    std::fill(x_u, x_u + n, kInfinity);
+    const bool second_driven = layout_.voltages > 1;
+    const bool hoisting = problem_.hoist.start != problem_.hoist.target;
+    for (int k = 0; k < layout_.nodes; ++k) {
+      double* lo = x_l + k * layout_.stride;
+      double* hi = x_u + k * layout_.stride;
+      const bool end = k == 0 || k == layout_.nodes - 1;
+      auto axis = [&](int slot, int input, const AxisRange& range, bool driven) {
+        if (!driven) {
+          lo[layout_.position(slot)] = hi[layout_.position(slot)] = 0.0;
+          lo[layout_.velocity(slot)] = hi[layout_.velocity(slot)] = 0.0;
+          lo[layout_.input(input)] = hi[layout_.input(input)] = 0.0;
+          return;
+        }
+        lo[layout_.position(slot)] = range.min_position;
+        hi[layout_.position(slot)] = range.max_position;
+        lo[layout_.velocity(slot)] = -range.max_speed;
+        hi[layout_.velocity(slot)] = range.max_speed;
+        lo[layout_.input(input)] = -range.max_acceleration;
+        hi[layout_.input(input)] = range.max_acceleration;
+        if (end) {
+          lo[layout_.position(slot)] = hi[layout_.position(slot)] = k == 0 ? range.start : range.target;
+          lo[layout_.velocity(slot)] = hi[layout_.velocity(slot)] = 0.0;
+        }
+      };
+      axis(kTrolleyIndex, 0, problem_.trolley, true);
+      axis(kSlewIndex, 1, problem_.second, second_driven);
+      for (int i = 0; i < layout_.n; ++i) {
+        if (i == kTrolleyIndex || i == kSlewIndex) continue;
+        lo[layout_.position(i)] = end ? 0.0 : -problem_.max_swing;
+        hi[layout_.position(i)] = end ? 0.0 : problem_.max_swing;
+        if (end) lo[layout_.velocity(i)] = hi[layout_.velocity(i)] = 0.0;
+      }
+      if (hoisting) {
+        lo[layout_.cable_length()] = problem_.hoist.min_position;
+        hi[layout_.cable_length()] = problem_.hoist.max_position;
+        lo[layout_.cable_rate()] = end ? 0.0 : -problem_.hoist.max_speed;
+        hi[layout_.cable_rate()] = end ? 0.0 : problem_.hoist.max_speed;
+        lo[layout_.input(2)] = -problem_.hoist.max_acceleration;
+        hi[layout_.input(2)] = problem_.hoist.max_acceleration;
+        if (end) {
+          lo[layout_.cable_length()] = hi[layout_.cable_length()] = k == 0 ? problem_.hoist.start : problem_.hoist.target;
+        }
+      } else {
+        lo[layout_.cable_length()] = hi[layout_.cable_length()] = problem_.hoist.start;
+        lo[layout_.cable_rate()] = hi[layout_.cable_rate()] = 0.0;
+        lo[layout_.input(2)] = hi[layout_.input(2)] = 0.0;
+      }
+    }
+    x_l[layout_.duration_index()] = 1e-2;
+    x_u[layout_.duration_index()] = 1e3;
+    std::fill(g_l, g_l + layout_.defect_rows(), 0.0);
+    std::fill(g_u, g_u + layout_.defect_rows(), 0.0);
+    std::fill(g_l + layout_.defect_rows(), g_l + m, -problem_.voltage_limit);
+    std::fill(g_u + layout_.defect_rows(), g_u + m, problem_.voltage_limit);
+    return true;
+  }
+
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z, Ipopt::Number*, Ipopt::Number*,
+                          Ipopt::Index, bool init_lambda, Ipopt::Number*) override {
+    if (!init_x || init_z || init_lambda) return false;
+    std::copy(initial_.begin(), initial_.begin() + n, x);
+    return true;
+  }
+
+  // T + w sum_k sum_j ((u_j,k+1 - u_j,k) / a_j,max)^2 (header: the input smoothing).
+  bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& obj_value) override {
+    obj_value = x[layout_.duration_index()];
+    for (int k = 0; k + 1 < layout_.nodes; ++k) {
+      for (int j = 0; j < kInputs; ++j) {
+        const double d = (x[(k + 1) * layout_.stride + layout_.input(j)] - x[k * layout_.stride + layout_.input(j)]) /
+                         input_scale_[j];
+        obj_value += problem_.input_smoothing * d * d;
+      }
+    }
+    return true;
+  }
+
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* grad_f) override {
+    std::fill(grad_f, grad_f + n, 0.0);
+    grad_f[layout_.duration_index()] = 1.0;
+    for (int k = 0; k + 1 < layout_.nodes; ++k) {
+      for (int j = 0; j < kInputs; ++j) {
+        const int a = k * layout_.stride + layout_.input(j);
+        const int b = a + layout_.stride;
+        const double d = 2.0 * problem_.input_smoothing * (x[b] - x[a]) / (input_scale_[j] * input_scale_[j]);
+        grad_f[b] += d;
+        grad_f[a] -= d;
+      }
+    }
+    return true;
+  }
+
+  bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Number* g) override {
+    evaluate_constraints(x, g);
+    return true;
+  }
+
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index* i_row,
+                  Ipopt::Index* j_col, Ipopt::Number* values) override {
+    const int stride = layout_.stride;
+    const int states = layout_.states;
+    const int N = layout_.nodes - 1;
+    if (values == nullptr) {
+      int e = 0;
+      for (int k = 0; k < N; ++k) {
+        for (int r = 0; r < states; ++r) {
+          const int row = k * states + r;
+          for (int c = 0; c < 2 * stride; ++c) {
+            i_row[e] = row;
+            j_col[e++] = k * stride + c;
+          }
+          i_row[e] = row;
+          j_col[e++] = layout_.duration_index();
+        }
+      }
+      for (int k = 0; k <= N; ++k) {
+        for (int r = 0; r < layout_.voltages; ++r) {
+          for (int c = 0; c < stride; ++c) {
+            i_row[e] = layout_.defect_rows() + k * layout_.voltages + r;
+            j_col[e++] = k * stride + c;
+          }
+        }
+      }
+      return true;
+    }
+    const double T = x[layout_.duration_index()];
+    const double half_step = 0.5 * T / N;
+    std::vector<NodeVector> f(layout_.nodes);
+    std::vector<NodeJacobian> jf(layout_.nodes);
+    std::vector<NodeJacobian> jv(layout_.nodes);
+    NodeVector v;
+    for (int k = 0; k <= N; ++k) {
+      dynamics_.evaluate(x + k * stride, f[k], v);
+      dynamics_.jacobian(x + k * stride, jf[k], jv[k]);
+    }
+    int e = 0;
+    for (int k = 0; k < N; ++k) {
+      for (int r = 0; r < states; ++r) {
+        for (int c = 0; c < stride; ++c) values[e++] = (c == r ? -1.0 : 0.0) - half_step * jf[k](r, c);
+        for (int c = 0; c < stride; ++c) values[e++] = (c == r ? 1.0 : 0.0) - half_step * jf[k + 1](r, c);
+        values[e++] = -0.5 / N * (f[k][r] + f[k + 1][r]);
+      }
+    }
+    for (int k = 0; k <= N; ++k) {
+      for (int r = 0; r < layout_.voltages; ++r) {
+        for (int c = 0; c < stride; ++c) values[e++] = jv[k](r, c);
+      }
+    }
+    return true;
+  }
+
+  bool eval_h(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Number, Ipopt::Index, const Ipopt::Number*, bool,
+              Ipopt::Index, Ipopt::Index*, Ipopt::Index*, Ipopt::Number*) override {
+    return false;  // limited-memory quasi-Newton
+  }
+
+  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
+                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    solver_return_ = status;
+    solution_.assign(x, x + n);
+  }
+
+  void evaluate_constraints(const double* x, double* g) const {
+    const int stride = layout_.stride;
+    const int N = layout_.nodes - 1;
+    const double half_step = 0.5 * x[layout_.duration_index()] / N;
+    NodeVector f_k, f_next, v;
+    dynamics_.evaluate(x, f_k, v);
+    for (int r = 0; r < layout_.voltages; ++r) g[layout_.defect_rows() + r] = v[r];
+    for (int k = 0; k < N; ++k) {
+      dynamics_.evaluate(x + (k + 1) * stride, f_next, v);
+      for (int r = 0; r < layout_.voltages; ++r) g[layout_.defect_rows() + (k + 1) * layout_.voltages + r] = v[r];
+      for (int r = 0; r < layout_.states; ++r) {
+        g[k * layout_.states + r] =
+            x[(k + 1) * stride + r] - x[k * stride + r] - half_step * (f_k[r] + f_next[r]);
+      }
+      f_k = f_next;
+    }
+  }
+
+  [[nodiscard]] const std::vector<double>& solution() const { return solution_; }
+  [[nodiscard]] Ipopt::SolverReturn solver_return() const { return solver_return_; }
+  [[nodiscard]] const NodeDynamics& dynamics() const { return dynamics_; }
+
+ private:
+  const MinimumTimeProblem& problem_;
+  Layout layout_;
+  NodeDynamics dynamics_;
+  std::vector<double> initial_;
+  double input_scale_[kInputs];
+  std::vector<double> solution_;
+  Ipopt::SolverReturn solver_return_{Ipopt::INTERNAL_ERROR};
+};
+
+const char* solver_return_name(Ipopt::SolverReturn status) {
+  switch (status) {
+    case Ipopt::SUCCESS: return "Solve_Succeeded";
+    case Ipopt::MAXITER_EXCEEDED: return "Maximum_Iterations_Exceeded";
+    case Ipopt::CPUTIME_EXCEEDED: return "Maximum_CpuTime_Exceeded";
+    case Ipopt::STOP_AT_TINY_STEP: return "Search_Direction_Becomes_Too_Small";
+    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return "Solved_To_Acceptable_Level";
+    case Ipopt::LOCAL_INFEASIBILITY: return "Infeasible_Problem_Detected";
+    case Ipopt::USER_REQUESTED_STOP: return "User_Requested_Stop";
+    case Ipopt::DIVERGING_ITERATES: return "Diverging_Iterates";
+    case Ipopt::RESTORATION_FAILURE: return "Restoration_Failed";
+    case Ipopt::ERROR_IN_STEP_COMPUTATION: return "Error_In_Step_Computation";
+    case Ipopt::INVALID_NUMBER_DETECTED: return "Invalid_Number_Detected";
+    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return "Not_Enough_Degrees_Of_Freedom";
+    default: return "Internal_Error";
+  }
+}
+
+void validate_axis(const std::string& name, const AxisRange& axis) {
+  common::require_finite(name + ".min_position", axis.min_position);
+  common::require_finite(name + ".max_position", axis.max_position);
+  common::require_greater(name + ".max_position", axis.max_position, axis.min_position);
+  common::require_in_range(name + ".start", axis.start, axis.min_position, axis.max_position);
+  common::require_in_range(name + ".target", axis.target, axis.min_position, axis.max_position);
+  common::require_greater(name + ".max_speed", axis.max_speed, 0.0);
+  common::require_finite(name + ".max_speed", axis.max_speed);
+  common::require_greater(name + ".max_acceleration", axis.max_acceleration, 0.0);
+  common::require_finite(name + ".max_acceleration", axis.max_acceleration);
+}
+
+// The initial guess of the header: each axis on its linear profile, the passive coordinates by RK4
+// along it, stretched to the longest axis.
+std::vector<double> initial_guess(const MinimumTimeProblem& problem, const Layout& layout, double& duration) {
+  namespace tp = trajectory_planner;
+  const double gravity = problem.model->parameters().gravity;
+  const bool second_driven = layout.voltages > 1;
+  tp::TimeOptimalProfile trolley;
+  tp::TimeOptimalProfile second;
+  tp::TrapezoidProfile hoist;
+  const double frequency = std::sqrt(gravity / std::max(problem.hoist.start, problem.hoist.target));
+  (void)trolley.plan(problem.trolley.start, problem.trolley.target,
+                     {problem.trolley.max_speed, problem.trolley.max_acceleration}, frequency);
+  if (second_driven) {
+    (void)second.plan(problem.second.start, problem.second.target,
+                      {problem.second.max_speed, problem.second.max_acceleration}, frequency);
+  }
+  hoist.plan(problem.hoist.start, problem.hoist.target, {problem.hoist.max_speed, problem.hoist.max_acceleration});
+  duration = std::max({trolley.duration(), second.duration(), hoist.duration(), 0.1});
+
+  std::vector<double> x(static_cast<std::size_t>(layout.variable_count()), 0.0);
+  const int N = layout.nodes - 1;
+  NodeDynamics dynamics(problem, layout);
+  NodeVector z(layout.stride);
+  NodeVector k1, k2, k3, k4, v;
+  auto set_drives = [&](NodeVector& node, double t) {
+    const common::AxisReference a = trolley.sample(t);
+    node[layout.position(kTrolleyIndex)] = a.position;
+    node[layout.velocity(kTrolleyIndex)] = a.velocity;
+    node[layout.input(0)] = a.acceleration;
+    if (second_driven) {
+      const common::AxisReference b = second.sample(t);
+      node[layout.position(kSlewIndex)] = b.position;
+      node[layout.velocity(kSlewIndex)] = b.velocity;
+      node[layout.input(1)] = b.acceleration;
+    }
+    const common::AxisReference h = hoist.sample(t);
+    node[layout.cable_length()] = problem.hoist.start == problem.hoist.target ? problem.hoist.start : h.position;
+    node[layout.cable_rate()] = problem.hoist.start == problem.hoist.target ? 0.0 : h.velocity;
+    node[layout.input(2)] = problem.hoist.start == problem.hoist.target ? 0.0 : h.acceleration;
+  };
+  z.setZero();
+  set_drives(z, 0.0);
+  constexpr int kSubsteps = 10;
+  const double h = duration / N / kSubsteps;
+  for (int k = 0; k <= N; ++k) {
+    std::copy(z.data(), z.data() + layout.stride, x.begin() + k * layout.stride);
+    if (k == N) break;
+    for (int s = 0; s < kSubsteps; ++s) {
+      // RK4 on the passive coordinates; the drives follow their profiles exactly.
+      const double t = (k * kSubsteps + s) * h;
+      NodeVector stage = z;
+      dynamics.evaluate(stage.data(), k1, v);
+      stage.head(layout.states) = z.head(layout.states) + 0.5 * h * k1;
+      set_drives(stage, t + 0.5 * h);
+      dynamics.evaluate(stage.data(), k2, v);
+      stage.head(layout.states) = z.head(layout.states) + 0.5 * h * k2;
+      set_drives(stage, t + 0.5 * h);
+      dynamics.evaluate(stage.data(), k3, v);
+      stage.head(layout.states) = z.head(layout.states) + h * k3;
+      set_drives(stage, t + h);
+      dynamics.evaluate(stage.data(), k4, v);
+      z.head(layout.states) += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      set_drives(z, t + h);
+    }
+    for (int i = 0; i < layout.n; ++i) {  // keep the guess inside the swing bound
+      if (i == kTrolleyIndex || i == kSlewIndex) continue;
+      z[layout.position(i)] = std::clamp(z[layout.position(i)], -problem.max_swing, problem.max_swing);
+    }
+  }
+  x[static_cast<std::size_t>(layout.duration_index())] = duration;
+  return x;
+}
+
+}  // namespace
+
+double drive_voltage(double force, double force_per_volt, double velocity, const common::AxisFriction& friction,
+                     double smoothing_speed) noexcept {
+  const double positive = 0.5 * (1.0 + std::tanh(velocity / smoothing_speed));
+  const double friction_volts = positive * (friction.coulomb_positive + friction.viscous_positive * velocity) +
+                                (1.0 - positive) * (-friction.coulomb_negative + friction.viscous_negative * velocity);
+  return force / force_per_volt + friction_volts;
+}
+
+void validate(const MinimumTimeProblem& problem) {
+  if (!problem.model) throw common::ConfigError("minimum_time.model: no crane model");
+  const int n = problem.model->coordinate_count();
+  if (n != plant::kNumCoordinates && n != plant::kMaxCoordinates) {
+    throw common::ConfigError("minimum_time.model: plant.rope.enabled = true is not modelled by the bound (its rest "
+                              "stretch depends on the cable length); coordinates = " + std::to_string(n));
+  }
+  validate_axis("minimum_time.trolley", problem.trolley);
+  if (second_axis_driven(*problem.model)) validate_axis("minimum_time.second", problem.second);
+  validate_axis("minimum_time.hoist", problem.hoist);
+  common::require_greater("minimum_time.hoist.min_position", problem.hoist.min_position, 0.0);
+  common::require_greater("minimum_time.voltage_limit", problem.voltage_limit, 0.0);
+  common::require_finite("minimum_time.voltage_limit", problem.voltage_limit);
+  common::require_in_range("minimum_time.max_swing", problem.max_swing, 1e-3, 1.5);
+  common::require_in_range("minimum_time.friction_smoothing_speed", problem.friction_smoothing_speed, 1e-6, 1.0);
+  common::require_in_range("minimum_time.intervals", problem.intervals, 4, 2000);
+  common::require_in_range("minimum_time.input_smoothing", problem.input_smoothing, 0.0, 1.0);
+  common::require_in_range("minimum_time.tolerance", problem.tolerance, 1e-14, 1e-2);
+  common::require_in_range("minimum_time.max_iterations", problem.max_iterations, 1, 1e6);
+  common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
+  common::validate(problem.second_friction, "minimum_time.second_friction");
+}
+
+MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
+  validate(problem);
+  Layout layout;
+  layout.n = problem.model->coordinate_count();
+  layout.states = 2 * layout.n + 2;
+  layout.stride = layout.states + kInputs;
+  layout.nodes = problem.intervals + 1;
+  layout.voltages = second_axis_driven(*problem.model) ? 2 : 1;
+
+  MinimumTimeResult result;
+  std::vector<double> guess = initial_guess(problem, layout, result.initial_guess_duration);
+  Ipopt::SmartPtr<MinimumTimeProgram> program = new MinimumTimeProgram(problem, layout, std::move(guess));
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->Options()->SetIntegerValue("print_level", 0);
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetNumericValue("tol", problem.tolerance);
+  app->Options()->SetNumericValue("constr_viol_tol", 1e-9);
+  app->Options()->SetIntegerValue("max_iter", problem.max_iterations);
+  app->Options()->SetStringValue("mu_strategy", "adaptive");
+  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+    result.status = "Ipopt_Initialization_Failed";
+    return result;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(program);
+  result.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.status = solver_return_name(program->solver_return());
+  result.solved = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+  if (IsValid(app->Statistics())) result.iterations = app->Statistics()->IterationCount();
+  const std::vector<double>& x = program->solution();
+  if (x.size() != static_cast<std::size_t>(layout.variable_count())) {
+    result.solved = false;
+    return result;
+  }
+
+  std::vector<double> g(static_cast<std::size_t>(layout.constraint_count()));
+  program->evaluate_constraints(x.data(), g.data());
+  for (int r = 0; r < layout.defect_rows(); ++r) result.max_defect = std::max(result.max_defect, std::abs(g[r]));
+
+  result.duration = x[static_cast<std::size_t>(layout.duration_index())];
+  result.nodes.resize(static_cast<std::size_t>(layout.nodes));
+  for (int k = 0; k < layout.nodes; ++k) {
+    const double* z = x.data() + k * layout.stride;
+    TrajectoryNode& node = result.nodes[static_cast<std::size_t>(k)];
+    node.time = result.duration * k / problem.intervals;
+    for (int i = 0; i < layout.n; ++i) {
+      node.state.position[i] = z[layout.position(i)];
+      node.state.velocity[i] = z[layout.velocity(i)];
+    }
+    node.cable_length = z[layout.cable_length()];
+    node.cable_length_rate = z[layout.cable_rate()];
+    node.trolley_acceleration = z[layout.input(0)];
+    node.second_acceleration = z[layout.input(1)];
+    node.hoist_acceleration = z[layout.input(2)];
+    const double* v = g.data() + layout.defect_rows() + k * layout.voltages;
+    node.trolley_voltage = v[0];
+    node.second_voltage = layout.voltages > 1 ? v[1] : 0.0;
+  }
+  return result;
+}
+
+TrajectoryNode sample(const MinimumTimeResult& result, double time) {
+  if (result.nodes.empty()) return {};
+  if (result.nodes.size() == 1 || !(time > 0.0)) return result.nodes.front();
+  if (time >= result.duration) return result.nodes.back();
+  const double position = time / result.duration * static_cast<double>(result.nodes.size() - 1);
+  const std::size_t k = std::min(static_cast<std::size_t>(position), result.nodes.size() - 2);
+  const double w = position - static_cast<double>(k);
+  const TrajectoryNode& a = result.nodes[k];
+  const TrajectoryNode& b = result.nodes[k + 1];
+  auto mix = [w](double p, double q) { return (1.0 - w) * p + w * q; };
+  TrajectoryNode s;
+  s.time = time;
+  s.state.position = (1.0 - w) * a.state.position + w * b.state.position;
+  s.state.velocity = (1.0 - w) * a.state.velocity + w * b.state.velocity;
+  s.cable_length = mix(a.cable_length, b.cable_length);
+  s.cable_length_rate = mix(a.cable_length_rate, b.cable_length_rate);
+  s.trolley_acceleration = mix(a.trolley_acceleration, b.trolley_acceleration);
+  s.second_acceleration = mix(a.second_acceleration, b.second_acceleration);
+  s.hoist_acceleration = mix(a.hoist_acceleration, b.hoist_acceleration);
+  s.trolley_voltage = mix(a.trolley_voltage, b.trolley_voltage);
+  s.second_voltage = mix(a.second_voltage, b.second_voltage);
+  return s;
+}
+
+}  // namespace crane::optimal_control
