@@ -29,6 +29,12 @@
 //       docs/optimal_control.md): T* on N and on 2N intervals (their difference: the
 //       discretization's), the linear profile's time, IPOPT's iterations and solve time, the largest
 //       drive voltage and swing; --out writes bound.csv and <maneuver>_bound.csv (the trajectory);
+//   crane_sim follow --config FILE [--maneuver M ...] [--intervals N] [--corners] [--out DIR]
+//       each demo maneuver followed in closed loop from its minimum-time trajectory (follower_run.hpp:
+//       the bound's feedforward with time-varying LQR, friction compensation on; docs/optimal_control.md):
+//       T*, the settle time and its ratio to T*, the final errors, swing, voltage and the supervisor's
+//       faults; --corners: also with the plant's cable length and load mass off by +-20 % and its
+//       friction by +-30 % (the eight corners) from what the follower assumes; --out: one CSV per run;
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -51,6 +57,7 @@
 #include "crane/stack/convergence_study.hpp"
 #include "crane/stack/gantry_gain_study.hpp"
 #include "crane/stack/in_process_stack.hpp"
+#include "crane/stack/follower_run.hpp"
 #include "crane/stack/maneuver_bound.hpp"
 
 namespace {
@@ -487,6 +494,63 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
   return failures == 0 ? 0 : 1;
 }
 
+int follow(const Selection& s, int intervals, bool corners, const optimal_control::FollowerWeights& weights,
+           const std::string& out_dir) {
+  const auto cfg = load_config(s);
+  if (!out_dir.empty()) fs::create_directories(out_dir);
+  const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
+  struct Corner {
+    std::string label;
+    plant::PlantMismatch mismatch;
+  };
+  std::vector<Corner> runs{{"nominal", {}}};
+  if (corners) {
+    for (const double length : {0.8, 1.2}) {
+      for (const double mass : {0.8, 1.2}) {
+        for (const double friction : {0.7, 1.3}) {
+          plant::PlantMismatch m;
+          m.cable_length_factor = length;
+          m.load_mass_factor = mass;
+          m.friction_factor = friction;
+          char label[64];
+          std::snprintf(label, sizeof label, "L%.1f_m%.1f_f%.1f", length, mass, friction);
+          runs.push_back({label, m});
+        }
+      }
+    }
+  }
+  std::printf("the minimum-time trajectory followed in closed loop (%s crane; feedforward + time-varying LQR, "
+              "friction compensation on)\n",
+              common::to_string(cfg.facts.crane_kind));
+  std::printf("%-14s %-16s %8s %8s %7s %10s %13s %13s %15s %6s %7s\n", "maneuver", "plant", "T* [s]", "settle_s",
+              "ratio", "pos_err_mm", bridge ? "bridge_err_mm" : "slew_err_mrad", "max_swing_deg", "resid_swing_deg",
+              "max_V", "faults");
+  int failures = 0;
+  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+    for (const auto& corner : runs) {
+      stack::FollowerRun run;
+      run.maneuver = m;
+      run.mismatch = corner.mismatch;
+      run.intervals = intervals;
+      run.weights = weights;
+      const auto r = stack::run_follower(cfg, run);
+      const auto& x = r.metrics;
+      constexpr double deg = 180.0 / std::numbers::pi;
+      std::printf("%-14s %-16s %8.4f %8s %7s %10.2f %13.2f %13.2f %15.3f %6.2f %7u\n", m.name.c_str(),
+                  corner.label.c_str(), r.bound.duration, stack::format_number(x.settle_time, 2).c_str(),
+                  stack::format_number(x.settle_time / r.bound.duration, 2).c_str(), 1e3 * x.final_position_error,
+                  bridge ? 1e3 * x.final_bridge_error : 1e3 * x.final_slew_error, deg * x.max_swing,
+                  deg * x.residual_swing, x.max_voltage, r.latched_faults);
+      if (r.latched_faults != 0) ++failures;
+      if (!out_dir.empty()) {
+        std::ofstream csv(fs::path(out_dir) / (m.name + "_follow_" + corner.label + ".csv"));
+        stack::write_csv(csv, r.records, bridge);
+      }
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}
+
 int converge(const Selection& s, const plant::IntegratorSettings& reference) {
   const auto cfg = load_config(s);
   std::printf("convergence study: %s against the reference %s\n", integrator_label(cfg.plant.integrator).c_str(),
@@ -667,6 +731,21 @@ int main(int argc, char** argv) {
   bound_cmd->add_option("--intervals", intervals, "collocation intervals N (also solved on 2N)")->check(CLI::Range(4, 1000));
   bound_cmd->add_option("--out", out_dir, "write bound.csv and <maneuver>_bound.csv here");
 
+  auto* follow_cmd = app.add_subcommand("follow", "each maneuver's minimum-time trajectory followed in closed loop");
+  common_options(follow_cmd);
+  int follow_intervals = 200;
+  bool corners = false;
+  follow_cmd->add_option("--intervals", follow_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
+  follow_cmd->add_flag("--corners", corners, "also the eight +-20 % length and mass, +-30 % friction corners");
+  follow_cmd->add_option("--out", out_dir, "write <maneuver>_follow_<plant>.csv here");
+  optimal_control::FollowerWeights weights;
+  follow_cmd->add_option("--position-weight", weights.position, "the LQR's acceptable position deviation [m or rad]")
+      ->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--swing-weight", weights.swing, "acceptable swing [rad]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--speed-weight", weights.speed, "acceptable speed deviation [m/s or rad/s]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--swing-rate-weight", weights.swing_rate, "acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--voltage-weight", weights.voltage, "acceptable input [V]")->check(CLI::PositiveNumber);
+
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
   gantry_cmd->add_option("--K", full_forward_gain, "forward gain K [V/m] of the full-state law (Figure 3.8), > 0")
@@ -686,6 +765,7 @@ int main(int argc, char** argv) {
     }
     if (*integrators_cmd) return integrators(s);
     if (*bound_cmd) return bound(s, intervals, out_dir);
+    if (*follow_cmd) return follow(s, follow_intervals, corners, weights, out_dir);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

@@ -1,0 +1,103 @@
+#pragma once
+// A closed-loop follower of a minimum-time trajectory (issue 32, item 2; docs/optimal_control.md):
+// the bound's drive forces as feedforward, plus time-varying LQR state feedback around the bound's
+// states, from the model's own linearization along the trajectory.
+//
+// At each sample t_k = k T_s of the trajectory (and at the rest state at the target after it ends):
+//   u_k = u_ff(t_k + T_s / 2) - K_k (z_k - z_ref(t_k)),   |u_k| <= voltage_limit
+// where
+//   z    the generalized positions and velocities of the model's driven and swing coordinates
+//        (crane_dynamics.hpp slots 0..3; a crane without a second drive axis, the gantry, keeps
+//        slots 0 and 1 only), [m, rad, rad or m, rad, m/s, rad/s, rad/s or m/s, rad/s]
+//   u    the drive voltages without friction [V] (the friction compensation stage adds the crane's
+//        friction, (3.1)-(3.5)): u_ff = the bound's voltage less its smoothed friction, the average
+//        over the sample (zero-order hold) taken at its middle
+//   K_k  from the backward Riccati recursion of the discrete linear-quadratic regulator,
+//        P_k = Q + A_k' P_k+1 (A_k - B_k K_k), K_k = (R + B_k' P_k+1 B_k)^-1 B_k' P_k+1 A_k
+//        (B. D. O. Anderson, J. B. Moore, "Optimal Control: Linear Quadratic Methods", 1990,
+//        section 2.3), started from the stationary solution at the target's rest state (the
+//        discrete algebraic Riccati equation, iterated to convergence): after the trajectory the
+//        law is the time-invariant LQR that holds the load at rest at the target
+//   A_k, B_k  the Jacobians of the model's zero-order-hold map over one sample (RK4, 4 sub-steps,
+//        the hoist following the trajectory) by central differences at (z_ref(t_k), u_ff): the
+//        plant's equations, not a second copy of them
+//   Q, R diagonal, Bryson's rule: 1 / (the acceptable deviation)^2 of each state and input
+//        (A. E. Bryson, Y.-C. Ho, "Applied Optimal Control", 1975, section 5.7).
+// The hoist is not a feedback axis: hoist_speed is the trajectory's cable-length rate.
+//
+// Errors: the constructor throws common::ConfigError naming the field for a model with more than
+// four coordinates (a hook or a rope), a non-positive weight, sample period or voltage limit, or a
+// trajectory that is not solved or has fewer than two nodes. step() is noexcept and allocates
+// nothing; a non-finite state gives 0 V (the safe output) and rejected_nonfinite.
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "crane/common/crane_signals.hpp"
+#include "crane/optimal_control/minimum_time.hpp"
+
+namespace crane::optimal_control {
+
+/// Acceptable deviations (Bryson's rule), each > 0.
+struct FollowerWeights {
+  double position{0.005};      // [m] trolley and bridge; [rad] the slew (the settle band of the demo table)
+  double swing{0.0087};        // [rad] both swing angles (0.5 deg)
+  double speed{0.05};          // [m/s or rad/s] drive axes
+  double swing_rate{0.05};     // [rad/s]
+  double voltage{0.2};         // [V] the input (measured on the demo maneuvers, docs/optimal_control.md)
+};
+
+struct FollowerParams {
+  double sample_period{0.01};  // [s] T_s, the control cycle, > 0
+  double voltage_limit{10.0};  // [V] |u| before friction, > 0
+  FollowerWeights weights{};
+};
+
+/// The law's output for one cycle.
+struct FollowerCommand {
+  double trolley_voltage{0.0};  // [V] without friction
+  double second_voltage{0.0};   // [V] the slew (tower) or the bridge (overhead); 0 on a gantry
+  double hoist_speed{0.0};      // [m/s] the trajectory's cable length rate (positive lowers)
+  common::AxisReference trolley;  // the reference at this cycle [m, m/s, m/s^2]
+  common::AxisReference second;   // [rad or m, ...]
+  common::AxisReference cable;    // [m, m/s, m/s^2]
+  double swing_in_plane{0.0};     // [rad] the trajectory's phi
+  double swing_out_of_plane{0.0};  // [rad] theta
+};
+
+class TrajectoryFollower {
+ public:
+  /// The follower of `trajectory` (solve_minimum_time of `problem`) on `problem.model`, the
+  /// controller's model of the crane. Throws common::ConfigError (see the header).
+  TrajectoryFollower(const MinimumTimeProblem& problem, const MinimumTimeResult& trajectory, const FollowerParams& params);
+
+  /// Cycle `k` (0 at the trajectory's start; k beyond its end: regulation at the target) from the
+  /// measured state in the model's slots (the estimate: positions, rates, swings; slots 2 and 3
+  /// ignored without a second drive). ok, or rejected_nonfinite (every voltage 0). Never throws,
+  /// never allocates.
+  [[nodiscard]] common::StepStatus step(std::size_t k, const plant::ModelState& measured,
+                                        FollowerCommand& command) const noexcept;
+
+  /// Samples of the trajectory (the last is its end, t >= T*).
+  [[nodiscard]] std::size_t samples() const noexcept { return gains_.size() - 1; }
+  /// The gain of sample k (clamped to the stationary one), rows: inputs, columns: the state z.
+  [[nodiscard]] const Eigen::MatrixXd& gain(std::size_t k) const noexcept;
+  /// The number of state coordinates of z (8, or 4 without a second axis).
+  [[nodiscard]] int state_size() const noexcept { return static_cast<int>(slots_.size()) * 2; }
+
+ private:
+  struct Sample {
+    plant::ModelState state;  // the reference in the model's slots
+    Eigen::Vector2d input;    // u_ff [V] (trolley, second)
+    TrajectoryNode node;      // the reference (rates, accelerations, the hoist)
+  };
+  std::vector<int> slots_;  // model coordinates in z
+  std::vector<Sample> samples_;
+  std::vector<Eigen::MatrixXd> gains_;  // K_k; the last is the stationary gain at the target
+  double voltage_limit_;
+  bool second_drive_;
+};
+
+}  // namespace crane::optimal_control
