@@ -19,6 +19,7 @@
 
 namespace {
 
+using crane::stack::find_maneuver;
 using crane::stack::InProcessStack;
 using crane::stack::ManeuverConfig;
 using crane::stack::StackConfig;
@@ -32,13 +33,6 @@ StackConfig lab(bool adaptation) {
   return c;
 }
 
-const ManeuverConfig& maneuver(const StackConfig& c, const std::string& name) {
-  for (const auto& m : c.maneuvers) {
-    if (m.name == name) return m;
-  }
-  throw std::runtime_error("no maneuver " + name);
-}
-
 // ---- Payload mass ---------------------------------------------------------------------------------
 
 struct MassRun {
@@ -50,7 +44,7 @@ struct MassRun {
 // every cycle from the move's start on.
 MassRun heavy_combined_run() {
   const StackConfig cfg = lab(true);
-  const ManeuverConfig& m = maneuver(cfg, "combined");
+  const ManeuverConfig& m = find_maneuver(cfg, "combined");
   crane::stack::InProcessOptions options;
   options.controller = crane::stack::choose_controller("delay1", m, false);
   options.mismatch.load_mass_factor = kHeavy;
@@ -114,7 +108,7 @@ struct RowCase {
 // in, its slew lagged the reference by 0.18 rad and caught up at 2.03 rad/s, and the supervisor
 // stopped it (slew_overspeed; architecture.md); the gain schedule with full ones.
 ManeuverConfig learning_move(const StackConfig& cfg, const ManeuverConfig& measured, const std::string& controller) {
-  ManeuverConfig back = maneuver(cfg, "combined");
+  ManeuverConfig back = find_maneuver(cfg, "combined");
   back.name = "combined backwards";
   back.initial_trolley_position = back.trolley_target;
   back.initial_slew_angle = back.slew_target;
@@ -131,7 +125,7 @@ Row run_row(const std::string& controller, const std::string& maneuver_name, con
   StackConfig cfg = lab(c.adaptation);
   cfg.state_estimator.adaptation.adapt_friction = c.adapt_friction;
   cfg.facts.crane.load_mass *= c.configured_factor;
-  const ManeuverConfig& m = maneuver(cfg, maneuver_name);
+  const ManeuverConfig& m = find_maneuver(cfg, maneuver_name);
   crane::stack::InProcessRun run;
   run.maneuver = m;
   run.controller = crane::stack::choose_controller(controller, m, false);
@@ -214,7 +208,7 @@ struct FrictionRun {
 // the plant's friction is `change` times the configured from the end of the first move on.
 FrictionRun friction_run(bool adaptation, double change, int moves, double step_size) {
   const StackConfig cfg = lab(adaptation);
-  const ManeuverConfig& base = maneuver(cfg, "combined");
+  const ManeuverConfig& base = find_maneuver(cfg, "combined");
   crane::stack::InProcessOptions options;
   options.controller = crane::stack::choose_controller("delay1", base, false);
   options.initial_trolley_position = 0.6;

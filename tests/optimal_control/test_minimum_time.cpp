@@ -21,13 +21,6 @@ stack::StackConfig config(const std::string& name) {
   return stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/" + name);
 }
 
-const stack::ManeuverConfig& maneuver(const stack::StackConfig& cfg, const std::string& name) {
-  for (const auto& m : cfg.maneuvers) {
-    if (m.name == name) return m;
-  }
-  throw std::runtime_error("no maneuver " + name);
-}
-
 double max_abs_swing(const optimal_control::MinimumTimeResult& r) {
   double s = 0.0;
   for (const auto& n : r.nodes) {
@@ -42,7 +35,7 @@ double max_abs_swing(const optimal_control::MinimumTimeResult& r) {
 // within 1 % of it (8 deg of swing: the nonlinearity is small).
 TEST(MinimumTime, TrolleyMoveRespectsTheLinearBangBangTime) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const auto& m = maneuver(cfg, "trolley");
+  const auto& m = stack::find_maneuver(cfg, "trolley");
   const auto result = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, 100));
   ASSERT_TRUE(result.solved) << result.status;
   trajectory_planner::TimeOptimalProfile linear;
@@ -92,7 +85,8 @@ TEST(MinimumTime, RefiningTheGridChangesTStarByLessThanOnePercent) {
 // within 0.1 deg, and the swing it passes through is the bound's to 1 %.
 TEST(MinimumTime, TheBoundsTrolleyAccelerationLeavesThePendulumAtRest) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const auto result = optimal_control::solve_minimum_time(stack::bound_problem(cfg, maneuver(cfg, "trolley"), 200));
+  const auto result =
+      optimal_control::solve_minimum_time(stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), 200));
   ASSERT_TRUE(result.solved) << result.status;
   const double g = cfg.facts.crane.gravity;
   const double L = cfg.facts.crane.cable_length;
@@ -126,7 +120,7 @@ TEST(MinimumTime, TheBoundsTrolleyAccelerationLeavesThePendulumAtRest) {
 // trolley costs time.
 TEST(MinimumTime, TheSlewsBoundUsesTheTrolley) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const auto& m = maneuver(cfg, "slew");
+  const auto& m = stack::find_maneuver(cfg, "slew");
   auto problem = stack::bound_problem(cfg, m, 100);
   const auto free = optimal_control::solve_minimum_time(problem);
   problem.trolley.min_position = m.initial_trolley_position - 1e-6;  // held
@@ -145,7 +139,7 @@ TEST(MinimumTime, TheSlewsBoundUsesTheTrolley) {
 
 TEST(MinimumTime, AMalformedProblemIsRefusedNamingTheField) {
   const auto cfg = config("lab_tower_crane.yaml");
-  auto problem = stack::bound_problem(cfg, maneuver(cfg, "trolley"), 100);
+  auto problem = stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), 100);
   auto message = [](const optimal_control::MinimumTimeProblem& p) {
     try {
       optimal_control::validate(p);

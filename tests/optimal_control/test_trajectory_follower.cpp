@@ -24,13 +24,6 @@ stack::StackConfig config(const std::string& name) {
   return stack::load_stack_config(std::string(CRANE_SOURCE_DIR) + "/deploy/config/" + name);
 }
 
-const stack::ManeuverConfig& maneuver(const stack::StackConfig& cfg, const std::string& name) {
-  for (const auto& m : cfg.maneuvers) {
-    if (m.name == name) return m;
-  }
-  throw std::runtime_error("no maneuver " + name);
-}
-
 // The model integrated by RK4 over one sample with the drive voltages held (no friction: the
 // follower's voltages are those before the friction compensation).
 plant::ModelState advance(const plant::CraneDynamics& model, plant::ModelState s, double period, double trolley_voltage,
@@ -71,7 +64,7 @@ Solved solve(const stack::StackConfig& cfg, const stack::ManeuverConfig& m) {
 // target: the feedforward is the bound's and the feedback holds what the 10 ms hold adds.
 TEST(TrajectoryFollower, EndsTheSlewAtRestOnItsModel) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const auto& m = maneuver(cfg, "slew");
+  const auto& m = stack::find_maneuver(cfg, "slew");
   const Solved b = solve(cfg, m);
   ASSERT_TRUE(b.result.solved) << b.result.status;
   const optimal_control::TrajectoryFollower follower(b.problem, b.result, {});
@@ -104,7 +97,7 @@ TEST(TrajectoryFollower, EndsTheSlewAtRestOnItsModel) {
 // On the reference the output is the feedforward alone: the bound's voltage less its friction.
 TEST(TrajectoryFollower, OnTheReferenceTheOutputIsTheFeedforward) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const Solved b = solve(cfg, maneuver(cfg, "trolley"));
+  const Solved b = solve(cfg, stack::find_maneuver(cfg, "trolley"));
   ASSERT_TRUE(b.result.solved);
   const optimal_control::TrajectoryFollower follower(b.problem, b.result, {});
   EXPECT_EQ(follower.state_size(), 8);
@@ -129,7 +122,7 @@ TEST(TrajectoryFollower, OnTheReferenceTheOutputIsTheFeedforward) {
 
 TEST(TrajectoryFollower, RefusesWhatItCannotFollow) {
   const auto cfg = config("lab_tower_crane.yaml");
-  const Solved b = solve(cfg, maneuver(cfg, "trolley"));
+  const Solved b = solve(cfg, stack::find_maneuver(cfg, "trolley"));
   ASSERT_TRUE(b.result.solved);
   optimal_control::FollowerParams bad;
   bad.weights.voltage = 0.0;

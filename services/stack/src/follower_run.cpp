@@ -8,6 +8,7 @@
 #include "crane/common/protocol_signals.hpp"
 #include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/plant/crane_simulator.hpp"
+#include "crane/stack/in_process_stack.hpp"
 #include "crane/stack/maneuver_bound.hpp"
 #include "crane/state_estimator/state_estimator_stage.hpp"
 #include "crane/supervisor/actuation_gate.hpp"
@@ -37,14 +38,12 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   const optimal_control::TrajectoryFollower follower(problem, result.bound, follower_params);
   result.follower_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
 
-  plant::PlantStageParams plant_params;
-  plant_params.simulator = cfg.plant;
-  plant_params.simulator.initial_state.trolley_position = m.initial_trolley_position;
-  plant_params.simulator.initial_state.slew_angle = m.initial_slew_angle;
-  plant_params.simulator.initial_state.bridge_position = m.initial_bridge_position;
-  plant_params.gate = cfg.actuation;
-  plant_params.mismatch = run.mismatch;
-  plant::PlantStage plant(plant_params);
+  InProcessOptions plant_options;
+  plant_options.mismatch = run.mismatch;
+  plant_options.initial_trolley_position = m.initial_trolley_position;
+  plant_options.initial_slew_angle = m.initial_slew_angle;
+  plant_options.initial_bridge_position = m.initial_bridge_position;
+  plant::PlantStage plant(plant_stage_params(cfg, plant_options));
   state_estimator::StateEstimatorStage estimator(cfg.state_estimator);
   auto compensation_params = cfg.friction_compensation;
   if (!run.friction_compensation) compensation_params.enabled = false;

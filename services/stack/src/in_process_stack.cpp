@@ -14,16 +14,6 @@
 namespace crane::stack {
 namespace {
 
-plant::PlantStageParams plant_params(const StackConfig& cfg, const InProcessOptions& o) {
-  plant::PlantStageParams p;
-  p.simulator = cfg.plant;
-  p.simulator.initial_state.trolley_position = o.initial_trolley_position;
-  p.simulator.initial_state.slew_angle = o.initial_slew_angle;
-  p.simulator.initial_state.bridge_position = o.initial_bridge_position;
-  p.gate = cfg.actuation;
-  p.mismatch = o.mismatch;
-  return p;
-}
 anti_swing::AntiSwingStageParams anti_swing_params(const StackConfig& cfg, const InProcessOptions& o) {
   auto p = cfg.anti_swing;
   p.law = o.controller.anti_swing;
@@ -49,10 +39,21 @@ supervisor::SupervisorParams supervisor_params(const StackConfig& cfg) {
 
 }  // namespace
 
+plant::PlantStageParams plant_stage_params(const StackConfig& cfg, const InProcessOptions& o) {
+  plant::PlantStageParams p;
+  p.simulator = cfg.plant;
+  p.simulator.initial_state.trolley_position = o.initial_trolley_position;
+  p.simulator.initial_state.slew_angle = o.initial_slew_angle;
+  p.simulator.initial_state.bridge_position = o.initial_bridge_position;
+  p.gate = cfg.actuation;
+  p.mismatch = o.mismatch;
+  return p;
+}
+
 struct InProcessStack::Stages {
   Stages(const StackConfig& cfg, const InProcessOptions& o)
       : dt(cfg.facts.sample_period),
-        plant(plant_params(cfg, o)),
+        plant(plant_stage_params(cfg, o)),
         estimator(cfg.state_estimator),
         planner(cfg.trajectory_planner, dt),
         anti_swing(anti_swing_params(cfg, o)),

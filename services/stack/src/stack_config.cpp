@@ -1,6 +1,7 @@
 #include "crane/stack/stack_config.hpp"
 
 #include <numbers>
+#include <stdexcept>
 
 #include "crane/config/config_document.hpp"
 
@@ -67,5 +68,12 @@ StackConfig parse_stack_config(const std::string& yaml_text, const std::string& 
 }
 
 StackConfig load_stack_config(const std::string& path) { return read(config::ConfigDocument::load(path)); }
+
+const ManeuverConfig& find_maneuver(const StackConfig& cfg, const std::string& name) {
+  for (const auto& m : cfg.maneuvers) {
+    if (m.name == name) return m;
+  }
+  throw std::out_of_range("no demo maneuver '" + name + "' in the config");
+}
 
 }  // namespace crane::stack

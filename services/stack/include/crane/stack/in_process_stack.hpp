@@ -39,6 +39,10 @@ struct InProcessOptions {
   double initial_bridge_position{0.0};    // [m] overhead crane
 };
 
+/// The plant stage of a run: the configured simulator and actuation gate, at rest at the options'
+/// initial trolley position [m], slew angle [rad] and bridge position [m], with their mismatch.
+[[nodiscard]] plant::PlantStageParams plant_stage_params(const StackConfig& cfg, const InProcessOptions& options);
+
 class InProcessStack {
  public:
   /// Throws common::ConfigError for invalid params.

@@ -64,4 +64,7 @@ struct StackConfig {
 /// Same, from YAML text (tests); `source_name` prefixes the messages.
 [[nodiscard]] StackConfig parse_stack_config(const std::string& yaml_text, const std::string& source_name);
 
+/// The demo maneuver called `name` of `cfg`. Throws std::out_of_range naming it when there is none.
+[[nodiscard]] const ManeuverConfig& find_maneuver(const StackConfig& cfg, const std::string& name);
+
 }  // namespace crane::stack
