@@ -49,21 +49,23 @@ common::CraneParameters read_crane(YamlSection& s) {
   return c;
 }
 
+common::Zone read_zone(YamlSection& z) {
+  common::Zone zone;
+  zone.name = z.text("name");
+  zone.polygon = z.points("polygon");
+  zone.bottom = z.number("bottom", -1.0e3, 1.0e3);
+  zone.top = z.number("top", -1.0e3, 1.0e3);
+  zone.enabled = z.flag("enabled");
+  zone.fixed = z.flag("fixed");
+  z.finish();
+  return zone;
+}
+
 common::Site read_site(YamlSection& s) {
   common::Site site;
   site.jib_height = s.number("jib_height", 0.0, 1.0e3);
   site.zone_clearance = s.number("zone_clearance", 0.0, 100.0);
-  for (auto& z : s.list("zones")) {
-    common::Zone zone;
-    zone.name = z.text("name");
-    zone.polygon = z.points("polygon");
-    zone.bottom = z.number("bottom", -1.0e3, 1.0e3);
-    zone.top = z.number("top", -1.0e3, 1.0e3);
-    zone.enabled = z.flag("enabled");
-    zone.fixed = z.flag("fixed");
-    z.finish();
-    site.zones.push_back(std::move(zone));
-  }
+  for (auto& z : s.list("zones")) site.zones.push_back(read_zone(z));
   s.finish();
   common::validate(site, "site");
   return site;
@@ -113,7 +115,7 @@ ConfigDocument::ConfigDocument(YAML::Node root, std::string source_name)
   });
 }
 
-ConfigDocument ConfigDocument::parse(const std::string& yaml_text, const std::string& source_name) {
+YAML::Node parse_yaml_mapping(const std::string& yaml_text, const std::string& source_name) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -122,15 +124,23 @@ ConfigDocument ConfigDocument::parse(const std::string& yaml_text, const std::st
                       error.msg);
   }
   if (!root.IsMap()) throw ConfigError(source_name + ": the document must be a mapping of fields");
-  return ConfigDocument(root, source_name);
+  return root;
 }
 
-ConfigDocument ConfigDocument::load(const std::string& path) {
+std::string read_text_file(const std::string& path) {
   std::ifstream file(path);
   if (!file) throw ConfigError(path + ": cannot be read");
   std::stringstream text;
   text << file.rdbuf();
-  return parse(text.str(), std::filesystem::path(path).filename().string());
+  return text.str();
+}
+
+ConfigDocument ConfigDocument::parse(const std::string& yaml_text, const std::string& source_name) {
+  return ConfigDocument(parse_yaml_mapping(yaml_text, source_name), source_name);
+}
+
+ConfigDocument ConfigDocument::load(const std::string& path) {
+  return parse(read_text_file(path), std::filesystem::path(path).filename().string());
 }
 
 void ConfigDocument::check_blocks(std::initializer_list<std::string_view> known) const {

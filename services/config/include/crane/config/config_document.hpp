@@ -28,6 +28,14 @@ namespace crane::config {
 /// Reads the `site:` block (jib_height, zone_clearance, zones: name, polygon [[x, y], ...], bottom, top,
 /// enabled). Throws common::ConfigError naming the field or the zone (common::validate(Site)).
 [[nodiscard]] common::Site read_site(YamlSection& block);
+/// Reads one zone of a `zones:` list (name, polygon [[x, y], ...], bottom, top, enabled, fixed); the
+/// caller validates the zones (common::validate(Site)).
+[[nodiscard]] common::Zone read_zone(YamlSection& zone);
+/// Parses YAML text whose root must be a mapping. Throws common::ConfigError prefixed with
+/// `source_name`: "YAML syntax error at line N: ..." or "the document must be a mapping of fields".
+[[nodiscard]] YAML::Node parse_yaml_mapping(const std::string& yaml_text, const std::string& source_name);
+/// The whole text of `path`. Throws common::ConfigError "<path>: cannot be read".
+[[nodiscard]] std::string read_text_file(const std::string& path);
 /// Reads a bridge block (common::BridgeParameters: drive_mass, drive_gain, friction {the six
 /// volt-equivalents of the crane's frictions}) and validates it.
 [[nodiscard]] common::BridgeParameters read_bridge(YamlSection& block);

@@ -1,0 +1,98 @@
+#pragma once
+// A construction site of several cranes (issue 34): where each crane stands, the shape of its
+// structure, its drives' stopping data, its DDS domain, its priority, and the site's fixed zones.
+// One YAML file (deploy/config/site_*.yaml), read by site_file.hpp strictly like the crane configs;
+// validate() is the one place of the site's structural rules. Errors are common::ConfigError
+// naming the field, the value and the bound, e.g.
+//   "site.cranes[2] (tc3).jib_length = 0 is out of range: must be in [0.1, 200]"
+//
+// Site frame: origin anywhere on the ground, x east, y north, z up [m]. A crane's slew angle
+// (its own encoder's, crane frame of common/site.hpp) points its jib at the site heading
+// `slew_zero_heading + slew` [rad], counter-clockwise from +x.
+//
+// The structure is the usual tower-crane outline (EN 14439, the industrial anti-collision
+// systems' "jib box"): a square mast from the ground to the jib; the jib from the slew axis to its
+// tip and the counter-jib from the axis backwards, both of cross-section width x depth, their
+// lower chord at `jib_height` (where the trolley runs and the hoist cable leaves it); the hook
+// between `hook_height_min` and `hook_height_max`; the trolley between `trolley_min` and
+// `trolley_max` from the axis. Apex, cat-head and pendants are not modelled (say so in a site
+// survey where they stand above the jib).
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "crane/common/crane_parameters.hpp"
+#include "crane/common/site.hpp"
+
+namespace crane::anti_collision {
+
+/// What a crane's drives do when told to stop; the envelope of its stopping motion (crane_geometry.hpp).
+struct StoppingData {
+  double reaction_time{0.1};          // [s] from the decision to the drives acting (one cycle and the link)
+  double trolley_deceleration{0.5};   // [m/s^2] a soft (controlled) stop of the trolley
+  double slew_deceleration{0.5};      // [rad/s^2] a soft stop of the slew
+  double hoist_deceleration{0.5};     // [m/s^2] a soft stop of the hoist
+  double brake_deceleration_factor{3.0};  // emergency stop (brakes) decelerates this many times faster, >= 1
+  bool shaped_soft_stop{true};        // the soft stop is input shaped (ZV): it travels v T/4 further and
+                                      // leaves no residual swing (Singer & Seering 1990)
+};
+
+/// One crane of the site.
+struct SiteCrane {
+  std::string name;                   // unique on the site ("tc1")
+  common::CraneKind kind{common::CraneKind::tower};  // tower only in this version
+  common::Point2 base{0.0, 0.0};      // [m] slew axis at the ground, site frame
+  double slew_zero_heading{0.0};      // [rad] site heading of the jib at slew angle 0, in [-pi, pi]
+  double jib_height{2.0};             // [m] lower chord of the jib above the ground (the trolley's rails)
+  double jib_length{1.0};             // [m] slew axis to jib tip, > trolley_max
+  double counter_jib_length{0.3};     // [m] slew axis to counter-jib tail
+  double jib_width{0.1};              // [m] width of the jib's and counter-jib's cross-section
+  double jib_depth{0.1};              // [m] depth (height) of that cross-section
+  double mast_width{0.1};             // [m] side of the square mast
+  double trolley_min{0.1};            // [m] trolley travel from the slew axis, trolley_min < trolley_max
+  double trolley_max{0.9};            // [m]
+  double hook_height_min{0.0};        // [m] lowest the load's centre goes above the ground
+  double hook_height_max{1.5};        // [m] highest, below jib_height
+  double load_radius{0.1};            // [m] radius of a sphere enclosing the load and the hook block
+  double max_trolley_speed{0.5};      // [m/s] the drives' rated speeds (stopping distances)
+  double max_slew_rate{1.0};          // [rad/s]
+  double max_hoist_speed{0.2};        // [m/s]
+  StoppingData stopping;
+  int domain_id{0};                   // the crane's own DDS domain, unique on the site, in [0, 232]
+  int priority{0};                    // higher wins a conflict (0: none); see the site rules
+};
+
+/// Distances every rule of the site keeps between any two parts of two cranes [m]; 0 < stop <
+/// slow_down < warning.
+struct Margins {
+  double warning{1.0};    // operators are warned
+  double slow_down{0.5};  // the crane slows to its creep speed
+  double stop{0.2};       // the crane stops (a soft stop whose envelope keeps this margin)
+};
+
+struct SiteLayout {
+  std::string name;                   // the site's name (messages, the HMI)
+  std::vector<SiteCrane> cranes;      // 1 to kMaxCranes
+  std::vector<common::Zone> zones;    // fixed zones in the site frame (buildings, roads, neighbours' plots)
+  Margins margins;
+  double link_deadline{0.3};          // [s] a crane hears nothing from the site service this long: it stops
+                                      // moving into shared airspace (the supervisor's rule)
+
+  static constexpr std::size_t kMaxCranes = 20;
+};
+
+/// Checks every field and the site's structure. Throws common::ConfigError naming the field, the
+/// value and the bound when: a number is out of its range (site_layout.cpp's ranges, which the file
+/// reader uses too); a name
+/// or a domain id is repeated; a crane's trolley range leaves its jib, its hook range reaches its
+/// jib; the margins are not 0 < stop < slow_down < warning; a zone is malformed (common::validate);
+/// two masts stand within each other's margins; or a crane's jib can reach another crane's mast
+/// and does not pass above that crane's highest part by the stop margin (the lower crane's jib
+/// would hit the higher crane's mast; EN 14439's vertical clearance between cranes).
+void validate(const SiteLayout& layout, const std::string& prefix = "site");
+
+/// The index of the crane called `name`, or -1.
+[[nodiscard]] int find_crane(const SiteLayout& layout, const std::string& name) noexcept;
+
+}  // namespace crane::anti_collision

@@ -1,0 +1,89 @@
+#include "crane/anti_collision/site_file.hpp"
+
+#include <filesystem>
+#include <utility>
+
+#include "crane/common/validation.hpp"
+#include "crane/config/config_document.hpp"
+#include "crane/config/yaml_section.hpp"
+#include "site_ranges.hpp"
+
+namespace crane::anti_collision {
+namespace {
+
+using common::ConfigError;
+using namespace detail;
+
+StoppingData read_stopping(config::YamlSection s) {
+  StoppingData d;
+  d.reaction_time = s.number("reaction_time", kReaction.lower, kReaction.upper);
+  d.trolley_deceleration = s.number("trolley_deceleration", kDeceleration.lower, kDeceleration.upper);
+  d.slew_deceleration = s.number("slew_deceleration", kDeceleration.lower, kDeceleration.upper);
+  d.hoist_deceleration = s.number("hoist_deceleration", kDeceleration.lower, kDeceleration.upper);
+  d.brake_deceleration_factor = s.number("brake_deceleration_factor", kBrakeFactor.lower, kBrakeFactor.upper);
+  d.shaped_soft_stop = s.flag("shaped_soft_stop");
+  s.finish();
+  return d;
+}
+
+}  // namespace
+
+SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& source_name) {
+  const YAML::Node root = config::parse_yaml_mapping(yaml_text, source_name);
+  SiteLayout layout;
+  try {
+    config::YamlSection document(root, "");
+    config::YamlSection s = document.child("site");
+    layout.name = s.text("name");
+    config::YamlSection margins = s.child("margins");
+    layout.margins.warning = margins.number("warning", kMargin.lower, kMargin.upper);
+    layout.margins.slow_down = margins.number("slow_down", kMargin.lower, kMargin.upper);
+    layout.margins.stop = margins.number("stop", kMargin.lower, kMargin.upper);
+    margins.finish();
+    layout.link_deadline = s.number("link_deadline", kDeadline.lower, kDeadline.upper);
+    for (auto& z : s.list("zones")) layout.zones.push_back(config::read_zone(z));
+    for (auto& c : s.list("cranes")) {
+      SiteCrane crane;
+      crane.name = c.text("name");
+      crane.kind = common::crane_kind_from_string(c.text("kind", {"tower"}), c.field("kind"));
+      config::YamlSection base = c.child("base");
+      crane.base = {base.number("x", kCoordinate.lower, kCoordinate.upper),
+                    base.number("y", kCoordinate.lower, kCoordinate.upper)};
+      base.finish();
+      crane.slew_zero_heading = c.number("slew_zero_heading", kHeading.lower, kHeading.upper);
+      crane.jib_height = c.number("jib_height", kHeight.lower, kHeight.upper);
+      crane.jib_length = c.number("jib_length", kLength.lower, kLength.upper);
+      crane.counter_jib_length = c.number("counter_jib_length", kCounterJib.lower, kCounterJib.upper);
+      crane.jib_width = c.number("jib_width", kSection.lower, kSection.upper);
+      crane.jib_depth = c.number("jib_depth", kSection.lower, kSection.upper);
+      crane.mast_width = c.number("mast_width", kSection.lower, kSection.upper);
+      crane.trolley_min = c.number("trolley_min", kTrolley.lower, kTrolley.upper);
+      crane.trolley_max = c.number("trolley_max", kTrolley.lower, kTrolley.upper);
+      crane.hook_height_min = c.number("hook_height_min", kHook.lower, kHook.upper);
+      crane.hook_height_max = c.number("hook_height_max", kHook.lower, kHook.upper);
+      crane.load_radius = c.number("load_radius", kLoadRadius.lower, kLoadRadius.upper);
+      crane.max_trolley_speed = c.number("max_trolley_speed", kSpeed.lower, kSpeed.upper);
+      crane.max_slew_rate = c.number("max_slew_rate", kSpeed.lower, kSpeed.upper);
+      crane.max_hoist_speed = c.number("max_hoist_speed", kSpeed.lower, kSpeed.upper);
+      crane.stopping = read_stopping(c.child("stopping"));
+      crane.domain_id = c.integer("domain_id", 0, kMaxDomain);
+      crane.priority = c.integer("priority", 0, kMaxPriority);
+      c.finish();
+      layout.cranes.push_back(std::move(crane));
+    }
+    s.finish();
+    document.finish();
+    validate(layout, "site");
+  } catch (const ConfigError& error) {
+    throw ConfigError(source_name + ": " + error.what());
+  } catch (const YAML::Exception& error) {
+    throw ConfigError(source_name + ": " + error.what());
+  }
+  return layout;
+}
+
+SiteLayout load_site_layout(const std::string& path) {
+  return parse_site_layout(config::read_text_file(path), std::filesystem::path(path).filename().string());
+}
+
+}  // namespace crane::anti_collision

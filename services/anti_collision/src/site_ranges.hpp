@@ -1,0 +1,30 @@
+#pragma once
+// The range of each number of the site file: one place for the reader (site_file.cpp) and
+// validate() (site_layout.cpp).
+
+#include <numbers>
+
+namespace crane::anti_collision::detail {
+
+struct Range {
+  double lower, upper;
+};
+inline constexpr Range kCoordinate{-1.0e4, 1.0e4};
+inline constexpr Range kHeading{-std::numbers::pi, std::numbers::pi};
+inline constexpr Range kHeight{0.1, 500.0};
+inline constexpr Range kLength{0.1, 200.0};
+inline constexpr Range kCounterJib{0.0, 200.0};
+inline constexpr Range kSection{0.01, 20.0};
+inline constexpr Range kTrolley{0.0, 200.0};
+inline constexpr Range kHook{-100.0, 500.0};
+inline constexpr Range kLoadRadius{0.0, 50.0};
+inline constexpr Range kSpeed{1.0e-3, 20.0};
+inline constexpr Range kReaction{0.0, 5.0};
+inline constexpr Range kDeceleration{1.0e-3, 50.0};
+inline constexpr Range kBrakeFactor{1.0, 100.0};
+inline constexpr Range kMargin{1.0e-3, 100.0};
+inline constexpr Range kDeadline{1.0e-3, 10.0};
+inline constexpr int kMaxDomain = 232;  // the DDS port mapping's largest domain id
+inline constexpr int kMaxPriority = 100;
+
+}  // namespace crane::anti_collision::detail

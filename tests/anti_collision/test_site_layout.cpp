@@ -1,0 +1,131 @@
+// The site file (anti_collision/site_layout.hpp): the shipped three-crane site loads with its
+// values; bad files are refused naming the field, the value and the bound (each rule of
+// validate(), hand-computed where it is geometry: the lower jib that reaches a higher crane's mast).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/site_file.hpp"
+#include "crane/common/validation.hpp"
+
+namespace {
+
+using namespace crane::anti_collision;
+using crane::common::ConfigError;
+
+const std::string kSitePath = std::string(CRANE_SOURCE_DIR) + "/deploy/config/site_three_towers.yaml";
+
+std::string shipped_text() {
+  std::ifstream file(kSitePath);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// The shipped text with the first match of `pattern` replaced.
+std::string edited(const std::string& pattern, const std::string& replacement) {
+  const std::string text = shipped_text();
+  const std::regex re(pattern);
+  if (!std::regex_search(text, re)) throw std::runtime_error("the site file has no '" + pattern + "'");
+  return std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
+}
+
+// The message of the ConfigError parsing `text` throws ("" when none).
+std::string refusal(const std::string& text) {
+  try {
+    (void)parse_site_layout(text, "site.yaml");
+  } catch (const ConfigError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(SiteLayout, ShippedSiteLoads) {
+  const SiteLayout site = load_site_layout(kSitePath);
+  ASSERT_EQ(site.cranes.size(), 3u);
+  EXPECT_EQ(site.cranes[0].name, "tc1");
+  EXPECT_DOUBLE_EQ(site.cranes[1].base[0], 2.0);
+  EXPECT_DOUBLE_EQ(site.cranes[2].jib_height, 3.3);
+  EXPECT_EQ(site.cranes[2].priority, 1);
+  EXPECT_EQ(site.cranes[1].domain_id, 12);
+  EXPECT_DOUBLE_EQ(site.margins.stop, 0.05);
+  EXPECT_TRUE(site.cranes[0].stopping.shaped_soft_stop);
+  ASSERT_EQ(site.zones.size(), 1u);
+  EXPECT_TRUE(site.zones[0].fixed);
+  EXPECT_EQ(find_crane(site, "tc3"), 2);
+  EXPECT_EQ(find_crane(site, "tc9"), -1);
+  // The jibs overlap in plan view (bases 2 m apart, each reaching 1.4 m + its radius).
+  EXPECT_LT(std::hypot(site.cranes[0].base[0] - site.cranes[1].base[0], site.cranes[0].base[1] - site.cranes[1].base[1]),
+            site.cranes[0].jib_length + site.cranes[1].jib_length);
+}
+
+TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
+  EXPECT_EQ(refusal(shipped_text()), "");
+  EXPECT_EQ(refusal(edited("jib_length: 1.4", "jib_length: 0")),
+            "site.yaml: site.cranes[0].jib_length = 0 is out of range: must be in [0.1, 200]");
+  EXPECT_EQ(refusal(edited("stop: 0.05", "stop: 0.2")),
+            "site.yaml: site.margins.slow_down = 0.15 is out of range: must be > margins.stop = 0.2");
+  EXPECT_EQ(refusal(edited("name: tc2", "name: tc1")), "site.yaml: site.cranes[1] (tc1).name is used by an earlier crane");
+  EXPECT_EQ(refusal(edited("domain_id: 12", "domain_id: 11")),
+            "site.yaml: site.cranes[1] (tc2).domain_id is used by an earlier crane");
+  EXPECT_EQ(refusal(edited("trolley_max: 1.30", "trolley_max: 1.50")),
+            "site.yaml: site.cranes[0] (tc1).trolley_max = 1.5 is out of range: must be in [0, 1.4]");
+  EXPECT_EQ(refusal(edited("hook_height_max: 2.3", "hook_height_max: 2.48")),
+            "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.48 is out of range: must be in [0.5, 2.45]");
+  EXPECT_EQ(refusal(edited("kind: tower", "kind: gantry")),
+            "site.yaml: site.cranes[0].kind = 'gantry' is not one of: tower");
+  EXPECT_EQ(refusal(edited("priority: 0", "priority: 0\n      colour: red")),
+            "site.yaml: unknown field site.cranes[0].colour");
+  EXPECT_EQ(refusal(edited("link_deadline: 0.3", "link_deadline: [0.3")).rfind("site.yaml: YAML syntax error at line", 0),
+            0u);
+  EXPECT_EQ(refusal(edited("bottom: 0.0", "bottom: 2.0")).rfind("site.yaml: site.zones[0] (site office)", 0), 0u)
+      << refusal(edited("bottom: 0.0", "bottom: 2.0"));
+}
+
+// tc2 moved to 1.5 m from tc1: its jib (1.4 m, radius 0.05) reaches tc1's mast (radius 0.0566) with
+// the stop margin 0.05 (reach 1.5566 m > 1.5 m), and it is higher, so it must pass above tc1's
+// highest part: 2.5 + 0.04 + 0.05 = 2.59 m plus the margin, 2.64 m, against its own jib's lowest
+// point 2.9 + 0.04 - 0.05 = 2.89 m: accepted. Lowered to 2.6 m (lowest point 2.59 m) it is refused.
+// And tc1's jib reaches tc2's mast too and is the lower: refused whatever tc2's height.
+TEST(SiteLayout, AJibThatReachesAnotherMastMustPassAboveThatCrane) {
+  SiteLayout site = load_site_layout(kSitePath);
+  site.cranes[1].base = {1.5, 0.0};
+  site.cranes[0].jib_length = 1.35;  // tc1's own jib: 1.35 + 0.05 + 0.0566 + 0.05 = 1.5066 > 1.5 still reaches
+  site.cranes[0].trolley_max = 1.3;
+  try {
+    validate(site);
+    FAIL() << "tc1's jib reaches tc2's mast from below";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("site.cranes[0] (tc1).jib_height = 2.5: its jib reaches tc2's mast", 0), 0u)
+        << error.what();
+  }
+  site.cranes[0].jib_length = 1.32;  // 1.32 + 0.05 + 0.0566 + 0.05 = 1.4766 < 1.5: tc1 no longer reaches
+  site.cranes[0].trolley_max = 1.3;
+  EXPECT_NO_THROW(validate(site));
+  EXPECT_NEAR(jib_bottom(site.cranes[1]), 2.89, 1e-12);
+  EXPECT_NEAR(top_of_structure(site.cranes[0]) + site.margins.stop, 2.64, 1e-12);
+  site.cranes[1].jib_height = 2.6;
+  site.cranes[1].hook_height_max = 2.4;
+  try {
+    validate(site);
+    FAIL() << "tc2's jib passes 0.05 m above tc1's top";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "site.cranes[1] (tc2).jib_height = 2.6: its jib reaches tc1's mast (1.5 m away, reach 1.556568542 "
+              "m) and must pass above tc1 by margins.stop: its jib's lowest point 2.59 m must be >= 2.64 m");
+  }
+}
+
+TEST(SiteLayout, MastsTooCloseAreRefused) {
+  SiteLayout site = load_site_layout(kSitePath);
+  site.cranes[1].base = {0.1, 0.0};
+  site.cranes[1].jib_height = 3.6;
+  EXPECT_THROW(validate(site), ConfigError);
+}
+
+}  // namespace
