@@ -34,8 +34,8 @@ ASAN_TARGETS=(
   test_hardware_bridge_board_config test_hardware_bridge_bridge_core test_hardware_bridge_conversions
   test_hardware_bridge_shm_board test_hardware_bridge_comedi_board
   test_services_adaptation test_plant_hook_and_wind test_operator_command
-  test_closed_loop test_operate test_adaptation test_gantry_gain_study test_convergence test_transport)
-ASAN_TESTS='^(test_plant_[a-z_]+|services|supervisor|config|gain_scheduling|trajectory_profiles|launch|hardware_bridge|closed_loop|transport)\.'
+  test_closed_loop test_operate test_adaptation test_gantry_gain_study test_convergence test_transport test_anti_collision)
+ASAN_TESTS='^(test_plant_[a-z_]+|services|supervisor|config|gain_scheduling|trajectory_profiles|launch|hardware_bridge|closed_loop|transport|anti_collision)\.'
 TSAN_TARGETS=(test_transport)
 TSAN_TESTS='^transport\.'
 
