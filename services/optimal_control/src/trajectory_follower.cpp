@@ -53,7 +53,7 @@ plant::ModelState zero_order_hold(const plant::CraneDynamics& model, const Minim
 
 TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const MinimumTimeResult& trajectory,
                                        const FollowerParams& params)
-    : voltage_limit_(params.voltage_limit) {
+    : voltage_limit_(params.voltage_limit), sliding_friction_scale_(params.hold.sliding_friction_scale) {
   if (!problem.model) throw common::ConfigError("follower.model: no model");
   const plant::CraneDynamics& model = *problem.model;
   if (model.coordinate_count() != plant::kNumCoordinates) {
@@ -68,6 +68,13 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_greater("follower.weights.speed", w.speed, 0.0);
   common::require_greater("follower.weights.swing_rate", w.swing_rate, 0.0);
   common::require_greater("follower.weights.voltage", w.voltage, 0.0);
+  const FollowerWeights& h = params.hold.weights;
+  common::require_greater("follower.hold.weights.position", h.position, 0.0);
+  common::require_greater("follower.hold.weights.swing", h.swing, 0.0);
+  common::require_greater("follower.hold.weights.speed", h.speed, 0.0);
+  common::require_greater("follower.hold.weights.swing_rate", h.swing_rate, 0.0);
+  common::require_greater("follower.hold.weights.voltage", h.voltage, 0.0);
+  common::require_in_range("follower.hold.sliding_friction_scale", params.hold.sliding_friction_scale, 0.0, 1.0);
   if (!trajectory.solved || trajectory.nodes.size() < 2 || !(trajectory.duration > 0.0)) {
     throw common::ConfigError("follower.trajectory: not solved (" + trajectory.status + ")");
   }
@@ -153,14 +160,18 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   };
 
   // Bryson's weights.
-  Eigen::VectorXd q(n);
-  for (int i = 0; i < c; ++i) {
-    const bool swing = slots_[i] == kInPlaneSwingIndex || slots_[i] == kOutOfPlaneSwingIndex;
-    q[i] = 1.0 / std::pow(swing ? w.swing : w.position, 2);
-    q[c + i] = 1.0 / std::pow(swing ? w.swing_rate : w.speed, 2);
-  }
-  const Eigen::MatrixXd Q = q.asDiagonal();
-  const Eigen::MatrixXd R = Eigen::MatrixXd::Identity(m, m) / (w.voltage * w.voltage);
+  const auto bryson = [&](const FollowerWeights& bw, Eigen::MatrixXd& Qw, Eigen::MatrixXd& Rw) {
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < c; ++i) {
+      const bool swing = slots_[i] == kInPlaneSwingIndex || slots_[i] == kOutOfPlaneSwingIndex;
+      q[i] = 1.0 / std::pow(swing ? bw.swing : bw.position, 2);
+      q[c + i] = 1.0 / std::pow(swing ? bw.swing_rate : bw.speed, 2);
+    }
+    Qw = q.asDiagonal();
+    Rw = Eigen::MatrixXd::Identity(m, m) / (bw.voltage * bw.voltage);
+  };
+  Eigen::MatrixXd Q, R;
+  bryson(h, Q, R);  // the hold's, for the stationary solution; the trajectory's below
   const auto riccati_step = [&](const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& P,
                                 Eigen::MatrixXd& K) {
     K = (R + B.transpose() * P * B).ldlt().solve(B.transpose() * P * A);
@@ -185,6 +196,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     throw common::ConfigError("follower: the stationary Riccati equation at the target did not converge");
   }
   gains_[count] = K;
+  bryson(w, Q, R);
   for (std::size_t k = count; k-- > 0;) {
     const Eigen::VectorXd u = samples_[k].input.head(m);
     linearize(samples_[k].state, u, static_cast<double>(k) * period, A, B);
@@ -223,6 +235,7 @@ common::StepStatus TrajectoryFollower::step(std::size_t k, const plant::ModelSta
   command.second_voltage = second_drive_ ? u[1] : 0.0;
   const TrajectoryNode& n = s.node;
   const bool moving = i + 1 < samples_.size();
+  command.sliding_friction_scale = moving ? 1.0 : sliding_friction_scale_;
   command.hoist_speed = n.cable_length_rate;
   command.trolley = {n.state.position[kTrolleyIndex], n.state.velocity[kTrolleyIndex], moving ? n.trolley_acceleration : 0.0};
   command.second = {n.state.position[kSlewIndex], n.state.velocity[kSlewIndex], moving ? n.second_acceleration : 0.0};

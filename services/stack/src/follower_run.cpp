@@ -1,5 +1,6 @@
 #include "crane/stack/follower_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -15,6 +16,37 @@
 #include "crane/supervisor/supervisor_stage.hpp"
 
 namespace crane::stack {
+namespace {
+
+// The follower's hold (FollowerHold::sliding_friction_scale): the friction compensation's part on a
+// drive that slides (outside its zero-velocity band, on the velocity the compensation uses) scaled
+// by `scale`, the stiction part on a drive at rest left whole; the drive voltage is then (3.5) again.
+void scale_sliding_friction(const friction_compensation::FrictionCompensationParams& params,
+                            const protocol::CraneState& estimate, const protocol::LinearCommand& linear, double scale,
+                            double voltage_limit, protocol::ActuatorCommand& actuators) {
+  const auto slides = [](const friction_compensation::AxisCompensationParams& axis, double raw, double filtered) {
+    const double v = axis.velocity_source == friction_compensation::VelocitySource::raw ? raw : filtered;
+    return friction_compensation::friction_direction(v, axis.zero_velocity_band) != 0;
+  };
+  if (slides(params.trolley, estimate.trolley_velocity_raw, estimate.trolley_velocity)) {
+    actuators.trolley_friction_voltage *= scale;
+    actuators.trolley_voltage =
+        std::clamp(linear.trolley_voltage + actuators.trolley_friction_voltage, -voltage_limit, voltage_limit);
+  }
+  if (slides(params.slew, estimate.slew_rate_raw, estimate.slew_rate)) {
+    actuators.slew_friction_voltage *= scale;
+    actuators.slew_voltage =
+        std::clamp(linear.slew_voltage + actuators.slew_friction_voltage, -voltage_limit, voltage_limit);
+  }
+  // The overhead crane's bridge has its own parameters (friction_compensation.bridge).
+  if (params.bridge && slides(*params.bridge, estimate.bridge_velocity_raw, estimate.bridge_velocity)) {
+    actuators.bridge_friction_voltage *= scale;
+    actuators.bridge_voltage =
+        std::clamp(linear.bridge_voltage + actuators.bridge_friction_voltage, -voltage_limit, voltage_limit);
+  }
+}
+
+}  // namespace
 
 FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   const ManeuverConfig& m = run.maneuver;
@@ -30,10 +62,9 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   if (!result.bound.solved) {
     throw std::runtime_error("follower run " + m.name + ": the bound was not solved (" + result.bound.status + ")");
   }
-  optimal_control::FollowerParams follower_params;
+  optimal_control::FollowerParams follower_params = run.follower;
   follower_params.sample_period = dt;
   follower_params.voltage_limit = cfg.facts.voltage_limit;
-  follower_params.weights = run.weights;
   const auto setup_start = std::chrono::steady_clock::now();
   const optimal_control::TrajectoryFollower follower(problem, result.bound, follower_params);
   result.follower_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
@@ -109,6 +140,10 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
     reference.move_duration = result.bound.duration;
     common::same_cycle(estimate.header, reference.header);
     (void)compensation.step(estimate, linear, actuators);
+    if (command.sliding_friction_scale != 1.0) {
+      scale_sliding_friction(compensation_params, estimate, linear, command.sliding_friction_scale,
+                             cfg.facts.voltage_limit, actuators);
+    }
     observed.sensors = &sensors;
     observed.actuators = &actuators;
     observed.reference = &reference;

@@ -34,7 +34,8 @@
 //       the bound's feedforward with time-varying LQR, friction compensation on; docs/optimal_control.md):
 //       T*, the settle time and its ratio to T*, the final errors, swing, voltage and the supervisor's
 //       faults; --corners: also with the plant's cable length and load mass off by +-20 % and its
-//       friction by +-30 % (the eight corners) from what the follower assumes; --out: one CSV per run;
+//       friction by +-30 % (the eight corners) from what the follower assumes; --mismatch L m f: one
+//       such plant instead; --hold-*: the hold at the target (FollowerHold); --out: one CSV per run;
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -494,8 +495,8 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
   return failures == 0 ? 0 : 1;
 }
 
-int follow(const Selection& s, int intervals, bool corners, const optimal_control::FollowerWeights& weights,
-           const std::string& out_dir) {
+int follow(const Selection& s, int intervals, bool corners, const std::vector<double>& mismatch,
+           const optimal_control::FollowerParams& params, const std::string& out_dir) {
   const auto cfg = load_config(s);
   if (!out_dir.empty()) fs::create_directories(out_dir);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
@@ -504,6 +505,15 @@ int follow(const Selection& s, int intervals, bool corners, const optimal_contro
     plant::PlantMismatch mismatch;
   };
   std::vector<Corner> runs{{"nominal", {}}};
+  if (mismatch.size() == 3) {
+    plant::PlantMismatch m;
+    m.cable_length_factor = mismatch[0];
+    m.load_mass_factor = mismatch[1];
+    m.friction_factor = mismatch[2];
+    char label[64];
+    std::snprintf(label, sizeof label, "L%.2g_m%.2g_f%.2g", mismatch[0], mismatch[1], mismatch[2]);
+    runs = {{label, m}};
+  }
   if (corners) {
     for (const double length : {0.8, 1.2}) {
       for (const double mass : {0.8, 1.2}) {
@@ -532,7 +542,7 @@ int follow(const Selection& s, int intervals, bool corners, const optimal_contro
       run.maneuver = m;
       run.mismatch = corner.mismatch;
       run.intervals = intervals;
-      run.weights = weights;
+      run.follower = params;
       const auto r = stack::run_follower(cfg, run);
       const auto& x = r.metrics;
       constexpr double deg = 180.0 / std::numbers::pi;
@@ -738,13 +748,27 @@ int main(int argc, char** argv) {
   follow_cmd->add_option("--intervals", follow_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
   follow_cmd->add_flag("--corners", corners, "also the eight +-20 % length and mass, +-30 % friction corners");
   follow_cmd->add_option("--out", out_dir, "write <maneuver>_follow_<plant>.csv here");
-  optimal_control::FollowerWeights weights;
+  std::vector<double> mismatch;
+  follow_cmd->add_option("--mismatch", mismatch, "one plant instead of the nominal: cable length, load mass and friction factors")
+      ->expected(3)->check(CLI::Range(0.1, 10.0));
+  optimal_control::FollowerParams follower_params;
+  optimal_control::FollowerWeights& weights = follower_params.weights;
   follow_cmd->add_option("--position-weight", weights.position, "the LQR's acceptable position deviation [m or rad]")
       ->check(CLI::PositiveNumber);
   follow_cmd->add_option("--swing-weight", weights.swing, "acceptable swing [rad]")->check(CLI::PositiveNumber);
   follow_cmd->add_option("--speed-weight", weights.speed, "acceptable speed deviation [m/s or rad/s]")->check(CLI::PositiveNumber);
   follow_cmd->add_option("--swing-rate-weight", weights.swing_rate, "acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
   follow_cmd->add_option("--voltage-weight", weights.voltage, "acceptable input [V]")->check(CLI::PositiveNumber);
+  optimal_control::FollowerWeights& hold = follower_params.hold.weights;
+  follow_cmd->add_option("--hold-position-weight", hold.position, "at the target: acceptable position deviation [m or rad]")
+      ->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--hold-swing-weight", hold.swing, "at the target: acceptable swing [rad]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--hold-speed-weight", hold.speed, "at the target: acceptable speed [m/s or rad/s]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--hold-swing-rate-weight", hold.swing_rate, "at the target: acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--hold-voltage-weight", hold.voltage, "at the target: acceptable input [V]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--hold-sliding-friction-scale", follower_params.hold.sliding_friction_scale,
+                         "at the target: the fraction of the sliding friction compensation applied [-]")
+      ->check(CLI::Range(0.0, 1.0));
 
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
@@ -765,7 +789,7 @@ int main(int argc, char** argv) {
     }
     if (*integrators_cmd) return integrators(s);
     if (*bound_cmd) return bound(s, intervals, out_dir);
-    if (*follow_cmd) return follow(s, follow_intervals, corners, weights, out_dir);
+    if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

@@ -16,8 +16,9 @@
 //        P_k = Q + A_k' P_k+1 (A_k - B_k K_k), K_k = (R + B_k' P_k+1 B_k)^-1 B_k' P_k+1 A_k
 //        (B. D. O. Anderson, J. B. Moore, "Optimal Control: Linear Quadratic Methods", 1990,
 //        section 2.3), started from the stationary solution at the target's rest state (the
-//        discrete algebraic Riccati equation, iterated to convergence): after the trajectory the
-//        law is the time-invariant LQR that holds the load at rest at the target
+//        discrete algebraic Riccati equation, iterated to convergence, with the hold's weights,
+//        FollowerHold): after the trajectory the law is the time-invariant LQR that holds the
+//        load at rest at the target
 //   A_k, B_k  the Jacobians of the model's zero-order-hold map over one sample (RK4, 4 sub-steps,
 //        the hoist following the trajectory) by central differences at (z_ref(t_k), u_ff): the
 //        plant's equations, not a second copy of them
@@ -25,8 +26,13 @@
 //        (A. E. Bryson, Y.-C. Ho, "Applied Optimal Control", 1975, section 5.7).
 // The hoist is not a feedback axis: hoist_speed is the trajectory's cable-length rate.
 //
+// After the trajectory (FollowerHold) the stationary gain comes from the hold's own weights, and
+// the command asks the friction compensation for a fraction of its sliding part
+// (FollowerCommand::sliding_friction_scale; stack::run_follower applies it).
+//
 // Errors: the constructor throws common::ConfigError naming the field for a model with more than
-// four coordinates (a hook or a rope), a non-positive weight, sample period or voltage limit, or a
+// four coordinates (a hook or a rope), a non-positive weight, sample period or voltage limit, a
+// sliding_friction_scale outside [0, 1], or a
 // trajectory that is not solved or has fewer than two nodes. step() is noexcept and allocates
 // nothing; a non-finite state gives 0 V (the safe output) and rejected_nonfinite.
 
@@ -49,10 +55,27 @@ struct FollowerWeights {
   double voltage{0.2};         // [V] the input (measured on the demo maneuvers, docs/optimal_control.md)
 };
 
+/// The hold at the target after the trajectory ends (docs/optimal_control.md, "Following the bound
+/// in closed loop": measured at the +-20 % length and mass, +-30 % friction corners).
+struct FollowerHold {
+  /// Bryson's weights of the stationary regulator (and so of the time-varying gains near the
+  /// trajectory's end): the swing tighter than along the trajectory, so that a small swing still
+  /// commands the breakaway of a trolley whose stiction is under-compensated by 30 % (0.25 deg;
+  /// 0.17 deg destabilizes the slew with a 20 % shorter cable).
+  FollowerWeights weights{0.005, 0.0044, 0.05, 0.05, 0.2};
+  /// [-] in [0, 1]: the fraction of the friction compensation's sliding part (Coulomb and viscous,
+  /// (3.1), (3.3)) to apply while a drive slides after the trajectory; the stiction part (3.2) stays
+  /// whole. Compensation of a friction 30 % above the plant's pushes the drive along its motion and
+  /// sustains a 1.5-2.5 Hz hunting around the target; at 0.5 the sliding drive is braked by the
+  /// remaining friction. 1 keeps the compensation as configured.
+  double sliding_friction_scale{0.5};
+};
+
 struct FollowerParams {
   double sample_period{0.01};  // [s] T_s, the control cycle, > 0
   double voltage_limit{10.0};  // [V] |u| before friction, > 0
   FollowerWeights weights{};
+  FollowerHold hold{};
 };
 
 /// The law's output for one cycle.
@@ -65,6 +88,7 @@ struct FollowerCommand {
   common::AxisReference cable;    // [m, m/s, m/s^2]
   double swing_in_plane{0.0};     // [rad] the trajectory's phi
   double swing_out_of_plane{0.0};  // [rad] theta
+  double sliding_friction_scale{1.0};  // [-] FollowerHold::sliding_friction_scale after the trajectory, 1 along it
 };
 
 class TrajectoryFollower {
@@ -97,6 +121,7 @@ class TrajectoryFollower {
   std::vector<Sample> samples_;
   std::vector<Eigen::MatrixXd> gains_;  // K_k; the last is the stationary gain at the target
   double voltage_limit_;
+  double sliding_friction_scale_;
   bool second_drive_;
 };
 

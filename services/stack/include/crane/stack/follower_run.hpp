@@ -32,7 +32,8 @@ struct FollowerRun {
   bool friction_compensation{true};
   plant::PlantMismatch mismatch{};
   int intervals{200};                          // collocation intervals of the bound
-  optimal_control::FollowerWeights weights{};  // the LQR's acceptable deviations
+  // The law's weights and its hold at the target; sample_period and voltage_limit are the stack's.
+  optimal_control::FollowerParams follower{};
 };
 
 struct FollowerResult {
