@@ -50,7 +50,7 @@ TEST(SiteLayout, ShippedSiteLoads) {
   ASSERT_EQ(site.cranes.size(), 3u);
   EXPECT_EQ(site.cranes[0].name, "tc1");
   EXPECT_DOUBLE_EQ(site.cranes[1].base[0], 2.0);
-  EXPECT_DOUBLE_EQ(site.cranes[2].jib_height, 3.3);
+  EXPECT_DOUBLE_EQ(site.cranes[2].jib_height, 3.5);
   EXPECT_EQ(site.cranes[2].priority, 1);
   EXPECT_EQ(site.cranes[1].domain_id, 12);
   EXPECT_DOUBLE_EQ(site.margins.stop, 0.05);
@@ -77,6 +77,10 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: site.cranes[0] (tc1).trolley_max = 1.5 is out of range: must be in [0, 1.4]");
   EXPECT_EQ(refusal(edited("hook_height_max: 2.3", "hook_height_max: 2.48")),
             "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.48 is out of range: must be in [0.5, 2.45]");
+  EXPECT_EQ(refusal(edited("travel_swing: 0.6", "travel_swing: 2")),
+            "site.yaml: site.paths.travel_swing = 2 is out of range: must be in [0, 1.5]");
+  EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: -3.5")),
+            "site.yaml: site.cranes[0] (tc1).slew_min = -3 is out of range: must be < slew_max = -3.5");
   EXPECT_EQ(refusal(edited("kind: tower", "kind: gantry")),
             "site.yaml: site.cranes[0].kind = 'gantry' is not one of: tower");
   EXPECT_EQ(refusal(edited("priority: 0", "priority: 0\n      colour: red")),
@@ -90,7 +94,7 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
 // tc2 moved to 1.5 m from tc1: its jib (1.4 m, radius 0.05) reaches tc1's mast (radius 0.0566) with
 // the stop margin 0.05 (reach 1.5566 m > 1.5 m), and it is higher, so it must pass above tc1's
 // highest part: 2.5 + 0.04 + 0.05 = 2.59 m plus the margin, 2.64 m, against its own jib's lowest
-// point 2.9 + 0.04 - 0.05 = 2.89 m: accepted. Lowered to 2.6 m (lowest point 2.59 m) it is refused.
+// point 3.0 + 0.04 - 0.05 = 2.99 m: accepted. Lowered to 2.6 m (lowest point 2.59 m) it is refused.
 // And tc1's jib reaches tc2's mast too and is the lower: refused whatever tc2's height.
 TEST(SiteLayout, AJibThatReachesAnotherMastMustPassAboveThatCrane) {
   SiteLayout site = load_site_layout(kSitePath);
@@ -107,7 +111,7 @@ TEST(SiteLayout, AJibThatReachesAnotherMastMustPassAboveThatCrane) {
   site.cranes[0].jib_length = 1.32;  // 1.32 + 0.05 + 0.0566 + 0.05 = 1.4766 < 1.5: tc1 no longer reaches
   site.cranes[0].trolley_max = 1.3;
   EXPECT_NO_THROW(validate(site));
-  EXPECT_NEAR(jib_bottom(site.cranes[1]), 2.89, 1e-12);
+  EXPECT_NEAR(jib_bottom(site.cranes[1]), 2.99, 1e-12);
   EXPECT_NEAR(top_of_structure(site.cranes[0]) + site.margins.stop, 2.64, 1e-12);
   site.cranes[1].jib_height = 2.6;
   site.cranes[1].hook_height_max = 2.4;

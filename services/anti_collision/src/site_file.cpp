@@ -41,6 +41,12 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.margins.stop = margins.number("stop", kMargin.lower, kMargin.upper);
     margins.finish();
     layout.link_deadline = s.number("link_deadline", kDeadline.lower, kDeadline.upper);
+    config::YamlSection paths = s.child("paths");
+    layout.paths.trolley_overshoot = paths.number("trolley_overshoot", kOvershoot.lower, kOvershoot.upper);
+    layout.paths.slew_overshoot = paths.number("slew_overshoot", kOvershoot.lower, kOvershoot.upper);
+    layout.paths.travel_swing = paths.number("travel_swing", kSwingAllowance.lower, kSwingAllowance.upper);
+    layout.paths.hoist_swing = paths.number("hoist_swing", kSwingAllowance.lower, kSwingAllowance.upper);
+    paths.finish();
     for (auto& z : s.list("zones")) layout.zones.push_back(config::read_zone(z));
     for (auto& c : s.list("cranes")) {
       SiteCrane crane;
@@ -59,6 +65,8 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
       crane.mast_width = c.number("mast_width", kSection.lower, kSection.upper);
       crane.trolley_min = c.number("trolley_min", kTrolley.lower, kTrolley.upper);
       crane.trolley_max = c.number("trolley_max", kTrolley.lower, kTrolley.upper);
+      crane.slew_min = c.number("slew_min", kSlewTravel.lower, kSlewTravel.upper);
+      crane.slew_max = c.number("slew_max", kSlewTravel.lower, kSlewTravel.upper);
       crane.hook_height_min = c.number("hook_height_min", kHook.lower, kHook.upper);
       crane.hook_height_max = c.number("hook_height_max", kHook.lower, kHook.upper);
       crane.load_radius = c.number("load_radius", kLoadRadius.lower, kLoadRadius.upper);

@@ -49,6 +49,10 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_below(prefix + ".margins.slow_down", m.slow_down, "margins.stop", m.stop, false);
   require_below(prefix + ".margins.warning", m.warning, "margins.slow_down", m.slow_down, false);
   require_in_range(prefix + ".link_deadline", layout.link_deadline, kDeadline.lower, kDeadline.upper);
+  require_in_range(prefix + ".paths.trolley_overshoot", layout.paths.trolley_overshoot, kOvershoot.lower, kOvershoot.upper);
+  require_in_range(prefix + ".paths.slew_overshoot", layout.paths.slew_overshoot, kOvershoot.lower, kOvershoot.upper);
+  require_in_range(prefix + ".paths.travel_swing", layout.paths.travel_swing, kSwingAllowance.lower, kSwingAllowance.upper);
+  require_in_range(prefix + ".paths.hoist_swing", layout.paths.hoist_swing, kSwingAllowance.lower, kSwingAllowance.upper);
 
   std::set<std::string> names;
   std::set<int> domains;
@@ -72,6 +76,9 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
     require_in_range(p + ".trolley_min", c.trolley_min, kTrolley.lower, kTrolley.upper);
     require_in_range(p + ".trolley_max", c.trolley_max, kTrolley.lower, c.jib_length);
     require_below(p + ".trolley_min", c.trolley_min, "trolley_max", c.trolley_max, true);
+    require_in_range(p + ".slew_min", c.slew_min, kSlewTravel.lower, kSlewTravel.upper);
+    require_in_range(p + ".slew_max", c.slew_max, kSlewTravel.lower, kSlewTravel.upper);
+    require_below(p + ".slew_min", c.slew_min, "slew_max", c.slew_max, true);
     require_in_range(p + ".hook_height_min", c.hook_height_min, kHook.lower, kHook.upper);
     require_in_range(p + ".hook_height_max", c.hook_height_max, c.hook_height_min, c.jib_height - c.load_radius);
     require_in_range(p + ".load_radius", c.load_radius, kLoadRadius.lower, kLoadRadius.upper);

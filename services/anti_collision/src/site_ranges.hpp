@@ -16,6 +16,7 @@ inline constexpr Range kLength{0.1, 200.0};
 inline constexpr Range kCounterJib{0.0, 200.0};
 inline constexpr Range kSection{0.01, 20.0};
 inline constexpr Range kTrolley{0.0, 200.0};
+inline constexpr Range kSlewTravel{-10.0, 10.0};  // [rad] a slew limited by cables may turn more than once
 inline constexpr Range kHook{-100.0, 500.0};
 inline constexpr Range kLoadRadius{0.0, 50.0};
 inline constexpr Range kSpeed{1.0e-3, 20.0};
@@ -24,6 +25,8 @@ inline constexpr Range kDeceleration{1.0e-3, 50.0};
 inline constexpr Range kBrakeFactor{1.0, 100.0};
 inline constexpr Range kMargin{1.0e-3, 100.0};
 inline constexpr Range kDeadline{1.0e-3, 10.0};
+inline constexpr Range kOvershoot{0.0, 10.0};
+inline constexpr Range kSwingAllowance{0.0, 1.5};
 inline constexpr int kMaxDomain = 232;  // the DDS port mapping's largest domain id
 inline constexpr int kMaxPriority = 100;
 

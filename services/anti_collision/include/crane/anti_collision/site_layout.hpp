@@ -52,6 +52,8 @@ struct SiteCrane {
   double mast_width{0.1};             // [m] side of the square mast
   double trolley_min{0.1};            // [m] trolley travel from the slew axis, trolley_min < trolley_max
   double trolley_max{0.9};            // [m]
+  double slew_min{-3.0};              // [rad] the slew's travel (its planner's range), slew_min < slew_max
+  double slew_max{3.0};               // [rad]
   double hook_height_min{0.0};        // [m] lowest the load's centre goes above the ground
   double hook_height_max{1.5};        // [m] highest, below jib_height
   double load_radius{0.1};            // [m] radius of a sphere enclosing the load and the hook block
@@ -71,6 +73,15 @@ struct Margins {
   double stop{0.2};       // the crane stops (a soft stop whose envelope keeps this margin)
 };
 
+/// What a granted path of a crane may deviate from its plan (airspace.hpp): the tracking
+/// controller's overshoot of a goal and the load's swing, bounded by the crane's own supervisor.
+struct PathAllowance {
+  double trolley_overshoot{0.07};  // [m] past a trolley goal (the delayed-feedback law's, measured)
+  double slew_overshoot{0.05};     // [rad] past a slew goal
+  double travel_swing{0.6};        // [rad] swing while the trolley or the slew moves (the supervisor's max_swing)
+  double hoist_swing{0.05};        // [rad] swing while only the hoist moves (the residual of the travel)
+};
+
 struct SiteLayout {
   std::string name;                   // the site's name (messages, the HMI)
   std::vector<SiteCrane> cranes;      // 1 to kMaxCranes
@@ -78,6 +89,7 @@ struct SiteLayout {
   Margins margins;
   double link_deadline{0.3};          // [s] a crane hears nothing from the site service this long: it stops
                                       // moving into shared airspace (the supervisor's rule)
+  PathAllowance paths;
 
   static constexpr std::size_t kMaxCranes = 20;
 };

@@ -1,0 +1,70 @@
+#pragma once
+// The airspace a crane may use: what the site service grants (site_arbiter.hpp) and what two
+// cranes must keep apart (issue 34; docs/site.md, "Grants"). Pure functions, noexcept.
+//
+// A crane's airspace is a union of boxes of its joint space: a slew interval [rad], a trolley
+// interval [m] and a cable-length interval [m], with the load's swing (a horizontal radius [m]
+// about the sheave's vertical). A path through waypoints is one box per segment, widened by the
+// tracking controller's overshoot past each goal; the swing is the site's travel allowance (the
+// crane's supervisor brakes beyond it) while the trolley or the slew moves, and its hoist
+// allowance while only the hoist does. At rest a crane holds the box of its pose.
+//
+// Geometry: each part of a crane at one slew angle is a slab, a segment in plan view swept by a
+// disc, times a height interval (every part of a tower crane is one: the jib and counter-jib
+// (plan segment, its half width, the chord's height), the mast (a point, its half diagonal, from
+// the ground to the jib), and what hangs from the trolley (the trolley's interval in plan, the
+// swing plus the load's radius, from the lowest load to the jib)). The distance between two
+// slabs is exact: sqrt(d_plan^2 + d_height^2), d_plan the plan segments' distance less both
+// radii, d_height the gap between the height intervals (each clamped at 0). A box's slew interval
+// is sampled every CraneEnvelope::kMaxSlewStep at most and each sample padded by 2 R sin(delta/4)
+// (R the crane's largest radius, delta the step: the chord's sagitta bound of crane_geometry.hpp),
+// so the samples' union contains the swept parts. Distances are >= 0 (0: touching or overlapping).
+
+#include <array>
+#include <cstddef>
+#include <span>
+
+#include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+
+namespace crane::anti_collision {
+
+/// A crane's pose in its own coordinates.
+struct Pose {
+  double slew{0.0};          // [rad] slew angle
+  double trolley{0.5};       // [m] from the slew axis
+  double cable_length{1.0};  // [m] sheave to the load's centre, > 0
+};
+
+/// One box of joint space (see the header).
+struct JointBox {
+  double slew_low{0.0}, slew_high{0.0};        // [rad] slew_low <= slew_high
+  double trolley_low{0.0}, trolley_high{0.0};  // [m]
+  double cable_low{0.0}, cable_high{0.0};      // [m]
+  double swing_radius{0.0};                    // [m] horizontal, about the sheave's vertical
+};
+
+struct Airspace {
+  static constexpr std::size_t kMaxBoxes = 8;
+  std::array<JointBox, kMaxBoxes> boxes{};
+  std::size_t count{0};  // boxes used; 0: no airspace
+};
+
+/// At rest at `pose`: one box, the pose itself, with the hoist swing allowance.
+[[nodiscard]] Airspace rest_airspace(const Pose& pose, const PathAllowance& allowance) noexcept;
+
+/// The path through `waypoints` (the first is where the crane is; 1 to Airspace::kMaxBoxes + 1 of
+/// them; extra waypoints are ignored): one box per segment (see the header). A single waypoint is
+/// rest_airspace.
+[[nodiscard]] Airspace path_airspace(std::span<const Pose> waypoints, const PathAllowance& allowance) noexcept;
+
+/// Everything the crane can reach: any slew, its whole trolley and hook range, the travel swing.
+/// What a crane that stops reporting holds (issue 34, item 4).
+[[nodiscard]] Airspace whole_reach(const SiteCrane& crane, const PathAllowance& allowance) noexcept;
+
+/// Closest distance [m] between two cranes' airspaces (>= 0; +infinity when either is empty), and
+/// the parts it is between (Part::cable stands for what hangs from the trolley, the load included).
+[[nodiscard]] PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const SiteCrane& second,
+                                             const Airspace& b) noexcept;
+
+}  // namespace crane::anti_collision

@@ -1,0 +1,129 @@
+#pragma once
+// The site service's rules (issue 34, item 3; docs/site.md, "Grants"): which crane may use which
+// airspace next. A core with no clock, no DDS and no threads: the site service process, the
+// lockstep site simulation and the tests drive it the same way.
+//
+// Each crane holds an airspace at all times: at rest, the box of its pose (rest); moving, the
+// path it was granted (airspace.hpp); when it stops reporting, its whole reach (lost). A crane at
+// rest asks for the path of its next leg (request). decide() grants a request when the path keeps
+// at least margins.slow_down from every other crane's held airspace, so that a granted crane never
+// meets another crane's slow-down margin while it keeps to its path (the site's warning and
+// slow-down layer, crane_geometry.hpp's classify, is for cranes that leave their paths).
+//
+// Who goes first, when requests compete (the rules of real sites, in this order):
+//   1. the higher `priority` of the site file;
+//   2. the lower crane yields its jib to the higher crane's cable: when the closest parts of two
+//      pending paths are the lower crane's jib or counter-jib and the higher crane's cable or load,
+//      the higher crane goes first;
+//   3. first come: the earlier request;
+//   4. the crane listed first in the site file.
+// No deadlock: a crane waits for the cranes whose held airspace its path meets (waits_for). A
+// crane at rest that blocks another and has nothing to do, or two or more cranes at rest that wait
+// for each other in a cycle, would wait forever; the one of them that ranks last by the rules
+// above is told to yield: it goes, hook up, to the nearest pose (its current slew and trolley
+// first, then the trolley in and the slew turned by kYieldSlewStep, 2 kYieldSlewStep, ...) whose
+// rest airspace keeps clear of the paths that wait for it and whose path there meets nothing held.
+// A crane reports each waypoint it reaches (progress) and holds only the rest of its path.
+//
+// The serialized mode is the baseline of issue 34's demo: also, at most one crane at a time
+// travels in shared airspace (the part of its reach that another crane's whole reach meets within
+// margins.slow_down).
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+
+namespace crane::anti_collision {
+
+enum class ArbiterMode : std::uint8_t { coordinated, serialized };
+
+/// What decide() tells a crane.
+struct Instruction {
+  enum class Kind : std::uint8_t { go, yield };
+  std::size_t crane{0};
+  Kind kind{Kind::go};
+  std::vector<Pose> waypoints;  // go: the path requested; yield: where the crane is, then its yield pose
+};
+
+enum class Holding : std::uint8_t { rest, path, yield, whole_reach };
+/// "rest", "path", "yield", "whole_reach".
+[[nodiscard]] const char* to_string(Holding holding) noexcept;
+
+class SiteArbiter {
+ public:
+  static constexpr double kYieldSlewStep = 0.5236;  // [rad] (30 deg)
+
+  /// Every crane starts lost (holding its whole reach) until its first rest(). Throws
+  /// common::ConfigError when the layout is invalid (validate()).
+  SiteArbiter(SiteLayout layout, ArbiterMode mode);
+
+  /// Crane `crane` is at rest at `pose`: it holds the pose's box (ending a path or a yield, or
+  /// coming back after being lost). std::out_of_range for a crane index not on the site.
+  void rest(std::size_t crane, const Pose& pose);
+  /// Crane `crane` asks for the path through `waypoints` (the first where it is) at `time` [s]; a
+  /// new request replaces its pending one. std::invalid_argument for no waypoint, more than
+  /// Airspace::kMaxBoxes + 1, a non-finite field or a cable length <= 0.
+  void request(std::size_t crane, std::vector<Pose> waypoints, double time);
+  /// Crane `crane`, moving on its path or yield, has reached a waypoint: it holds the rest of the
+  /// path from there (`remaining`, its first waypoint where the crane is), and what it left behind
+  /// is free for the others. std::logic_error when the crane holds no path or yield;
+  /// std::invalid_argument as request() for bad waypoints.
+  void progress(std::size_t crane, const std::vector<Pose>& remaining);
+  /// Crane `crane` withdraws its pending request (nothing left to do).
+  void withdraw(std::size_t crane);
+  /// Crane `crane` stopped reporting: it holds its whole reach until its next rest().
+  void lost(std::size_t crane);
+
+  /// Grants and yields, by the rules of the header; each crane at most one instruction. The
+  /// instructed cranes hold the path or the yield from now on.
+  [[nodiscard]] std::vector<Instruction> decide();
+
+  [[nodiscard]] std::size_t size() const noexcept { return cranes_.size(); }
+  [[nodiscard]] Holding holding(std::size_t crane) const { return cranes_.at(crane).holding; }
+  [[nodiscard]] const Airspace& held(std::size_t crane) const { return cranes_.at(crane).held; }
+  [[nodiscard]] bool pending(std::size_t crane) const { return cranes_.at(crane).request.has_value(); }
+  /// The cranes whose held airspace the pending request meets (as of the last decide()).
+  [[nodiscard]] const std::vector<std::size_t>& waits_for(std::size_t crane) const { return cranes_.at(crane).waits_for; }
+  /// Yields told so far, and the times decide() found a blocked crane no yield could free.
+  [[nodiscard]] std::uint64_t yields() const noexcept { return yields_; }
+  [[nodiscard]] std::uint64_t unresolved() const noexcept { return unresolved_; }
+  [[nodiscard]] const SiteLayout& layout() const noexcept { return layout_; }
+
+  /// True when `a` of crane i and `b` of crane j keep margins.slow_down.
+  [[nodiscard]] bool clear(std::size_t i, const Airspace& a, std::size_t j, const Airspace& b) const noexcept;
+
+ private:
+  struct Request {
+    std::vector<Pose> waypoints;
+    Airspace airspace;
+    double time{0.0};
+    bool shared{false};  // serialized mode: meets another crane's reach
+  };
+  struct CraneState {
+    Holding holding{Holding::whole_reach};
+    Airspace held;
+    Pose pose;            // at rest: where; else the last rest pose
+    bool held_shared{false};
+    std::optional<Request> request;
+    std::vector<std::size_t> waits_for;
+  };
+
+  [[nodiscard]] bool ranks_before(std::size_t i, std::size_t j) const;  // rules 1, 3, 4
+  [[nodiscard]] bool yields_jib_to(std::size_t i, std::size_t j) const;  // rule 2: i's request gives way to j's
+  [[nodiscard]] bool shared(std::size_t i, const Airspace& a) const;
+  [[nodiscard]] std::optional<std::vector<Pose>> yield_path(std::size_t victim, const std::vector<std::size_t>& waiting) const;
+
+  SiteLayout layout_;
+  ArbiterMode mode_;
+  std::vector<CraneState> cranes_;
+  std::vector<Airspace> reach_;
+  std::uint64_t yields_{0};
+  std::uint64_t unresolved_{0};
+};
+
+}  // namespace crane::anti_collision

@@ -1,0 +1,235 @@
+#include "crane/anti_collision/site_arbiter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace crane::anti_collision {
+
+const char* to_string(Holding holding) noexcept {
+  switch (holding) {
+    case Holding::rest: return "rest";
+    case Holding::path: return "path";
+    case Holding::yield: return "yield";
+    case Holding::whole_reach: return "whole_reach";
+  }
+  return "?";
+}
+
+SiteArbiter::SiteArbiter(SiteLayout layout, ArbiterMode mode) : layout_(std::move(layout)), mode_(mode) {
+  validate(layout_);
+  cranes_.resize(layout_.cranes.size());
+  for (std::size_t i = 0; i < cranes_.size(); ++i) {
+    reach_.push_back(whole_reach(layout_.cranes[i], layout_.paths));
+    cranes_[i].held = reach_.back();
+  }
+}
+
+bool SiteArbiter::clear(std::size_t i, const Airspace& a, std::size_t j, const Airspace& b) const noexcept {
+  return airspace_distance(layout_.cranes[i], a, layout_.cranes[j], b).distance >= layout_.margins.slow_down;
+}
+
+void SiteArbiter::rest(std::size_t crane, const Pose& pose) {
+  CraneState& c = cranes_.at(crane);
+  c.holding = Holding::rest;
+  c.pose = pose;
+  c.held = rest_airspace(pose, layout_.paths);
+  c.held_shared = false;
+}
+
+namespace {
+
+void check_waypoints(const std::string& crane, const std::vector<Pose>& waypoints) {
+  if (waypoints.empty() || waypoints.size() > Airspace::kMaxBoxes + 1) {
+    throw std::invalid_argument("site arbiter: a path of crane " + crane + " has " + std::to_string(waypoints.size()) +
+                                " waypoints: must be 1 to " + std::to_string(Airspace::kMaxBoxes + 1));
+  }
+  for (const Pose& p : waypoints) {
+    if (!std::isfinite(p.slew) || !std::isfinite(p.trolley) || !std::isfinite(p.cable_length) || !(p.cable_length > 0.0)) {
+      throw std::invalid_argument("site arbiter: a path of crane " + crane + " has a non-finite waypoint or a cable length <= 0");
+    }
+  }
+}
+
+}  // namespace
+
+void SiteArbiter::progress(std::size_t crane, const std::vector<Pose>& remaining) {
+  CraneState& c = cranes_.at(crane);
+  if (c.holding != Holding::path && c.holding != Holding::yield) {
+    throw std::logic_error("site arbiter: crane " + layout_.cranes[crane].name + " reports progress holding " +
+                           to_string(c.holding));
+  }
+  check_waypoints(layout_.cranes[crane].name, remaining);
+  c.held = path_airspace(remaining, layout_.paths);
+  c.held_shared = shared(crane, c.held);
+}
+
+void SiteArbiter::request(std::size_t crane, std::vector<Pose> waypoints, double time) {
+  CraneState& c = cranes_.at(crane);
+  check_waypoints(layout_.cranes[crane].name, waypoints);
+  if (!std::isfinite(time)) throw std::invalid_argument("site arbiter: a request time is not finite");
+  Request r;
+  r.airspace = path_airspace(waypoints, layout_.paths);
+  r.waypoints = std::move(waypoints);
+  r.time = time;
+  r.shared = shared(crane, r.airspace);
+  c.request = std::move(r);
+}
+
+void SiteArbiter::withdraw(std::size_t crane) { cranes_.at(crane).request.reset(); }
+
+void SiteArbiter::lost(std::size_t crane) {
+  CraneState& c = cranes_.at(crane);
+  c.holding = Holding::whole_reach;
+  c.held = reach_[crane];
+  c.held_shared = true;
+}
+
+bool SiteArbiter::ranks_before(std::size_t i, std::size_t j) const {
+  const int pi = layout_.cranes[i].priority;
+  const int pj = layout_.cranes[j].priority;
+  if (pi != pj) return pi > pj;
+  const auto& ri = cranes_[i].request;
+  const auto& rj = cranes_[j].request;
+  if (ri && rj && ri->time != rj->time) return ri->time < rj->time;
+  if (ri.has_value() != rj.has_value()) return ri.has_value();
+  return i < j;
+}
+
+bool SiteArbiter::yields_jib_to(std::size_t i, std::size_t j) const {
+  const SiteCrane& a = layout_.cranes[i];
+  const SiteCrane& b = layout_.cranes[j];
+  if (!(a.jib_height < b.jib_height) || layout_.cranes[i].priority != layout_.cranes[j].priority) return false;
+  const PairDistance d = airspace_distance(a, cranes_[i].request->airspace, b, cranes_[j].request->airspace);
+  return d.distance < layout_.margins.slow_down && (d.first == Part::jib || d.first == Part::counter_jib) &&
+         (d.second == Part::cable || d.second == Part::load);
+}
+
+bool SiteArbiter::shared(std::size_t i, const Airspace& a) const {
+  for (std::size_t j = 0; j < cranes_.size(); ++j) {
+    if (j != i && !clear(i, a, j, reach_[j])) return true;
+  }
+  return false;
+}
+
+std::optional<std::vector<Pose>> SiteArbiter::yield_path(std::size_t v, const std::vector<std::size_t>& waiting) const {
+  const SiteCrane& crane = layout_.cranes[v];
+  const Pose here = cranes_[v].pose;
+  const double hook_up = crane.jib_height - crane.hook_height_max;
+  std::vector<Pose> candidates;
+  if (here.cable_length > hook_up + 1e-9) candidates.push_back({here.slew, here.trolley, hook_up});
+  for (int k = 1; k * kYieldSlewStep <= 2.0 * 3.14159265358979; ++k) {
+    for (const double sign : {1.0, -1.0}) {
+      const double slew = here.slew + sign * k * kYieldSlewStep;
+      if (slew >= crane.slew_min && slew <= crane.slew_max) candidates.push_back({slew, here.trolley, hook_up});
+    }
+  }
+  for (const Pose& target : candidates) {
+    const Airspace at = rest_airspace(target, layout_.paths);
+    const bool frees = std::all_of(waiting.begin(), waiting.end(),
+                                   [&](std::size_t w) { return clear(v, at, w, cranes_[w].request->airspace); });
+    if (!frees) continue;
+    std::vector<Pose> path{here};
+    if (here.cable_length > hook_up + 1e-9) path.push_back({here.slew, here.trolley, hook_up});
+    if (target.slew != here.slew) path.push_back(target);
+    const Airspace way = path_airspace(path, layout_.paths);
+    bool free = true;
+    for (std::size_t j = 0; j < cranes_.size() && free; ++j) free = j == v || clear(v, way, j, cranes_[j].held);
+    if (free) return path;
+  }
+  return std::nullopt;
+}
+
+std::vector<Instruction> SiteArbiter::decide() {
+  const std::size_t n = cranes_.size();
+  std::vector<Instruction> out;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    cranes_[i].waits_for.clear();
+    if (cranes_[i].request && cranes_[i].holding == Holding::rest) order.push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [this](std::size_t a, std::size_t b) { return ranks_before(a, b); });
+
+  std::vector<bool> instructed(n, false);
+  std::vector<std::vector<bool>> blocks(n, std::vector<bool>(n, false));  // i waits for j's held airspace
+  const auto blockers = [&](std::size_t i) {
+    std::vector<std::size_t> waits;
+    const Request& r = *cranes_[i].request;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const CraneState& c = cranes_[j];
+      const bool travels_shared = c.held_shared && c.holding != Holding::rest;
+      if (!clear(i, r.airspace, j, c.held) || (mode_ == ArbiterMode::serialized && r.shared && travels_shared)) {
+        waits.push_back(j);
+      }
+    }
+    return waits;
+  };
+  for (std::size_t position = 0; position < order.size(); ++position) {
+    const std::size_t i = order[position];
+    std::vector<std::size_t> waits = blockers(i);
+    for (const std::size_t j : waits) blocks[i][j] = true;
+    if (waits.empty()) {
+      // Rule 2: a later request of a higher crane whose cable meets this jib, and that could go now.
+      for (std::size_t later = position + 1; later < order.size() && waits.empty(); ++later) {
+        const std::size_t k = order[later];
+        if (yields_jib_to(i, k) && blockers(k).empty()) waits.push_back(k);
+      }
+    }
+    cranes_[i].waits_for = waits;
+    if (!waits.empty()) continue;
+    CraneState& c = cranes_[i];
+    c.holding = Holding::path;
+    c.held = c.request->airspace;
+    c.held_shared = c.request->shared;
+    out.push_back({i, Instruction::Kind::go, std::move(c.request->waypoints)});
+    c.request.reset();
+    instructed[i] = true;
+  }
+
+  // Who would wait forever: reach[a][b] when a waits, through cranes at rest, for b.
+  std::vector<std::vector<bool>> reach(n, std::vector<bool>(n, false));
+  for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t b = 0; b < n; ++b) reach[a][b] = blocks[a][b] && cranes_[b].holding == Holding::rest;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t a = 0; a < n; ++a) {
+      for (std::size_t b = 0; b < n; ++b) reach[a][b] = reach[a][b] || (reach[a][k] && reach[k][b]);
+    }
+  }
+  for (const std::size_t i : order) {
+    if (instructed[i]) continue;
+    for (const std::size_t j : cranes_[i].waits_for) {
+      if (instructed[j] || cranes_[j].holding != Holding::rest || instructed[i]) continue;
+      std::size_t victim = j;
+      if (cranes_[j].request) {
+        if (!reach[j][i]) continue;  // j waits for something that will move
+        // A cycle: the one of it that ranks last yields.
+        victim = i;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (reach[i][k] && reach[k][i] && !instructed[k] && ranks_before(victim, k)) victim = k;
+        }
+      }
+      std::vector<std::size_t> waiting;
+      for (std::size_t w = 0; w < n; ++w) {
+        if (cranes_[w].request && !instructed[w] && blocks[w][victim]) waiting.push_back(w);
+      }
+      const auto path = yield_path(victim, waiting);
+      if (!path) {
+        ++unresolved_;
+        continue;
+      }
+      CraneState& c = cranes_[victim];
+      c.holding = Holding::yield;
+      c.held = path_airspace(*path, layout_.paths);
+      c.held_shared = shared(victim, c.held);
+      out.push_back({victim, Instruction::Kind::yield, *path});
+      instructed[victim] = true;
+      ++yields_;
+    }
+  }
+  return out;
+}
+
+}  // namespace crane::anti_collision

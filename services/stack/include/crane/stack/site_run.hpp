@@ -1,0 +1,91 @@
+#pragma once
+// A site of several cranes in lockstep, in one thread (issue 34, item 6; docs/site.md): one
+// in-process stack per crane (in_process_stack.hpp: the same stage objects as each crane's
+// processes, its own plant) and the site service's rules (anti_collision::SiteArbiter), cycle by
+// cycle. Each crane works through a queue of pick-and-place jobs; each job is two legs (to the
+// pick, to the place), and a leg is: hoist up to the travel height, travel (slew and trolley),
+// lower to the work height, hold `dwell` (hooking or unhooking), hoist up. A crane asks the
+// arbiter for the whole leg's path and starts it only when granted; it obeys a yield at once.
+// A move ends when its reference arrived and the crane has settled (trolley < 0.01 m/s, slew
+// < 0.01 rad/s, swing amplitude < 0.5 deg), or `settle_timeout` after the reference arrived.
+//
+// The true distance between any two cranes is measured every cycle from the plants' states
+// (crane_geometry.hpp's capsules of jib, counter-jib and mast, the cable from the sheave to the
+// swinging load, the load's sphere): the figure "no contact, ever" is about.
+//
+// Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
+// outside a crane's reach or a job list not one per crane.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/stack/stack_config.hpp"
+
+namespace crane::stack {
+
+/// A place a crane lifts from or sets down at, in its own coordinates.
+struct WorkPoint {
+  double slew{0.0};          // [rad]
+  double trolley{0.5};       // [m]
+  double cable_length{1.5};  // [m] at the work height
+};
+
+struct SiteJob {
+  WorkPoint pick;
+  WorkPoint place;
+};
+
+enum class SiteMode : std::uint8_t {
+  coordinated,  // the site service's rules (SiteArbiter, coordinated)
+  serialized,   // the baseline: one crane at a time in shared airspace
+  solo,         // each crane alone on the site (no other crane): the reference for throughput
+};
+[[nodiscard]] const char* to_string(SiteMode mode) noexcept;
+
+struct SiteRunOptions {
+  SiteMode mode{SiteMode::coordinated};
+  double dwell{1.0};            // [s] at the pick and at the place
+  double settle_timeout{8.0};   // [s] after the reference arrived
+  double time_limit{1800.0};    // [s] simulated; the run stops there (SiteOutcome::completed false)
+  // [rad/s^2] of every move, half the lab crane's rated 2.08: at the travel height (0.2 m of cable)
+  // the default controller slewing at the rated acceleration swings past the supervisor's
+  // max_swing (0.6 rad) in 8 of 40 seeded job sets (docs/site.md).
+  double slew_acceleration{1.0};
+};
+
+struct CraneOutcome {
+  std::string name;
+  int jobs_done{0};
+  double finish_time{0.0};   // [s] its last job done
+  double waiting_time{0.0};  // [s] between asking for a leg and its grant
+  int yields{0};             // yields it obeyed
+  int unsettled_moves{0};    // moves ended by settle_timeout
+  std::uint32_t latched_faults{0};  // its supervisor's, at the end (FAULT_* bits)
+};
+
+struct SiteOutcome {
+  std::vector<CraneOutcome> cranes;
+  bool completed{false};     // every job done within the time limit
+  double total_time{0.0};    // [s] the last crane's finish time
+  double min_distance{0.0};  // [m] true, between any two parts of any two cranes, over the run
+  std::string closest;       // "tc1.jib-tc3.cable at 41.23 s"
+  std::uint64_t unresolved{0};  // arbiter decisions that found a blocked crane no yield could free
+  double simulated_seconds{0.0};  // [s] crane-seconds stepped (all cranes)
+};
+
+/// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`
+/// (its stack; the site file gives where it stands and its shape).
+[[nodiscard]] SiteOutcome run_site(const anti_collision::SiteLayout& site, const StackConfig& config,
+                                   const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options);
+
+/// `per_crane` seeded random jobs for each crane of `site`: pick and place points within the
+/// planner's reach of `config`, at random work heights in the lowest 0.8 m of the crane's hook
+/// range; with probability 0.7 a point lies within another crane's reach too (jobs that force
+/// conflicts). Deterministic in `seed`.
+[[nodiscard]] std::vector<std::vector<SiteJob>> random_site_jobs(const anti_collision::SiteLayout& site,
+                                                                 const StackConfig& config, int per_crane,
+                                                                 std::uint64_t seed);
+
+}  // namespace crane::stack

@@ -1,0 +1,352 @@
+#include "crane/stack/site_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <stdexcept>
+
+#include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/common/site.hpp"
+#include "crane/stack/in_process_stack.hpp"
+
+namespace crane::stack {
+namespace {
+
+namespace ac = anti_collision;
+using Request = protocol::MoveRequest;
+
+constexpr double kSettledSpeed = 0.01;   // [m/s], [rad/s]
+constexpr double kSettledSwing = 0.0087;  // [rad] (0.5 deg) swing amplitude
+
+double wrap(double angle) { return std::remainder(angle, 2.0 * std::numbers::pi); }
+
+// A leg: where to travel and the cable length to lower to there.
+struct Leg {
+  WorkPoint at;
+  bool place{false};  // the job's second leg: the job is done when it ends
+};
+
+struct Crane {
+  std::unique_ptr<InProcessStack> stack;
+  std::vector<Leg> legs;  // left to do, front first
+  std::size_t next_leg{0};
+  enum class Phase { resting, asking, moving, dwelling, done } phase{Phase::resting};
+  std::vector<ac::Pose> path;    // the granted path or yield, path[0] where it started
+  std::size_t waypoint{0};       // the waypoint being moved to
+  bool yielding{false};
+  std::uint32_t request_id{0};
+  bool start_next{false};        // the move to waypoint + 1 starts at the next cycle
+  std::optional<std::uint64_t> arrived_cycle;  // the reference arrived at this cycle
+  std::uint64_t dwell_until{0};
+  double asked_at{0.0};
+  CraneOutcome outcome;
+};
+
+ac::Pose measured_pose(const InProcessStack& stack) {
+  const auto& e = stack.estimate();
+  return {e.slew_angle, e.trolley_position, e.cable_length};
+}
+
+bool settled(const InProcessStack& stack, double gravity) {
+  const auto& e = stack.estimate();
+  const double omega2 = gravity / std::max(e.cable_length, 0.01);
+  const double amplitude = std::sqrt(e.swing_in_plane * e.swing_in_plane + e.swing_out_of_plane * e.swing_out_of_plane +
+                                     (e.swing_in_plane_rate * e.swing_in_plane_rate +
+                                      e.swing_out_of_plane_rate * e.swing_out_of_plane_rate) / omega2);
+  return std::abs(e.trolley_velocity) < kSettledSpeed && std::abs(e.slew_rate) < kSettledSpeed &&
+         std::abs(e.cable_length_rate) < kSettledSpeed && amplitude < kSettledSwing;
+}
+
+Request move_to(const ac::Pose& to, std::uint32_t id, double slew_acceleration) {
+  Request r{};
+  r.request_id = id;
+  r.profile = Request::PROFILE_TRAPEZOID;
+  r.command = Request::COMMAND_MOVE;
+  // Every axis named: an axis left out keeps its measured position as its target, which the
+  // planner refuses when it reads a hair outside its range (a hoist at its top: 0.19999 m).
+  r.axes = Request::AXIS_SLEW | Request::AXIS_TROLLEY | Request::AXIS_HOIST;
+  r.trolley_target = to.trolley;
+  r.slew_target = to.slew;
+  r.cable_length_target = to.cable_length;
+  r.slew_max_acceleration = slew_acceleration;
+  return r;
+}
+
+// The true parts of a crane from its plant's state (crane_geometry.hpp's capsules; the cable to
+// the swinging load).
+std::array<ac::Capsule, ac::kPartCount> true_parts(const ac::SiteCrane& c, const plant::PlantState& s) {
+  common::Site local;
+  local.jib_height = c.jib_height;
+  const auto load = common::load_position(local, s.trolley_position, s.slew_angle, s.swing_in_plane,
+                                          s.swing_out_of_plane, s.cable_length);
+  const double h = c.slew_zero_heading;
+  const auto to_site = [&](double x, double y, double z) {
+    return ac::Vector3(c.base[0] + std::cos(h) * x - std::sin(h) * y, c.base[1] + std::sin(h) * x + std::cos(h) * y, z);
+  };
+  ac::CraneMotion m;
+  m.slew = s.slew_angle;
+  m.trolley = s.trolley_position;
+  m.cable_length = s.cable_length;
+  auto parts = ac::envelope(c, m, ac::StopKind::none).samples[0];  // jib, counter-jib, mast at the pose
+  const ac::Vector3 sheave = to_site(s.trolley_position * std::cos(s.slew_angle), s.trolley_position * std::sin(s.slew_angle),
+                                     c.jib_height);
+  const ac::Vector3 hook = to_site(load[0], load[1], load[2]);
+  parts[static_cast<std::size_t>(ac::Part::cable)] = {sheave, hook, 0.0};
+  parts[static_cast<std::size_t>(ac::Part::load)] = {hook, hook, c.load_radius};
+  return parts;
+}
+
+SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
+                         const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options) {
+  const std::size_t n = site.cranes.size();
+  ac::SiteArbiter arbiter(site, options.mode == SiteMode::serialized ? ac::ArbiterMode::serialized
+                                                                       : ac::ArbiterMode::coordinated);
+  const double dt = config.facts.sample_period;
+  const double gravity = config.facts.crane.gravity;
+  const double hook_up_cable = config.trajectory_planner.cable_min_length;
+  // Where each crane starts: its jib turned away from the site's centre, trolley in.
+  double cx = 0.0, cy = 0.0;
+  for (const auto& c : site.cranes) cx += c.base[0] / static_cast<double>(n), cy += c.base[1] / static_cast<double>(n);
+  std::vector<Crane> cranes(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& c = site.cranes[i];
+    InProcessOptions o;
+    const double away = n > 1 ? std::atan2(c.base[1] - cy, c.base[0] - cx) : 0.0;
+    const double low = std::max(c.slew_min, config.trajectory_planner.slew_min_angle) + 0.1;
+    const double high = std::min(c.slew_max, config.trajectory_planner.slew_max_angle) - 0.1;
+    o.initial_slew_angle = std::clamp(wrap(away - c.slew_zero_heading), low, high);
+    o.initial_trolley_position = config.trajectory_planner.trolley_min_position + 0.1;
+    cranes[i].stack = std::make_unique<InProcessStack>(config, o);
+    for (const SiteJob& j : jobs[i]) {
+      cranes[i].legs.push_back({j.pick, false});
+      cranes[i].legs.push_back({j.place, true});
+    }
+    cranes[i].outcome.name = c.name;
+  }
+
+  SiteOutcome out;
+  out.min_distance = std::numeric_limits<double>::infinity();
+  const auto limit = static_cast<std::uint64_t>(std::llround(options.time_limit / dt));
+  const auto dwell_cycles = static_cast<std::uint64_t>(std::llround(options.dwell / dt));
+  const auto settle_cycles = static_cast<std::uint64_t>(std::llround(options.settle_timeout / dt));
+  std::vector<Request> goal(n);
+  std::vector<bool> has_goal(n);
+  bool changed = true;
+  std::uint64_t k = 0;
+  for (; k < limit; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    // Each crane at rest asks for its next leg.
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      if (c.phase != Crane::Phase::resting || k == 0) continue;
+      const ac::Pose here = measured_pose(*c.stack);
+      arbiter.rest(i, here);
+      changed = true;
+      if (c.next_leg == c.legs.size()) {
+        arbiter.withdraw(i);
+        c.phase = Crane::Phase::done;
+        continue;
+      }
+      const WorkPoint& w = c.legs[c.next_leg].at;
+      std::vector<ac::Pose> path{here};
+      if (here.cable_length > hook_up_cable + 1e-3) path.push_back({here.slew, here.trolley, hook_up_cable});
+      path.push_back({w.slew, w.trolley, hook_up_cable});
+      path.push_back({w.slew, w.trolley, w.cable_length});
+      path.push_back({w.slew, w.trolley, hook_up_cable});
+      arbiter.request(i, std::move(path), t);
+      c.phase = Crane::Phase::asking;
+      c.asked_at = t;
+    }
+    if (changed) {
+      changed = false;
+      for (ac::Instruction& instruction : arbiter.decide()) {
+        Crane& c = cranes[instruction.crane];
+        c.yielding = instruction.kind == ac::Instruction::Kind::yield;
+        if (c.yielding) ++c.outcome.yields;
+        c.outcome.waiting_time += t - c.asked_at;
+        c.path = std::move(instruction.waypoints);
+        // The site file's hook range is the planner's cable range to its rounding (3.0 - 2.8 m).
+        for (ac::Pose& p : c.path) {
+          if (std::abs(p.cable_length - hook_up_cable) < 1e-9) p.cable_length = hook_up_cable;
+        }
+        c.waypoint = 0;
+        c.phase = Crane::Phase::moving;
+        c.start_next = true;
+      }
+    }
+    // The next move of each crane that has one: the first of a path, the one after a dwell or
+    // after the last move ended.
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      has_goal[i] = false;
+      if (c.phase == Crane::Phase::dwelling && k >= c.dwell_until) {
+        c.phase = Crane::Phase::moving;
+        c.start_next = true;
+      }
+      if (c.phase != Crane::Phase::moving || !c.start_next) continue;
+      c.start_next = false;
+      if (c.waypoint > 0) {
+        // What the crane left behind is free for the others.
+        arbiter.progress(i, std::vector<ac::Pose>(c.path.begin() + static_cast<std::ptrdiff_t>(c.waypoint), c.path.end()));
+        changed = true;
+      }
+      ++c.waypoint;
+      goal[i] = move_to(c.path[c.waypoint], ++c.request_id, options.slew_acceleration);
+      has_goal[i] = true;
+      c.arrived_cycle.reset();
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      cranes[i].stack->step(has_goal[i] ? std::span(&goal[i], 1) : std::span<const Request>());
+      for (const auto& outcome : cranes[i].stack->planner().goal_outcomes()) {
+        if (outcome.status != trajectory_planner::GoalStatus::accepted) {
+          throw std::runtime_error("site run: " + site.cranes[i].name + "'s planner refused a move at " + std::to_string(t) +
+                                   " s: " + trajectory_planner::goal_status_name(outcome.status) + " (targets: slew " +
+                                   std::to_string(goal[i].slew_target) + " rad, trolley " + std::to_string(goal[i].trolley_target) +
+                                   " m, cable " + std::to_string(goal[i].cable_length_target) + " m; after waypoint " + std::to_string(cranes[i].waypoint - 1) + " of " + std::to_string(cranes[i].path.size()) +
+                                   (cranes[i].yielding ? " (yield)" : "") + "; supervisor faults " +
+                                   std::to_string(cranes[i].stack->status().latched_faults) + ")");
+        }
+      }
+    }
+    // Moves that ended.
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      if (c.phase != Crane::Phase::moving || c.start_next) continue;
+      const auto& r = c.stack->reference();
+      if (r.request_id != c.request_id || r.phase != protocol::Reference::PHASE_ARRIVED) continue;
+      if (!c.arrived_cycle) c.arrived_cycle = k;
+      const bool timed_out = k - *c.arrived_cycle >= settle_cycles;
+      if (!settled(*c.stack, gravity) && !timed_out) continue;
+      if (timed_out) ++c.outcome.unsettled_moves;
+      if (c.waypoint + 1 < c.path.size()) {
+        if (!c.yielding && c.waypoint + 2 == c.path.size()) {  // at the work height
+          c.phase = Crane::Phase::dwelling;
+          c.dwell_until = k + dwell_cycles;
+        } else {
+          c.start_next = true;
+        }
+        continue;
+      }
+      if (!c.yielding) {
+        if (c.legs[c.next_leg].place) {
+          ++c.outcome.jobs_done;
+          c.outcome.finish_time = t + dt;
+        }
+        ++c.next_leg;
+      }
+      c.yielding = false;
+      c.phase = Crane::Phase::resting;
+    }
+    // The true distance between every two cranes.
+    std::vector<std::array<ac::Capsule, ac::kPartCount>> parts(n);
+    for (std::size_t i = 0; i < n; ++i) parts[i] = true_parts(site.cranes[i], cranes[i].stack->plant().simulator().state());
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = i + 1; j < n; ++j) {
+        for (std::size_t p = 0; p < ac::kPartCount; ++p) {
+          for (std::size_t q = 0; q < ac::kPartCount; ++q) {
+            const double d = ac::capsule_distance(parts[i][p], parts[j][q]);
+            if (d < out.min_distance) {
+              out.min_distance = d;
+              out.closest = site.cranes[i].name + "." + ac::to_string(static_cast<ac::Part>(p)) + "-" +
+                            site.cranes[j].name + "." + ac::to_string(static_cast<ac::Part>(q)) + " at " +
+                            std::to_string(t) + " s";
+            }
+          }
+        }
+      }
+    }
+    if (std::all_of(cranes.begin(), cranes.end(), [](const Crane& c) { return c.phase == Crane::Phase::done; })) break;
+  }
+  out.completed = k < limit;
+  out.unresolved = arbiter.unresolved();
+  for (Crane& c : cranes) {
+    c.outcome.latched_faults = c.stack->status().latched_faults;
+    out.total_time = std::max(out.total_time, c.outcome.finish_time);
+    out.cranes.push_back(c.outcome);
+  }
+  out.simulated_seconds = static_cast<double>(k) * dt * static_cast<double>(n);
+  return out;
+}
+
+}  // namespace
+
+const char* to_string(SiteMode mode) noexcept {
+  switch (mode) {
+    case SiteMode::coordinated: return "coordinated";
+    case SiteMode::serialized: return "serialized";
+    case SiteMode::solo: return "solo";
+  }
+  return "?";
+}
+
+SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, const std::vector<std::vector<SiteJob>>& jobs,
+                     const SiteRunOptions& options) {
+  ac::validate(site);
+  if (jobs.size() != site.cranes.size()) {
+    throw std::invalid_argument("site run: " + std::to_string(jobs.size()) + " job lists for " +
+                                std::to_string(site.cranes.size()) + " cranes");
+  }
+  if (options.mode != SiteMode::solo) return run_together(site, config, jobs, options);
+  SiteOutcome out;
+  out.min_distance = std::numeric_limits<double>::infinity();
+  out.completed = true;
+  for (std::size_t i = 0; i < site.cranes.size(); ++i) {
+    ac::SiteLayout alone = site;
+    alone.cranes = {site.cranes[i]};
+    const SiteOutcome one = run_together(alone, config, {jobs[i]}, options);
+    out.cranes.push_back(one.cranes[0]);
+    out.completed = out.completed && one.completed;
+    out.total_time = std::max(out.total_time, one.total_time);
+    out.simulated_seconds += one.simulated_seconds;
+  }
+  return out;
+}
+
+std::vector<std::vector<SiteJob>> random_site_jobs(const ac::SiteLayout& site, const StackConfig& config, int per_crane,
+                                                   std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto& planner = config.trajectory_planner;
+  const double r_low = planner.trolley_min_position + 0.1;
+  const double r_high = planner.trolley_max_position - 0.05;
+  std::vector<std::vector<SiteJob>> jobs(site.cranes.size());
+  for (std::size_t i = 0; i < site.cranes.size(); ++i) {
+    const auto& c = site.cranes[i];
+    const double s_low = std::max(c.slew_min, planner.slew_min_angle) + 0.2;
+    const double s_high = std::min(c.slew_max, planner.slew_max_angle) - 0.2;
+    const auto point = [&]() {
+      const bool shared = site.cranes.size() > 1 && unit(rng) < 0.7;
+      WorkPoint w;
+      for (int attempt = 0; attempt < 1000; ++attempt) {
+        w.slew = s_low + (s_high - s_low) * unit(rng);
+        w.trolley = r_low + (r_high - r_low) * unit(rng);
+        const double heading = c.slew_zero_heading + w.slew;
+        const double x = c.base[0] + w.trolley * std::cos(heading);
+        const double y = c.base[1] + w.trolley * std::sin(heading);
+        bool in_other = false;
+        for (std::size_t j = 0; j < site.cranes.size(); ++j) {
+          if (j == i) continue;
+          const double d = std::hypot(x - site.cranes[j].base[0], y - site.cranes[j].base[1]);
+          in_other = in_other || (d > r_low && d < r_high);
+        }
+        if (!shared || in_other) break;
+      }
+      const double height = c.hook_height_min + 0.8 * unit(rng);
+      w.cable_length = std::clamp(c.jib_height - height, planner.cable_min_length, planner.cable_max_length);
+      return w;
+    };
+    for (int j = 0; j < per_crane; ++j) {
+      SiteJob job;
+      job.pick = point();
+      job.place = point();
+      jobs[i].push_back(job);
+    }
+  }
+  return jobs;
+}
+
+}  // namespace crane::stack

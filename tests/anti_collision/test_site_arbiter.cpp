@@ -1,0 +1,273 @@
+// The site service's rules (site_arbiter.hpp) and the airspace they grant (airspace.hpp): distances
+// computed by hand, the priority rules, a deadlock of two cranes that wait for each other, a lost
+// crane holding its whole reach, bad requests.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/common/validation.hpp"
+
+namespace {
+
+using namespace crane::anti_collision;
+
+// Two towers 2 m apart on the x axis, jibs 1.4 m long, 6 x 8 cm section, mast 8 cm, loads of
+// radius 5 cm: A at (0, 0) with its jib at 2.5 m, B at (2, 0) at `b_height`, heading +x at slew 0.
+SiteLayout two_towers(double b_height = 3.0) {
+  SiteLayout s;
+  s.name = "two";
+  s.margins = {0.30, 0.15, 0.05};
+  s.paths = {0.0, 0.0, 0.0, 0.0};  // no allowance unless a test sets one
+  for (int i = 0; i < 2; ++i) {
+    SiteCrane c;
+    c.name = i == 0 ? "a" : "b";
+    c.base = {2.0 * i, 0.0};
+    c.jib_height = i == 0 ? 2.5 : b_height;
+    c.jib_length = 1.4;
+    c.counter_jib_length = 0.4;
+    c.jib_width = 0.06;
+    c.jib_depth = 0.08;
+    c.mast_width = 0.08;
+    c.trolley_min = 0.05;
+    c.trolley_max = 1.3;
+    c.slew_min = -3.0;
+    c.slew_max = 3.0;
+    c.hook_height_min = c.jib_height - 2.0;
+    c.hook_height_max = c.jib_height - 0.2;
+    c.load_radius = 0.05;
+    c.domain_id = 11 + i;
+    s.cranes.push_back(c);
+  }
+  return s;
+}
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A's jib along +x (its chord 2.5..2.58 m, half width 0.03) under B's load hanging at x = 1.0
+// (B's slew pi, trolley 1.0), at cable 2.0 (load centre 1.0 m, bottom 0.95): in plan the load's
+// disc (0.05) sits on A's jib line: plan distance 0; heights overlap: distance 0. With B's cable
+// 0.2 (load 2.8 m, bottom 2.75 m) the gap is 2.75 - 2.58 = 0.17 m, straight up.
+TEST(Airspace, RestPosesByHand) {
+  const SiteLayout s = two_towers();
+  const Airspace a = rest_airspace({0.0, 0.5, 0.2}, s.paths);
+  EXPECT_NEAR(airspace_distance(s.cranes[0], a, s.cranes[1], rest_airspace({kPi, 1.0, 2.0}, s.paths)).distance, 0.0, 1e-12);
+  const PairDistance up = airspace_distance(s.cranes[0], a, s.cranes[1], rest_airspace({kPi, 1.0, 0.2}, s.paths));
+  EXPECT_NEAR(up.distance, 0.17, 1e-9);
+  EXPECT_EQ(up.first, Part::jib);
+  EXPECT_EQ(up.second, Part::cable);
+  // B's load beside A's jib in plan: B's slew pi + 0.3 puts its sheave (trolley 1.0) at
+  // (2 - cos 0.3, -sin 0.3) = (1.04466, -0.29552); A's jib line is y = 0 (x in [0, 1.4]): plan gap
+  // 0.29552 - 0.03 - 0.05 = 0.21552, heights overlapping.
+  const double d = airspace_distance(s.cranes[0], a, s.cranes[1], rest_airspace({kPi + 0.3, 1.0, 2.0}, s.paths)).distance;
+  EXPECT_NEAR(d, std::sin(0.3) - 0.03 - 0.05, 1e-9);
+  // Its swing allowance widens the load: 0.05 rad at cable 2 m is 2 sin(0.05) = 0.09996 m.
+  SiteLayout swinging = two_towers();
+  swinging.paths.hoist_swing = 0.05;
+  const double dswing = airspace_distance(swinging.cranes[0], rest_airspace({0.0, 0.5, 0.2}, swinging.paths),
+                                          swinging.cranes[1], rest_airspace({kPi + 0.3, 1.0, 2.0}, swinging.paths))
+                            .distance;
+  EXPECT_NEAR(dswing, std::sin(0.3) - 0.03 - 0.05 - 2.0 * std::sin(0.05), 1e-9);
+}
+
+// A slewing path sweeps every heading between its ends: A turning from -1 to +1 rad passes under
+// B's lowered load at heading 0; the samples' padding keeps the swept jib inside the airspace at
+// every heading, checked against 2000 seeded random headings of the path.
+TEST(Airspace, ASlewingPathContainsEveryHeadingBetween) {
+  const SiteLayout s = two_towers();
+  const Pose from{-1.0, 0.5, 0.2};
+  const Pose to{1.0, 0.5, 0.2};
+  const Pose path[] = {from, to};
+  const Airspace swept = path_airspace(path, s.paths);
+  ASSERT_EQ(swept.count, 1u);
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> heading(-1.0, 1.0);
+  std::uniform_real_distribution<double> b_slew(kPi - 0.6, kPi + 0.6);
+  for (int i = 0; i < 2000; ++i) {
+    const Airspace at = rest_airspace({heading(rng), 0.5, 0.2}, s.paths);
+    const Airspace other = rest_airspace({b_slew(rng), 1.0, 2.0}, s.paths);
+    const double whole = airspace_distance(s.cranes[0], swept, s.cranes[1], other).distance;
+    const double one = airspace_distance(s.cranes[0], at, s.cranes[1], other).distance;
+    ASSERT_LE(whole, one + 1e-12) << "sample " << i;
+  }
+  EXPECT_NEAR(airspace_distance(s.cranes[0], swept, s.cranes[1], rest_airspace({kPi, 1.0, 2.0}, s.paths)).distance, 0.0,
+              1e-12);
+}
+
+TEST(SiteArbiter, AClearRequestIsGrantedAndAConflictingOneWaits) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  arbiter.rest(0, {-1.5, 0.5, 0.2});  // A's jib away from B
+  arbiter.rest(1, {kPi - 1.5, 0.5, 0.2});
+  // B lowers its load at x = 1.0 on A's jib line: A's jib is turned away, so B goes.
+  arbiter.request(1, {{kPi - 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
+  auto decided = arbiter.decide();
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 1u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
+  EXPECT_EQ(arbiter.holding(1), Holding::path);
+  // A now asks to turn its jib to heading 0, under B's load: it waits for B.
+  arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 2.0);
+  EXPECT_TRUE(arbiter.decide().empty());
+  ASSERT_EQ(arbiter.waits_for(0).size(), 1u);
+  EXPECT_EQ(arbiter.waits_for(0)[0], 1u);
+  // B hoists up and rests there: its load 0.17 m above A's jib, beyond slow_down (0.15): A goes.
+  arbiter.rest(1, {kPi, 1.0, 0.2});
+  decided = arbiter.decide();
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 0u);
+}
+
+// Rules 1 and 3: two cranes with their jibs at the same height (2 m apart, 1.4 m jibs: they meet
+// between the masts) both turn toward each other; the priority crane goes first, and without
+// priorities the earlier request.
+TEST(SiteArbiter, PriorityThenFirstCome) {
+  for (const bool b_priority : {false, true}) {
+    SiteLayout s = two_towers(2.5);
+    s.cranes[1].priority = b_priority ? 1 : 0;
+    SiteArbiter arbiter(s, ArbiterMode::coordinated);
+    arbiter.rest(0, {-1.5, 0.5, 0.2});
+    arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
+    arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);  // first
+    arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 0.5, 0.2}}, 2.0);
+    const auto decided = arbiter.decide();
+    ASSERT_EQ(decided.size(), 1u);
+    EXPECT_EQ(decided[0].crane, b_priority ? 1u : 0u);
+    EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
+  }
+}
+
+// Rule 2: A's jib (the lower crane) and B's cable want the same place; B asked later and has no
+// priority, yet goes first.
+TEST(SiteArbiter, TheLowerCraneYieldsItsJibToTheHigherCranesCable) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  arbiter.rest(0, {-1.5, 0.5, 0.2});
+  arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
+  arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);  // A's jib to heading 0
+  arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 2.0);  // B's load down on it
+  const auto decided = arbiter.decide();
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 1u);
+  EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
+}
+
+// The deadlock: A rests with its jib under the place where B must lower, B rests with its load
+// lowered where A's jib must pass. Each waits for the other's held airspace; A ranks last (the
+// later request), so A is told to yield: hook up where it is does not free B (A's jib stays), so
+// A turns its jib away; B then goes, and A after B rests hook up.
+TEST(SiteArbiter, TwoCranesThatWaitForEachOtherAreResolvedByAYield) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  arbiter.rest(0, {0.0, 0.5, 0.2});         // A's jib along +x: under (1, 0)
+  arbiter.rest(1, {kPi + 0.5, 1.0, 2.0});   // B's load lowered at heading pi + 0.5, beside A's jib
+  // B wants to lower at (1, 0), over A's jib; A wants to slew to -0.6, through B's load (at
+  // (2 - cos 0.5, -sin 0.5) = (1.12, -0.48) in plan; A's trolley 0.5 does not reach it, its jib does).
+  arbiter.request(1, {{kPi + 0.5, 1.0, 2.0}, {kPi, 1.0, 2.0}}, 1.0);
+  arbiter.request(0, {{0.0, 0.5, 0.2}, {-0.6, 0.5, 0.2}}, 2.0);
+  const auto decided = arbiter.decide();
+  EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
+  EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 0u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
+  ASSERT_GE(decided[0].waypoints.size(), 2u);
+  const Pose yielded = decided[0].waypoints.back();
+  EXPECT_NEAR(std::abs(yielded.slew), SiteArbiter::kYieldSlewStep * std::round(std::abs(yielded.slew) / SiteArbiter::kYieldSlewStep), 1e-12);
+  EXPECT_EQ(arbiter.yields(), 1u);
+  EXPECT_EQ(arbiter.holding(0), Holding::yield);
+  EXPECT_TRUE(arbiter.pending(0));
+  // A rests at its yield pose: B goes; A asks again from there and waits for B.
+  arbiter.rest(0, yielded);
+  arbiter.request(0, {yielded, {-0.6, 0.5, 0.2}}, 3.0);
+  auto next = arbiter.decide();
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_EQ(next[0].crane, 1u);
+  EXPECT_EQ(next[0].kind, Instruction::Kind::go);
+  EXPECT_EQ(arbiter.unresolved(), 0u);
+}
+
+// An idle crane in the way (no request of its own) is told to yield as well.
+TEST(SiteArbiter, AnIdleCraneInTheWayYields) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  arbiter.rest(0, {0.0, 0.5, 0.2});
+  arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
+  arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
+  const auto decided = arbiter.decide();
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 0u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
+}
+
+// A crane that stops reporting holds its whole reach: nothing of the other crane that meets it is
+// granted until it rests again; nothing is allowed by default (every crane starts so). B's travel
+// with its hook up passes above all of A (its load's bottom 2.75 m, A's jib top 2.58 m) and is
+// granted even so; lowering is not.
+TEST(SiteArbiter, ALostCraneHoldsItsWholeReach) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  EXPECT_EQ(arbiter.holding(0), Holding::whole_reach);
+  arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
+  arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
+  EXPECT_TRUE(arbiter.decide().empty());  // A never reported
+  EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
+  arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}}, 1.5);  // hook up only
+  ASSERT_EQ(arbiter.decide().size(), 1u);
+  arbiter.rest(1, {kPi, 1.0, 0.2});
+  arbiter.rest(0, {-1.5, 0.5, 0.2});
+  arbiter.lost(0);
+  arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 2.0);
+  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
+  arbiter.rest(0, {-1.5, 0.5, 0.2});  // A reports again, its jib away
+  ASSERT_EQ(arbiter.decide().size(), 1u);
+}
+
+// A crane that reports reaching a waypoint holds only the rest of its path: B's load hangs low at
+// (1, 0), on the line A's jib wants to turn to; B hoists up, travels to (1.93, 1.0) and lowers
+// there, beyond A's reach. Once B reports it has hoisted up and travelled, A's jib may turn.
+TEST(SiteArbiter, ProgressFreesThePathBehind) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  arbiter.rest(0, {-1.5, 0.5, 0.2});
+  arbiter.rest(1, {kPi, 1.0, 1.5});
+  const std::vector<Pose> path{{kPi, 1.0, 1.5}, {kPi, 1.0, 0.2}, {kPi - 1.5, 1.0, 0.2}, {kPi - 1.5, 1.0, 1.5}};
+  arbiter.request(1, path, 1.0);
+  ASSERT_EQ(arbiter.decide().size(), 1u);
+  // A's jib to heading 0 meets B's load where B's path starts.
+  arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 2.0);
+  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
+  arbiter.progress(1, {path.begin() + 2, path.end()});  // B hoisted up and travelled
+  ASSERT_EQ(arbiter.decide().size(), 1u);
+  EXPECT_THROW(arbiter.progress(0, {}), std::invalid_argument);
+  SiteArbiter idle(two_towers(), ArbiterMode::coordinated);
+  idle.rest(0, {0.0, 0.5, 0.2});
+  EXPECT_THROW(idle.progress(0, {{0.0, 0.5, 0.2}}), std::logic_error);
+}
+
+// The serialized baseline: two requests in shared airspace that keep apart geometrically still go
+// one at a time.
+TEST(SiteArbiter, SerializedModeLetsOneCraneAtATimeIntoSharedAirspace) {
+  for (const auto mode : {ArbiterMode::coordinated, ArbiterMode::serialized}) {
+    SiteArbiter arbiter(two_towers(), mode);
+    arbiter.rest(0, {-1.5, 0.5, 0.2});
+    arbiter.rest(1, {kPi - 1.5, 0.5, 0.2});
+    // A's load down in the overlap, south (0.99, -0.68); B's, north (1.01, 0.68): 1.36 m apart,
+    // and neither jib turns over the other's load.
+    arbiter.request(0, {{-1.5, 0.5, 0.2}, {-0.6, 1.2, 0.2}, {-0.6, 1.2, 1.5}}, 1.0);
+    arbiter.request(1, {{kPi - 1.5, 0.5, 0.2}, {kPi - 0.6, 1.2, 0.2}, {kPi - 0.6, 1.2, 1.5}}, 2.0);
+    EXPECT_EQ(arbiter.decide().size(), mode == ArbiterMode::coordinated ? 2u : 1u);
+  }
+}
+
+TEST(SiteArbiter, BadRequestsAreRefused) {
+  SiteArbiter arbiter(two_towers(), ArbiterMode::coordinated);
+  EXPECT_THROW(arbiter.request(0, {}, 0.0), std::invalid_argument);
+  EXPECT_THROW(arbiter.request(0, {{std::nan(""), 0.5, 0.2}}, 0.0), std::invalid_argument);
+  EXPECT_THROW(arbiter.request(0, {{0.0, 0.5, 0.0}}, 0.0), std::invalid_argument);
+  EXPECT_THROW(arbiter.request(5, {{0.0, 0.5, 0.2}}, 0.0), std::out_of_range);
+  SiteLayout bad = two_towers();
+  bad.margins.stop = 0.2;
+  EXPECT_THROW(SiteArbiter(bad, ArbiterMode::coordinated), crane::common::ConfigError);
+}
+
+}  // namespace
