@@ -20,10 +20,7 @@ const char* to_string(Holding holding) noexcept {
 SiteArbiter::SiteArbiter(SiteLayout layout, ArbiterMode mode) : layout_(std::move(layout)), mode_(mode) {
   validate(layout_);
   cranes_.resize(layout_.cranes.size());
-  for (std::size_t i = 0; i < cranes_.size(); ++i) {
-    reach_.push_back(whole_reach(layout_.cranes[i], layout_.paths));
-    cranes_[i].held = reach_.back();
-  }
+  for (std::size_t i = 0; i < cranes_.size(); ++i) cranes_[i].held = whole_reach(layout_.cranes[i], layout_.paths);
 }
 
 bool SiteArbiter::clear(std::size_t i, const Airspace& a, std::size_t j, const Airspace& b) const noexcept {
@@ -82,7 +79,7 @@ void SiteArbiter::withdraw(std::size_t crane) { cranes_.at(crane).request.reset(
 void SiteArbiter::lost(std::size_t crane) {
   CraneState& c = cranes_.at(crane);
   c.holding = Holding::whole_reach;
-  c.held = reach_[crane];
+  c.held = whole_reach(layout_.cranes[crane], layout_.paths);
   c.held_shared = true;
 }
 
@@ -106,12 +103,17 @@ bool SiteArbiter::yields_jib_to(std::size_t i, std::size_t j) const {
          (d.second == Part::cable || d.second == Part::load);
 }
 
-bool SiteArbiter::shared(std::size_t i, const Airspace& a) const {
-  for (std::size_t j = 0; j < cranes_.size(); ++j) {
-    if (j != i && !clear(i, a, j, reach_[j])) return true;
+bool in_shared_airspace(const SiteLayout& layout, std::size_t crane, const Airspace& airspace) {
+  const SiteCrane& self = layout.cranes.at(crane);
+  for (std::size_t j = 0; j < layout.cranes.size(); ++j) {
+    if (j == crane) continue;
+    const Airspace reach = whole_reach(layout.cranes[j], layout.paths);
+    if (airspace_distance(self, airspace, layout.cranes[j], reach).distance < layout.margins.slow_down) return true;
   }
   return false;
 }
+
+bool SiteArbiter::shared(std::size_t i, const Airspace& a) const { return in_shared_airspace(layout_, i, a); }
 
 std::optional<std::vector<Pose>> SiteArbiter::yield_path(std::size_t v, const std::vector<std::size_t>& waiting) const {
   const SiteCrane& crane = layout_.cranes[v];

@@ -15,6 +15,8 @@
 //       baseline: one crane at a time in shared airspace) and solo (each crane alone); prints the
 //       first set per crane, then over all sets the minimum true distance between any two cranes'
 //       parts (its distribution), the total times and their ratios, waits, yields and faults.
+//       --faults K injects K random link faults in each coordinated set (stack::random_link_faults)
+//       and prints the reaction times.
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -114,7 +116,7 @@ double quantile(std::vector<double> v, double q) {
 }
 
 int demo(const std::string& site_path, const std::string& config_path, int sets, int jobs, std::uint64_t seed,
-         int threads) {
+         int threads, int faults) {
   using namespace crane::stack;
   SiteLayout site;
   StackConfig config;
@@ -132,9 +134,14 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
       SetResult& r = results[static_cast<std::size_t>(s)];
       try {
         const auto set = random_site_jobs(site, config, jobs, seed + static_cast<std::uint64_t>(s));
-        r.coordinated = run_site(site, config, set, {SiteMode::coordinated});
-        r.serialized = run_site(site, config, set, {SiteMode::serialized});
-        r.solo = run_site(site, config, set, {SiteMode::solo});
+        SiteRunOptions options;
+        options.faults = random_link_faults(site, faults, seed + static_cast<std::uint64_t>(s));
+        r.coordinated = run_site(site, config, set, options);
+        options.faults.clear();
+        options.mode = SiteMode::serialized;
+        r.serialized = run_site(site, config, set, options);
+        options.mode = SiteMode::solo;
+        r.solo = run_site(site, config, set, options);
       } catch (const std::exception& error) {
         r.error = error.what();
       }
@@ -164,7 +171,7 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
   }
 
   std::vector<double> min_distance, serial_min, vs_serialized, vs_solo;
-  int failed = 0, incomplete = 0, faults = 0;
+  int failed = 0, incomplete = 0, faulted = 0;
   std::uint64_t unresolved = 0;
   int yields = 0;
   double waiting = 0.0, simulated = 0.0;
@@ -176,7 +183,7 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
     }
     for (const auto* o : {&r.coordinated, &r.serialized, &r.solo}) {
       if (!o->completed) ++incomplete;
-      for (const auto& c : o->cranes) faults += c.latched_faults != 0 ? 1 : 0;
+      for (const auto& c : o->cranes) faulted += c.latched_faults != 0 ? 1 : 0;
       simulated += o->simulated_seconds;
     }
     min_distance.push_back(r.coordinated.min_distance);
@@ -188,7 +195,7 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
   }
   std::printf("\nover %zu set(s) (%d failed, %d runs incomplete, %d cranes with a supervisor fault, %llu unresolved "
               "waits; %.0f crane-seconds simulated)\n",
-              min_distance.size(), failed, incomplete, faults, static_cast<unsigned long long>(unresolved), simulated);
+              min_distance.size(), failed, incomplete, faulted, static_cast<unsigned long long>(unresolved), simulated);
   std::printf("  min distance, coordinated [m]: min %.3f  p1 %.3f  p10 %.3f  median %.3f  (stop margin %.3f)\n",
               quantile(min_distance, 0.0), quantile(min_distance, 0.01), quantile(min_distance, 0.1),
               quantile(min_distance, 0.5), site.margins.stop);
@@ -198,10 +205,31 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
               quantile(vs_serialized, 1.0), quantile(vs_serialized, 0.0));
   std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", quantile(vs_solo, 0.5),
               quantile(vs_solo, 1.0), quantile(vs_solo, 0.0));
+  int slow = 0, stops = 0, emergency = 0;
+  for (const SetResult& r : results) {
+    slow += r.coordinated.watch_slow_downs, stops += r.coordinated.watch_stops, emergency += r.coordinated.watch_emergency_stops;
+  }
+  std::printf("  distance-watching rule on the coordinated runs (counted, not applied): %d slow-downs, %d stops, %d "
+              "emergency stops\n", slow, stops, emergency);
+  std::vector<double> reactions;
+  int halts = 0;
+  for (const SetResult& r : results) {
+    reactions.insert(reactions.end(), r.coordinated.reactions.begin(), r.coordinated.reactions.end());
+    halts += r.coordinated.halts;
+  }
+  if (faults > 0) {
+    std::printf("  link faults: %d per coordinated set (a crane's link lost 0.5-30 s, or the site service killed and "
+                "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d soft stops\n",
+                faults, reactions.size(), site.link_deadline, halts);
+    std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace [ms]: min %.0f  median %.0f  "
+                "p90 %.0f  p99 %.0f  max %.0f\n",
+                1e3 * quantile(reactions, 0.0), 1e3 * quantile(reactions, 0.5), 1e3 * quantile(reactions, 0.9),
+                1e3 * quantile(reactions, 0.99), 1e3 * quantile(reactions, 1.0));
+  }
   std::printf("  coordinated: %d yields, %.1f s waiting per set\n", yields,
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));
   const bool safe = !min_distance.empty() && quantile(min_distance, 0.0) >= site.margins.stop;
-  return failed == 0 && incomplete == 0 && faults == 0 && safe ? 0 : 1;
+  return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
 }
 
 }  // namespace
@@ -222,8 +250,10 @@ int main(int argc, char** argv) {
   demo_command->add_option("--jobs", jobs, "pick-and-place jobs per crane and set")->check(CLI::Range(1, 100));
   demo_command->add_option("--seed", seed, "the first set's seed");
   demo_command->add_option("--threads", threads, "sets run in parallel")->check(CLI::Range(1, 256));
+  int faults = 0;
+  demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
   CLI11_PARSE(app, argc, argv);
   if (check_command->parsed()) return check(site_path);
-  if (demo_command->parsed()) return demo(site_path, config_path, sets, jobs, seed, threads);
+  if (demo_command->parsed()) return demo(site_path, config_path, sets, jobs, seed, threads, faults);
   return 1;
 }

@@ -34,13 +34,17 @@ struct Crane {
   std::unique_ptr<InProcessStack> stack;
   std::vector<Leg> legs;  // left to do, front first
   std::size_t next_leg{0};
-  enum class Phase { resting, asking, moving, dwelling, done } phase{Phase::resting};
+  enum class Phase { resting, asking, moving, dwelling, halting, halted, done } phase{Phase::resting};
+  std::optional<double> down_since;  // [s] its link to the site service is down since
+  bool link_lost{false};             // down for link_deadline: the site service holds its whole reach
+  double halt_from{0.0};             // [s] the link loss its soft stop answers
   std::vector<ac::Pose> path;    // the granted path or yield, path[0] where it started
   std::size_t waypoint{0};       // the waypoint being moved to
   bool yielding{false};
   std::uint32_t request_id{0};
   bool start_next{false};        // the move to waypoint + 1 starts at the next cycle
   std::optional<std::uint64_t> arrived_cycle;  // the reference arrived at this cycle
+  std::optional<Request> stop_goal;             // a soft stop to send this cycle
   std::uint64_t dwell_until{0};
   double asked_at{0.0};
   CraneOutcome outcome;
@@ -49,6 +53,13 @@ struct Crane {
 ac::Pose measured_pose(const InProcessStack& stack) {
   const auto& e = stack.estimate();
   return {e.slew_angle, e.trolley_position, e.cable_length};
+}
+
+// The drives at rest (the swing may still decay).
+bool at_rest(const InProcessStack& stack) {
+  const auto& e = stack.estimate();
+  return std::abs(e.trolley_velocity) < kSettledSpeed && std::abs(e.slew_rate) < kSettledSpeed &&
+         std::abs(e.cable_length_rate) < kSettledSpeed;
 }
 
 bool settled(const InProcessStack& stack, double gravity) {
@@ -103,8 +114,9 @@ std::array<ac::Capsule, ac::kPartCount> true_parts(const ac::SiteCrane& c, const
 SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
                          const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options) {
   const std::size_t n = site.cranes.size();
-  ac::SiteArbiter arbiter(site, options.mode == SiteMode::serialized ? ac::ArbiterMode::serialized
-                                                                       : ac::ArbiterMode::coordinated);
+  const auto arbiter_mode =
+      options.mode == SiteMode::serialized ? ac::ArbiterMode::serialized : ac::ArbiterMode::coordinated;
+  auto arbiter_ptr = std::make_unique<ac::SiteArbiter>(site, arbiter_mode);
   const double dt = config.facts.sample_period;
   const double gravity = config.facts.crane.gravity;
   const double hook_up_cable = config.trajectory_planner.cable_min_length;
@@ -135,14 +147,70 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   const auto settle_cycles = static_cast<std::uint64_t>(std::llround(options.settle_timeout / dt));
   std::vector<Request> goal(n);
   std::vector<bool> has_goal(n);
+  std::vector<ac::Action> watched(n * n, ac::Action::clear);
   bool changed = true;
+  bool service_was_down = false;
   std::uint64_t k = 0;
   for (; k < limit; ++k) {
     const double t = static_cast<double>(k) * dt;
+    // The links: which are down, which came back, which are lost.
+    const auto active = [&](const LinkFault& f) { return t >= f.start && t < f.start + f.duration; };
+    const bool service_down = std::any_of(options.faults.begin(), options.faults.end(),
+                                          [&](const LinkFault& f) { return f.crane == kSiteService && active(f); });
+    if (service_was_down && !service_down) {
+      // The site service restarted with no memory: every crane holds its whole reach until it
+      // reports, and a request it had asked for is asked again.
+      arbiter_ptr = std::make_unique<ac::SiteArbiter>(site, arbiter_mode);
+      for (Crane& c : cranes) {
+        if (c.phase == Crane::Phase::asking) c.phase = Crane::Phase::resting;
+      }
+      changed = true;
+    }
+    service_was_down = service_down;
+    ac::SiteArbiter& arbiter = *arbiter_ptr;
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      const bool down = service_down || std::any_of(options.faults.begin(), options.faults.end(),
+                                                    [&](const LinkFault& f) { return f.crane == i && active(f); });
+      if (down && !c.down_since) c.down_since = t;
+      if (!down && c.down_since) {
+        // Back: the crane reports where it rests and asks again (a grant sent meanwhile was lost).
+        c.down_since.reset();
+        if (c.phase == Crane::Phase::halted || c.phase == Crane::Phase::asking) c.phase = Crane::Phase::resting;
+        if (c.phase == Crane::Phase::done) arbiter.rest(i, measured_pose(*c.stack));
+        c.link_lost = false;
+        changed = true;
+      }
+      if (!down || c.link_lost || t - *c.down_since < site.link_deadline - 1e-9) continue;
+      c.link_lost = true;
+      if (!service_down) arbiter.lost(i);
+      if (c.phase == Crane::Phase::moving || c.phase == Crane::Phase::dwelling) {
+        std::vector<ac::Pose> rest{measured_pose(*c.stack)};
+        rest.insert(rest.end(), c.path.begin() + static_cast<std::ptrdiff_t>(std::min(c.waypoint, c.path.size() - 1)), c.path.end());
+        // A path longer than an airspace holds is not checked: the crane stops.
+        if (rest.size() > ac::Airspace::kMaxBoxes + 1 ||
+            ac::in_shared_airspace(site, i, ac::path_airspace(rest, site.paths))) {
+          c.phase = Crane::Phase::halting;
+          c.halt_from = *c.down_since;
+          c.arrived_cycle.reset();
+          c.start_next = false;
+          Request stop{};
+          stop.request_id = ++c.request_id;
+          stop.command = Request::COMMAND_STOP;
+          c.stop_goal = stop;
+          ++out.halts;
+          continue;
+        }
+        out.reactions.push_back(t - *c.down_since);  // it keeps to its own airspace
+      } else if (c.phase != Crane::Phase::done) {
+        if (c.phase == Crane::Phase::asking || c.phase == Crane::Phase::resting) c.phase = Crane::Phase::halted;
+        out.reactions.push_back(t - *c.down_since);  // at rest already
+      }
+    }
     // Each crane at rest asks for its next leg.
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
-      if (c.phase != Crane::Phase::resting || k == 0) continue;
+      if (c.phase != Crane::Phase::resting || k == 0 || c.down_since) continue;
       const ac::Pose here = measured_pose(*c.stack);
       arbiter.rest(i, here);
       changed = true;
@@ -161,10 +229,13 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       c.phase = Crane::Phase::asking;
       c.asked_at = t;
     }
-    if (changed) {
+    if (changed && !service_down) {
       changed = false;
       for (ac::Instruction& instruction : arbiter.decide()) {
         Crane& c = cranes[instruction.crane];
+        // A crane whose link is down does not hear it (the service holds the path for it until it
+        // reports again); an idle one (done) may be told to yield.
+        if (c.down_since || (c.phase != Crane::Phase::asking && c.phase != Crane::Phase::done)) continue;
         c.yielding = instruction.kind == ac::Instruction::Kind::yield;
         if (c.yielding) ++c.outcome.yields;
         c.outcome.waiting_time += t - c.asked_at;
@@ -189,7 +260,8 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       }
       if (c.phase != Crane::Phase::moving || !c.start_next) continue;
       c.start_next = false;
-      if (c.waypoint > 0) {
+      if (c.waypoint > 0 && !c.down_since &&
+          (arbiter.holding(i) == ac::Holding::path || arbiter.holding(i) == ac::Holding::yield)) {
         // What the crane left behind is free for the others.
         arbiter.progress(i, std::vector<ac::Pose>(c.path.begin() + static_cast<std::ptrdiff_t>(c.waypoint), c.path.end()));
         changed = true;
@@ -200,6 +272,11 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       c.arrived_cycle.reset();
     }
     for (std::size_t i = 0; i < n; ++i) {
+      if (cranes[i].stop_goal) {
+        goal[i] = *cranes[i].stop_goal;
+        cranes[i].stop_goal.reset();
+        has_goal[i] = true;
+      }
       cranes[i].stack->step(has_goal[i] ? std::span(&goal[i], 1) : std::span<const Request>());
       for (const auto& outcome : cranes[i].stack->planner().goal_outcomes()) {
         if (outcome.status != trajectory_planner::GoalStatus::accepted) {
@@ -215,6 +292,18 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     // Moves that ended.
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
+      if (c.phase == Crane::Phase::halting) {
+        const auto& r = c.stack->reference();
+        // The stop was taken at the cycle it was sent: a soft stop's reference moves until it
+        // arrives; a crane that was not moving (settling at a waypoint) holds at once.
+        if (r.phase != protocol::Reference::PHASE_MOVING && at_rest(*c.stack)) {
+          c.yielding = false;
+          out.reactions.push_back(t + dt - c.halt_from);
+          // At rest; if the link came back while it stopped, it asks again at once.
+          c.phase = c.down_since ? Crane::Phase::halted : Crane::Phase::resting;
+        }
+        continue;
+      }
       if (c.phase != Crane::Phase::moving || c.start_next) continue;
       const auto& r = c.stack->reference();
       if (r.request_id != c.request_id || r.phase != protocol::Reference::PHASE_ARRIVED) continue;
@@ -259,10 +348,43 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         }
       }
     }
+    // The distance-watching rule, counted.
+    if (k % kWatchStride == 0) {
+      std::vector<ac::CraneEnvelope> soft(n), emergency(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto& e = cranes[i].stack->estimate();
+        ac::CraneMotion m;
+        m.slew = e.slew_angle;
+        m.slew_rate = e.slew_rate;
+        m.trolley = e.trolley_position;
+        m.trolley_velocity = e.trolley_velocity;
+        m.cable_length = e.cable_length;
+        m.cable_rate = e.cable_length_rate;
+        m.swing_in_plane = e.swing_in_plane;
+        m.swing_out_of_plane = e.swing_out_of_plane;
+        m.swing_in_plane_rate = e.swing_in_plane_rate;
+        m.swing_out_of_plane_rate = e.swing_out_of_plane_rate;
+        soft[i] = ac::envelope(site.cranes[i], m, ac::StopKind::soft);
+        emergency[i] = ac::envelope(site.cranes[i], m, ac::StopKind::emergency);
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = i + 1; j < n; ++j) {
+          const ac::Action action = ac::classify(ac::distance(soft[i], soft[j]).distance,
+                                                 ac::distance(emergency[i], emergency[j]).distance, site.margins);
+          ac::Action& before = watched[i * n + j];
+          if (action > before) {
+            if (action >= ac::Action::slow_down && before < ac::Action::slow_down) ++out.watch_slow_downs;
+            if (action >= ac::Action::stop && before < ac::Action::stop) ++out.watch_stops;
+            if (action == ac::Action::emergency_stop) ++out.watch_emergency_stops;
+          }
+          before = action;
+        }
+      }
+    }
     if (std::all_of(cranes.begin(), cranes.end(), [](const Crane& c) { return c.phase == Crane::Phase::done; })) break;
   }
   out.completed = k < limit;
-  out.unresolved = arbiter.unresolved();
+  out.unresolved = arbiter_ptr->unresolved();
   for (Crane& c : cranes) {
     c.outcome.latched_faults = c.stack->status().latched_faults;
     out.total_time = std::max(out.total_time, c.outcome.finish_time);
@@ -304,6 +426,25 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
     out.simulated_seconds += one.simulated_seconds;
   }
   return out;
+}
+
+std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<LinkFault> faults;
+  for (int f = 0; f < count; ++f) {
+    LinkFault fault;
+    fault.start = 80.0 * unit(rng);
+    if (unit(rng) < 0.6) {
+      fault.crane = std::min(site.cranes.size() - 1, static_cast<std::size_t>(unit(rng) * static_cast<double>(site.cranes.size())));
+      fault.duration = 0.5 + 29.5 * unit(rng);
+    } else {
+      fault.crane = kSiteService;
+      fault.duration = 0.5 + 9.5 * unit(rng);
+    }
+    faults.push_back(fault);
+  }
+  return faults;
 }
 
 std::vector<std::vector<SiteJob>> random_site_jobs(const ac::SiteLayout& site, const StackConfig& config, int per_crane,

@@ -42,6 +42,11 @@ namespace crane::anti_collision {
 
 enum class ArbiterMode : std::uint8_t { coordinated, serialized };
 
+/// True when `airspace` of crane `crane` meets another crane's whole reach within
+/// margins.slow_down: shared airspace, which a crane without a live link to the site service must
+/// not move in (issue 34, item 4). std::out_of_range for a crane index not on the site.
+[[nodiscard]] bool in_shared_airspace(const SiteLayout& layout, std::size_t crane, const Airspace& airspace);
+
 /// What decide() tells a crane.
 struct Instruction {
   enum class Kind : std::uint8_t { go, yield };
@@ -121,7 +126,6 @@ class SiteArbiter {
   SiteLayout layout_;
   ArbiterMode mode_;
   std::vector<CraneState> cranes_;
-  std::vector<Airspace> reach_;
   std::uint64_t yields_{0};
   std::uint64_t unresolved_{0};
 };

@@ -13,6 +13,18 @@
 // (crane_geometry.hpp's capsules of jib, counter-jib and mast, the cable from the sheave to the
 // swinging load, the load's sphere): the figure "no contact, ever" is about.
 //
+// Beside it runs the rule of the industrial systems, which watch distances only: every
+// kWatchStride cycles, each pair's soft- and emergency-stop envelopes from the estimators' states
+// (crane_geometry.hpp's envelope and classify). Its actions are counted, not applied: each time a
+// pair enters slow_down, stop or emergency_stop. On a run whose true distance never comes below
+// margins.stop, every one of them is a stop the grants made needless.
+//
+// A lost link (SiteRunOptions::faults): instructions to the crane and its reports are dropped. When
+// the link has been down for the site's link_deadline, the site service treats the crane as
+// holding its whole reach, and the crane, on its own, soft-stops (the planner's COMMAND_STOP) if the
+// rest of its path is in shared airspace (in_shared_airspace), else finishes it; then it waits at
+// rest. When the link is back it reports where it rests and asks again for the leg it was on.
+//
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
 // outside a crane's reach or a job list not one per crane.
 
@@ -44,6 +56,20 @@ enum class SiteMode : std::uint8_t {
 };
 [[nodiscard]] const char* to_string(SiteMode mode) noexcept;
 
+/// A fault between the cranes and the site service, from `start` for `duration` [s]: crane
+/// `crane`'s link lost (both ways), or, with crane == kSiteService, the site service killed and
+/// restarted with no memory (every link down meanwhile; the new service holds every crane's whole
+/// reach until it reports).
+struct LinkFault {
+  std::size_t crane{0};
+  double start{0.0};     // [s]
+  double duration{1.0};  // [s]
+};
+inline constexpr std::size_t kSiteService = static_cast<std::size_t>(-1);
+
+/// Cycles between two evaluations of the distance-watching rule (20 Hz at the stack's 100 Hz).
+inline constexpr int kWatchStride = 5;
+
 struct SiteRunOptions {
   SiteMode mode{SiteMode::coordinated};
   double dwell{1.0};            // [s] at the pick and at the place
@@ -53,6 +79,7 @@ struct SiteRunOptions {
   // the default controller slewing at the rated acceleration swings past the supervisor's
   // max_swing (0.6 rad) in 8 of 40 seeded job sets (docs/site.md).
   double slew_acceleration{1.0};
+  std::vector<LinkFault> faults;
 };
 
 struct CraneOutcome {
@@ -72,13 +99,27 @@ struct SiteOutcome {
   double min_distance{0.0};  // [m] true, between any two parts of any two cranes, over the run
   std::string closest;       // "tc1.jib-tc3.cable at 41.23 s"
   std::uint64_t unresolved{0};  // arbiter decisions that found a blocked crane no yield could free
+  // The distance-watching rule's actions (see the header), each pair's entries into them.
+  int watch_slow_downs{0};
+  int watch_stops{0};
+  int watch_emergency_stops{0};
   double simulated_seconds{0.0};  // [s] crane-seconds stepped (all cranes)
+  // For each link loss that lasted link_deadline: from the loss to the crane safe [s], its drives
+  // at rest (trolley, slew and hoist under 0.01 m/s, rad/s) after its soft stop (its path was in
+  // shared airspace), or still on a path outside it.
+  std::vector<double> reactions;
+  int halts{0};  // soft stops for a lost link
 };
 
 /// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`
 /// (its stack; the site file gives where it stands and its shape).
 [[nodiscard]] SiteOutcome run_site(const anti_collision::SiteLayout& site, const StackConfig& config,
                                    const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options);
+
+/// `count` seeded random faults for `site`: a crane's link lost for 0.5-30 s (probability 0.6) or
+/// the site service killed and restarted after 0.5-10 s, each starting within the first 80 s.
+[[nodiscard]] std::vector<LinkFault> random_link_faults(const anti_collision::SiteLayout& site, int count,
+                                                        std::uint64_t seed);
 
 /// `per_crane` seeded random jobs for each crane of `site`: pick and place points within the
 /// planner's reach of `config`, at random work heights in the lowest 0.8 m of the crane's hook
