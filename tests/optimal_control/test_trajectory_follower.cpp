@@ -61,13 +61,16 @@ Solved solve(const stack::StackConfig& cfg, const stack::ManeuverConfig& m) {
 }
 
 // On its own model with no friction and no error, the follower's law ends the slew at rest at the
-// target: the feedforward is the bound's and the feedback holds what the 10 ms hold adds.
+// target: the feedforward is the bound's and the feedback holds what the 10 ms hold adds. (No
+// friction here and no compensation stage: none of it is fed forward either.)
 TEST(TrajectoryFollower, EndsTheSlewAtRestOnItsModel) {
   const auto cfg = config("lab_tower_crane.yaml");
   const auto& m = stack::find_maneuver(cfg, "slew");
   const Solved b = solve(cfg, m);
   ASSERT_TRUE(b.result.solved) << b.result.status;
-  const optimal_control::TrajectoryFollower follower(b.problem, b.result, {});
+  optimal_control::FollowerParams params;
+  params.trajectory_sliding_friction_scale = 1.0;
+  const optimal_control::TrajectoryFollower follower(b.problem, b.result, params);
   EXPECT_EQ(follower.state_size(), 8);
   plant::ModelState s;
   s.position[plant::kTrolleyIndex] = m.initial_trolley_position;
@@ -94,24 +97,38 @@ TEST(TrajectoryFollower, EndsTheSlewAtRestOnItsModel) {
   EXPECT_LT(max_swing, b.problem.max_swing);
 }
 
-// On the reference the output is the feedforward alone: the bound's voltage less its friction.
+// On the reference the output is the feedforward alone: the bound's voltage less the part of its
+// friction that the compensation stage adds on the measured speed (trajectory_sliding_friction_scale;
+// the rest is fed forward at the reference speed). After the trajectory the hold's scale applies.
 TEST(TrajectoryFollower, OnTheReferenceTheOutputIsTheFeedforward) {
   const auto cfg = config("lab_tower_crane.yaml");
   const Solved b = solve(cfg, stack::find_maneuver(cfg, "trolley"));
   ASSERT_TRUE(b.result.solved);
-  const optimal_control::TrajectoryFollower follower(b.problem, b.result, {});
-  EXPECT_EQ(follower.state_size(), 8);
   const double t = 50 * 0.01;
   const auto mid = optimal_control::sample(b.result, t + 0.005);
   const auto at = optimal_control::sample(b.result, t);
   plant::ModelState s;
   s.position = at.state.position.head<plant::kNumCoordinates>();
   s.velocity = at.state.velocity.head<plant::kNumCoordinates>();
-  optimal_control::FollowerCommand u;
-  ASSERT_EQ(follower.step(50, s, u), common::StepStatus::ok);
   const double friction = optimal_control::drive_voltage(0.0, 1.0, mid.state.velocity[plant::kTrolleyIndex],
                                                          b.problem.trolley_friction, b.problem.friction_smoothing_speed);
-  EXPECT_NEAR(u.trolley_voltage, mid.trolley_voltage - friction, 1e-9);
+  ASSERT_GT(std::abs(friction), 0.5);  // the lab trolley's friction at speed, so that the cases differ
+  for (const double scale : {1.0, 0.5, 0.0}) {
+    optimal_control::FollowerParams params;
+    params.trajectory_sliding_friction_scale = scale;
+    const optimal_control::TrajectoryFollower f(b.problem, b.result, params);
+    optimal_control::FollowerCommand c;
+    ASSERT_EQ(f.step(50, s, c), common::StepStatus::ok);
+    EXPECT_NEAR(c.trolley_voltage, mid.trolley_voltage - scale * friction, 1e-9) << scale;
+    EXPECT_EQ(c.sliding_friction_scale, scale);
+    optimal_control::FollowerCommand after;
+    ASSERT_EQ(f.step(f.samples() + 10, s, after), common::StepStatus::ok);
+    EXPECT_EQ(after.sliding_friction_scale, params.hold.sliding_friction_scale);
+  }
+  const optimal_control::TrajectoryFollower follower(b.problem, b.result, {});
+  EXPECT_EQ(follower.state_size(), 8);
+  optimal_control::FollowerCommand u;
+  ASSERT_EQ(follower.step(50, s, u), common::StepStatus::ok);
   EXPECT_DOUBLE_EQ(u.trolley.position, at.state.position[plant::kTrolleyIndex]);
   // A trolley 1 cm behind the reference is driven forward.
   s.position[plant::kTrolleyIndex] -= 0.01;
@@ -127,6 +144,9 @@ TEST(TrajectoryFollower, RefusesWhatItCannotFollow) {
   optimal_control::FollowerParams bad;
   bad.weights.voltage = 0.0;
   EXPECT_THROW(optimal_control::TrajectoryFollower(b.problem, b.result, bad), common::ConfigError);
+  optimal_control::FollowerParams bad_scale;
+  bad_scale.trajectory_sliding_friction_scale = 1.5;
+  EXPECT_THROW(optimal_control::TrajectoryFollower(b.problem, b.result, bad_scale), common::ConfigError);
   optimal_control::MinimumTimeResult unsolved = b.result;
   unsolved.solved = false;
   EXPECT_THROW(optimal_control::TrajectoryFollower(b.problem, unsolved, {}), common::ConfigError);

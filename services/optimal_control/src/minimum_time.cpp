@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <string>
 
 #include "crane/common/validation.hpp"
@@ -516,6 +517,11 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   MinimumTimeResult result;
   std::vector<double> guess = initial_guess(problem, layout, result.initial_guess_duration);
   Ipopt::SmartPtr<MinimumTimeProgram> program = new MinimumTimeProgram(problem, layout, std::move(guess));
+  // One solve at a time in the process: IPOPT's linear solver here, Debian's sequential MUMPS, keeps
+  // global state (two concurrent solves abort in DMUMPS_LOAD_INIT or corrupt the heap; measured
+  // with crane_sim compare on two threads).
+  static std::mutex mumps;
+  const std::lock_guard lock(mumps);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");

@@ -53,7 +53,9 @@ plant::ModelState zero_order_hold(const plant::CraneDynamics& model, const Minim
 
 TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const MinimumTimeResult& trajectory,
                                        const FollowerParams& params)
-    : voltage_limit_(params.voltage_limit), sliding_friction_scale_(params.hold.sliding_friction_scale) {
+    : voltage_limit_(params.voltage_limit),
+      sliding_friction_scale_(params.hold.sliding_friction_scale),
+      trajectory_sliding_friction_scale_(params.trajectory_sliding_friction_scale) {
   if (!problem.model) throw common::ConfigError("follower.model: no model");
   const plant::CraneDynamics& model = *problem.model;
   if (model.coordinate_count() != plant::kNumCoordinates) {
@@ -75,6 +77,8 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_greater("follower.hold.weights.swing_rate", h.swing_rate, 0.0);
   common::require_greater("follower.hold.weights.voltage", h.voltage, 0.0);
   common::require_in_range("follower.hold.sliding_friction_scale", params.hold.sliding_friction_scale, 0.0, 1.0);
+  common::require_in_range("follower.trajectory_sliding_friction_scale", params.trajectory_sliding_friction_scale, 0.0,
+                           1.0);
   if (!trajectory.solved || trajectory.nodes.size() < 2 || !(trajectory.duration > 0.0)) {
     throw common::ConfigError("follower.trajectory: not solved (" + trajectory.status + ")");
   }
@@ -97,17 +101,22 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     s.velocity = node.state.velocity.head<plant::kNumCoordinates>();
     return s;
   };
+  // The model's friction [V] at the trajectory's speeds of time t.
+  const auto friction = [&](double t) {
+    if (t >= trajectory.duration) return Eigen::Vector2d::Zero().eval();
+    const TrajectoryNode node = sample(trajectory, t);
+    Eigen::Vector2d f;
+    f[0] = drive_voltage(0.0, fpv_trolley, node.state.velocity[kTrolleyIndex], problem.trolley_friction,
+                         problem.friction_smoothing_speed);
+    f[1] = second_drive_ ? drive_voltage(0.0, fpv_second, node.state.velocity[kSlewIndex], problem.second_friction,
+                                         problem.friction_smoothing_speed)
+                         : 0.0;
+    return f;
+  };
   const auto feedforward = [&](double t) {
     if (t >= trajectory.duration) return Eigen::Vector2d::Zero().eval();
     const TrajectoryNode node = sample(trajectory, t);
-    Eigen::Vector2d u;
-    u[0] = node.trolley_voltage - drive_voltage(0.0, fpv_trolley, node.state.velocity[kTrolleyIndex],
-                                                problem.trolley_friction, problem.friction_smoothing_speed);
-    u[1] = second_drive_ ? node.second_voltage - drive_voltage(0.0, fpv_second, node.state.velocity[kSlewIndex],
-                                                               problem.second_friction,
-                                                               problem.friction_smoothing_speed)
-                         : 0.0;
-    return u;
+    return (Eigen::Vector2d(node.trolley_voltage, second_drive_ ? node.second_voltage : 0.0) - friction(t)).eval();
   };
   samples_.resize(count + 1);
   for (std::size_t k = 0; k <= count; ++k) {
@@ -115,6 +124,8 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     samples_[k].node = sample(trajectory, t);
     samples_[k].state = model_state(samples_[k].node);
     samples_[k].input = k == count ? Eigen::Vector2d::Zero().eval() : feedforward(t + 0.5 * period);
+    samples_[k].friction = k == count ? Eigen::Vector2d::Zero().eval()
+                                      : ((1.0 - params.trajectory_sliding_friction_scale) * friction(t + 0.5 * period)).eval();
   }
 
   // z <-> the model's state, the forces of an input.
@@ -149,13 +160,13 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     for (int j = 0; j < n + m; ++j) {
       Eigen::VectorXd z = z0, u = u0;
       double& x = j < n ? z[j] : u[j - n];
-      const double h = 1e-6 * std::max(1.0, std::abs(x));
+      const double delta = 1e-6 * std::max(1.0, std::abs(x));
       const double x0 = x;
-      x = x0 + h;
+      x = x0 + delta;
       const Eigen::VectorXd plus = to_z(zero_order_hold(model, trajectory, from_z(z, base), t, period, forces(u)));
-      x = x0 - h;
+      x = x0 - delta;
       const Eigen::VectorXd minus = to_z(zero_order_hold(model, trajectory, from_z(z, base), t, period, forces(u)));
-      (j < n ? A.col(j) : B.col(j - n)) = (plus - minus) / (2.0 * h);
+      (j < n ? A.col(j) : B.col(j - n)) = (plus - minus) / (2.0 * delta);
     }
   };
 
@@ -217,7 +228,7 @@ common::StepStatus TrajectoryFollower::step(std::size_t k, const plant::ModelSta
   const Sample& s = samples_[i];
   const Eigen::MatrixXd& K = gains_[i];
   const int c = static_cast<int>(slots_.size());
-  double u[2] = {s.input[0], s.input[1]};
+  double u[2] = {s.input[0] + s.friction[0], s.input[1] + s.friction[1]};
   for (int r = 0; r < K.rows(); ++r) {
     double feedback = 0.0;
     for (int j = 0; j < c; ++j) {
@@ -235,7 +246,7 @@ common::StepStatus TrajectoryFollower::step(std::size_t k, const plant::ModelSta
   command.second_voltage = second_drive_ ? u[1] : 0.0;
   const TrajectoryNode& n = s.node;
   const bool moving = i + 1 < samples_.size();
-  command.sliding_friction_scale = moving ? 1.0 : sliding_friction_scale_;
+  command.sliding_friction_scale = moving ? trajectory_sliding_friction_scale_ : sliding_friction_scale_;
   command.hoist_speed = n.cable_length_rate;
   command.trolley = {n.state.position[kTrolleyIndex], n.state.velocity[kTrolleyIndex], moving ? n.trolley_acceleration : 0.0};
   command.second = {n.state.position[kSlewIndex], n.state.velocity[kSlewIndex], moving ? n.second_acceleration : 0.0};

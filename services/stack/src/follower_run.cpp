@@ -48,17 +48,22 @@ void scale_sliding_friction(const friction_compensation::FrictionCompensationPar
 
 }  // namespace
 
+optimal_control::MinimumTimeProblem follower_problem(const StackConfig& cfg, const ManeuverConfig& m, int intervals) {
+  // The bound on the controllers' model: the configured crane, rigid.
+  optimal_control::MinimumTimeProblem problem = bound_problem(cfg, m, intervals);
+  problem.model = plant::make_crane_dynamics(cfg.plant.kind, cfg.facts.crane, cfg.facts.bridge);
+  return problem;
+}
+
 FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   const ManeuverConfig& m = run.maneuver;
   const double dt = cfg.facts.sample_period;
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
 
-  // The bound on the controllers' model: the configured crane, rigid.
-  optimal_control::MinimumTimeProblem problem = bound_problem(cfg, m, run.intervals);
-  problem.model = plant::make_crane_dynamics(cfg.plant.kind, cfg.facts.crane, cfg.facts.bridge);
+  const optimal_control::MinimumTimeProblem problem = follower_problem(cfg, m, run.intervals);
   FollowerResult result;
-  result.bound = optimal_control::solve_minimum_time(problem);
+  result.bound = run.bound ? *run.bound : optimal_control::solve_minimum_time(problem);
   if (!result.bound.solved) {
     throw std::runtime_error("follower run " + m.name + ": the bound was not solved (" + result.bound.status + ")");
   }

@@ -38,10 +38,16 @@ optimal_control::MinimumTimeProblem bound_problem(const StackConfig& config, con
     problem.second_friction = p.crane.slew_friction;
   }
   const trajectory_planner::AxisLimits hoist = trajectory_planner::MoveGoal{}.cable_limits;
-  problem.hoist = {p.crane.cable_length,   maneuver.cable_length_target, planner.cable_min_length,
-                   planner.cable_max_length, hoist.max_velocity,          hoist.max_acceleration};
+  // The hoist's speed is also bounded by what the actuation gate accepts (a faster command is
+  // rejected, and three in a row brake the crane).
+  problem.hoist = {p.crane.cable_length,
+                   maneuver.cable_length_target,
+                   planner.cable_min_length,
+                   planner.cable_max_length,
+                   std::min(hoist.max_velocity, config.actuation.hoist_speed_limit),
+                   hoist.max_acceleration};
   problem.voltage_limit = config.facts.voltage_limit;
-  problem.max_swing = limits.max_swing;
+  problem.max_swing = kBoundSwingFraction * limits.max_swing;
   problem.intervals = intervals;
   return problem;
 }

@@ -29,13 +29,20 @@
 //       docs/optimal_control.md): T* on N and on 2N intervals (their difference: the
 //       discretization's), the linear profile's time, IPOPT's iterations and solve time, the largest
 //       drive voltage and swing; --out writes bound.csv and <maneuver>_bound.csv (the trajectory);
-//   crane_sim follow --config FILE [--maneuver M ...] [--intervals N] [--corners] [--out DIR]
+//   crane_sim follow --config FILE [--maneuver M ... | --moves N --seed S] [--intervals N] [--corners] [--out DIR]
 //       each demo maneuver followed in closed loop from its minimum-time trajectory (follower_run.hpp:
 //       the bound's feedforward with time-varying LQR, friction compensation on; docs/optimal_control.md):
 //       T*, the settle time and its ratio to T*, the final errors, swing, voltage and the supervisor's
 //       faults; --corners: also with the plant's cable length and load mass off by +-20 % and its
 //       friction by +-30 % (the eight corners) from what the follower assumes; --mismatch L m f: one
 //       such plant instead; --hold-*: the hold at the target (FollowerHold); --out: one CSV per run;
+//   crane_sim compare --config FILE [--maneuver M ...] [--moves N] [--seed S] [--corners]
+//                     [--controllers C,C,...] [--intervals N] [--jobs J] [--out DIR]
+//       issue 32's comparison (controller_comparison.hpp, docs/optimal_control.md): for the demo
+//       maneuvers and N seeded random moves, T* and each controller's settle time as a ratio to it
+//       (follower, delay1, delay2, time_optimal, zv, zvd), then per controller the median and worst
+//       ratio, residual swing, final errors and peak voltage; --corners: also at the eight mismatch
+//       corners; --out: compare.csv, one row per move, plant and controller;
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -55,6 +62,7 @@
 #include <sstream>
 #include <thread>
 
+#include "crane/stack/controller_comparison.hpp"
 #include "crane/stack/convergence_study.hpp"
 #include "crane/stack/gantry_gain_study.hpp"
 #include "crane/stack/in_process_stack.hpp"
@@ -496,8 +504,10 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
 }
 
 int follow(const Selection& s, int intervals, bool corners, const std::vector<double>& mismatch,
-           const optimal_control::FollowerParams& params, const std::string& out_dir) {
+           const optimal_control::FollowerParams& params, const std::string& out_dir, int moves, std::uint64_t seed) {
   const auto cfg = load_config(s);
+  // The demo maneuvers (those named), or with --moves the seeded random moves of crane_sim compare.
+  const auto maneuvers = moves > 0 ? stack::random_moves(cfg, moves, seed) : selected_maneuvers(cfg, s.maneuvers);
   if (!out_dir.empty()) fs::create_directories(out_dir);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   struct Corner {
@@ -510,24 +520,10 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
     m.cable_length_factor = mismatch[0];
     m.load_mass_factor = mismatch[1];
     m.friction_factor = mismatch[2];
-    char label[64];
-    std::snprintf(label, sizeof label, "L%.2g_m%.2g_f%.2g", mismatch[0], mismatch[1], mismatch[2]);
-    runs = {{label, m}};
+    runs = {{stack::mismatch_label(m), m}};
   }
   if (corners) {
-    for (const double length : {0.8, 1.2}) {
-      for (const double mass : {0.8, 1.2}) {
-        for (const double friction : {0.7, 1.3}) {
-          plant::PlantMismatch m;
-          m.cable_length_factor = length;
-          m.load_mass_factor = mass;
-          m.friction_factor = friction;
-          char label[64];
-          std::snprintf(label, sizeof label, "L%.1f_m%.1f_f%.1f", length, mass, friction);
-          runs.push_back({label, m});
-        }
-      }
-    }
+    for (const auto& m : stack::mismatch_corners()) runs.push_back({stack::mismatch_label(m), m});
   }
   std::printf("the minimum-time trajectory followed in closed loop (%s crane; feedforward + time-varying LQR, "
               "friction compensation on)\n",
@@ -536,7 +532,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
               "ratio", "pos_err_mm", bridge ? "bridge_err_mm" : "slew_err_mrad", "max_swing_deg", "resid_swing_deg",
               "max_V", "faults");
   int failures = 0;
-  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+  for (const auto& m : maneuvers) {
     for (const auto& corner : runs) {
       stack::FollowerRun run;
       run.maneuver = m;
@@ -559,6 +555,130 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
     }
   }
   return failures == 0 ? 0 : 1;
+}
+
+// The comparison of issue 32, item 3 (controller_comparison.hpp): the demo maneuvers and `moves`
+// seeded random moves, each controller's settle time as a ratio to T*, on the nominal plant and,
+// with `corners`, at the eight mismatch corners; one move (its bound and its runs) per thread.
+int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, const std::string& controllers_text,
+            int intervals, unsigned jobs, const std::string& out_dir) {
+  const auto cfg = load_config(s);
+  const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
+  const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
+  const auto controllers = controllers_text.empty() ? stack::compared_controllers()
+                                                    : stack::compared_controllers(split_list(controllers_text));
+  auto maneuvers = selected_maneuvers(cfg, s.maneuvers);
+  const std::size_t demo_count = maneuvers.size();
+  if (moves > 0) {
+    const auto random = stack::random_moves(cfg, moves, seed);
+    maneuvers.insert(maneuvers.end(), random.begin(), random.end());
+  }
+  std::vector<plant::PlantMismatch> plants{plant::PlantMismatch{}};
+  if (corners) {
+    const auto c = stack::mismatch_corners();
+    plants.insert(plants.end(), c.begin(), c.end());
+  }
+  struct MoveResult {
+    std::vector<stack::MoveComparison> runs;  // one per plant
+    double solve_seconds{0.0};
+    std::string error;
+  };
+  std::vector<MoveResult> results(maneuvers.size());
+  std::atomic<std::size_t> next{0};
+  const auto start = std::chrono::steady_clock::now();
+  const auto work = [&] {
+    for (std::size_t i = next++; i < maneuvers.size(); i = next++) {
+      try {
+        const auto bound = stack::comparison_bound(cfg, maneuvers[i], intervals);
+        results[i].solve_seconds = bound.solve_seconds;
+        for (const auto& plant : plants) {
+          results[i].runs.push_back(stack::compare_move(cfg, maneuvers[i], bound, controllers, plant, intervals));
+        }
+      } catch (const std::exception& error) {
+        results[i].error = error.what();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned t = 1; t < std::max(1U, jobs); ++t) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::printf("controllers against the minimum-time bound T* (%s crane, %zu demo maneuvers and %d random moves, seed "
+              "%llu; friction compensation on; settle: 5 mm, 0.005 rad, 0.5 deg)\n",
+              common::to_string(cfg.facts.crane_kind), demo_count, moves, static_cast<unsigned long long>(seed));
+  std::printf("settle time / T* per controller ('-': not settled within the record, '!': a supervisor fault or "
+              "the brakes)\n%-12s %-16s %8s", "move", "plant", "T* [s]");
+  for (const auto& c : controllers) std::printf(" %12s", c.name.c_str());
+  std::printf("\n");
+  int errors = 0;
+  std::vector<stack::MoveComparison> demo_nominal, random_nominal, at_corners;
+  std::vector<double> solve_times;
+  for (std::size_t i = 0; i < maneuvers.size(); ++i) {
+    const MoveResult& r = results[i];
+    if (!r.error.empty()) {
+      std::printf("%-13s %s\n", maneuvers[i].name.c_str(), r.error.c_str());
+      ++errors;
+      continue;
+    }
+    solve_times.push_back(r.solve_seconds);
+    for (const auto& run : r.runs) {
+      const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
+      (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
+      std::printf("%-13s %-16s %8.4f", maneuvers[i].name.c_str(), stack::mismatch_label(run.mismatch).c_str(), run.bound);
+      for (const auto& o : run.outcomes) {
+        if (!o.error.empty()) ++errors;
+        const bool faulted = o.latched_faults != 0 || o.braked_cycles != 0;
+        std::printf(" %11s%s", o.error.empty() ? stack::format_number(o.ratio, 2).c_str() : "error", faulted ? "!" : " ");
+      }
+      std::printf("\n");
+    }
+  }
+  constexpr double deg = 180.0 / std::numbers::pi;
+  const auto print_summary = [&](const char* title, const std::vector<stack::MoveComparison>& runs) {
+    if (runs.empty()) return;
+    std::printf("\n%s (%zu runs per controller)\n%-13s %7s %7s %8s %7s %7s %16s %12s %15s %6s\n", title, runs.size(),
+                "controller", "median", "worst", "settled", "faults", "errors", "median_resid_deg",
+                bridge ? "worst_pos_mm*" : "worst_pos_mm", "worst_slew_mrad", "peak_V");
+    for (const auto& x : stack::summarize(runs)) {
+      std::printf("%-13s %7s %7s %4d/%-3d %7d %7d %16.3f %12.2f %15s %6.2f\n", x.controller.c_str(),
+                  stack::format_number(x.median_ratio, 2).c_str(), stack::format_number(x.worst_ratio, 2).c_str(),
+                  x.settled, x.runs, x.faulted, x.failed, deg * x.median_residual_swing, 1e3 * x.worst_position_error,
+                  slews ? stack::format_number(1e3 * x.worst_slew_error, 2).c_str() : "-", x.peak_voltage);
+    }
+    if (bridge) std::printf("(* the trolley's or the bridge's, the larger)\n");
+  };
+  print_summary("demo maneuvers, nominal plant: settle / T*", demo_nominal);
+  print_summary("random moves, nominal plant: settle / T*", random_nominal);
+  print_summary("every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3): settle / T*", at_corners);
+  std::sort(solve_times.begin(), solve_times.end());
+  if (!solve_times.empty()) {
+    std::printf("\nbound solve (IPOPT, %d intervals): median %.2f s, max %.2f s over %zu moves; %.1f s wall on %u "
+                "thread(s)\n",
+                intervals, solve_times[solve_times.size() / 2], solve_times.back(), solve_times.size(), wall,
+                std::max(1U, jobs));
+  }
+  if (!out_dir.empty()) {
+    fs::create_directories(out_dir);
+    std::ofstream csv(fs::path(out_dir) / "compare.csv");
+    csv << "move,plant,T_star_s,controller,settle_s,ratio,pos_err_mm,slew_err_mrad,bridge_err_mm,max_swing_deg,"
+           "resid_swing_deg,max_V,latched_faults,braked_cycles,error\n";
+    csv.precision(6);
+    for (const auto& r : results) {
+      for (const auto& run : r.runs) {
+        for (const auto& o : run.outcomes) {
+          const auto& x = o.metrics;
+          csv << run.maneuver.name << ',' << stack::mismatch_label(run.mismatch) << ',' << run.bound << ','
+              << o.controller << ',' << x.settle_time << ',' << o.ratio << ',' << 1e3 * x.final_position_error << ','
+              << 1e3 * x.final_slew_error << ',' << 1e3 * x.final_bridge_error << ',' << deg * x.max_swing << ','
+              << deg * x.residual_swing << ',' << x.max_voltage << ',' << o.latched_faults << ',' << o.braked_cycles
+              << ",\"" << o.error << "\"\n";
+        }
+      }
+    }
+  }
+  return errors == 0 ? 0 : 1;
 }
 
 int converge(const Selection& s, const plant::IntegratorSettings& reference) {
@@ -749,6 +869,11 @@ int main(int argc, char** argv) {
   follow_cmd->add_flag("--corners", corners, "also the eight +-20 % length and mass, +-30 % friction corners");
   follow_cmd->add_option("--out", out_dir, "write <maneuver>_follow_<plant>.csv here");
   std::vector<double> mismatch;
+  int follow_moves = 0;
+  std::uint64_t follow_seed = 1;
+  follow_cmd->add_option("--moves", follow_moves, "N seeded random moves (crane_sim compare's) instead of the demo maneuvers")
+      ->check(CLI::Range(0, 1000));
+  follow_cmd->add_option("--seed", follow_seed, "the random moves' seed");
   follow_cmd->add_option("--mismatch", mismatch, "one plant instead of the nominal: cable length, load mass and friction factors")
       ->expected(3)->check(CLI::Range(0.1, 10.0));
   optimal_control::FollowerParams follower_params;
@@ -766,9 +891,30 @@ int main(int argc, char** argv) {
   follow_cmd->add_option("--hold-speed-weight", hold.speed, "at the target: acceptable speed [m/s or rad/s]")->check(CLI::PositiveNumber);
   follow_cmd->add_option("--hold-swing-rate-weight", hold.swing_rate, "at the target: acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
   follow_cmd->add_option("--hold-voltage-weight", hold.voltage, "at the target: acceptable input [V]")->check(CLI::PositiveNumber);
+  follow_cmd->add_option("--trajectory-sliding-friction-scale", follower_params.trajectory_sliding_friction_scale,
+                         "along the trajectory: the fraction of the sliding friction compensated on the measured speed; "
+                         "the rest fed forward at the reference speed [-]")
+      ->check(CLI::Range(0.0, 1.0));
   follow_cmd->add_option("--hold-sliding-friction-scale", follower_params.hold.sliding_friction_scale,
                          "at the target: the fraction of the sliding friction compensation applied [-]")
       ->check(CLI::Range(0.0, 1.0));
+
+  auto* compare_cmd = app.add_subcommand("compare", "every controller's settle time against T*: demo and seeded random moves");
+  common_options(compare_cmd);
+  int compare_moves = 20;
+  std::uint64_t compare_seed = 1;
+  bool compare_corners = false;
+  std::string compare_controllers;
+  int compare_intervals = 200;
+  unsigned compare_jobs = default_jobs();
+  compare_cmd->add_option("--moves", compare_moves, "seeded random moves besides the demo maneuvers")->check(CLI::Range(0, 1000));
+  compare_cmd->add_option("--seed", compare_seed, "the random moves' seed");
+  compare_cmd->add_flag("--corners", compare_corners, "also at the eight +-20 % length and mass, +-30 % friction corners");
+  compare_cmd->add_option("--controllers", compare_controllers,
+                          "comma-separated: follower,delay1,delay2,time_optimal,zv,zvd (default: all)");
+  compare_cmd->add_option("--intervals", compare_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
+  compare_cmd->add_option("--jobs", compare_jobs, "threads (default: every core)")->check(CLI::Range(1, 256));
+  compare_cmd->add_option("--out", out_dir, "write compare.csv here");
 
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
@@ -789,7 +935,11 @@ int main(int argc, char** argv) {
     }
     if (*integrators_cmd) return integrators(s);
     if (*bound_cmd) return bound(s, intervals, out_dir);
-    if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir);
+    if (*compare_cmd) {
+      return compare(s, compare_moves, compare_seed, compare_corners, compare_controllers, compare_intervals, compare_jobs,
+                     out_dir);
+    }
+    if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

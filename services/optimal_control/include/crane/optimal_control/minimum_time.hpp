@@ -33,6 +33,10 @@
 // for a problem that is malformed (a non-finite or non-positive limit, a start or target outside
 // its axis's range, intervals outside [4, 2000]); a problem IPOPT does not solve is returned with
 // `solved == false` and IPOPT's status in `status` (never an exception).
+//
+// Threads: solve_minimum_time may be called from several threads; the solves run one at a time
+// (IPOPT's linear solver, Debian's sequential MUMPS, is not reentrant), so solve_seconds counts
+// only the solve, not the wait.
 
 #include <memory>
 #include <string>

@@ -9,9 +9,11 @@
 //   z    the generalized positions and velocities of the model's driven and swing coordinates
 //        (crane_dynamics.hpp slots 0..3; a crane without a second drive axis, the gantry, keeps
 //        slots 0 and 1 only), [m, rad, rad or m, rad, m/s, rad/s, rad/s or m/s, rad/s]
-//   u    the drive voltages without friction [V] (the friction compensation stage adds the crane's
-//        friction, (3.1)-(3.5)): u_ff = the bound's voltage less its smoothed friction, the average
-//        over the sample (zero-order hold) taken at its middle
+//   u    the drive voltages without the friction that the friction compensation stage adds on the
+//        measured speed ((3.1)-(3.5), its sliding part scaled by trajectory_sliding_friction_scale
+//        s): u_ff = the bound's voltage less s x its smoothed friction at the reference speed (the
+//        other (1 - s) of the friction fed forward), the average over the sample (zero-order hold)
+//        taken at its middle; K_k is computed on the friction-free model either way
 //   K_k  from the backward Riccati recursion of the discrete linear-quadratic regulator,
 //        P_k = Q + A_k' P_k+1 (A_k - B_k K_k), K_k = (R + B_k' P_k+1 B_k)^-1 B_k' P_k+1 A_k
 //        (B. D. O. Anderson, J. B. Moore, "Optimal Control: Linear Quadratic Methods", 1990,
@@ -26,13 +28,16 @@
 //        (A. E. Bryson, Y.-C. Ho, "Applied Optimal Control", 1975, section 5.7).
 // The hoist is not a feedback axis: hoist_speed is the trajectory's cable-length rate.
 //
-// After the trajectory (FollowerHold) the stationary gain comes from the hold's own weights, and
-// the command asks the friction compensation for a fraction of its sliding part
-// (FollowerCommand::sliding_friction_scale; stack::run_follower applies it).
+// The command asks the friction compensation for a fraction of its sliding part
+// (FollowerCommand::sliding_friction_scale; stack::run_follower applies it): s along the
+// trajectory, where its other part is fed forward (compensated on the measured speed alone, a
+// friction 30 % below the model's drove the trolley past its overspeed on random moves), and the
+// hold's after it. After the trajectory (FollowerHold) the stationary gain comes from the hold's
+// own weights.
 //
 // Errors: the constructor throws common::ConfigError naming the field for a model with more than
 // four coordinates (a hook or a rope), a non-positive weight, sample period or voltage limit, a
-// sliding_friction_scale outside [0, 1], or a
+// sliding_friction_scale (the hold's or the trajectory's) outside [0, 1], or a
 // trajectory that is not solved or has fewer than two nodes. step() is noexcept and allocates
 // nothing; a non-finite state gives 0 V (the safe output) and rejected_nonfinite.
 
@@ -76,6 +81,10 @@ struct FollowerParams {
   double voltage_limit{10.0};  // [V] |u| before friction, > 0
   FollowerWeights weights{};
   FollowerHold hold{};
+  /// [-] in [0, 1]: along the trajectory, the fraction of the friction compensation's sliding part
+  /// applied on the measured speed (FollowerCommand::sliding_friction_scale); the rest of the
+  /// model's friction (Coulomb and viscous at the reference speed) is fed forward with u_ff.
+  double trajectory_sliding_friction_scale{0.5};
 };
 
 /// The law's output for one cycle.
@@ -114,7 +123,9 @@ class TrajectoryFollower {
  private:
   struct Sample {
     plant::ModelState state;  // the reference in the model's slots
-    Eigen::Vector2d input;    // u_ff [V] (trolley, second)
+    Eigen::Vector2d input;    // u_ff [V] (trolley, second), without friction
+    Eigen::Vector2d friction;  // [V] the friction feedforward: (1 - trajectory_sliding_friction_scale) x
+                               // the model's friction at the reference speed
     TrajectoryNode node;      // the reference (rates, accelerations, the hoist)
   };
   std::vector<int> slots_;  // model coordinates in z
@@ -122,6 +133,7 @@ class TrajectoryFollower {
   std::vector<Eigen::MatrixXd> gains_;  // K_k; the last is the stationary gain at the target
   double voltage_limit_;
   double sliding_friction_scale_;
+  double trajectory_sliding_friction_scale_;
   bool second_drive_;
 };
 

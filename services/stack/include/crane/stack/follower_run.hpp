@@ -17,6 +17,7 @@
 // when the bound is not solved or the estimator refuses a sample.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "crane/optimal_control/minimum_time.hpp"
@@ -32,6 +33,9 @@ struct FollowerRun {
   bool friction_compensation{true};
   plant::PlantMismatch mismatch{};
   int intervals{200};                          // collocation intervals of the bound
+  // The bound of follower_problem(config, maneuver, intervals), when solved already (a comparison
+  // runs several plants on one bound); empty: solved here.
+  std::optional<optimal_control::MinimumTimeResult> bound;
   // The law's weights and its hold at the target; sample_period and voltage_limit are the stack's.
   optimal_control::FollowerParams follower{};
 };
@@ -45,6 +49,11 @@ struct FollowerResult {
   std::uint64_t braked_cycles{0};            // cycles of the move with the brakes on
   double follower_setup_seconds{0.0};        // [s] wall time of the gains (linearization and Riccati)
 };
+
+/// The bound's problem on the controllers' model: bound_problem (maneuver_bound.hpp) on the
+/// configured crane, rigid (no hook, no rope: the follower's model), with `intervals` intervals.
+[[nodiscard]] optimal_control::MinimumTimeProblem follower_problem(const StackConfig& config,
+                                                                   const ManeuverConfig& maneuver, int intervals);
 
 /// Runs `run` on `config` (see the header).
 [[nodiscard]] FollowerResult run_follower(const StackConfig& config, const FollowerRun& run);

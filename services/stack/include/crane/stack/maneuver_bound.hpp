@@ -10,9 +10,14 @@
 //                                      bridge_max_speed)
 //   travel                             the planner's range (trajectory_planner.*_position/_angle,
 //                                      the cable's min/max length)
-//   hoist                              the planner's hoist limits (MoveGoal::cable_limits)
+//   hoist                              the planner's hoist limits (MoveGoal::cable_limits), the speed
+//                                      capped by the actuation gate's hoist_speed_limit
 //   drive voltage                      stack.voltage_limit, with the crane's friction (3.1)
-//   swing                              supervisor.max_swing
+//   swing                              kBoundSwingFraction x supervisor.max_swing: a margin for the
+//                                      follower's tracking error and a mismatched plant, so that a
+//                                      healthy crane on its bound never trips the sway limiter (with
+//                                      the whole limit the overhead crane's 10 m trolley bound swung
+//                                      to 20 deg, the limit itself, and its follower tripped it)
 //
 // Errors: common::ConfigError from optimal_control::validate (a maneuver outside the planner's
 // range names the field and the bound).
@@ -23,6 +28,9 @@
 #include "crane/stack/stack_config.hpp"
 
 namespace crane::stack {
+
+/// The bound's swing limit as a fraction of the supervisor's max_swing (see the header).
+inline constexpr double kBoundSwingFraction = 0.5;
 
 /// The problem of `maneuver` on `config`'s crane, on `intervals` collocation intervals.
 [[nodiscard]] optimal_control::MinimumTimeProblem bound_problem(const StackConfig& config,

@@ -1,0 +1,120 @@
+#pragma once
+// The comparison of the controllers against the minimum-time bound (issue 32, item 3;
+// docs/optimal_control.md, "The comparison"): for a move, T* of its bound (maneuver_bound.hpp, on
+// the controllers' model: follower_run.hpp's follower_problem) and, for each controller, the
+// settle time as a ratio to T*, the residual swing, the final position errors, the peak voltage
+// and the supervisor's faults, on the nominal plant or on one whose cable length, load mass and
+// friction differ from what the controllers assume.
+//
+// The controllers (compared_controllers(), in this order):
+//   follower      the bound's trajectory followed by feedforward + time-varying LQR (follower_run.hpp)
+//   delay1        the default: the dissertation's delayed swing feedback (3.47) on a trapezoid profile
+//   delay2        the second delayed-feedback law (3.50) on a trapezoid profile
+//   time_optimal  the time-optimal profile with no swing feedback (tracking PD with acceleration
+//                 feedforward)
+//   zv, zvd       the trapezoid shaped by ZV / ZVD (input shaping) with no swing feedback (tracking PD)
+// every one with the friction compensation on, in the in-process stack's order and gating
+// (in_process_stack.hpp), the settle criterion of the demo table (5 mm, 0.005 rad, 0.5 deg).
+//
+// Errors: std::invalid_argument for an unknown controller name, a count out of range or a crane
+// whose planner range leaves no room for a move; std::runtime_error when a bound is not solved;
+// common::ConfigError for an invalid config (the bound's validation names the field).
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "crane/optimal_control/minimum_time.hpp"
+#include "crane/plant/plant_stage.hpp"
+#include "crane/stack/maneuver_run.hpp"
+#include "crane/stack/stack_config.hpp"
+
+namespace crane::stack {
+
+struct ComparedController {
+  std::string name;          // "follower", "delay1", ...
+  bool follower{false};      // the bound's follower; otherwise the stack's planner and laws:
+  std::string controller;    // choose_controller's name
+  bool acceleration_feedforward{false};
+  std::uint8_t profile{protocol::MoveRequest::PROFILE_TRAPEZOID};
+};
+
+/// The controllers of the header, in its order.
+[[nodiscard]] std::vector<ComparedController> compared_controllers();
+
+/// Those of compared_controllers() named in `names` (in the given order). std::invalid_argument
+/// naming an unknown one.
+[[nodiscard]] std::vector<ComparedController> compared_controllers(const std::vector<std::string>& names);
+
+/// `count` (1..1000) seeded random point-to-point moves of `config`'s crane, each named
+/// "random_<i>", starting where the crane rests (the configured cable length) and with the rated
+/// limits of its first demo maneuver:
+///   tower     trolley start and target anywhere in the planner's range, at least a fifth of it
+///             apart; the jib from a random angle by 10-180 deg either way within the planner's
+///             slew range;
+///   gantry    the trolley as the tower's;
+///   overhead  the trolley as the tower's and the bridge likewise in its range;
+/// each with probability 1/4 hoisting to a cable length in [0.5, 1.5] x the configured one (within
+/// the planner's cable range). Recorded for `record_factor` x the linear profile's time of the
+/// move plus 10 swing periods at the target length, so that a controller at a few T* still has
+/// its settle and residual-swing window inside the record.
+[[nodiscard]] std::vector<ManeuverConfig> random_moves(const StackConfig& config, int count, std::uint64_t seed,
+                                                        double record_factor = 4.0);
+
+struct ControllerOutcome {
+  std::string controller;
+  ManeuverMetrics metrics;
+  double ratio{0.0};                 // settle_time / T* (NaN: never settled within the record)
+  std::uint32_t latched_faults{0};   // the supervisor's FAULT_* bits at the end
+  std::uint64_t braked_cycles{0};    // cycles of the move with the brakes on
+  std::string error;                 // what a run threw (its figures are then NaN)
+};
+
+struct MoveComparison {
+  ManeuverConfig maneuver;
+  plant::PlantMismatch mismatch;     // the plant's, against the controllers' model
+  double bound{0.0};                 // [s] T*
+  double bound_solve_seconds{0.0};   // [s] IPOPT's wall time (0 when the bound was given)
+  double swing_period{0.0};          // [s] at the target cable length
+  std::vector<ControllerOutcome> outcomes;  // one per controller, in their order
+};
+
+/// The bound of `maneuver` on the controllers' model (follower_problem) with `intervals`
+/// collocation intervals. std::runtime_error when IPOPT does not solve it.
+[[nodiscard]] optimal_control::MinimumTimeResult comparison_bound(const StackConfig& config,
+                                                                  const ManeuverConfig& maneuver, int intervals = 200);
+
+/// Runs each of `controllers` on `maneuver` against a plant with `mismatch`, the ratio taken to
+/// `bound` (comparison_bound of the same maneuver and intervals). A run that throws is kept with
+/// its error and NaN figures.
+[[nodiscard]] MoveComparison compare_move(const StackConfig& config, const ManeuverConfig& maneuver,
+                                          const optimal_control::MinimumTimeResult& bound,
+                                          const std::vector<ComparedController>& controllers,
+                                          const plant::PlantMismatch& mismatch = {}, int intervals = 200);
+
+/// The eight corners of cable length and load mass x0.8/x1.2 and friction x0.7/x1.3 (issue 32).
+[[nodiscard]] std::vector<plant::PlantMismatch> mismatch_corners();
+
+/// A mismatch's label, "nominal" or "L0.8_m1.2_f0.7".
+[[nodiscard]] std::string mismatch_label(const plant::PlantMismatch& mismatch);
+
+/// One controller's figures over many compared moves.
+struct ControllerSummary {
+  std::string controller;
+  int runs{0};
+  int settled{0};                 // runs that settled within the record
+  int faulted{0};                 // runs with a latched supervisor fault or brakes on
+  int failed{0};                  // runs that threw
+  double median_ratio{0.0};       // over every run; a run that never settled counts as +inf
+  double worst_ratio{0.0};
+  double median_residual_swing{0.0};  // [rad]
+  double worst_position_error{0.0};   // [m] trolley (and bridge) at the last cycle
+  double worst_slew_error{0.0};       // [rad]
+  double peak_voltage{0.0};           // [V]
+};
+
+/// The summaries of `moves`' outcomes per controller, in the controllers' order of the first move.
+[[nodiscard]] std::vector<ControllerSummary> summarize(const std::vector<MoveComparison>& moves);
+
+}  // namespace crane::stack
