@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
 #include "crane/common/validation.hpp"
 
@@ -268,6 +269,88 @@ TEST(SiteArbiter, BadRequestsAreRefused) {
   SiteLayout bad = two_towers();
   bad.margins.stop = 0.2;
   EXPECT_THROW(SiteArbiter(bad, ArbiterMode::coordinated), crane::common::ConfigError);
+}
+
+// Containment in joint space, by hand: one box, each axis at its edge, within and beyond the
+// tolerance.
+TEST(GrantGuard, ContainmentByHand) {
+  Airspace a;
+  a.boxes[0] = {0.0, 1.0, 0.5, 1.0, 0.2, 1.0, 0.1};
+  a.count = 1;
+  EXPECT_TRUE(contains(a, {0.5, 0.7, 0.5}));
+  EXPECT_TRUE(contains(a, {0.5, 1.0 + 0.9 * kContainmentTolerance, 0.5}));
+  EXPECT_FALSE(contains(a, {0.5, 1.0 + 1.1 * kContainmentTolerance, 0.5}));
+  EXPECT_FALSE(contains(a, {-1.1 * kContainmentTolerance, 0.7, 0.5}));
+  EXPECT_FALSE(contains(a, {0.5, 0.7, 0.2 - 1.1 * kContainmentTolerance}));
+  EXPECT_FALSE(contains(Airspace{}, {0.5, 0.7, 0.5}));
+  // A second box of a path: the union.
+  a.boxes[1] = {1.0, 1.0, 1.0, 1.2, 0.2, 0.2, 0.1};
+  a.count = 2;
+  EXPECT_TRUE(contains(a, {1.0, 1.15, 0.2}));
+  EXPECT_FALSE(contains(a, {0.5, 1.15, 0.2}));
+}
+
+// Crane A's guard on the two-tower site (default stopping data: reaction 0.1 s, trolley 0.5 m/s^2,
+// brakes 3 times that). Its grant: the trolley from 0.3 to 1.0 m at slew 0 (towards B), hook up.
+TEST(GrantGuard, EachRuleByHand) {
+  const SiteLayout site = two_towers();
+  GrantGuard guard(site, 0);
+  CraneMotion m;
+  m.slew = 0.0;
+  m.trolley = 0.6;
+  m.cable_length = 0.2;
+  // Nothing is allowed by default: at rest it may stay, moving it is stopped.
+  EXPECT_EQ(guard.check(m, 0.0).action, GrantAction::proceed);
+  m.trolley_velocity = 0.5;
+  EXPECT_EQ(guard.check(m, 0.0).action, GrantAction::emergency_stop);
+  EXPECT_STREQ(guard.check(m, 0.0).reason, "moving with no grant");
+
+  const std::vector<Pose> path{{0.0, 0.3, 0.2}, {0.0, 1.0, 0.2}};
+  guard.grant(path_airspace(path, site.paths), 10.0);
+  EXPECT_EQ(guard.check(m, 10.0).action, GrantAction::proceed);
+  // The brakes from 0.5 m/s: 0.5 x 0.1 + 0.5^2 / (2 x 1.5) = 0.1333 m. From 0.85 m they end at
+  // 0.983 m, inside; from 0.90 m at 1.033 m, beyond the box (1.0 m) and its tolerance.
+  m.trolley = 0.85;
+  EXPECT_EQ(guard.check(m, 10.0).action, GrantAction::proceed);
+  m.trolley = 0.90;
+  EXPECT_EQ(guard.check(m, 10.0).action, GrantAction::emergency_stop);
+  EXPECT_STREQ(guard.check(m, 10.0).reason, "leaving its grant");
+  // Off the path sideways (the jib turned 0.05 rad from the slew-0 path): outside.
+  m.trolley = 0.6;
+  m.slew = 0.05;
+  EXPECT_EQ(guard.check(m, 10.0).action, GrantAction::emergency_stop);
+  m.slew = 0.0;
+  // The link: the path reaches B's airspace (A's jib towards B), so once nothing was heard for
+  // link_deadline the crane soft-stops; a message from the service in time keeps it going.
+  ASSERT_TRUE(in_shared_airspace(site, 0, guard.granted()));
+  EXPECT_EQ(guard.check(m, 10.0 + 0.9 * site.link_deadline).action, GrantAction::proceed);
+  EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::soft_stop);
+  guard.heard(10.0 + site.link_deadline);
+  EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::proceed);
+  // The same path turned away from B (slew pi: the load 0.3-1.0 m on the far side) is A's own
+  // airspace: with the link lost it goes on.
+  guard.grant(path_airspace(std::vector<Pose>{{kPi, 0.3, 0.2}, {kPi, 1.0, 0.2}}, site.paths), 20.0);
+  ASSERT_FALSE(in_shared_airspace(site, 0, guard.granted()));
+  m.slew = kPi;
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::proceed);
+  // Progress: what the crane left behind is no longer its own.
+  guard.progress(path_airspace(std::vector<Pose>{{kPi, 0.8, 0.2}, {kPi, 1.0, 0.2}}, site.paths));
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::emergency_stop);
+  m.trolley = 0.8;
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::proceed);
+  // The swing: the path's allowance here is 0 (two_towers), the load swinging 0.1 rad at 0.2 m of
+  // cable spreads 0.02 m: wider than allowed plus the tolerance? 0.2 sin 0.1 = 0.01997 < 0.02: no.
+  // At 0.15 rad it is 0.0299 m: yes.
+  m.trolley_velocity = 0.0;
+  m.swing_in_plane = 0.1;
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::proceed);
+  m.swing_in_plane = 0.15;
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::soft_stop);
+  EXPECT_STREQ(guard.check(m, 30.0).reason, "the load swings wider than its grant allows");
+  // Non-finite motion: the brakes.
+  m.swing_in_plane = std::nan("");
+  EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::emergency_stop);
+  EXPECT_THROW(GrantGuard(site, 2), std::out_of_range);
 }
 
 }  // namespace

@@ -226,6 +226,15 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
                 1e3 * quantile(reactions, 0.0), 1e3 * quantile(reactions, 0.5), 1e3 * quantile(reactions, 0.9),
                 1e3 * quantile(reactions, 0.99), 1e3 * quantile(reactions, 1.0));
   }
+  int guard_emergency = 0, guard_soft = 0;
+  std::string guard_first;
+  for (const SetResult& r : results) {
+    guard_emergency += r.coordinated.guard_emergency_stops, guard_soft += r.coordinated.guard_soft_stops;
+    if (guard_first.empty() && !r.coordinated.guard_first.empty()) guard_first = r.coordinated.guard_first;
+  }
+  std::printf("  each crane's guard on its grant, coordinated runs (counted, not applied): %d cycles asking for the brakes, "
+              "%d for a soft stop%s%s\n",
+              guard_emergency, guard_soft, guard_first.empty() ? "" : "; first: ", guard_first.c_str());
   std::printf("  coordinated: %d yields, %.1f s waiting per set\n", yields,
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));
   const bool safe = !min_distance.empty() && quantile(min_distance, 0.0) >= site.margins.stop;

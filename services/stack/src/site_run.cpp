@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/grant_guard.hpp"
 #include "crane/common/site.hpp"
 #include "crane/stack/in_process_stack.hpp"
 
@@ -45,10 +46,27 @@ struct Crane {
   bool start_next{false};        // the move to waypoint + 1 starts at the next cycle
   std::optional<std::uint64_t> arrived_cycle;  // the reference arrived at this cycle
   std::optional<Request> stop_goal;             // a soft stop to send this cycle
+  std::optional<ac::GrantGuard> guard;          // the crane's own enforcement of its grant
   std::uint64_t dwell_until{0};
   double asked_at{0.0};
   CraneOutcome outcome;
 };
+
+// The estimator's state as the site's geometry takes it.
+ac::CraneMotion motion_of(const protocol::CraneState& e) {
+  ac::CraneMotion m;
+  m.slew = e.slew_angle;
+  m.slew_rate = e.slew_rate;
+  m.trolley = e.trolley_position;
+  m.trolley_velocity = e.trolley_velocity;
+  m.cable_length = e.cable_length;
+  m.cable_rate = e.cable_length_rate;
+  m.swing_in_plane = e.swing_in_plane;
+  m.swing_out_of_plane = e.swing_out_of_plane;
+  m.swing_in_plane_rate = e.swing_in_plane_rate;
+  m.swing_out_of_plane_rate = e.swing_out_of_plane_rate;
+  return m;
+}
 
 ac::Pose measured_pose(const InProcessStack& stack) {
   const auto& e = stack.estimate();
@@ -138,6 +156,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       cranes[i].legs.push_back({j.place, true});
     }
     cranes[i].outcome.name = c.name;
+    cranes[i].guard.emplace(site, i);
   }
 
   SiteOutcome out;
@@ -177,19 +196,24 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         // Back: the crane reports where it rests and asks again (a grant sent meanwhile was lost).
         c.down_since.reset();
         if (c.phase == Crane::Phase::halted || c.phase == Crane::Phase::asking) c.phase = Crane::Phase::resting;
-        if (c.phase == Crane::Phase::done) arbiter.rest(i, measured_pose(*c.stack));
+        if (c.phase == Crane::Phase::done) {
+          arbiter.rest(i, measured_pose(*c.stack));
+          c.guard->grant(ac::rest_airspace(measured_pose(*c.stack), site.paths), t);
+        }
         c.link_lost = false;
         changed = true;
       }
+      if (!down) c.guard->heard(t);
       if (!down || c.link_lost || t - *c.down_since < site.link_deadline - 1e-9) continue;
       c.link_lost = true;
       if (!service_down) arbiter.lost(i);
       if (c.phase == Crane::Phase::moving || c.phase == Crane::Phase::dwelling) {
         std::vector<ac::Pose> rest{measured_pose(*c.stack)};
         rest.insert(rest.end(), c.path.begin() + static_cast<std::ptrdiff_t>(std::min(c.waypoint, c.path.size() - 1)), c.path.end());
-        // A path longer than an airspace holds is not checked: the crane stops.
-        if (rest.size() > ac::Airspace::kMaxBoxes + 1 ||
-            ac::in_shared_airspace(site, i, ac::path_airspace(rest, site.paths))) {
+        // The crane holds only what is ahead of it; its guard's rule 4 decides. A path longer than
+        // an airspace holds is not checked: the crane stops.
+        c.guard->progress(ac::path_airspace(rest, site.paths));
+        if (rest.size() > ac::Airspace::kMaxBoxes + 1 || c.guard->must_leave_shared_airspace(t)) {
           c.phase = Crane::Phase::halting;
           c.halt_from = *c.down_since;
           c.arrived_cycle.reset();
@@ -207,12 +231,26 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         out.reactions.push_back(t - *c.down_since);  // at rest already
       }
     }
+    // Each crane's guard on its grant (grant_guard.hpp): rule 4 (a lost link) is applied above;
+    // rules 1-3 and 5 are counted every cycle, not applied (docs/site.md, "The crane's own guard").
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      if (k == 0 || c.phase == Crane::Phase::done) continue;  // no estimate before cycle 0
+      const ac::GrantCheck verdict = c.guard->check(motion_of(c.stack->estimate()), t);
+      if (verdict.action == ac::GrantAction::proceed || c.guard->must_leave_shared_airspace(t)) continue;
+      if (verdict.action == ac::GrantAction::emergency_stop) ++out.guard_emergency_stops;
+      if (verdict.action == ac::GrantAction::soft_stop) ++out.guard_soft_stops;
+      if (out.guard_first.empty()) {
+        out.guard_first = site.cranes[i].name + " at " + std::to_string(t) + " s: " + verdict.reason;
+      }
+    }
     // Each crane at rest asks for its next leg.
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
       if (c.phase != Crane::Phase::resting || k == 0 || c.down_since) continue;
       const ac::Pose here = measured_pose(*c.stack);
       arbiter.rest(i, here);
+      c.guard->grant(ac::rest_airspace(here, site.paths), t);
       changed = true;
       if (c.next_leg == c.legs.size()) {
         arbiter.withdraw(i);
@@ -244,6 +282,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         for (ac::Pose& p : c.path) {
           if (std::abs(p.cable_length - hook_up_cable) < 1e-9) p.cable_length = hook_up_cable;
         }
+        c.guard->grant(ac::path_airspace(c.path, site.paths), t);
         c.waypoint = 0;
         c.phase = Crane::Phase::moving;
         c.start_next = true;
@@ -263,7 +302,9 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       if (c.waypoint > 0 && !c.down_since &&
           (arbiter.holding(i) == ac::Holding::path || arbiter.holding(i) == ac::Holding::yield)) {
         // What the crane left behind is free for the others.
-        arbiter.progress(i, std::vector<ac::Pose>(c.path.begin() + static_cast<std::ptrdiff_t>(c.waypoint), c.path.end()));
+        const std::vector<ac::Pose> ahead(c.path.begin() + static_cast<std::ptrdiff_t>(c.waypoint), c.path.end());
+        arbiter.progress(i, ahead);
+        c.guard->progress(ac::path_airspace(ahead, site.paths));
         changed = true;
       }
       ++c.waypoint;
@@ -352,18 +393,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     if (k % kWatchStride == 0) {
       std::vector<ac::CraneEnvelope> soft(n), emergency(n);
       for (std::size_t i = 0; i < n; ++i) {
-        const auto& e = cranes[i].stack->estimate();
-        ac::CraneMotion m;
-        m.slew = e.slew_angle;
-        m.slew_rate = e.slew_rate;
-        m.trolley = e.trolley_position;
-        m.trolley_velocity = e.trolley_velocity;
-        m.cable_length = e.cable_length;
-        m.cable_rate = e.cable_length_rate;
-        m.swing_in_plane = e.swing_in_plane;
-        m.swing_out_of_plane = e.swing_out_of_plane;
-        m.swing_in_plane_rate = e.swing_in_plane_rate;
-        m.swing_out_of_plane_rate = e.swing_out_of_plane_rate;
+        const ac::CraneMotion m = motion_of(cranes[i].stack->estimate());
         soft[i] = ac::envelope(site.cranes[i], m, ac::StopKind::soft);
         emergency[i] = ac::envelope(site.cranes[i], m, ac::StopKind::emergency);
       }

@@ -22,8 +22,9 @@
 // A lost link (SiteRunOptions::faults): instructions to the crane and its reports are dropped. When
 // the link has been down for the site's link_deadline, the site service treats the crane as
 // holding its whole reach, and the crane, on its own, soft-stops (the planner's COMMAND_STOP) if the
-// rest of its path is in shared airspace (in_shared_airspace), else finishes it; then it waits at
-// rest. When the link is back it reports where it rests and asks again for the leg it was on.
+// rest of its path is in shared airspace (its GrantGuard's rule 4, grant_guard.hpp), else finishes
+// it; then it waits at rest. When the link is back it reports where it rests and asks again for
+// the leg it was on. The guard's other rules are counted, not applied (SiteOutcome::guard_*).
 //
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
 // outside a crane's reach or a job list not one per crane.
@@ -109,6 +110,13 @@ struct SiteOutcome {
   // shared airspace), or still on a path outside it.
   std::vector<double> reactions;
   int halts{0};  // soft stops for a lost link
+  // Each crane's guard on its grant (grant_guard.hpp), counted every cycle and not applied (its
+  // rule 4, the lost link, is the one applied: see the header): the cycles on which it would have
+  // asked for the brakes (leaving its grant) or for a soft stop (the swing wider than its grant),
+  // and the first such verdict ("tc1 at 12.3 s: leaving its grant"; empty: none).
+  int guard_emergency_stops{0};
+  int guard_soft_stops{0};
+  std::string guard_first;
 };
 
 /// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`

@@ -1,0 +1,98 @@
+#pragma once
+// Each crane's own enforcement of its grant (issue 34, item 4; docs/site.md, "The crane's own
+// guard"): what a crane checks every cycle against the airspace the site service granted it,
+// without the service. A pure core (no clock, no DDS, no allocation): the crane's supervisor, the
+// simulated site and the tests call it the same way.
+//
+// The crane keeps the last grant it heard (the airspace the service holds for it: a rest box, a
+// path or a yield; airspace.hpp) and the time it last heard the service. check() answers, in this
+// order (the first that holds):
+//   1. emergency_stop  the measured motion is not finite (is_finite);
+//   2. emergency_stop  no grant heard yet and the crane moves (its emergency stop would carry an
+//                      axis further than kContainmentTolerance): nothing is allowed by default;
+//   3. emergency_stop  the crane's emergency stop decided now (the pose plus stopping_travel(...,
+//                      StopKind::emergency) on each axis) ends outside every box of its grant,
+//                      or the pose itself is outside: it has left, or is about to leave, what it
+//                      was granted (a crane that disobeys; the site service's geometry assumes
+//                      it never does);
+//   4. soft_stop       the link is lost (nothing heard for the site's link_deadline, or never) and
+//                      the grant is in shared airspace (in_shared_airspace: within
+//                      margins.slow_down of another crane's whole reach): the service now holds
+//                      this crane's whole reach, and the crane keeps out of shared airspace on its
+//                      own; a grant outside shared airspace is finished;
+//   5. soft_stop       the load swings wider than the grant's allowance where the crane is (the
+//                      largest swing radius of the boxes that contain the pose);
+//   6. proceed.
+// Containment is per box of joint space with `kContainmentTolerance` on each axis: slew, trolley
+// and cable length each within the box's interval widened by it. A box's intervals are the
+// plan's (a slew-only segment has a zero-width trolley interval); the tolerance is what the
+// drives' tracking may deviate across them (the trolley held by its position loop while the jib
+// slews, the dither of the friction compensation). It is paid for by the site's margins: a grant
+// keeps margins.slow_down, and 0.02 m of trolley plus 0.02 rad at the lab jib's 1.4 m is 0.05 m,
+// within the 0.10 m between slow_down and stop. The stop's end point is tested, not the stop's sweep: a box is convex in joint space
+// and the boxes of a path share their waypoints, so a stop that starts in one box and ends in it
+// or in the next stays in the union.
+//
+// Errors: std::out_of_range for a crane index not on the site; check() itself never throws.
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+
+namespace crane::anti_collision {
+
+/// [m] and [rad]: how far outside a box a pose may be and still count as inside it (see the header).
+inline constexpr double kContainmentTolerance = 0.02;
+
+/// True when `pose` lies within `tolerance` of at least one box of `airspace` on every axis.
+[[nodiscard]] bool contains(const Airspace& airspace, const Pose& pose, double tolerance = kContainmentTolerance) noexcept;
+
+enum class GrantAction : std::uint8_t { proceed, soft_stop, emergency_stop };
+/// "proceed", "soft_stop", "emergency_stop".
+[[nodiscard]] const char* to_string(GrantAction action) noexcept;
+
+struct GrantCheck {
+  GrantAction action{GrantAction::proceed};
+  const char* reason{"within its grant"};  // a static string naming the rule (see the header)
+};
+
+class GrantGuard {
+ public:
+  /// The guard of crane `crane` of `layout` (copied). std::out_of_range for a crane index not on
+  /// the site.
+  GrantGuard(const SiteLayout& layout, std::size_t crane);
+
+  /// A grant heard at `time` [s]: the airspace the service now holds for this crane. Also a
+  /// message from the service (heard).
+  void grant(const Airspace& granted, double time) noexcept;
+  /// Any message from the site service heard at `time` [s] (its heartbeat, an instruction to
+  /// another crane): the link is alive.
+  void heard(double time) noexcept;
+  /// The crane's own progress: it holds only `remaining` now (the part of its path ahead). The
+  /// service is told the same (SiteArbiter::progress); the guard does not wait for it.
+  void progress(const Airspace& remaining) noexcept;
+
+  /// The rules of the header for `motion` measured at `time` [s]. noexcept, no allocation.
+  [[nodiscard]] GrantCheck check(const CraneMotion& motion, double time) const noexcept;
+
+  [[nodiscard]] bool has_grant() const noexcept { return has_grant_; }
+  [[nodiscard]] const Airspace& granted() const noexcept { return granted_; }
+  /// True when nothing was heard from the service for link_deadline at `time` (or never).
+  [[nodiscard]] bool link_lost(double time) const noexcept;
+  /// Rule 4 alone: the link is lost at `time` and the grant is in shared airspace.
+  [[nodiscard]] bool must_leave_shared_airspace(double time) const noexcept;
+
+ private:
+  SiteLayout layout_;
+  std::size_t crane_;
+  Airspace granted_{};
+  bool has_grant_{false};
+  bool granted_shared_{false};  // in_shared_airspace(granted_), computed when the grant changes
+  double last_heard_{-std::numeric_limits<double>::infinity()};
+};
+
+}  // namespace crane::anti_collision
