@@ -1,10 +1,13 @@
 // The simulated site (stack::run_site): the three-tower site of deploy/config with the lab crane's
 // stack per crane, seeded random job sets run coordinated, serialized and solo. Every job done, no
 // supervisor fault, the true distance between any two cranes' parts never below the stop margin,
-// and the coordinated site faster than the serializing baseline over the sets; a site of one crane
-// runs as that crane alone.
+// and the coordinated site faster than the serializing baseline over the sets; lost links and a
+// restarted site service; a crane that leaves its grant braked by its own guard; a site of one
+// crane runs as that crane alone.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "crane/anti_collision/site_file.hpp"
@@ -73,6 +76,31 @@ TEST(SiteRun, LostLinksAndARestartedSiteServiceKeepTheMarginAndStopInBoundedTime
     EXPECT_GE(r, site.link_deadline - 1e-9);
     EXPECT_LE(r, site.link_deadline + 5.6);
   }
+}
+
+// A crane that disobeys: 30 s into the run tc1 is told to slew to 2.0 rad without asking. Its own
+// guard brakes it once its emergency stop would end outside its grant, well before it reaches
+// another crane: the true distance keeps the stop margin. The same jobs with no rogue brake no
+// crane (the guard's containment does not stop healthy cranes).
+TEST(SiteRun, ACraneThatLeavesItsGrantIsBrakedByItsOwnGuard) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const auto jobs = random_site_jobs(site, config, 2, 11);
+  SiteRunOptions options;
+  options.time_limit = 120.0;
+  const SiteOutcome healthy = run_site(site, config, jobs, options);
+  EXPECT_EQ(healthy.guard_emergency_stops, 0) << healthy.guard_first;
+  options.rogue = SiteRunOptions::Rogue{0, 30.0, {2.0, 1.0, 0.2}};
+  const SiteOutcome o = run_site(site, config, jobs, options);
+  EXPECT_EQ(o.guard_emergency_stops, 1) << o.guard_first;
+  ASSERT_TRUE(std::isfinite(o.cranes[0].braked_at)) << o.guard_first;
+  EXPECT_GE(o.cranes[0].braked_at, 30.0);
+  EXPECT_LT(o.cranes[0].braked_at, 32.0);
+  EXPECT_NE(o.cranes[0].latched_faults & crane::protocol::SupervisorStatus::FAULT_EMERGENCY_STOP, 0u);
+  EXPECT_FALSE(o.completed);
+  EXPECT_GE(o.min_distance, site.margins.stop) << o.closest;
+  std::printf("rogue tc1 braked by its guard at %.2f s (%s); min distance %.3f m (%s)\n", o.cranes[0].braked_at,
+              o.guard_first.c_str(), o.min_distance, o.closest.c_str());
 }
 
 TEST(SiteRun, ASiteOfOneCraneRunsAsThatCraneAlone) {

@@ -71,6 +71,12 @@ bool GrantGuard::must_leave_shared_airspace(double time) const noexcept {
   return has_grant_ && granted_shared_ && link_lost(time);
 }
 
+bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m) const noexcept {
+  if (!has_grant_ || !is_finite(m)) return false;
+  const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
+  return contains(granted_, {m.slew + stop.slew, m.trolley + stop.trolley, m.cable_length + stop.cable});
+}
+
 GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {
   if (!is_finite(m)) return {GrantAction::emergency_stop, "the measured motion is not finite"};
   const SiteCrane& crane = layout_.cranes[crane_];

@@ -46,6 +46,8 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.paths.slew_overshoot = paths.number("slew_overshoot", kOvershoot.lower, kOvershoot.upper);
     layout.paths.travel_swing = paths.number("travel_swing", kSwingAllowance.lower, kSwingAllowance.upper);
     layout.paths.hoist_swing = paths.number("hoist_swing", kSwingAllowance.lower, kSwingAllowance.upper);
+    layout.paths.trolley_tracking = paths.number("trolley_tracking", kOvershoot.lower, kOvershoot.upper);
+    layout.paths.slew_tracking = paths.number("slew_tracking", kOvershoot.lower, kOvershoot.upper);
     paths.finish();
     for (auto& z : s.list("zones")) layout.zones.push_back(config::read_zone(z));
     for (auto& c : s.list("cranes")) {

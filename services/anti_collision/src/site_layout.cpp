@@ -53,6 +53,8 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_in_range(prefix + ".paths.slew_overshoot", layout.paths.slew_overshoot, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.travel_swing", layout.paths.travel_swing, kSwingAllowance.lower, kSwingAllowance.upper);
   require_in_range(prefix + ".paths.hoist_swing", layout.paths.hoist_swing, kSwingAllowance.lower, kSwingAllowance.upper);
+  require_in_range(prefix + ".paths.trolley_tracking", layout.paths.trolley_tracking, kOvershoot.lower, kOvershoot.upper);
+  require_in_range(prefix + ".paths.slew_tracking", layout.paths.slew_tracking, kOvershoot.lower, kOvershoot.upper);
 
   std::set<std::string> names;
   std::set<int> domains;

@@ -188,8 +188,12 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
     }
     min_distance.push_back(r.coordinated.min_distance);
     serial_min.push_back(r.serialized.min_distance);
-    vs_serialized.push_back(r.coordinated.total_time / r.serialized.total_time);
-    vs_solo.push_back(r.coordinated.total_time / r.solo.total_time);
+    // The time ratios of the sets that every mode completed (a crane braked by its guard leaves
+    // its jobs undone: no total time to compare).
+    if (r.coordinated.completed && r.serialized.completed && r.solo.completed) {
+      vs_serialized.push_back(r.coordinated.total_time / r.serialized.total_time);
+      vs_solo.push_back(r.coordinated.total_time / r.solo.total_time);
+    }
     unresolved += r.coordinated.unresolved + r.serialized.unresolved;
     for (const auto& c : r.coordinated.cranes) yields += c.yields, waiting += c.waiting_time;
   }
@@ -201,7 +205,8 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
               quantile(min_distance, 0.5), site.margins.stop);
   std::printf("  min distance, serialized [m]:  min %.3f  median %.3f\n", quantile(serial_min, 0.0),
               quantile(serial_min, 0.5));
-  std::printf("  total time coordinated / serialized: median %.3f  worst %.3f  best %.3f\n", quantile(vs_serialized, 0.5),
+  std::printf("  total time coordinated / serialized (%zu sets every mode completed): median %.3f  worst %.3f  best %.3f\n",
+              vs_serialized.size(), quantile(vs_serialized, 0.5),
               quantile(vs_serialized, 1.0), quantile(vs_serialized, 0.0));
   std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", quantile(vs_solo, 0.5),
               quantile(vs_solo, 1.0), quantile(vs_solo, 0.0));
@@ -212,15 +217,17 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
   std::printf("  distance-watching rule on the coordinated runs (counted, not applied): %d slow-downs, %d stops, %d "
               "emergency stops\n", slow, stops, emergency);
   std::vector<double> reactions;
-  int halts = 0;
+  int halts = 0, at_waypoint = 0;
   for (const SetResult& r : results) {
     reactions.insert(reactions.end(), r.coordinated.reactions.begin(), r.coordinated.reactions.end());
     halts += r.coordinated.halts;
+    at_waypoint += r.coordinated.halts_at_waypoint;
   }
   if (faults > 0) {
     std::printf("  link faults: %d per coordinated set (a crane's link lost 0.5-30 s, or the site service killed and "
-                "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d soft stops\n",
-                faults, reactions.size(), site.link_deadline, halts);
+                "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d stops (%d of them at the "
+                "waypoint: a soft stop would have left the grant)\n",
+                faults, reactions.size(), site.link_deadline, halts, at_waypoint);
     std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace [ms]: min %.0f  median %.0f  "
                 "p90 %.0f  p99 %.0f  max %.0f\n",
                 1e3 * quantile(reactions, 0.0), 1e3 * quantile(reactions, 0.5), 1e3 * quantile(reactions, 0.9),
@@ -232,8 +239,8 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
     guard_emergency += r.coordinated.guard_emergency_stops, guard_soft += r.coordinated.guard_soft_stops;
     if (guard_first.empty() && !r.coordinated.guard_first.empty()) guard_first = r.coordinated.guard_first;
   }
-  std::printf("  each crane's guard on its grant, coordinated runs (counted, not applied): %d cycles asking for the brakes, "
-              "%d for a soft stop%s%s\n",
+  std::printf("  each crane's guard on its grant, coordinated runs: %d cranes braked (leaving their grant), %d cycles "
+              "asking for a soft stop for the swing (counted, not applied)%s%s\n",
               guard_emergency, guard_soft, guard_first.empty() ? "" : "; first: ", guard_first.c_str());
   std::printf("  coordinated: %d yields, %.1f s waiting per set\n", yields,
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));

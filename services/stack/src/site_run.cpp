@@ -35,7 +35,8 @@ struct Crane {
   std::unique_ptr<InProcessStack> stack;
   std::vector<Leg> legs;  // left to do, front first
   std::size_t next_leg{0};
-  enum class Phase { resting, asking, moving, dwelling, halting, halted, done } phase{Phase::resting};
+  // braked: its guard braked it (it left its grant); it stays braked and asks for nothing.
+  enum class Phase { resting, asking, moving, dwelling, halting, halted, done, braked } phase{Phase::resting};
   std::optional<double> down_since;  // [s] its link to the site service is down since
   bool link_lost{false};             // down for link_deadline: the site service holds its whole reach
   double halt_from{0.0};             // [s] the link loss its soft stop answers
@@ -217,12 +218,18 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
           c.phase = Crane::Phase::halting;
           c.halt_from = *c.down_since;
           c.arrived_cycle.reset();
-          c.start_next = false;
-          Request stop{};
-          stop.request_id = ++c.request_id;
-          stop.command = Request::COMMAND_STOP;
-          c.stop_goal = stop;
           ++out.halts;
+          // A soft stop, unless it would run out of the grant (a fast slew near its goal: the shaped
+          // stop travels v T/4 further); then the move under way ends at its waypoint, inside.
+          if (c.start_next || c.guard->soft_stop_stays_in_grant(motion_of(c.stack->estimate()))) {
+            Request stop{};
+            stop.request_id = ++c.request_id;
+            stop.command = Request::COMMAND_STOP;
+            c.stop_goal = stop;
+          } else {
+            ++out.halts_at_waypoint;
+          }
+          c.start_next = false;
           continue;
         }
         out.reactions.push_back(t - *c.down_since);  // it keeps to its own airspace
@@ -231,18 +238,40 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         out.reactions.push_back(t - *c.down_since);  // at rest already
       }
     }
-    // Each crane's guard on its grant (grant_guard.hpp): rule 4 (a lost link) is applied above;
-    // rules 1-3 and 5 are counted every cycle, not applied (docs/site.md, "The crane's own guard").
+    // A crane that disobeys (SiteRunOptions::rogue): told to move off its grant, without asking.
+    std::vector<bool> estop(n, false);
+    if (options.rogue && k == static_cast<std::uint64_t>(std::llround(options.rogue->time / dt))) {
+      Crane& c = cranes.at(options.rogue->crane);
+      c.phase = Crane::Phase::moving;
+      c.start_next = false;
+      c.arrived_cycle.reset();
+      c.stop_goal = move_to(options.rogue->to, ++c.request_id, options.slew_acceleration);
+      c.path = {measured_pose(*c.stack), options.rogue->to};
+      c.waypoint = 1;
+      c.yielding = true;  // its leg is not a job's
+    }
+    // Each crane's guard on its grant (grant_guard.hpp), every cycle: rules 1-3 brake the crane;
+    // rule 4 (a lost link) is applied above; rule 5 (the swing) is counted, not applied.
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
-      if (k == 0 || c.phase == Crane::Phase::done) continue;  // no estimate before cycle 0
+      if (k == 0 || c.phase == Crane::Phase::done || c.phase == Crane::Phase::braked) continue;  // no estimate at 0
       const ac::GrantCheck verdict = c.guard->check(motion_of(c.stack->estimate()), t);
       if (verdict.action == ac::GrantAction::proceed || c.guard->must_leave_shared_airspace(t)) continue;
-      if (verdict.action == ac::GrantAction::emergency_stop) ++out.guard_emergency_stops;
-      if (verdict.action == ac::GrantAction::soft_stop) ++out.guard_soft_stops;
       if (out.guard_first.empty()) {
         out.guard_first = site.cranes[i].name + " at " + std::to_string(t) + " s: " + verdict.reason;
       }
+      if (verdict.action == ac::GrantAction::soft_stop) {
+        ++out.guard_soft_stops;
+        continue;
+      }
+      ++out.guard_emergency_stops;
+      estop[i] = true;
+      // Outside its grant the crane is somewhere the service did not give it: the service holds
+      // its whole reach from now on, as for a crane that stops reporting.
+      if (!service_down && !c.down_since) arbiter.lost(i);  // (link down: at its deadline)
+      c.phase = Crane::Phase::braked;
+      c.stop_goal.reset();
+      c.outcome.braked_at = t;
     }
     // Each crane at rest asks for its next leg.
     for (std::size_t i = 0; i < n; ++i) {
@@ -318,7 +347,11 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         cranes[i].stop_goal.reset();
         has_goal[i] = true;
       }
-      cranes[i].stack->step(has_goal[i] ? std::span(&goal[i], 1) : std::span<const Request>());
+      protocol::SupervisorCommand brake{};
+      brake.request_id = 1;
+      brake.command = protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP;
+      cranes[i].stack->step(has_goal[i] && !estop[i] ? std::span(&goal[i], 1) : std::span<const Request>(), {},
+                            estop[i] ? &brake : nullptr);
       for (const auto& outcome : cranes[i].stack->planner().goal_outcomes()) {
         if (outcome.status != trajectory_planner::GoalStatus::accepted) {
           throw std::runtime_error("site run: " + site.cranes[i].name + "'s planner refused a move at " + std::to_string(t) +
@@ -411,9 +444,14 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         }
       }
     }
-    if (std::all_of(cranes.begin(), cranes.end(), [](const Crane& c) { return c.phase == Crane::Phase::done; })) break;
+    if (std::all_of(cranes.begin(), cranes.end(), [](const Crane& c) {
+          return c.phase == Crane::Phase::done || c.phase == Crane::Phase::braked;
+        })) {
+      break;
+    }
   }
-  out.completed = k < limit;
+  out.completed = k < limit && std::none_of(cranes.begin(), cranes.end(),
+                                             [](const Crane& c) { return c.phase == Crane::Phase::braked; });
   out.unresolved = arbiter_ptr->unresolved();
   for (Crane& c : cranes) {
     c.outcome.latched_faults = c.stack->status().latched_faults;

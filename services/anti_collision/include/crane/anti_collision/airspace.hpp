@@ -5,7 +5,8 @@
 // A crane's airspace is a union of boxes of its joint space: a slew interval [rad], a trolley
 // interval [m] and a cable-length interval [m], with the load's swing (a horizontal radius [m]
 // about the sheave's vertical). A path through waypoints is one box per segment, widened by the
-// tracking controller's overshoot past each goal; the swing is the site's travel allowance (the
+// tracking controller's overshoot past each goal and by the tracking allowance on either side of
+// its slew and trolley intervals; the swing is the site's travel allowance (the
 // crane's supervisor brakes beyond it) while the trolley or the slew moves, and its hoist
 // allowance while only the hoist does. At rest a crane holds the box of its pose.
 //

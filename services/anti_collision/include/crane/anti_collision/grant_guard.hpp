@@ -85,6 +85,11 @@ class GrantGuard {
   [[nodiscard]] bool link_lost(double time) const noexcept;
   /// Rule 4 alone: the link is lost at `time` and the grant is in shared airspace.
   [[nodiscard]] bool must_leave_shared_airspace(double time) const noexcept;
+  /// True when a soft stop decided now (stopping_travel(..., StopKind::soft): shaped when the
+  /// crane's stopping data says so) ends inside the grant. When it would not (a fast slew near its
+  /// goal: the shaped stop runs past it), the crane's move to its next waypoint is the shorter way
+  /// to rest inside what it holds.
+  [[nodiscard]] bool soft_stop_stays_in_grant(const CraneMotion& motion) const noexcept;
 
  private:
   SiteLayout layout_;

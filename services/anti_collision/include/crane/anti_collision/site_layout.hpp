@@ -80,6 +80,10 @@ struct PathAllowance {
   double slew_overshoot{0.05};     // [rad] past a slew goal
   double travel_swing{0.6};        // [rad] swing while the trolley or the slew moves (the supervisor's max_swing)
   double hoist_swing{0.05};        // [rad] swing while only the hoist moves (the residual of the travel)
+  // How far the drives' tracking strays from the plan, on either side of every box: the trolley
+  // pulled outward while the jib slews, a stop from the slew's speed (measured: docs/site.md).
+  double trolley_tracking{0.0};    // [m]
+  double slew_tracking{0.0};       // [rad]
 };
 
 struct SiteLayout {

@@ -21,15 +21,20 @@
 //
 // A lost link (SiteRunOptions::faults): instructions to the crane and its reports are dropped. When
 // the link has been down for the site's link_deadline, the site service treats the crane as
-// holding its whole reach, and the crane, on its own, soft-stops (the planner's COMMAND_STOP) if the
-// rest of its path is in shared airspace (its GrantGuard's rule 4, grant_guard.hpp), else finishes
-// it; then it waits at rest. When the link is back it reports where it rests and asks again for
-// the leg it was on. The guard's other rules are counted, not applied (SiteOutcome::guard_*).
+// holding its whole reach, and the crane, on its own, stops if the rest of its path is in shared
+// airspace (its GrantGuard's rule 4, grant_guard.hpp), else finishes it; then it waits at rest. It
+// stops with the planner's COMMAND_STOP (a soft stop), or, when that stop would run out of its
+// grant (soft_stop_stays_in_grant), by ending the move under way at its waypoint. When the link is back it reports where it rests and asks again for
+// the leg it was on. The guard's rules 1-3 brake a crane that leaves its grant (it then stays
+// braked, and the site service holds its whole reach); its swing rule is counted, not applied
+// (SiteOutcome::guard_*).
 //
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
 // outside a crane's reach or a job list not one per crane.
 
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +86,14 @@ struct SiteRunOptions {
   // max_swing (0.6 rad) in 8 of 40 seeded job sets (docs/site.md).
   double slew_acceleration{1.0};
   std::vector<LinkFault> faults;
+  // A crane that disobeys: at `time` [s] crane `crane` is told to move to `to` without asking the
+  // site service (a test of its guard, grant_guard.hpp).
+  struct Rogue {
+    std::size_t crane{0};
+    double time{0.0};
+    anti_collision::Pose to;
+  };
+  std::optional<Rogue> rogue;
 };
 
 struct CraneOutcome {
@@ -91,11 +104,12 @@ struct CraneOutcome {
   int yields{0};             // yields it obeyed
   int unsettled_moves{0};    // moves ended by settle_timeout
   std::uint32_t latched_faults{0};  // its supervisor's, at the end (FAULT_* bits)
+  double braked_at{std::numeric_limits<double>::quiet_NaN()};  // [s] when its guard braked it (NaN: never)
 };
 
 struct SiteOutcome {
   std::vector<CraneOutcome> cranes;
-  bool completed{false};     // every job done within the time limit
+  bool completed{false};     // every job done within the time limit (no crane braked by its guard)
   double total_time{0.0};    // [s] the last crane's finish time
   double min_distance{0.0};  // [m] true, between any two parts of any two cranes, over the run
   std::string closest;       // "tc1.jib-tc3.cable at 41.23 s"
@@ -109,11 +123,12 @@ struct SiteOutcome {
   // at rest (trolley, slew and hoist under 0.01 m/s, rad/s) after its soft stop (its path was in
   // shared airspace), or still on a path outside it.
   std::vector<double> reactions;
-  int halts{0};  // soft stops for a lost link
-  // Each crane's guard on its grant (grant_guard.hpp), counted every cycle and not applied (its
-  // rule 4, the lost link, is the one applied: see the header): the cycles on which it would have
-  // asked for the brakes (leaving its grant) or for a soft stop (the swing wider than its grant),
-  // and the first such verdict ("tc1 at 12.3 s: leaving its grant"; empty: none).
+  int halts{0};  // stops for a lost link: a soft stop, or the move under way ended at its waypoint
+  int halts_at_waypoint{0};  // of them, those whose soft stop would have run out of the grant
+  // Each crane's guard on its grant (grant_guard.hpp): the cranes it braked (leaving their grant:
+  // applied, the crane stays braked), the cycles on which it would have asked for a soft stop for
+  // a swing wider than the grant (counted, not applied), and its first verdict ("tc1 at 12.3 s:
+  // leaving its grant"; empty: none).
   int guard_emergency_stops{0};
   int guard_soft_stops{0};
   std::string guard_first;
