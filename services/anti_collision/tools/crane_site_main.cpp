@@ -33,6 +33,7 @@
 #include "crane/anti_collision/crane_geometry.hpp"
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/common/validation.hpp"
+#include "crane/stack/maneuver_metrics.hpp"
 #include "crane/stack/site_run.hpp"
 #include "crane/stack/stack_config.hpp"
 
@@ -108,12 +109,6 @@ struct SetResult {
   crane::stack::SiteOutcome coordinated, serialized, solo;
   std::string error;
 };
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::llround(q * static_cast<double>(v.size() - 1)))];
-}
 
 int demo(const std::string& site_path, const std::string& config_path, int sets, int jobs, std::uint64_t seed,
          int threads, int faults) {
@@ -201,15 +196,15 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
               "waits; %.0f crane-seconds simulated)\n",
               min_distance.size(), failed, incomplete, faulted, static_cast<unsigned long long>(unresolved), simulated);
   std::printf("  min distance, coordinated [m]: min %.3f  p1 %.3f  p10 %.3f  median %.3f  (stop margin %.3f)\n",
-              quantile(min_distance, 0.0), quantile(min_distance, 0.01), quantile(min_distance, 0.1),
-              quantile(min_distance, 0.5), site.margins.stop);
-  std::printf("  min distance, serialized [m]:  min %.3f  median %.3f\n", quantile(serial_min, 0.0),
-              quantile(serial_min, 0.5));
+              crane::stack::nearest_rank_quantile(min_distance, 0.0), crane::stack::nearest_rank_quantile(min_distance, 0.01), crane::stack::nearest_rank_quantile(min_distance, 0.1),
+              crane::stack::nearest_rank_quantile(min_distance, 0.5), site.margins.stop);
+  std::printf("  min distance, serialized [m]:  min %.3f  median %.3f\n", crane::stack::nearest_rank_quantile(serial_min, 0.0),
+              crane::stack::nearest_rank_quantile(serial_min, 0.5));
   std::printf("  total time coordinated / serialized (%zu sets every mode completed): median %.3f  worst %.3f  best %.3f\n",
-              vs_serialized.size(), quantile(vs_serialized, 0.5),
-              quantile(vs_serialized, 1.0), quantile(vs_serialized, 0.0));
-  std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", quantile(vs_solo, 0.5),
-              quantile(vs_solo, 1.0), quantile(vs_solo, 0.0));
+              vs_serialized.size(), crane::stack::nearest_rank_quantile(vs_serialized, 0.5),
+              crane::stack::nearest_rank_quantile(vs_serialized, 1.0), crane::stack::nearest_rank_quantile(vs_serialized, 0.0));
+  std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", crane::stack::nearest_rank_quantile(vs_solo, 0.5),
+              crane::stack::nearest_rank_quantile(vs_solo, 1.0), crane::stack::nearest_rank_quantile(vs_solo, 0.0));
   int slow = 0, stops = 0, emergency = 0;
   for (const SetResult& r : results) {
     slow += r.coordinated.watch_slow_downs, stops += r.coordinated.watch_stops, emergency += r.coordinated.watch_emergency_stops;
@@ -230,8 +225,8 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
                 faults, reactions.size(), site.link_deadline, halts, at_waypoint);
     std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace [ms]: min %.0f  median %.0f  "
                 "p90 %.0f  p99 %.0f  max %.0f\n",
-                1e3 * quantile(reactions, 0.0), 1e3 * quantile(reactions, 0.5), 1e3 * quantile(reactions, 0.9),
-                1e3 * quantile(reactions, 0.99), 1e3 * quantile(reactions, 1.0));
+                1e3 * crane::stack::nearest_rank_quantile(reactions, 0.0), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.5), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.9),
+                1e3 * crane::stack::nearest_rank_quantile(reactions, 0.99), 1e3 * crane::stack::nearest_rank_quantile(reactions, 1.0));
   }
   int guard_emergency = 0, guard_soft = 0;
   std::string guard_first;
@@ -244,7 +239,7 @@ int demo(const std::string& site_path, const std::string& config_path, int sets,
               guard_emergency, guard_soft, guard_first.empty() ? "" : "; first: ", guard_first.c_str());
   std::printf("  coordinated: %d yields, %.1f s waiting per set\n", yields,
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));
-  const bool safe = !min_distance.empty() && quantile(min_distance, 0.0) >= site.margins.stop;
+  const bool safe = !min_distance.empty() && crane::stack::nearest_rank_quantile(min_distance, 0.0) >= site.margins.stop;
   return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
 }
 

@@ -24,13 +24,6 @@ double trapezoid_time(double distance, double velocity, double acceleration) {
   return 2.0 * std::sqrt(distance / acceleration);
 }
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::llround(q * static_cast<double>(v.size() - 1)));
-  return v[std::min(i, v.size() - 1)];
-}
-
 }  // namespace
 
 std::vector<ComparedController> compared_controllers() {
@@ -233,9 +226,9 @@ std::vector<ControllerSummary> summarize(const std::vector<MoveComparison>& move
       s.worst_slew_error = std::max(s.worst_slew_error, o.metrics.final_slew_error);
       s.peak_voltage = std::max(s.peak_voltage, o.metrics.max_voltage);
     }
-    s.median_ratio = quantile(ratios, 0.5);
-    s.worst_ratio = quantile(ratios, 1.0);
-    s.median_residual_swing = quantile(residual, 0.5);
+    s.median_ratio = nearest_rank_quantile(ratios, 0.5);
+    s.worst_ratio = nearest_rank_quantile(ratios, 1.0);
+    s.median_residual_swing = nearest_rank_quantile(residual, 0.5);
     out.push_back(s);
   }
   return out;

@@ -7,6 +7,13 @@
 
 namespace crane::stack {
 
+double nearest_rank_quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const auto i = static_cast<std::size_t>(std::llround(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1)));
+  return values[std::min(i, values.size() - 1)];
+}
+
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
                                   double slew_target, const SettleCriteria& criteria, double bridge_target) {
   if (cycles.empty()) throw std::invalid_argument("evaluate_maneuver: the recording has no cycles");

@@ -656,7 +656,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   if (!solve_times.empty()) {
     std::printf("\nbound solve (IPOPT, %d intervals): median %.2f s, max %.2f s over %zu moves; %.1f s wall on %u "
                 "thread(s)\n",
-                intervals, solve_times[solve_times.size() / 2], solve_times.back(), solve_times.size(), wall,
+                intervals, stack::nearest_rank_quantile(solve_times, 0.5), solve_times.back(), solve_times.size(), wall,
                 std::max(1U, jobs));
   }
   if (!out_dir.empty()) {

@@ -36,6 +36,11 @@ struct ManeuverMetrics {
   double max_voltage{0.0};            // [V] max |applied voltage| over every drive
 };
 
+/// The nearest-rank q-quantile of `values` (q in [0, 1]: 0 the smallest, 1 the largest, 0.5 the
+/// median, the upper one of an even count's two middles); NaN when `values` is empty. The
+/// distributions the benchmarks print (crane_sim compare, crane_site demo).
+[[nodiscard]] double nearest_rank_quantile(std::vector<double> values, double q);
+
 /// Evaluates a recording (cycles in time order, at least one). Throws std::invalid_argument when
 /// `cycles` is empty.
 ManeuverMetrics evaluate_maneuver(const std::vector<RecordedCycle>& cycles, double trolley_target,
