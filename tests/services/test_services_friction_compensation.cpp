@@ -64,6 +64,29 @@ TEST(FrictionCompensation, StictionInZeroVelocityBand) {
   EXPECT_NEAR(out.slew_friction, -0.6, 1e-9);
 }
 
+// The follower's sliding friction reduction (LinearCommand.sliding_friction_reduction): the sliding
+// part (3.1) scaled by 1 - r on every axis outside the zero-velocity band, the stiction part (3.2)
+// kept; outside [0, 1] refused with the safe output.
+TEST(FrictionCompensation, TheSlidingReductionScalesTheSlidingPartAndKeepsStiction) {
+  fc::FrictionCompensation comp(fc::FrictionCompensationParams{});
+  fc::FrictionCompensationOutput out;
+  auto in = input(0.2, 0.5, 0.0, 3.0);  // trolley sliding, slew at rest
+  in.sliding_friction_reduction = 0.25;
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_friction, 0.75 * 1.2, 1e-12);      // (4.12): 0.9 + 1.5 x 0.2
+  EXPECT_NEAR(out.command.trolley_voltage, 0.5 + 0.9, 1e-12);
+  EXPECT_NEAR(out.slew_friction, 0.7, 1e-9);                 // stiction (4.15), whole
+  in.sliding_friction_reduction = 1.0;
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_EQ(out.trolley_friction, 0.0);
+  for (const double bad : {-0.1, 1.01, std::nan("")}) {
+    in.sliding_friction_reduction = bad;
+    ASSERT_EQ(comp.step(in, out), StepStatus::rejected_nonfinite) << bad;
+    EXPECT_EQ(out.command.trolley_voltage, 0.0);
+    EXPECT_EQ(out.command.slew_voltage, 0.0);
+  }
+}
+
 TEST(FrictionCompensation, SlewUsesFilteredRateByDefault) {
   // Slew rate 0.5 rad/s (filtered): c+ + b+ w = 0.7 + 1.5*0.5 = 1.45 V (4.16); -0.5: -(0.6+0.025).
   fc::FrictionCompensation comp(fc::FrictionCompensationParams{});

@@ -297,6 +297,102 @@ TEST(TrackingStage, AConfidentPayloadEstimateReplacesTheConfiguredMass) {
   EXPECT_TRUE(std::isfinite(absurd.trolley_voltage) && std::isfinite(absurd.slew_voltage));
 }
 
+// The tracking law `follower` applies the feedback law the reference carries (Reference.feedback_law,
+// the minimum-time follower's; trajectory_feedback.hpp): u = feedforward - K (z - z_ref), by hand
+// here for a gain with one entry in each block, on the slew (tower) and on the bridge (overhead).
+TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarries) {
+  tracking::TrackingStageParams params;
+  params.law = tracking::TrackingLaw::follower;
+  tracking::TrackingStage stage{params};
+  EXPECT_EQ(tracking::law_from_name("follower"), tracking::TrackingLaw::follower);
+  auto state = at_rest(9, 0.52);
+  state.trolley_velocity = 0.31;
+  state.slew_angle = 0.2;
+  state.slew_rate = 0.4;
+  state.swing_in_plane = 0.03;
+  state.swing_out_of_plane = -0.01;
+  state.swing_out_of_plane_rate = 0.05;
+  common::TrajectoryFeedback law;
+  law.position = {0.5, 0.02, 0.25, 0.0};
+  law.velocity = {0.3, 0.0, 0.35, 0.0};
+  law.feedforward = {1.5, -0.7};
+  law.gain[0] = 40.0;       // trolley row: V/m on the trolley position
+  law.gain[1] = -12.0;      // V/rad on the in-plane swing
+  law.gain[4] = 8.0;        // V s/m on the trolley speed
+  law.gain[8 + 2] = 30.0;   // slew row: V/rad on the slew angle
+  law.gain[8 + 7] = 5.0;    // V s/rad on the out-of-plane swing rate
+  law.sliding_friction_reduction = 0.5;
+  protocol::Reference reference;
+  reference.cable_length = 1.0;
+  reference.cable_length_rate = 0.02;
+  common::set_trajectory_feedback(law, false, reference);
+  EXPECT_EQ(reference.slew_angle, 0.25);
+  protocol::LinearCommand command;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+  EXPECT_NEAR(command.trolley_voltage, 1.5 - (40.0 * 0.02 - 12.0 * 0.01 + 8.0 * 0.01), 1e-12);
+  EXPECT_NEAR(command.slew_voltage, -0.7 - (30.0 * -0.05 + 5.0 * 0.05), 1e-12);
+  EXPECT_EQ(command.hoist_speed, 0.02);
+  EXPECT_EQ(command.sliding_friction_reduction, 0.5);
+  EXPECT_EQ(command.header.seq, 9U);
+
+  // The voltage limit clamps.
+  reference.trolley_feedforward_voltage = 50.0;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+  EXPECT_EQ(command.trolley_voltage, params.tracking.voltage_limit);
+
+  // A reduction outside [0, 1], or a NaN in the law: 0 V, refused.
+  reference.trolley_feedforward_voltage = 1.5;
+  reference.sliding_friction_reduction = 1.5;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::rejected_nonfinite);
+  EXPECT_EQ(command.trolley_voltage, 0.0);
+  EXPECT_EQ(command.slew_voltage, 0.0);
+  reference.sliding_friction_reduction = 0.5;
+  reference.feedback_gain[3] = std::nan("");
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::rejected_nonfinite);
+  EXPECT_EQ(command.trolley_voltage, 0.0);
+
+  // A reference without a law (holding, a stop, manual motion) is tracked by the PD law.
+  reference.feedback_law = false;
+  tracking::TrackingStage pd{tracking::TrackingStageParams{}};
+  protocol::LinearCommand by_pd;
+  const protocol::AntiSwingCommand action{};
+  ASSERT_EQ(stage.step(state, reference, action, command), common::StepStatus::ok);
+  ASSERT_EQ(pd.step(state, reference, action, by_pd), common::StepStatus::ok);
+  EXPECT_EQ(command.trolley_voltage, by_pd.trolley_voltage);
+  EXPECT_EQ(command.slew_voltage, by_pd.slew_voltage);
+  EXPECT_EQ(command.sliding_friction_reduction, 0.0);
+}
+
+TEST(TrackingStage, TheFollowerLawDrivesTheBridgeOfAnOverheadCrane) {
+  common::StackFacts overhead;
+  overhead.crane_kind = common::CraneKind::overhead;
+  overhead.bridge = common::BridgeParameters{50.0, 1.5, {1.0, 1.2, 0.5, 0.6, 0.7, 0.8}};
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false}");
+  config::YamlSection block(yaml, "tracking");
+  tracking::TrackingStageParams params = tracking::read_params(block, overhead);
+  params.law = tracking::TrackingLaw::follower;
+  tracking::TrackingStage stage{params};
+  auto state = at_rest(3, 0.5);
+  state.slew_angle = 7.0;  // not the second axis here
+  state.bridge_position = 2.1;
+  state.bridge_velocity = 0.1;
+  common::TrajectoryFeedback law;
+  law.position = {0.5, 0.0, 2.0, 0.0};
+  law.feedforward = {0.0, 0.4};
+  law.gain[8 + 2] = 10.0;
+  law.gain[8 + 6] = 3.0;
+  protocol::Reference reference;
+  reference.cable_length = 1.0;
+  common::set_trajectory_feedback(law, true, reference);
+  EXPECT_EQ(reference.bridge_position, 2.0);
+  EXPECT_EQ(reference.slew_angle, 0.0);
+  protocol::LinearCommand command;
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+  EXPECT_NEAR(command.bridge_voltage, 0.4 - (10.0 * 0.1 + 3.0 * 0.1), 1e-12);
+  EXPECT_EQ(command.slew_voltage, 0.0);
+  EXPECT_EQ(command.trolley_voltage, 0.0);
+}
+
 // The friction compensation stage takes an axis's friction from the estimate only while its
 // ADAPTATION_*_FRICTION_ADAPTED bit is set: sliding at v = 0.1 m/s, F_f/K_m = c+ + b+ v (3.1).
 TEST(FrictionCompensationStage, UsesTheReleasedFrictionOnlyWhileItsBitIsSet) {

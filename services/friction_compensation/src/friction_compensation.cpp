@@ -78,7 +78,8 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
       params_.slew.velocity_source == VelocitySource::raw ? est.slew_rate_raw : est.slew_rate;
   if (!std::isfinite(trolley_velocity) || !std::isfinite(slew_velocity) ||
       !std::isfinite(input.command.trolley_voltage) || !std::isfinite(input.command.slew_voltage) ||
-      !std::isfinite(input.command.hoist_speed)) {
+      !std::isfinite(input.command.hoist_speed) ||
+      !(input.sliding_friction_reduction >= 0.0 && input.sliding_friction_reduction <= 1.0)) {
     output = FrictionCompensationOutput{};
     return common::StepStatus::rejected_nonfinite;
   }
@@ -100,6 +101,11 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
         friction_voltage(in_use(params_.trolley, input.trolley_friction), trolley_velocity, input.command.trolley_voltage);
     output.slew_friction =
         friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
+    if (input.sliding_friction_reduction != 0.0) {
+      const double kept = 1.0 - input.sliding_friction_reduction;
+      if (friction_direction(trolley_velocity, params_.trolley.zero_velocity_band) != 0) output.trolley_friction *= kept;
+      if (friction_direction(slew_velocity, params_.slew.zero_velocity_band) != 0) output.slew_friction *= kept;
+    }
     // Finite inputs can still overflow (a coefficient of 1e284 times a rate of 1e202): the clamp
     // below would pass Inf as the limit and NaN as is, so such a step gives the safe output.
     if (!std::isfinite(output.trolley_friction) || !std::isfinite(output.slew_friction)) {

@@ -1,5 +1,7 @@
 #include "crane/optimal_control/trajectory_follower.hpp"
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -7,6 +9,8 @@
 #include <Eigen/Dense>
 
 #include "crane/common/validation.hpp"
+
+#include "crane/tracking/trajectory_feedback.hpp"
 
 namespace crane::optimal_control {
 namespace {
@@ -220,37 +224,53 @@ const Eigen::MatrixXd& TrajectoryFollower::gain(std::size_t k) const noexcept {
   return gains_[std::min(k, gains_.size() - 1)];
 }
 
-common::StepStatus TrajectoryFollower::step(std::size_t k, const plant::ModelState& measured,
-                                            FollowerCommand& command) const noexcept {
-  command = FollowerCommand{};
-  if (!measured.position.allFinite() || !measured.velocity.allFinite()) return common::StepStatus::rejected_nonfinite;
+common::TrajectoryFeedback TrajectoryFollower::law(std::size_t k) const noexcept {
   const std::size_t i = std::min(k, samples_.size() - 1);
   const Sample& s = samples_[i];
   const Eigen::MatrixXd& K = gains_[i];
   const int c = static_cast<int>(slots_.size());
-  double u[2] = {s.input[0] + s.friction[0], s.input[1] + s.friction[1]};
+  common::TrajectoryFeedback law;
+  for (int slot = 0; slot < 4; ++slot) {
+    law.position[static_cast<std::size_t>(slot)] = s.state.position[slot];
+    law.velocity[static_cast<std::size_t>(slot)] = s.state.velocity[slot];
+  }
+  law.feedforward = {s.input[0] + s.friction[0], s.input[1] + s.friction[1]};
   for (int r = 0; r < K.rows(); ++r) {
-    double feedback = 0.0;
     for (int j = 0; j < c; ++j) {
-      const int slot = slots_[j];
-      feedback += K(r, j) * (measured.position[slot] - s.state.position[slot]);
-      feedback += K(r, c + j) * (measured.velocity[slot] - s.state.velocity[slot]);
+      const auto slot = static_cast<std::size_t>(slots_[static_cast<std::size_t>(j)]);
+      law.gain[static_cast<std::size_t>(r) * 8 + slot] = K(r, j);
+      law.gain[static_cast<std::size_t>(r) * 8 + 4 + slot] = K(r, c + j);
     }
-    u[r] = std::clamp(u[r] - feedback, -voltage_limit_, voltage_limit_);
   }
-  if (!std::isfinite(u[0]) || !std::isfinite(u[1])) {
-    command = FollowerCommand{};
-    return common::StepStatus::rejected_nonfinite;
+  law.sliding_friction_reduction = 1.0 - (moving(k) ? trajectory_sliding_friction_scale_ : sliding_friction_scale_);
+  return law;
+}
+
+const TrajectoryNode& TrajectoryFollower::node(std::size_t k) const noexcept {
+  return samples_[std::min(k, samples_.size() - 1)].node;
+}
+
+common::StepStatus TrajectoryFollower::step(std::size_t k, const plant::ModelState& measured,
+                                            FollowerCommand& command) const noexcept {
+  command = FollowerCommand{};
+  if (!measured.position.allFinite() || !measured.velocity.allFinite()) return common::StepStatus::rejected_nonfinite;
+  std::array<double, 4> position{}, velocity{};
+  for (int slot = 0; slot < 4; ++slot) {
+    position[static_cast<std::size_t>(slot)] = measured.position[slot];
+    velocity[static_cast<std::size_t>(slot)] = measured.velocity[slot];
   }
+  const common::TrajectoryFeedback feedback = law(k);
+  const std::array<double, 2> u = tracking::trajectory_feedback_voltages(feedback, position, velocity, voltage_limit_);
+  if (!std::isfinite(u[0]) || !std::isfinite(u[1])) return common::StepStatus::rejected_nonfinite;
   command.trolley_voltage = u[0];
   command.second_voltage = second_drive_ ? u[1] : 0.0;
-  const TrajectoryNode& n = s.node;
-  const bool moving = i + 1 < samples_.size();
-  command.sliding_friction_scale = moving ? trajectory_sliding_friction_scale_ : sliding_friction_scale_;
+  const TrajectoryNode& n = node(k);
+  const bool in_move = moving(k);
+  command.sliding_friction_scale = 1.0 - feedback.sliding_friction_reduction;
   command.hoist_speed = n.cable_length_rate;
-  command.trolley = {n.state.position[kTrolleyIndex], n.state.velocity[kTrolleyIndex], moving ? n.trolley_acceleration : 0.0};
-  command.second = {n.state.position[kSlewIndex], n.state.velocity[kSlewIndex], moving ? n.second_acceleration : 0.0};
-  command.cable = {n.cable_length, n.cable_length_rate, moving ? n.hoist_acceleration : 0.0};
+  command.trolley = {n.state.position[kTrolleyIndex], n.state.velocity[kTrolleyIndex], in_move ? n.trolley_acceleration : 0.0};
+  command.second = {n.state.position[kSlewIndex], n.state.velocity[kSlewIndex], in_move ? n.second_acceleration : 0.0};
+  command.cable = {n.cable_length, n.cable_length_rate, in_move ? n.hoist_acceleration : 0.0};
   command.swing_in_plane = n.state.position[kInPlaneSwingIndex];
   command.swing_out_of_plane = n.state.position[kOutOfPlaneSwingIndex];
   return common::StepStatus::ok;

@@ -14,37 +14,10 @@
 #include "crane/state_estimator/state_estimator_stage.hpp"
 #include "crane/supervisor/actuation_gate.hpp"
 #include "crane/supervisor/supervisor_stage.hpp"
+#include "crane/tracking/tracking_stage.hpp"
 
 namespace crane::stack {
 namespace {
-
-// The follower's hold (FollowerHold::sliding_friction_scale): the friction compensation's part on a
-// drive that slides (outside its zero-velocity band, on the velocity the compensation uses) scaled
-// by `scale`, the stiction part on a drive at rest left whole; the drive voltage is then (3.5) again.
-void scale_sliding_friction(const friction_compensation::FrictionCompensationParams& params,
-                            const protocol::CraneState& estimate, const protocol::LinearCommand& linear, double scale,
-                            double voltage_limit, protocol::ActuatorCommand& actuators) {
-  const auto slides = [](const friction_compensation::AxisCompensationParams& axis, double raw, double filtered) {
-    const double v = axis.velocity_source == friction_compensation::VelocitySource::raw ? raw : filtered;
-    return friction_compensation::friction_direction(v, axis.zero_velocity_band) != 0;
-  };
-  if (slides(params.trolley, estimate.trolley_velocity_raw, estimate.trolley_velocity)) {
-    actuators.trolley_friction_voltage *= scale;
-    actuators.trolley_voltage =
-        std::clamp(linear.trolley_voltage + actuators.trolley_friction_voltage, -voltage_limit, voltage_limit);
-  }
-  if (slides(params.slew, estimate.slew_rate_raw, estimate.slew_rate)) {
-    actuators.slew_friction_voltage *= scale;
-    actuators.slew_voltage =
-        std::clamp(linear.slew_voltage + actuators.slew_friction_voltage, -voltage_limit, voltage_limit);
-  }
-  // The overhead crane's bridge has its own parameters (friction_compensation.bridge).
-  if (params.bridge && slides(*params.bridge, estimate.bridge_velocity_raw, estimate.bridge_velocity)) {
-    actuators.bridge_friction_voltage *= scale;
-    actuators.bridge_voltage =
-        std::clamp(linear.bridge_voltage + actuators.bridge_friction_voltage, -voltage_limit, voltage_limit);
-  }
-}
 
 }  // namespace
 
@@ -81,6 +54,10 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   plant_options.initial_bridge_position = m.initial_bridge_position;
   plant::PlantStage plant(plant_stage_params(cfg, plant_options));
   state_estimator::StateEstimatorStage estimator(cfg.state_estimator);
+  auto tracking_params = cfg.tracking;
+  tracking_params.law = tracking::TrackingLaw::follower;
+  tracking::TrackingStage tracking(tracking_params);
+  const protocol::AntiSwingCommand no_anti_swing{};
   auto compensation_params = cfg.friction_compensation;
   if (!run.friction_compensation) compensation_params.enabled = false;
   const friction_compensation::FrictionCompensationStage compensation(compensation_params);
@@ -105,50 +82,30 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
     if (estimator.step(sensors, estimate) != common::StepStatus::ok) {
       throw std::runtime_error("follower run: the estimator refused the sensor sample of cycle " + std::to_string(k));
     }
-    // The follower: the trajectory's first sample (rest at the start) until the move starts.
+    // The follower's law, carried by the reference from the trajectory's first sample (rest at the
+    // start) on, and applied by the tracking stage's `follower` law; 0 V until the move starts.
     const std::size_t i = k < kMoveStartCycle ? 0 : static_cast<std::size_t>(k - kMoveStartCycle);
-    plant::ModelState measured;
-    measured.position << estimate.trolley_position, estimate.swing_in_plane,
-        bridge ? estimate.bridge_position : slews ? estimate.slew_angle : 0.0, estimate.swing_out_of_plane;
-    measured.velocity << estimate.trolley_velocity, estimate.swing_in_plane_rate,
-        bridge ? estimate.bridge_velocity : slews ? estimate.slew_rate : 0.0, estimate.swing_out_of_plane_rate;
-    optimal_control::FollowerCommand command;
-    (void)follower.step(i, measured, command);  // 0 V on a refusal, as a stage would
-    if (k < kMoveStartCycle) command.trolley_voltage = command.second_voltage = command.hoist_speed = 0.0;
-    linear = protocol::LinearCommand{};
-    linear.trolley_voltage = command.trolley_voltage;
-    linear.slew_voltage = slews ? command.second_voltage : 0.0;
-    linear.bridge_voltage = bridge ? command.second_voltage : 0.0;
-    linear.hoist_speed = command.hoist_speed;
-    common::same_cycle(estimate.header, linear.header);
+    const optimal_control::TrajectoryNode& node = follower.node(i);
+    const bool moving = follower.moving(i);
     reference = protocol::Reference{};
     reference.request_id = 1;
-    reference.phase = k < kMoveStartCycle              ? protocol::Reference::PHASE_HOLDING
-                      : i < follower.samples()         ? protocol::Reference::PHASE_MOVING
-                                                       : protocol::Reference::PHASE_ARRIVED;
-    reference.trolley_position = command.trolley.position;
-    reference.trolley_velocity = command.trolley.velocity;
-    reference.trolley_acceleration = command.trolley.acceleration;
-    if (bridge) {
-      reference.bridge_position = command.second.position;
-      reference.bridge_velocity = command.second.velocity;
-      reference.bridge_acceleration = command.second.acceleration;
-    } else {
-      reference.slew_angle = command.second.position;
-      reference.slew_rate = command.second.velocity;
-      reference.slew_acceleration = command.second.acceleration;
-    }
-    reference.cable_length = command.cable.position;
-    reference.cable_length_rate = command.cable.velocity;
-    reference.cable_length_acceleration = command.cable.acceleration;
+    reference.phase = k < kMoveStartCycle ? protocol::Reference::PHASE_HOLDING
+                      : moving            ? protocol::Reference::PHASE_MOVING
+                                          : protocol::Reference::PHASE_ARRIVED;
+    common::set_trajectory_feedback(follower.law(i), bridge, reference);
+    reference.trolley_acceleration = moving ? node.trolley_acceleration : 0.0;
+    (bridge ? reference.bridge_acceleration : reference.slew_acceleration) = moving ? node.second_acceleration : 0.0;
+    reference.cable_length = node.cable_length;
+    reference.cable_length_rate = node.cable_length_rate;
+    reference.cable_length_acceleration = moving ? node.hoist_acceleration : 0.0;
     reference.time_in_move = k < kMoveStartCycle ? 0.0 : static_cast<double>(i) * dt;
     reference.move_duration = result.bound.duration;
     common::same_cycle(estimate.header, reference.header);
-    (void)compensation.step(estimate, linear, actuators);
-    if (command.sliding_friction_scale != 1.0) {
-      scale_sliding_friction(compensation_params, estimate, linear, command.sliding_friction_scale,
-                             cfg.facts.voltage_limit, actuators);
+    (void)tracking.step(estimate, reference, no_anti_swing, linear);  // 0 V on a refusal
+    if (k < kMoveStartCycle) {
+      linear.trolley_voltage = linear.slew_voltage = linear.bridge_voltage = linear.hoist_speed = 0.0;
     }
+    (void)compensation.step(estimate, linear, actuators);
     observed.sensors = &sensors;
     observed.actuators = &actuators;
     observed.reference = &reference;

@@ -7,11 +7,13 @@
 #include "crane/common/protocol_signals.hpp"
 #include "crane/common/validation.hpp"
 #include "crane/config/yaml_section.hpp"
+#include "crane/tracking/trajectory_feedback.hpp"
 
 namespace crane::tracking {
 
 namespace {
-constexpr std::array<std::string_view, 3> kLawNames{"tracking", "gain_scheduling_partial", "gain_scheduling_full"};
+constexpr std::array<std::string_view, 4> kLawNames{"tracking", "gain_scheduling_partial", "gain_scheduling_full",
+                                                   "follower"};
 }
 
 std::string_view law_name(TrackingLaw law) noexcept { return kLawNames[static_cast<std::size_t>(law)]; }
@@ -72,11 +74,12 @@ TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts
 TrackingStage::TrackingStage(const TrackingStageParams& params)
     : law_(params.law),
       tracking_(params.tracking),
+      voltage_limit_(params.tracking.voltage_limit),
       trolley_drive_mass_(params.trolley_drive_mass),
       jib_inertia_(params.jib_inertia) {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
   common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
-  if (law_ != TrackingLaw::tracking) {
+  if (law_ == TrackingLaw::gain_scheduling_partial || law_ == TrackingLaw::gain_scheduling_full) {
     auto p = params.gain_scheduling;
     p.kind = law_ == TrackingLaw::gain_scheduling_full ? gain_scheduling::FeedbackKind::full
                                                         : gain_scheduling::FeedbackKind::partial;
@@ -84,7 +87,7 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
   }
   if (params.bridge) {
     TrackingStageParams bridge = *params.bridge;
-    bridge.law = law_;
+    bridge.law = law_ == TrackingLaw::follower ? TrackingLaw::tracking : law_;  // follow() drives the bridge
     bridge.bridge.reset();
     bridge_ = std::make_unique<TrackingStage>(bridge);
   }
@@ -93,6 +96,7 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
 common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, const protocol::Reference& reference,
                                        const protocol::AntiSwingCommand& anti_swing,
                                        protocol::LinearCommand& command) noexcept {
+  if (law_ == TrackingLaw::follower && reference.feedback_law) return follow(estimate, reference, command);
   TrackingInput in;
   in.estimate = common::to_estimate(estimate);
   in.reference = common::to_reference(reference);
@@ -139,6 +143,31 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   }
   common::same_cycle(estimate.header, command.header);
   return status;
+}
+
+common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
+                                         protocol::LinearCommand& command) const noexcept {
+  const bool bridge = bridge_ != nullptr;
+  const std::array<double, 4> position{estimate.trolley_position, estimate.swing_in_plane,
+                                       bridge ? estimate.bridge_position : estimate.slew_angle,
+                                       estimate.swing_out_of_plane};
+  const std::array<double, 4> velocity{estimate.trolley_velocity, estimate.swing_in_plane_rate,
+                                       bridge ? estimate.bridge_velocity : estimate.slew_rate,
+                                       estimate.swing_out_of_plane_rate};
+  const std::array<double, 2> u =
+      trajectory_feedback_voltages(common::to_trajectory_feedback(reference, bridge), position, velocity, voltage_limit_);
+  command = protocol::LinearCommand{};
+  common::same_cycle(estimate.header, command.header);
+  const double reduction = reference.sliding_friction_reduction;
+  if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(reference.cable_length_rate) ||
+      !(reduction >= 0.0 && reduction <= 1.0)) {
+    return common::StepStatus::rejected_nonfinite;  // 0 V, the safe output
+  }
+  command.trolley_voltage = u[0];
+  (bridge ? command.bridge_voltage : command.slew_voltage) = u[1];
+  command.hoist_speed = reference.cable_length_rate;
+  command.sliding_friction_reduction = reduction;
+  return common::StepStatus::ok;
 }
 
 }  // namespace crane::tracking

@@ -4,6 +4,8 @@
 // theta out-of-plane swing, L cable length. Tower sign convention: the load sits at
 // x - L cos(theta) sin(phi) along the jib.
 
+#include <array>
+
 namespace crane::common {
 
 /// What the sensors give each cycle, in SI units (already converted from counts).
@@ -44,6 +46,20 @@ struct MotionReference {
   AxisReference trolley;
   AxisReference slew;
   AxisReference cable_length;
+};
+
+/// The feedback law of one cycle of a trajectory that carries one (the minimum-time follower,
+/// optimal_control/trajectory_follower.hpp; Reference.feedback_law on the wire): per drive r,
+///   u_r = feedforward[r] - sum_j (gain[r][j] (position_j - reference_position_j)
+///                               + gain[r][4 + j] (velocity_j - reference_velocity_j)),
+/// j over the model's coordinate slots 0..3 (trolley, in-plane swing, the second axis: the slew or
+/// the bridge, out-of-plane swing; crane_dynamics.hpp), u before the friction the compensation adds.
+struct TrajectoryFeedback {
+  std::array<double, 4> position{};   // [m, rad, rad or m, rad] z_ref, the positions
+  std::array<double, 4> velocity{};   // [m/s, rad/s, rad/s or m/s, rad/s]
+  std::array<double, 2> feedforward{};  // [V] trolley, second axis
+  std::array<double, 16> gain{};      // row-major 2 x 8 [V/m, V/rad; V s/m, V s/rad]; 0 where an axis is absent
+  double sliding_friction_reduction{0.0};  // [-] in [0, 1]: of the compensation's sliding part, left out
 };
 
 /// The load as the controllers' model sees it, (2.25): m_t = m/M [-] and m_r = m/J_o [1/m^2]. The

@@ -100,6 +100,37 @@ inline void from_reference(const MotionReference& m, protocol::Reference& r) noe
   r.cable_length_acceleration = m.cable_length.acceleration;
 }
 
+// The feedback law a reference carries (Reference.feedback_law; common::TrajectoryFeedback): the
+// second axis of z is the bridge on an overhead crane (`bridge`), the slew elsewhere; z_ref's drive
+// axes are the reference's own positions and velocities.
+[[nodiscard]] inline TrajectoryFeedback to_trajectory_feedback(const protocol::Reference& r, bool bridge) noexcept {
+  TrajectoryFeedback f;
+  f.position = {r.trolley_position, r.swing_in_plane, bridge ? r.bridge_position : r.slew_angle, r.swing_out_of_plane};
+  f.velocity = {r.trolley_velocity, r.swing_in_plane_rate, bridge ? r.bridge_velocity : r.slew_rate,
+                r.swing_out_of_plane_rate};
+  f.feedforward = {r.trolley_feedforward_voltage, r.second_feedforward_voltage};
+  for (std::size_t i = 0; i < f.gain.size(); ++i) f.gain[i] = r.feedback_gain[i];
+  f.sliding_friction_reduction = r.sliding_friction_reduction;
+  return f;
+}
+
+/// Sets `r`'s feedback law (feedback_law TRUE) and its drive axes' positions and velocities from `f`.
+inline void set_trajectory_feedback(const TrajectoryFeedback& f, bool bridge, protocol::Reference& r) noexcept {
+  r.feedback_law = true;
+  r.trolley_position = f.position[0];
+  r.trolley_velocity = f.velocity[0];
+  r.swing_in_plane = f.position[1];
+  r.swing_in_plane_rate = f.velocity[1];
+  (bridge ? r.bridge_position : r.slew_angle) = f.position[2];
+  (bridge ? r.bridge_velocity : r.slew_rate) = f.velocity[2];
+  r.swing_out_of_plane = f.position[3];
+  r.swing_out_of_plane_rate = f.velocity[3];
+  r.trolley_feedforward_voltage = f.feedforward[0];
+  r.second_feedforward_voltage = f.feedforward[1];
+  for (std::size_t i = 0; i < f.gain.size(); ++i) r.feedback_gain[i] = f.gain[i];
+  r.sliding_friction_reduction = f.sliding_friction_reduction;
+}
+
 // The overhead crane's bridge, seen as the trolley of a gantry crane: how every controller stage
 // runs the bridge axis with its trolley law and the bridge's parameters (common::bridge_as_trolley,
 // which gives the reason). trolley_* := bridge_*, swing_in_plane := -swing_out_of_plane (theta moves

@@ -53,6 +53,11 @@ struct FrictionCompensationInput {
   // the configured one.
   std::optional<common::AxisFriction> trolley_friction;
   std::optional<common::AxisFriction> slew_friction;
+  // [-] in [0, 1]: the fraction of the sliding part ((3.1), (3.3): outside the zero-velocity band)
+  // left out on every axis this cycle, the stiction part (3.2) kept whole (LinearCommand's, asked by
+  // the minimum-time follower, whose feedforward carries the rest; optimal_control/
+  // trajectory_follower.hpp). 0 keeps the compensation as configured.
+  double sliding_friction_reduction{0.0};
 };
 
 struct FrictionCompensationOutput {
@@ -89,7 +94,8 @@ class FrictionCompensation {
   /// unknown velocity source.
   explicit FrictionCompensation(const FrictionCompensationParams& params);
 
-  /// rejected_nonfinite if a used input is NaN/Inf, or finite inputs overflow the friction voltage
+  /// rejected_nonfinite if a used input is NaN/Inf or sliding_friction_reduction is outside [0, 1],
+  /// or finite inputs overflow the friction voltage
   /// (an absurd online coefficient times an absurd rate): output set to zero voltages and hoist speed.
   [[nodiscard]] common::StepStatus step(const FrictionCompensationInput& input,
                                         FrictionCompensationOutput& output) const noexcept;

@@ -29,7 +29,8 @@
 // The hoist is not a feedback axis: hoist_speed is the trajectory's cable-length rate.
 //
 // The command asks the friction compensation for a fraction of its sliding part
-// (FollowerCommand::sliding_friction_scale; stack::run_follower applies it): s along the
+// (FollowerCommand::sliding_friction_scale; on the wire 1 - it, LinearCommand_.sliding_friction_reduction,
+// which the friction compensation stage applies): s along the
 // trajectory, where its other part is fed forward (compensated on the measured speed alone, a
 // friction 30 % below the model's drove the trolley past its overspeed on random moves), and the
 // hold's after it. After the trajectory (FollowerHold) the stationary gain comes from the hold's
@@ -113,6 +114,15 @@ class TrajectoryFollower {
   [[nodiscard]] common::StepStatus step(std::size_t k, const plant::ModelState& measured,
                                         FollowerCommand& command) const noexcept;
 
+  /// The law of cycle `k` (beyond the trajectory: the hold at the target), as the reference carries
+  /// it to the tracking stage's `follower` law (Reference.feedback_law): z_ref in the model's slots,
+  /// the feedforward with the friction fed forward, the gain, and the sliding friction left out
+  /// (1 - the scale of FollowerParams or FollowerHold). step() is this law applied.
+  [[nodiscard]] common::TrajectoryFeedback law(std::size_t k) const noexcept;
+  /// The trajectory's node at cycle `k` (clamped to its end).
+  [[nodiscard]] const TrajectoryNode& node(std::size_t k) const noexcept;
+  /// True while cycle `k` is on the trajectory (before its end).
+  [[nodiscard]] bool moving(std::size_t k) const noexcept { return k + 1 < samples_.size(); }
   /// Samples of the trajectory (the last is its end, t >= T*).
   [[nodiscard]] std::size_t samples() const noexcept { return gains_.size() - 1; }
   /// The gain of sample k (clamped to the stationary one), rows: inputs, columns: the state z.

@@ -3,15 +3,18 @@
 // trajectory_follower.hpp; issue 32, item 2; docs/optimal_control.md), in one process, on the
 // stack's own stage objects where the follower does not replace them:
 //
-//   cycle k:  plant.sample() -> state estimator -> the follower (in place of the planner, the
-//             anti-swing law and tracking) -> friction compensation -> actuators(k)
-//             -> supervisor(k) -> plant.step(actuators(k), gated by status(k - 1))
+//   cycle k:  plant.sample() -> state estimator -> the reference with the follower's law of
+//             cycle k (TrajectoryFollower::law, in place of the planner's; no anti-swing stage)
+//             -> tracking (law `follower`) -> friction compensation (the law's sliding friction
+//             reduction) -> actuators(k) -> supervisor(k) -> plant.step(actuators(k), gated by
+//             status(k - 1))
 //
 // in the order and with the gating of the in-process stack (in_process_stack.hpp); the move starts
 // at kMoveStartCycle like the demo's. The bound is solved on the controllers' model (the configured
 // crane, rigid: crane:, no hook or rope) with the limits of stack::bound_problem; the plant is the
 // configured one with `mismatch` applied, so the follower is measured against a crane it does not
-// know exactly. It is not yet a stage of the DDS stack (docs/optimal_control.md says what remains).
+// know exactly. The DDS stack cannot run it yet: the planner does not solve the bound
+// (docs/optimal_control.md, "The law on the wire", says what remains).
 //
 // Errors: common::ConfigError for invalid params (the bound's, the follower's); std::runtime_error
 // when the bound is not solved or the estimator refuses a sample.

@@ -8,6 +8,12 @@
 //                            reference position and velocity first
 //   gain_scheduling_partial  gain-scheduling state feedback (3.19) on the reference position
 //   gain_scheduling_full     gain-scheduling state feedback (3.26) on the reference position
+//   follower                 the feedback law the reference carries (Reference.feedback_law: the
+//                            minimum-time follower's feedforward and time-varying LQR gains,
+//                            trajectory_feedback.hpp; docs/optimal_control.md), the hoist at the
+//                            reference's cable rate and the reference's sliding friction reduction
+//                            passed on to the friction compensation; a reference without a law
+//                            (holding, a stop, manual motion) is tracked by `tracking`
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
 // Every law takes the load (m_t, m_r of (3.37)-(3.38) and the gain schedule) from the estimate's
@@ -30,8 +36,8 @@ class YamlSection;
 
 namespace crane::tracking {
 
-enum class TrackingLaw : std::uint8_t { tracking, gain_scheduling_partial, gain_scheduling_full };
-/// "tracking" | "gain_scheduling_partial" | "gain_scheduling_full".
+enum class TrackingLaw : std::uint8_t { tracking, gain_scheduling_partial, gain_scheduling_full, follower };
+/// "tracking" | "gain_scheduling_partial" | "gain_scheduling_full" | "follower".
 [[nodiscard]] std::string_view law_name(TrackingLaw law) noexcept;
 /// The law named `name`; throws common::ConfigError naming `field`, the value and the choices.
 [[nodiscard]] TrackingLaw law_from_name(std::string_view name, std::string_view field = "tracking law");
@@ -68,8 +74,13 @@ class TrackingStage {
   [[nodiscard]] TrackingLaw law() const noexcept { return law_; }
 
  private:
+  /// The follower law on a reference that carries one.
+  [[nodiscard]] common::StepStatus follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
+                                          protocol::LinearCommand& command) const noexcept;
+
   TrackingLaw law_;
   TrackingController tracking_;
+  double voltage_limit_;
   std::optional<gain_scheduling::GainSchedulingController> scheduled_;
   double trolley_drive_mass_;  // [kg]
   double jib_inertia_;         // [kg m^2]
