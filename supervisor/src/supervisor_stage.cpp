@@ -135,6 +135,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   status.last_request_result = last_request_result_;
   status.operating_mode = out.operating_mode;
   status.zones_enabled = out.zones_enabled;
+  status.max_swing = core_.params().max_swing;
 }
 
 }  // namespace crane::supervisor

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <string>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "crane/config/yaml_section.hpp"
 #include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
+#include "crane/trajectory_planner/planned_path.hpp"
 #include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 
 namespace {
@@ -97,6 +99,242 @@ TEST(PlannerStage, AMoveReportsWaitingMovingEveryTenCyclesAndArrived) {
   EXPECT_GT(feedback.back().move_duration, 0.5);
   // The distance to go shrinks as the move goes.
   EXPECT_NEAR(feedback[1].trolley_to_go, 0.30, 1e-3);
+}
+
+// The minimum-time profile (PROFILE_MINIMUM_TIME, planned_path.hpp): a path handed over by the
+// caller (here a synthetic one: the trolley 0.25 -> 0.35 m in 10 cycles, each sample's law marked by
+// its feedforward = 100 + k) runs sample by sample, the reference carrying each cycle's law and then
+// the hold at the end; without a plan the goal runs the time-optimal profile.
+std::shared_ptr<const trajectory_planner::PlannedPath> synthetic_path() {
+  auto path = std::make_shared<trajectory_planner::PlannedPath>();
+  constexpr std::size_t n = 11;
+  path->sample_period = 0.01;
+  path->minimum_time = 0.095;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double x = 0.25 + 0.01 * static_cast<double>(k);
+    const double v = k + 1 < n ? 1.0 : 0.0;
+    path->trolley.push_back({x, v, 0.0});
+    path->slew.push_back({});
+    path->cable.push_back({1.0, 0.0, 0.0});
+    common::TrajectoryFeedback law;
+    law.position = {x, 0.001 * static_cast<double>(k), 0.0, 0.0};
+    law.velocity = {v, 0.0, 0.0, 0.0};
+    law.feedforward = {100.0 + static_cast<double>(k), 0.0};
+    law.gain[0] = 30.0;
+    law.sliding_friction_reduction = k + 1 < n ? 0.5 : 0.25;
+    path->laws.push_back(law);
+  }
+  return path;
+}
+
+Request minimum_time_goal(std::uint32_t id, double target, std::uint64_t start = 0) {
+  Request r = trolley_goal(id, target, start);
+  r.profile = Request::PROFILE_MINIMUM_TIME;
+  return r;
+}
+
+protocol::SupervisorStatus with_sway_limit(std::uint64_t seq) {
+  protocol::SupervisorStatus st;
+  st.header.seq = seq;
+  st.mode = protocol::SupervisorStatus::MODE_OPERATING;
+  st.operating_mode = protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC;
+  st.max_swing = 0.6;
+  return st;
+}
+
+// A planner that has heard the supervisor's sway limit, stepped at rest one cycle at a time.
+struct HeardPlanner {
+  trajectory_planner::TrajectoryPlannerStage stage = lab_planner();
+  protocol::Reference reference;
+  protocol::SupervisorStatus status = with_sway_limit(0);
+  void step(std::uint64_t k, std::span<const Request> goals = {}) {
+    const auto state = at_rest(k);
+    EXPECT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, goals, {}, &status}, reference), common::StepStatus::ok);
+  }
+};
+
+TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
+  HeardPlanner p;
+  auto& stage = p.stage;
+  auto& reference = p.reference;
+  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  step(0);
+  const Request goal = minimum_time_goal(3, 0.35);
+  step(1, std::span(&goal, 1));
+  ASSERT_TRUE(stage.plan_request().has_value());
+  const auto& request = *stage.plan_request();
+  EXPECT_EQ(request.request_id, 3U);
+  EXPECT_EQ(request.trolley_from, 0.25);
+  EXPECT_EQ(request.trolley_target, 0.35);
+  EXPECT_EQ(request.max_swing, 0.6);
+  EXPECT_EQ(request.trolley_limits.max_velocity, 0.4982);  // the planner's rated speed: the request gave 0
+  ASSERT_FALSE(stage.move_statuses().empty());
+  EXPECT_EQ(stage.move_statuses().back().result, Feedback::RESULT_WAITING);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
+  EXPECT_FALSE(reference.feedback_law);
+  step(2);  // no plan yet: it holds
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
+  stage.provide_plan(99, synthetic_path());  // another id: ignored
+  step(3);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
+  stage.provide_plan(3, synthetic_path());
+  for (std::uint64_t k = 4; k <= 13; ++k) {
+    step(k);
+    const double sample = static_cast<double>(k - 3);  // the first cycle of a move is at t = T_s
+    ASSERT_TRUE(reference.feedback_law) << k;
+    EXPECT_EQ(reference.request_id, 3U);
+    EXPECT_EQ(reference.trolley_feedforward_voltage, 100.0 + sample) << k;
+    EXPECT_NEAR(reference.trolley_position, 0.25 + 0.01 * sample, 1e-12) << k;
+    EXPECT_NEAR(reference.swing_in_plane, 0.001 * sample, 1e-12) << k;
+    EXPECT_EQ(reference.feedback_gain[0], 30.0);
+    EXPECT_EQ(reference.move_duration, 0.095);  // T*
+  }
+  EXPECT_EQ(reference.sliding_friction_reduction, 0.25);  // the last sample: the hold's law
+  step(14);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_ARRIVED);
+  EXPECT_TRUE(reference.feedback_law);  // the hold at the target goes on
+  EXPECT_EQ(reference.trolley_feedforward_voltage, 110.0);
+  EXPECT_EQ(stage.unsolved_plans(), 0U);
+
+  // A new trapezoid goal replaces the plan: no law on its reference.
+  const Request next = trolley_goal(4, 0.5);
+  step(15, std::span(&next, 1));
+  EXPECT_FALSE(reference.feedback_law);
+  EXPECT_EQ(reference.sliding_friction_reduction, 0.0);
+  EXPECT_EQ(reference.feedback_gain[0], 0.0);
+}
+
+TEST(PlannerStage, AMinimumTimeGoalWithoutAPlanRunsTheTimeOptimalProfile) {
+  HeardPlanner p;
+  auto& stage = p.stage;
+  auto& reference = p.reference;
+  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  step(0);
+  const Request goal = minimum_time_goal(5, 0.55);
+  step(1, std::span(&goal, 1));
+  stage.provide_plan(5, nullptr);  // not solved
+  step(2);
+  EXPECT_EQ(stage.unsolved_plans(), 1U);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+  EXPECT_FALSE(reference.feedback_law);
+  // The time-optimal profile's duration for 0.3 m at the rated limits.
+  auto time_optimal = lab_planner();
+  protocol::Reference expected;
+  Request same = goal;
+  same.profile = Request::PROFILE_TIME_OPTIMAL;
+  (void)time_optimal.step(at_rest(0), {}, expected);
+  (void)time_optimal.step(at_rest(1), std::span(&same, 1), expected);
+  EXPECT_EQ(reference.move_duration, expected.move_duration);
+
+  // With no supervisor status heard (no sway limit), the goal runs the time-optimal profile at once.
+  auto unheard = lab_planner();
+  (void)unheard.step(at_rest(0), {}, reference);
+  const Request other = minimum_time_goal(6, 0.55);
+  (void)unheard.step(at_rest(1), std::span(&other, 1), reference);
+  EXPECT_FALSE(unheard.plan_request().has_value());
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+}
+
+TEST(PlannerStage, AMinimumTimeGoalWaitingForItsCycleIsPlannedAheadAndStartsOnTime) {
+  HeardPlanner p;
+  auto& stage = p.stage;
+  auto& reference = p.reference;
+  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  step(0);
+  const Request goal = minimum_time_goal(8, 0.35, 20);
+  step(1, std::span(&goal, 1));
+  ASSERT_TRUE(stage.plan_request().has_value());  // asked at once, while it waits
+  stage.provide_plan(8, synthetic_path());
+  for (std::uint64_t k = 2; k < 20; ++k) {
+    step(k);
+    EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING) << k;
+  }
+  step(20);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+  EXPECT_TRUE(reference.feedback_law);
+  EXPECT_EQ(reference.trolley_feedforward_voltage, 101.0);
+
+  // A stop while it runs: the law is dropped, the speed reference stops the crane.
+  Request stop;
+  stop.request_id = 9;
+  stop.command = Request::COMMAND_STOP;
+  step(21, std::span(&stop, 1));
+  EXPECT_FALSE(reference.feedback_law);
+  EXPECT_EQ(reference.request_id, 9U);
+
+  // A newer goal replaces one that waits for its plan: reported aborted (replaced).
+  const Request waiting = minimum_time_goal(10, 0.6);
+  for (std::uint64_t k = 22; k < 400; ++k) step(k);  // the stop comes to rest
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
+  step(400, std::span(&waiting, 1));
+  ASSERT_TRUE(stage.plan_request().has_value());
+  const Request newer = trolley_goal(11, 0.3);
+  step(401, std::span(&newer, 1));
+  EXPECT_FALSE(stage.plan_request().has_value());
+  bool aborted = false;
+  for (const auto& f : stage.move_statuses()) {
+    aborted = aborted || (f.request_id == 10U && f.result == Feedback::RESULT_ABORTED && f.reason == Feedback::REASON_REPLACED);
+  }
+  EXPECT_TRUE(aborted);
+}
+
+// Over DDS the goal can arrive before the planner has heard the supervisor (another vendor's
+// discovery is slower): it is planned as soon as the sway limit is heard, and still starts on time.
+TEST(PlannerStage, AWaitingMinimumTimeGoalIsPlannedOnceTheSwayLimitIsHeard) {
+  auto stage = lab_planner();
+  protocol::Reference reference;
+  const Request goal = minimum_time_goal(4, 0.35, 30);
+  (void)stage.step(at_rest(0), {}, reference);
+  (void)stage.step(at_rest(1), std::span(&goal, 1), reference);  // no status yet
+  EXPECT_FALSE(stage.plan_request().has_value());
+  const auto status = with_sway_limit(5);
+  for (std::uint64_t k = 2; k < 30; ++k) {
+    const auto state = at_rest(k);
+    (void)stage.step(trajectory_planner::PlannerCycle{&state, {}, {}, k >= 5 ? &status : nullptr}, reference);
+    if (k == 4) EXPECT_FALSE(stage.plan_request().has_value());
+    if (k == 5) {
+      ASSERT_TRUE(stage.plan_request().has_value());
+      stage.provide_plan(4, synthetic_path());
+    }
+  }
+  const auto state = at_rest(30);
+  ASSERT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, {}, {}, &status}, reference), common::StepStatus::ok);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+  EXPECT_TRUE(reference.feedback_law);
+}
+
+TEST(PlannedPath, RefusesBadShapesAndClampsItsSamples) {
+  auto good = *synthetic_path();
+  EXPECT_TRUE(good.valid());
+  EXPECT_EQ(good.index(-1.0), 0U);
+  EXPECT_EQ(good.index(0.034), 3U);
+  EXPECT_EQ(good.index(1e300), 10U);
+  EXPECT_NEAR(good.duration(), 0.1, 1e-15);
+  auto shorter = good;
+  shorter.laws.pop_back();
+  EXPECT_FALSE(shorter.valid());
+  auto nan = good;
+  nan.laws[3].gain[5] = std::nan("");
+  EXPECT_FALSE(nan.valid());
+  auto reduction = good;
+  reduction.laws[0].sliding_friction_reduction = 2.0;
+  EXPECT_FALSE(reduction.valid());
+  trajectory_planner::TrajectoryPlanner planner{trajectory_planner::TrajectoryPlannerParams{}};
+  EXPECT_EQ(planner.start_planned(1, nullptr), trajectory_planner::GoalStatus::rejected_nonfinite);
+  EXPECT_EQ(planner.start_planned(1, std::make_shared<const trajectory_planner::PlannedPath>(nan)),
+            trajectory_planner::GoalStatus::rejected_nonfinite);
+  EXPECT_EQ(planner.start_planned(1, std::make_shared<const trajectory_planner::PlannedPath>(good), true),
+            trajectory_planner::GoalStatus::rejected_nonfinite);  // no bridge in it
+  ASSERT_EQ(planner.start_planned(1, std::make_shared<const trajectory_planner::PlannedPath>(good)),
+            trajectory_planner::GoalStatus::accepted);
+  trajectory_planner::PlannerOutput out;
+  ASSERT_EQ(planner.step(0.02, out), common::StepStatus::ok);
+  EXPECT_NEAR(out.reference.trolley.position, 0.27, 1e-12);
+  EXPECT_EQ(out.reference.trolley.velocity, 1.0);
+  for (int i = 0; i < 20; ++i) (void)planner.step(0.01, out);
+  EXPECT_EQ(out.phase, trajectory_planner::MovePhase::arrived);
+  EXPECT_NEAR(out.reference.trolley.position, 0.35, 1e-12);
+  EXPECT_EQ(out.reference.trolley.velocity, 0.0);
 }
 
 // A client that resends a waiting request (it may have missed the first answer: crane_demo's

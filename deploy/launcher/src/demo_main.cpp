@@ -259,7 +259,10 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   const std::uint32_t probe_id = request_id;
   const std::uint32_t move_id = request_id + 1;
   tp::msgs::MoveRequest_ probe;
-  protocol::to_dds(stack::move_request(m, cfg.facts, probe_id, options.profile_code, kNeverCycle), probe);
+  // A trapezoid whatever the run's profile: a minimum-time probe would have the planner solve a bound
+  // for a move that never starts.
+  protocol::to_dds(stack::move_request(m, cfg.facts, probe_id, protocol::MoveRequest::PROFILE_TRAPEZOID, kNeverCycle),
+                   probe);
   auto next_probe = Clock::now();
   const auto plant_pid = result.processes.back().pid;  // the sensor writer (plant or bridge) starts last
   Recording rec;
@@ -458,6 +461,11 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   result.samples = records.size();
   result.csv = csv_path.filename().string();
   result.metrics = stack::evaluate(records, m);
+  if (const auto first = rec.references.find(*start_seq); first != rec.references.end()) {
+    protocol::Reference reference;
+    protocol::from_dds(first->second, reference);
+    result.metrics.minimum_time = stack::minimum_time_of(reference);
+  }
   return result;
 }
 
@@ -508,21 +516,25 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 10.0));
   auto* profile_option =
       app.add_option("--profile", options.profile,
-                     "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal "
-                     "(default trapezoid; step with a gain_scheduling controller)")
-          ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal"}));
+                     "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal | minimum_time "
+                     "(default trapezoid; step with a gain_scheduling controller, minimum_time with the follower)")
+          ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal", "minimum_time"}));
   app.add_option("--controller", options.controller,
                  "controller of the stack: gain_scheduling_partial (3.19) | gain_scheduling_full (3.26) (no "
                  "anti-swing) | none (PD tracking alone) | pd (3.45) | delay1 (3.47) | delay2 (3.50) | fuzzy (anti-swing with PD "
                  "tracking) | auto (per maneuver the best measured with the time-optimal profile: none for a trolley "
                  "move, delay2 when the jib slews, both with acceleration feedforward; the default with "
-                 "--profile time_optimal, else delay1)")
+                 "--profile time_optimal) | follower (the minimum-time bound followed in closed loop, profile "
+                 "minimum_time; the default, delay1 with another --profile)")
       ->check(CLI::IsMember({"gain_scheduling_partial", "gain_scheduling_full", "none", "pd", "delay1", "delay2", "fuzzy",
-                             "auto"}));
+                             "auto", "follower"}));
   CLI11_PARSE(app, argc, argv);
-  if (options.controller.empty()) options.controller = options.profile == "time_optimal" ? "auto" : "delay1";
-  // The dissertation drives the gain-scheduling controller with step references (section 3.2).
-  if (options.controller.rfind("gain_scheduling", 0) == 0 && profile_option->count() == 0) options.profile = "step";
+  if (options.controller.empty()) {
+    options.controller = stack::default_controller(profile_option->count() > 0 ? options.profile : std::string());
+  }
+  if (const auto implied = stack::implied_profile(options.controller); implied && profile_option->count() == 0) {
+    options.profile = std::string(*implied);
+  }
   options.profile_code = stack::profile_code(options.profile);
 
   try {
@@ -616,6 +628,7 @@ int main(int argc, char** argv) {
       j["settle_time_s"] = std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time) : json(nullptr);
       j["settle_time_periods"] =
           std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time / r.swing_period) : json(nullptr);
+      j["minimum_time_s"] = std::isfinite(r.metrics.minimum_time) ? json(r.metrics.minimum_time) : json(nullptr);
       j["final_position_error_m"] = r.metrics.final_position_error;
       j["final_slew_error_rad"] = r.metrics.final_slew_error;
       if (cfg.facts.crane_kind == common::CraneKind::overhead) j["final_bridge_error_m"] = r.metrics.final_bridge_error;

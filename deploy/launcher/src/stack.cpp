@@ -110,6 +110,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       spec.arguments.insert(spec.arguments.end(), {"--clock", is_shm(o.hardware) && o.lockstep ? "board" : "timer"});
       if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
     }
+    if (name == "trajectory_planner" && o.lockstep) spec.arguments.push_back("--lockstep");
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
     if (name == "supervisor") {
       if (o.lockstep) spec.arguments.push_back("--lockstep");

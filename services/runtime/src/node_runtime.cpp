@@ -91,6 +91,13 @@ void leave_realtime() noexcept {
   }
 }
 
+void leave_realtime_this_thread() noexcept {
+  if (sched_getscheduler(0) != SCHED_FIFO) return;
+  sched_param normal{};
+  normal.sched_priority = 0;
+  (void)sched_setscheduler(0, SCHED_OTHER, &normal);  // 0: the calling thread (Linux: per thread)
+}
+
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name) {
   (void)injected_loss();  // a malformed CRANE_INJECT_LOSS is refused here, at start
   if (options.realtime_priority > 0) {

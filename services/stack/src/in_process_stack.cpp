@@ -1,10 +1,12 @@
 #include "crane/stack/in_process_stack.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "crane/anti_swing/anti_swing_stage.hpp"
+#include "crane/common/validation.hpp"
 #include "crane/friction_compensation/friction_compensation_stage.hpp"
 #include "crane/state_estimator/state_estimator_stage.hpp"
 #include "crane/supervisor/actuation_gate.hpp"
@@ -53,6 +55,7 @@ plant::PlantStageParams plant_stage_params(const StackConfig& cfg, const InProce
 struct InProcessStack::Stages {
   Stages(const StackConfig& cfg, const InProcessOptions& o)
       : dt(cfg.facts.sample_period),
+        plan_move(o.plan_move),
         plant(plant_stage_params(cfg, o)),
         estimator(cfg.state_estimator),
         planner(cfg.trajectory_planner, dt),
@@ -66,6 +69,8 @@ struct InProcessStack::Stages {
     plant.sample(next_sensors);
   }
   double dt;
+  MovePlanner plan_move;
+  std::uint32_t planned_request{0};  // the last plan request answered
   plant::PlantStage plant;
   state_estimator::StateEstimatorStage estimator;
   trajectory_planner::TrajectoryPlannerStage planner;
@@ -85,8 +90,25 @@ struct InProcessStack::Stages {
   std::uint64_t plant_step_failures{0};
 };
 
+namespace {
+MovePlanner planner_node_way(const StackConfig& cfg) {
+  return [facts = cfg.facts, params = cfg.trajectory_planner](const trajectory_planner::PlanRequest& request)
+             -> std::shared_ptr<const trajectory_planner::PlannedPath> {
+    try {
+      return optimal_control::plan_minimum_time_move(request, facts, params, optimal_control::MovePlanning{});
+    } catch (const common::ConfigError&) {
+      return nullptr;  // a request the bound cannot take: the time-optimal profile runs
+    }
+  };
+}
+InProcessOptions with_planner(const StackConfig& cfg, InProcessOptions o) {
+  if (!o.plan_move) o.plan_move = planner_node_way(cfg);
+  return o;
+}
+}  // namespace
+
 InProcessStack::InProcessStack(const StackConfig& config, const InProcessOptions& options)
-    : stages_(std::make_unique<Stages>(config, options)) {}
+    : stages_(std::make_unique<Stages>(config, with_planner(config, options))) {}
 InProcessStack::~InProcessStack() = default;
 
 void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::span<const protocol::OperatorSpeed> speeds,
@@ -103,6 +125,12 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
   const trajectory_planner::PlannerCycle cycle{&s.estimate, goals, speeds, previous};
   if (s.planner.step(cycle, s.reference) != common::StepStatus::ok) {
     throw std::runtime_error("in-process run: the planner did not answer cycle " + std::to_string(k));
+  }
+  if (const auto& request = s.planner.plan_request(); request && request->request_id != s.planned_request) {
+    // A minimum-time goal: solved here, in the cycle it arrived (the DDS planner node solves in
+    // lockstep the same way, and on a worker thread in real time); its move starts next cycle.
+    s.planned_request = request->request_id;
+    s.planner.provide_plan(request->request_id, s.plan_move(*request));
   }
   if (s.anti_swing.step(s.estimate, previous, s.action) == common::StepStatus::rejected_nonfinite) {
     throw std::runtime_error("in-process run: the anti-swing law refused the estimate of cycle " + std::to_string(k));
@@ -144,6 +172,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   options.friction_compensation = run.friction_compensation;
   options.controller = run.controller;
   options.mismatch = run.mismatch;
+  options.plan_move = run.plan_move;
   const ManeuverConfig& from = run.first_move ? *run.first_move : m;  // where the crane starts
   options.initial_trolley_position = from.initial_trolley_position;
   options.initial_slew_angle = from.initial_slew_angle;
@@ -187,7 +216,10 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
     }
     start_cycle += k;
   }
-  const std::uint64_t goal_cycle = k;  // the measured move's request arrives at this cycle
+  // The measured move's request arrives at this cycle: after the first move, or at cycle 1, when the
+  // planner has heard the supervisor (its status of cycle 0: the sway limit a minimum-time plan
+  // needs), as over DDS, where it arrives a few cycles after the stack is ready.
+  const std::uint64_t goal_cycle = std::max<std::uint64_t>(k, 1);
   const std::uint32_t request_id = run.first_move ? run.request_id + 1 : run.request_id;  // the planner takes newer ids
   const protocol::MoveRequest goal = move_request(m, cfg.facts, request_id, run.profile, start_cycle);
 
@@ -195,6 +227,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   result.records.reserve(static_cast<std::size_t>(cycles_needed + 1));
   bool started = false;
   std::uint64_t start_seq = 0;
+  double minimum_time = 0.0;
   for (;; ++k) {
     // The goal arrives while the crane rests (over DDS: a few cycles after the stack is ready) and
     // waits in the planner for its start cycle.
@@ -210,6 +243,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
     if (!started && reference.request_id == goal.request_id && reference.phase != protocol::Reference::PHASE_HOLDING) {
       started = true;
       start_seq = k;
+      minimum_time = minimum_time_of(reference);
     }
     if (started) {
       result.records.push_back(record_of(static_cast<double>(k - start_seq) * dt, stack.sensors(), stack.next_sensors(),
@@ -227,6 +261,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   result.integrator_work = stack.plant().simulator().integrator_work();
   if (run.record_plant) result.plant_parameters = stack.plant().simulator().parameters();
   result.metrics = evaluate(result.records, m);
+  result.metrics.minimum_time = minimum_time;
   return result;
 }
 

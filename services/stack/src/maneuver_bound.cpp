@@ -6,49 +6,38 @@
 
 namespace crane::stack {
 
+trajectory_planner::PlanRequest plan_request_of(const StackConfig& cfg, const ManeuverConfig& m) {
+  // The maneuver as the planner stage would ask for it, with the limits of the header: the
+  // maneuver's rated motion capped by the supervisor's overspeed, the hoist by the actuation gate's.
+  const supervisor::SupervisorParams& limits = cfg.supervisor;
+  trajectory_planner::PlanRequest r;
+  r.request_id = 1;
+  r.trolley_from = m.initial_trolley_position;
+  r.trolley_target = m.trolley_target;
+  r.trolley_limits = {std::min(m.trolley_max_velocity, limits.trolley_max_speed), m.trolley_max_acceleration};
+  r.slew_from = m.initial_slew_angle;
+  r.slew_target = m.slew_target;
+  r.slew_limits = {std::min(m.slew_max_velocity, limits.slew_max_rate), m.slew_max_acceleration};
+  r.cable_from = cfg.facts.crane.cable_length;
+  r.cable_target = m.cable_length_target;
+  const trajectory_planner::AxisLimits hoist = trajectory_planner::MoveGoal{}.cable_limits;
+  r.cable_limits = {std::min(hoist.max_velocity, cfg.actuation.hoist_speed_limit), hoist.max_acceleration};
+  r.bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
+  r.bridge_from = m.initial_bridge_position;
+  r.bridge_target = m.bridge_target;
+  r.bridge_limits = {std::min(m.bridge_max_velocity, limits.bridge_max_speed), m.bridge_max_acceleration};
+  r.max_swing = limits.max_swing;
+  return r;
+}
+
 optimal_control::MinimumTimeProblem bound_problem(const StackConfig& config, const ManeuverConfig& maneuver,
                                                   int intervals) {
+  // The planner's mapping (minimum_time_problem), on the plant's model: the configured crane
+  // (plant.crane is crane:) with its hook if enabled.
+  optimal_control::MinimumTimeProblem problem = optimal_control::minimum_time_problem(
+      plan_request_of(config, maneuver), config.facts, config.trajectory_planner, intervals);
   const plant::SimulatorParameters& p = config.plant;
-  const trajectory_planner::TrajectoryPlannerParams& planner = config.trajectory_planner;
-  const supervisor::SupervisorParams& limits = config.supervisor;
-  optimal_control::MinimumTimeProblem problem;
   problem.model = plant::make_crane_dynamics(p.kind, p.crane, p.bridge, p.hook, p.rope);
-  problem.trolley = {maneuver.initial_trolley_position,
-                     maneuver.trolley_target,
-                     planner.trolley_min_position,
-                     planner.trolley_max_position,
-                     std::min(maneuver.trolley_max_velocity, limits.trolley_max_speed),
-                     maneuver.trolley_max_acceleration};
-  problem.trolley_friction = p.crane.trolley_friction;
-  if (p.kind == common::CraneKind::overhead) {
-    problem.second = {maneuver.initial_bridge_position,
-                      maneuver.bridge_target,
-                      planner.bridge_min_position,
-                      planner.bridge_max_position,
-                      std::min(maneuver.bridge_max_velocity, limits.bridge_max_speed),
-                      maneuver.bridge_max_acceleration};
-    problem.second_friction = p.bridge.friction;
-  } else {
-    problem.second = {maneuver.initial_slew_angle,
-                      maneuver.slew_target,
-                      planner.slew_min_angle,
-                      planner.slew_max_angle,
-                      std::min(maneuver.slew_max_velocity, limits.slew_max_rate),
-                      maneuver.slew_max_acceleration};
-    problem.second_friction = p.crane.slew_friction;
-  }
-  const trajectory_planner::AxisLimits hoist = trajectory_planner::MoveGoal{}.cable_limits;
-  // The hoist's speed is also bounded by what the actuation gate accepts (a faster command is
-  // rejected, and three in a row brake the crane).
-  problem.hoist = {p.crane.cable_length,
-                   maneuver.cable_length_target,
-                   planner.cable_min_length,
-                   planner.cable_max_length,
-                   std::min(hoist.max_velocity, config.actuation.hoist_speed_limit),
-                   hoist.max_acceleration};
-  problem.voltage_limit = config.facts.voltage_limit;
-  problem.max_swing = kBoundSwingFraction * limits.max_swing;
-  problem.intervals = intervals;
   return problem;
 }
 

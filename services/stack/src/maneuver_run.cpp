@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <numbers>
 #include <ostream>
@@ -22,6 +23,11 @@ ControllerChoice choose_controller(std::string_view controller, const ManeuverCo
     const bool slews = std::fabs(m.slew_target - m.initial_slew_angle) > 1e-9;
     c.anti_swing = slews ? anti_swing::AntiSwingLaw::delay2 : anti_swing::AntiSwingLaw::none;
     c.acceleration_feedforward = true;
+  } else if (controller == "follower") {
+    // The minimum-time follower: its law travels on the reference (PROFILE_MINIMUM_TIME); no
+    // anti-swing law beside it (a reference without a law is tracked by the PD alone).
+    c.tracking = tracking::TrackingLaw::follower;
+    c.anti_swing = anti_swing::AntiSwingLaw::none;
   } else if (controller.rfind("gain_scheduling", 0) == 0) {
     c.tracking = tracking::law_from_name(controller, "controller");
     c.anti_swing = anti_swing::AntiSwingLaw::none;
@@ -36,6 +42,22 @@ ControllerChoice choose_controller(std::string_view controller, const ManeuverCo
                                                                       : tracking::law_name(c.tracking));
   if (c.acceleration_feedforward) c.label += "+feedforward";
   return c;
+}
+
+double minimum_time_of(const protocol::Reference& first) noexcept {
+  return first.feedback_law ? first.move_duration : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string default_controller(std::string_view profile) {
+  if (profile.empty() || profile == "minimum_time") return "follower";
+  return profile == "time_optimal" ? "auto" : "delay1";
+}
+
+std::optional<std::string_view> implied_profile(std::string_view controller) {
+  // The dissertation drives the gain-scheduling controllers with step references (section 3.2).
+  if (controller.rfind("gain_scheduling", 0) == 0) return "step";
+  if (controller == "follower") return "minimum_time";
+  return std::nullopt;
 }
 
 std::uint8_t profile_code(std::string_view profile) {
@@ -136,11 +158,22 @@ std::string format_number(double v, int precision) {
   return b;
 }
 
+namespace {
+// The columns' widths, in printed_figures' order (the header is the figure's name).
+constexpr int kWidths[] = {9, 7, 6, 8, 10, 11, 10, 12, 8, 13};
+}  // namespace
+
 std::string table_header(bool bridge) {
-  char b[256];
-  std::snprintf(b, sizeof(b), "%-13s %-9s %9s %7s %10s %11s %10s %12s %8s", "maneuver", "friction", "settle_s",
-                "settle_T", "pos_err_mm", "slew_err_mrad", "max_swing_deg", "resid_swing_deg", "max_V");
-  return bridge ? std::string(b) + " bridge_err_mm" : std::string(b);
+  std::string line;
+  char b[64];
+  std::snprintf(b, sizeof(b), "%-13s %-9s", "maneuver", "friction");
+  line = b;
+  const auto figures = printed_figures(ManeuverMetrics{}, 1.0, bridge);
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    std::snprintf(b, sizeof(b), " %*s", kWidths[i], figures[i].name);
+    line += b;
+  }
+  return line;
 }
 
 std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& m, double period, bool bridge) {
@@ -148,6 +181,8 @@ std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& m, double peri
   std::vector<PrintedFigure> f{
       {"settle_s", m.settle_time, 2},
       {"settle_T", m.settle_time / period, 2},
+      {"T*_s", m.minimum_time, 2},
+      {"settle/T*", m.settle_time / m.minimum_time, 2},
       {"pos_err_mm", m.final_position_error * 1e3, 2},
       {"slew_err_mrad", m.final_slew_error * 1e3, 2},
       {"max_swing_deg", m.max_swing * kDegrees, 2},
@@ -161,13 +196,14 @@ std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& m, double peri
 std::string table_row(const std::string& maneuver, bool friction_compensation, const ManeuverMetrics& m,
                       double period, bool bridge) {
   const auto f = printed_figures(m, period, bridge);
-  const auto text = [&](std::size_t i) { return format_number(f[i].value, f[i].decimals); };
-  char b[256];
-  std::snprintf(b, sizeof(b), "%-13s %-9s %9s %7s %10s %11s %10s %12s %8s", maneuver.c_str(),
-                friction_compensation ? "comp_on" : "comp_off", text(0).c_str(), text(1).c_str(), text(2).c_str(),
-                text(3).c_str(), text(4).c_str(), text(5).c_str(), text(6).c_str());
-  if (bridge) return std::string(b) + " " + std::string(13 - std::min<std::size_t>(13, text(7).size()), ' ') + text(7);
-  return b;
+  char b[64];
+  std::snprintf(b, sizeof(b), "%-13s %-9s", maneuver.c_str(), friction_compensation ? "comp_on" : "comp_off");
+  std::string line = b;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    std::snprintf(b, sizeof(b), " %*s", kWidths[i], format_number(f[i].value, f[i].decimals).c_str());
+    line += b;
+  }
+  return line;
 }
 
 }  // namespace crane::stack

@@ -4,12 +4,19 @@
 // time-optimal swing-free profile) -> rt/crane/planner/reference, once per cycle, same seq and
 // origin. Goals are taken only with a new cycle (the stage's rules: trajectory_planner_stage.hpp);
 // their feedback (waiting, rejected with the bound, moving, arrived, aborted) goes to
-// rt/crane/planner/move_status.
+// rt/crane/planner/move_status. A goal with the minimum-time profile is planned here (Planning
+// below: the bound solved by IPOPT and its follower's law, optimal_control/planned_move.hpp) and
+// handed to the stage, whose reference then carries the law of each cycle.
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+#include <future>
 #include <optional>
 #include <vector>
 
+#include "crane/common/validation.hpp"
+#include "crane/optimal_control/planned_move.hpp"
+#include "crane/runtime/node_runtime.hpp"
 #include "crane/runtime/stage_node.hpp"
 #include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 
@@ -39,16 +46,80 @@ void log_outcome(const trajectory_planner::GoalOutcome& o) {
                o.slew_target, o.cycle, o.when == When::as_asked ? ", as asked" : "",
                trajectory_planner::goal_status_name(o.status));
 }
+// The minimum-time plan of a goal (PROFILE_MINIMUM_TIME): null when the bound is not solved or the
+// request is one the bound cannot take (the stage then runs the time-optimal profile).
+std::shared_ptr<const trajectory_planner::PlannedPath> plan(const trajectory_planner::PlanRequest& request,
+                                                           const common::StackFacts& facts,
+                                                           const trajectory_planner::TrajectoryPlannerParams& params) {
+  optimal_control::MinimumTimeResult bound;
+  try {
+    auto path = optimal_control::plan_minimum_time_move(request, facts, params, optimal_control::MovePlanning{}, &bound);
+    if (path) {
+      spdlog::info("move request {}: minimum-time plan, T* = {:.4f} s, {} IPOPT iterations in {:.2f} s",
+                   request.request_id, bound.duration, bound.iterations, bound.solve_seconds);
+    } else {
+      spdlog::warn("move request {}: the minimum-time bound was not solved ({}): the time-optimal profile runs",
+                   request.request_id, bound.status);
+    }
+    return path;
+  } catch (const std::exception& error) {
+    spdlog::warn("move request {}: no minimum-time plan ({}): the time-optimal profile runs", request.request_id,
+                 error.what());
+    return nullptr;
+  }
+}
+
+// Solves the stage's plan requests: in lockstep in the cycle the request appears (the chain waits for
+// this stage, as for any, so every run starts the move at the same cycle); in real time on a worker
+// thread at normal priority while the crane holds, handed over at the first cycle after it ends.
+class Planning {
+ public:
+  Planning(bool lockstep, common::StackFacts facts, trajectory_planner::TrajectoryPlannerParams params)
+      : lockstep_(lockstep), facts_(std::move(facts)), params_(std::move(params)) {}
+
+  void poll(trajectory_planner::TrajectoryPlannerStage& stage) {
+    if (worker_.valid() && worker_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      stage.provide_plan(worker_id_, worker_.get());  // ignored if the request was dropped meanwhile
+    }
+    const auto& request = stage.plan_request();
+    if (!request || request->request_id == started_id_ || worker_.valid()) return;
+    started_id_ = request->request_id;
+    if (lockstep_) {
+      stage.provide_plan(started_id_, plan(*request, facts_, params_));
+      return;
+    }
+    worker_id_ = started_id_;
+    worker_ = std::async(std::launch::async, [request = *request, facts = facts_, params = params_] {
+      runtime::leave_realtime_this_thread();
+      return plan(request, facts, params);
+    });
+  }
+
+ private:
+  bool lockstep_;
+  common::StackFacts facts_;
+  trajectory_planner::TrajectoryPlannerParams params_;
+  std::uint32_t started_id_{0};
+  std::uint32_t worker_id_{0};
+  std::future<std::shared_ptr<const trajectory_planner::PlannedPath>> worker_;
+};
 }  // namespace
 
 int main(int argc, char** argv) {
+  bool lockstep = false;
   return runtime::run_stage(
       argc, argv, runtime::ProcessId::trajectory_planner,
       "trajectory_planner: move requests to reference trajectories (step, trapezoid (3.43), ZV/ZVD/EI input shaping, "
-      "time-optimal swing-free)", {},
-      [](runtime::StageContext& ctx) -> std::function<void()> {
-        auto stage = std::make_shared<trajectory_planner::TrajectoryPlannerStage>(
-            ctx.config.read("trajectory_planner", trajectory_planner::read_params), ctx.config.facts().sample_period);
+      "time-optimal swing-free, the minimum-time bound with its follower's law)",
+      [&lockstep](CLI::App& app) {
+        app.add_flag("--lockstep", lockstep,
+                     "solve a minimum-time plan in the cycle its goal arrives (the chain waits); default: on a "
+                     "worker thread while the crane holds");
+      },
+      [&lockstep](runtime::StageContext& ctx) -> std::function<void()> {
+        const auto params = ctx.config.read("trajectory_planner", trajectory_planner::read_params);
+        auto stage = std::make_shared<trajectory_planner::TrajectoryPlannerStage>(params, ctx.config.facts().sample_period);
+        auto planning = std::make_shared<Planning>(lockstep, ctx.config.facts(), params);
         auto states = std::shared_ptr(ctx.participant.make_reader<tp::StateEstimate>(&ctx.wakeup));
         auto goals = std::shared_ptr(ctx.participant.make_reader<tp::Goal>(&ctx.wakeup));
         auto speeds = std::shared_ptr(ctx.participant.make_reader<tp::OperatorSpeed>(nullptr));
@@ -89,6 +160,7 @@ int main(int argc, char** argv) {
                 const trajectory_planner::PlannerCycle cycle{&state, *arrived, *operator_speeds,
                                                              status->has_value() ? &**status : nullptr};
                 const auto step_status = stage->step(cycle, *out);
+                planning->poll(*stage);
                 for (const auto& outcome : stage->goal_outcomes()) log_outcome(outcome);
                 for (const auto& move_status : stage->move_statuses()) runtime::write_plain(*feedback, move_status);
                 ctx.counters.nonfinite_rejected += stage->nonfinite_goals() + stage->rejected_speeds() - refused_before;

@@ -31,6 +31,7 @@ bool known_profile(ProfileKind kind) {
     case ProfileKind::zvd:
     case ProfileKind::ei:
     case ProfileKind::time_optimal: return true;
+    case ProfileKind::planned: break;  // start_planned() only
   }
   return false;
 }
@@ -83,6 +84,7 @@ bool TrajectoryPlanner::plan_axis(Axis& axis, ProfileKind kind, double start, do
     case ProfileKind::time_optimal:
       planned = axis.time_optimal.plan(start, target, limits, swing_frequency) == ProfileStatus::ok;
       break;
+    case ProfileKind::planned: break;  // start_planned() only
   }
   if (planned) axis.kind = kind;
   return planned;
@@ -189,6 +191,26 @@ GoalStatus TrajectoryPlanner::start_move(const MoveGoal& goal,
   move_duration_ = start_time;
   time_in_move_ = 0.0;
   request_id_ = goal.request_id;
+  phase_ = MovePhase::moving;
+  ready_ = true;
+  return GoalStatus::accepted;
+}
+
+GoalStatus TrajectoryPlanner::start_planned(std::uint64_t request_id, const std::shared_ptr<const PlannedPath>& path,
+                                            bool bridge_axis) noexcept {
+  if (!path || !path->valid() || (bridge_axis && path->bridge.empty())) return GoalStatus::rejected_nonfinite;
+  if (!(path->duration() <= kMaxMoveDuration)) return GoalStatus::rejected_invalid_limits;
+  Segment& s = segments_[0];
+  s.trolley.planned = PlannedProfile(path, bridge_axis ? &PlannedPath::bridge : &PlannedPath::trolley);
+  s.slew.planned = PlannedProfile(path, &PlannedPath::slew);
+  s.cable.planned = PlannedProfile(path, &PlannedPath::cable);
+  s.trolley.kind = s.slew.kind = s.cable.kind = ProfileKind::planned;
+  s.start_time = 0.0;
+  s.duration = path->duration();
+  segment_count_ = 1;
+  move_duration_ = s.duration;
+  time_in_move_ = 0.0;
+  request_id_ = request_id;
   phase_ = MovePhase::moving;
   ready_ = true;
   return GoalStatus::accepted;

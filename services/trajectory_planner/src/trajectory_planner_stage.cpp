@@ -89,7 +89,10 @@ MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current, co
     case Request::PROFILE_ZV: g.profile = ProfileKind::zv; break;
     case Request::PROFILE_ZVD: g.profile = ProfileKind::zvd; break;
     case Request::PROFILE_EI: g.profile = ProfileKind::ei; break;
-    case Request::PROFILE_TIME_OPTIMAL: g.profile = ProfileKind::time_optimal; break;
+    case Request::PROFILE_TIME_OPTIMAL:
+    case Request::PROFILE_MINIMUM_TIME:  // checked and, until its plan arrives or if none does, run as time-optimal
+      g.profile = ProfileKind::time_optimal;
+      break;
     default:
       // Not a ProfileKind: start_move() answers rejected_unknown_profile and keeps the running move.
       g.profile = static_cast<ProfileKind>(-1);
@@ -217,6 +220,67 @@ void TrajectoryPlannerStage::abort_active(std::uint8_t reason) noexcept {
   active_ = false;
 }
 
+void TrajectoryPlannerStage::cancel_plan(std::uint8_t reason) noexcept {
+  if (!plan_request_) return;
+  report(plan_request_->request_id, protocol::MoveStatus::RESULT_ABORTED, reason);
+  plan_request_.reset();
+  plan_answer_.reset();
+  plan_answered_ = false;
+}
+
+PlanRequest TrajectoryPlannerStage::plan_of(const protocol::MoveRequest& r, const common::CraneStateEstimate& current,
+                                            const common::MotionReference& rest, double bridge_rest) const noexcept {
+  // From where the reference rests (not the estimate: its last digits vary while the crane rests, and
+  // the plan would vary with the cycle the goal arrived at); an axis the goal does not name stays there.
+  const auto& params = planner_.params();
+  common::CraneStateEstimate at_rest = current;
+  at_rest.trolley_position = rest.trolley.position;
+  at_rest.slew_angle = rest.slew.position;
+  at_rest.cable_length = rest.cable_length.position;
+  const MoveGoal goal = to_goal(r, at_rest, params.manual);
+  PlanRequest plan;
+  plan.request_id = r.request_id;
+  plan.trolley_from = rest.trolley.position;
+  plan.slew_from = rest.slew.position;
+  plan.cable_from = rest.cable_length.position;
+  plan.trolley_target = goal.trolley_target;
+  plan.slew_target = goal.slew_target;
+  plan.cable_target = goal.cable_target;
+  plan.trolley_limits = goal.trolley_limits;
+  plan.slew_limits = goal.slew_limits;
+  plan.cable_limits = goal.cable_limits;
+  if (bridge_) {
+    plan.bridge = true;
+    plan.bridge_from = bridge_rest;
+    plan.bridge_target = (r.axes & protocol::MoveRequest::AXIS_BRIDGE) != 0 ? r.bridge_target : bridge_rest;
+    plan.bridge_limits = {r.bridge_max_velocity > 0.0 ? r.bridge_max_velocity : params.manual.bridge.rated_speed,
+                          r.bridge_max_acceleration > 0.0 ? r.bridge_max_acceleration : params.manual.bridge.acceleration};
+  }
+  plan.max_swing = max_swing_;
+  return plan;
+}
+
+void TrajectoryPlannerStage::plan_ahead(const protocol::MoveRequest& r, const common::CraneStateEstimate& current) noexcept {
+  // From rest only, with no waypoint and no zone to plan around, the sway limit heard: as start()
+  // would plan it, from where the crane rests now (it holds until the start cycle).
+  const auto& params = planner_.params();
+  if (moving() || source_ != Source::profile || r.waypoint_count != 0 || max_swing_ <= 0.0 ||
+      (zones_enabled_ != 0 && !params.site.zones.empty())) {
+    return;
+  }
+  const PlanRequest plan = plan_of(r, current, planner_.sample_now(),
+                                   bridge_ ? bridge_->planner.sample_now().trolley.position : 0.0);
+  plan_request_ = plan;
+  plan_answer_.reset();
+  plan_answered_ = false;
+}
+
+void TrajectoryPlannerStage::provide_plan(std::uint32_t request_id, std::shared_ptr<const PlannedPath> path) noexcept {
+  if (!plan_request_ || plan_request_->request_id != request_id) return;
+  plan_answer_ = std::move(path);
+  plan_answered_ = true;
+}
+
 bool TrajectoryPlannerStage::moving() const noexcept {
   return source_ == Source::speed ? !speed_.at_rest() || (bridge_ && !bridge_->speed.at_rest())
                                   : output_.phase == MovePhase::moving;
@@ -308,6 +372,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     const auto& st = *cycle.status;
     const std::uint8_t mode = st.operating_mode;
     if (mode >= Status::OPERATION_MANUAL && mode <= Status::OPERATION_MAINTENANCE && mode != operating_mode_) {
+      cancel_plan(Feedback::REASON_MODE);
       if (moving()) {
         abort_active(Feedback::REASON_MODE);
         soft_stop(0);
@@ -317,6 +382,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     zones_enabled_ = st.zones_enabled;
     supervisor_mode_ = st.mode;
     supervisor_stopped_ = st.mode == Status::MODE_FAULT || st.mode == Status::MODE_EMERGENCY_STOP;
+    if (std::isfinite(st.max_swing) && st.max_swing > 0.0) max_swing_ = st.max_swing;
     zone_warning = (st.warnings & Status::WARNING_ZONE_APPROACH) != 0;
     limit_warning = (st.warnings & Status::WARNING_SPEED_LIMITED) != 0;
   }
@@ -326,6 +392,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     // arrives at); when the supervisor lets the crane move again, it holds the measured position,
     // so a reset resumes nothing.
     abort_active(Feedback::REASON_FAULT);
+    cancel_plan(Feedback::REASON_FAULT);
     if (stop_id_ != 0) report(stop_id_, Feedback::RESULT_ARRIVED);
     stop_id_ = 0;
     hold_on_release_ = true;
@@ -342,7 +409,20 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
   }
 
   // Start `r` now: the planner takes it or refuses it (the running move then continues).
+  // The crane holds where a plan starts until the plan is handed over.
+  const auto hold_for_plan = [&](const PlanRequest& plan) {
+    common::CraneStateEstimate at_rest = current;
+    at_rest.trolley_position = plan.trolley_from;
+    at_rest.slew_angle = plan.slew_from;
+    at_rest.cable_length = plan.cable_from;
+    (void)planner_.hold(at_rest);
+    if (bridge_) hold_bridge(plan.bridge_from);
+  };
   const auto start = [&](const Request& r) {
+    const bool was_moving = moving();
+    // Where the reference rests before this goal (a minimum-time plan starts there: see plan_ahead).
+    const common::MotionReference rest = source_ == Source::speed ? speed_.reference() : planner_.sample_now();
+    const double bridge_rest = bridge_ ? bridge_->reference(source_ == Source::speed).position : 0.0;
     MoveGoal goal = to_goal(r, current, params.manual);
     // Refuses with the reason; `value` the mode or zone it names.
     const auto reject = [&](GoalStatus status, double value) {
@@ -417,8 +497,71 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     active_goal_ = goal;
     active_ = true;
     cycles_since_progress_ = kProgressCycles;  // report at this cycle's end
+    // The minimum-time profile: from rest, with no waypoint and no zone to plan around, and with the
+    // supervisor's sway limit heard, the crane holds where it is until the plan is handed over
+    // (provide_plan); otherwise the time-optimal profile just started runs.
+    const bool planned_ahead = plan_request_ && plan_request_->request_id == r.request_id;
+    if (planned_ahead && (was_moving || goal.waypoint_count != 0)) {
+      // The crane moved meanwhile: that plan starts from the wrong place; the time-optimal profile runs.
+      plan_request_.reset();
+      plan_answer_.reset();
+      plan_answered_ = false;
+    }
+    if (r.profile == Request::PROFILE_MINIMUM_TIME && plan_request_ && plan_request_->request_id == r.request_id) {
+      // Planned while the goal waited for its start cycle: the move starts with that plan (now if it
+      // was handed over already, else when it is).
+      hold_for_plan(*plan_request_);
+      active_ = false;
+      plan_fallback_ = r;
+      plan_fallback_.profile = Request::PROFILE_TIME_OPTIMAL;
+      if (!plan_answered_) report(r.request_id, Feedback::RESULT_WAITING);
+    } else if (r.profile == Request::PROFILE_MINIMUM_TIME && !was_moving && goal.waypoint_count == 0 &&
+        (zones_enabled_ == 0 || params.site.zones.empty()) && max_swing_ > 0.0) {
+      const PlanRequest plan = plan_of(r, current, rest, bridge_rest);
+      hold_for_plan(plan);
+      active_ = false;
+      plan_request_ = plan;
+      plan_fallback_ = r;
+      plan_fallback_.profile = Request::PROFILE_TIME_OPTIMAL;
+      plan_answered_ = false;
+      plan_answer_.reset();
+      report(r.request_id, Feedback::RESULT_WAITING);
+    }
     return status;
   };
+  // A plan handed over: its move starts now (or, unsolved, the time-optimal profile's), unless its
+  // goal still waits for its start cycle.
+  const auto hand_over = [&] {
+    if (!plan_request_ || !plan_answered_ || (pending_ && pending_->request_id == plan_request_->request_id)) return;
+    const std::uint32_t id = plan_request_->request_id;
+    const bool bridge_ok =
+        !bridge_ || (plan_answer_ && bridge_->planner.start_planned(id, plan_answer_, true) == GoalStatus::accepted);
+    if (plan_answer_ && bridge_ok && planner_.start_planned(id, plan_answer_) == GoalStatus::accepted) {
+      planned_ = plan_answer_;
+      planned_id_ = id;
+      active_goal_ = to_goal(plan_fallback_, current, params.manual);
+      if (bridge_) bridge_->target = plan_request_->bridge_target;
+      active_ = true;
+      source_ = Source::profile;
+      cycles_since_progress_ = kProgressCycles;
+      plan_request_.reset();
+    } else {
+      if (bridge_) hold_bridge(plan_request_->bridge_from);
+      plan_request_.reset();
+      ++unsolved_plans_;
+      GoalOutcome o;
+      o.request_id = id;
+      o.cycle = seq;
+      o.asked_cycle = plan_fallback_.header.seq;
+      o.status = start(plan_fallback_);
+      o.trolley_target = plan_fallback_.trolley_target;
+      o.slew_target = plan_fallback_.slew_target;
+      record(o);
+    }
+    plan_answer_.reset();
+    plan_answered_ = false;
+  };
+  hand_over();
   const auto outcome = [&](const Request& r, GoalOutcome::When when, GoalStatus status) {
     GoalOutcome o;
     o.request_id = r.request_id;
@@ -448,6 +591,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       continue;
     }
     last_request_ = request.request_id;
+    cancel_plan(request.command == Request::COMMAND_STOP ? Feedback::REASON_STOPPED : Feedback::REASON_REPLACED);
     if (request.command == Request::COMMAND_STOP) {
       pending_.reset();
       outcome(request, GoalOutcome::When::now, GoalStatus::accepted);
@@ -473,15 +617,24 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       pending_ = request;
       outcome(request, GoalOutcome::When::waiting, GoalStatus::accepted);
       report(request.request_id, Feedback::RESULT_WAITING);
+      if (request.profile == Request::PROFILE_MINIMUM_TIME) plan_ahead(request, current);
       continue;
     }
     pending_.reset();
     const auto when = request.header.seq != 0 && request.header.seq < seq ? GoalOutcome::When::late : GoalOutcome::When::now;
     outcome(request, when, start(request));
   }
+  // A minimum-time goal that waits and could not be planned when it arrived (the supervisor's sway
+  // limit not heard yet, the crane still moving): planned as soon as it can be.
+  if (pending_.has_value() && pending_->profile == Request::PROFILE_MINIMUM_TIME && !plan_request_ &&
+      pending_->header.seq > seq) {
+    plan_ahead(*pending_, current);
+  }
   if (pending_.has_value() && pending_->header.seq <= seq) {
-    outcome(*pending_, GoalOutcome::When::as_asked, start(*pending_));
+    const Request due = *pending_;
     pending_.reset();
+    outcome(due, GoalOutcome::When::as_asked, start(due));
+    hand_over();  // a plan made while it waited starts with it
   }
 
   // Operator speeds: taken in the manual modes; in SEMIAUTOMATIC they take over from a goal.
@@ -569,6 +722,19 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     reference.bridge_position = b.position;
     reference.bridge_velocity = b.velocity;
     reference.bridge_acceleration = b.acceleration;
+  }
+  if (planned_ && source_ == Source::profile && output_.request_id == planned_id_ && output_.phase != MovePhase::holding) {
+    // A planned move, under way or arrived: the reference carries its law (the hold after the end).
+    common::set_trajectory_feedback(planned_->laws[planned_->index(output_.time_in_move)], bridge_.has_value(), reference);
+    output_.move_duration = planned_->minimum_time;  // T*: the path's samples end on the cycle after it
+  } else {
+    planned_.reset();
+    reference.feedback_law = false;
+    reference.swing_in_plane = reference.swing_in_plane_rate = 0.0;
+    reference.swing_out_of_plane = reference.swing_out_of_plane_rate = 0.0;
+    reference.trolley_feedforward_voltage = reference.second_feedforward_voltage = 0.0;
+    reference.feedback_gain = {};
+    reference.sliding_friction_reduction = 0.0;
   }
   reference.request_id = static_cast<std::uint32_t>(output_.request_id);
   reference.phase = static_cast<std::uint8_t>(output_.phase);

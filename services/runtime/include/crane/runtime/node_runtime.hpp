@@ -79,6 +79,11 @@ std::string enter_realtime(int priority);
 /// everything else on the cores). Never throws; nothing happens when the process never entered.
 void leave_realtime() noexcept;
 
+/// Puts the calling thread alone on SCHED_OTHER (a worker of a real-time stage that computes
+/// outside the cycle, e.g. the planner's minimum-time solve: it must not starve the cycle's threads).
+/// Never throws; nothing happens on a thread that is not SCHED_FIFO.
+void leave_realtime_this_thread() noexcept;
+
 /// Creates the participant for `options` (vendor resolved from --dds / CRANE_DDS); first enters
 /// real time when options.realtime_priority > 0 (a warning in the log when it cannot).
 /// With --security (or $CRANE_SECURITY) the participant uses identity options.identity, else `name`.

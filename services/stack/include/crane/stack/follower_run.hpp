@@ -1,31 +1,26 @@
 #pragma once
 // A demo maneuver run by the follower of its minimum-time trajectory (optimal_control/
-// trajectory_follower.hpp; issue 32, item 2; docs/optimal_control.md), in one process, on the
-// stack's own stage objects where the follower does not replace them:
-//
-//   cycle k:  plant.sample() -> state estimator -> the reference with the follower's law of
-//             cycle k (TrajectoryFollower::law, in place of the planner's; no anti-swing stage)
-//             -> tracking (law `follower`) -> friction compensation (the law's sliding friction
-//             reduction) -> actuators(k) -> supervisor(k) -> plant.step(actuators(k), gated by
-//             status(k - 1))
-//
-// in the order and with the gating of the in-process stack (in_process_stack.hpp); the move starts
-// at kMoveStartCycle like the demo's. The bound is solved on the controllers' model (the configured
-// crane, rigid: crane:, no hook or rope) with the limits of stack::bound_problem; the plant is the
-// configured one with `mismatch` applied, so the follower is measured against a crane it does not
-// know exactly. The DDS stack cannot run it yet: the planner does not solve the bound
-// (docs/optimal_control.md, "The law on the wire", says what remains).
+// trajectory_follower.hpp; issue 32; docs/optimal_control.md) on the whole in-process stack
+// (run_in_process, the stage objects the DDS processes run), controller `follower` with the
+// profile minimum_time: the planner is handed the path of this run's bound (solved here on the
+// controllers' model, or given: a comparison runs several plants on one bound, FollowerRun::bound)
+// instead of solving it, and the tracking stage applies its law. The plant is the configured one
+// with `mismatch` applied, so the follower is measured against a crane it does not know exactly.
+// The DDS lockstep demo (`crane_demo --controller follower`) runs the same stages with the
+// planner process solving the bound (integration.Controllers/SimMatchesDemo.*follower).
 //
 // Errors: common::ConfigError for invalid params (the bound's, the follower's); std::runtime_error
-// when the bound is not solved or the estimator refuses a sample.
+// when the bound is not solved or the run fails (run_in_process).
 
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include "crane/optimal_control/minimum_time.hpp"
+#include "crane/optimal_control/planned_move.hpp"
 #include "crane/optimal_control/trajectory_follower.hpp"
 #include "crane/plant/plant_stage.hpp"
+#include "crane/stack/maneuver_bound.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
 
@@ -53,8 +48,8 @@ struct FollowerResult {
   double follower_setup_seconds{0.0};        // [s] wall time of the gains (linearization and Riccati)
 };
 
-/// The bound's problem on the controllers' model: bound_problem (maneuver_bound.hpp) on the
-/// configured crane, rigid (no hook, no rope: the follower's model), with `intervals` intervals.
+/// The bound's problem on the controllers' model: optimal_control::minimum_time_problem (the
+/// planner's mapping) of plan_request_of, with `intervals` intervals.
 [[nodiscard]] optimal_control::MinimumTimeProblem follower_problem(const StackConfig& config,
                                                                    const ManeuverConfig& maneuver, int intervals);
 

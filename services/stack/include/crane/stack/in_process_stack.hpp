@@ -15,11 +15,13 @@
 // the transport. Used by crane_sim (the demo maneuvers, the mismatch sweep) and tests/closed_loop.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
 #include <vector>
 
+#include "crane/optimal_control/planned_move.hpp"
 #include "crane/plant/plant_stage.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
@@ -30,6 +32,11 @@ namespace crane::stack {
 /// The whole stack in one thread, one cycle per step(): the composition run_in_process and the
 /// operator tests (manual mode, stops, zones) share. The plant starts at rest at the configured
 /// crane, trolley at `initial_trolley_position` [m], jib at `initial_slew_angle` [rad].
+/// Plans a minimum-time goal (trajectory_planner_stage.hpp, plan_request): its path, or null when
+/// it cannot (the goal then runs the time-optimal profile).
+using MovePlanner =
+    std::function<std::shared_ptr<const trajectory_planner::PlannedPath>(const trajectory_planner::PlanRequest&)>;
+
 struct InProcessOptions {
   bool friction_compensation{true};
   ControllerChoice controller{};
@@ -37,6 +44,9 @@ struct InProcessOptions {
   double initial_trolley_position{0.25};  // [m]
   double initial_slew_angle{0.0};         // [rad]
   double initial_bridge_position{0.0};    // [m] overhead crane
+  // How a minimum-time goal (PROFILE_MINIMUM_TIME) is planned when the planner asks (empty: the
+  // planner node's way, optimal_control::plan_minimum_time_move with MovePlanning{}).
+  MovePlanner plan_move{};
 };
 
 /// The plant stage of a run: the configured simulator and actuation gate, at rest at the options'
@@ -94,6 +104,7 @@ struct InProcessRun {
   // Keep the plant's drive input and true state of every cycle (InProcessResult::plant_inputs,
   // plant_states): the convergence study's replay (convergence_study.hpp).
   bool record_plant{false};
+  MovePlanner plan_move{};  // InProcessOptions::plan_move
 };
 
 struct InProcessResult {

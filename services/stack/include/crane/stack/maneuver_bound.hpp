@@ -13,7 +13,8 @@
 //   hoist                              the planner's hoist limits (MoveGoal::cable_limits), the speed
 //                                      capped by the actuation gate's hoist_speed_limit
 //   drive voltage                      stack.voltage_limit, with the crane's friction (3.1)
-//   swing                              kBoundSwingFraction x supervisor.max_swing: a margin for the
+//   swing                              optimal_control::kBoundSwingFraction x supervisor.max_swing
+//                                      (planned_move.hpp, the planner's rule too): a margin for the
 //                                      follower's tracking error and a mismatched plant, so that a
 //                                      healthy crane on its bound never trips the sway limiter (with
 //                                      the whole limit the overhead crane's 10 m trolley bound swung
@@ -25,14 +26,19 @@
 #include <string>
 
 #include "crane/optimal_control/minimum_time.hpp"
+#include "crane/optimal_control/planned_move.hpp"
 #include "crane/stack/stack_config.hpp"
 
 namespace crane::stack {
 
-/// The bound's swing limit as a fraction of the supervisor's max_swing (see the header).
-inline constexpr double kBoundSwingFraction = 0.5;
+/// The maneuver as the planner stage asks for its minimum-time plan, with the limits above (its rated
+/// motion capped by the supervisor's overspeed, the hoist's by the actuation gate's, the
+/// supervisor's sway limit); from the maneuver's initial positions and the configured cable.
+[[nodiscard]] trajectory_planner::PlanRequest plan_request_of(const StackConfig& config, const ManeuverConfig& maneuver);
 
-/// The problem of `maneuver` on `config`'s crane, on `intervals` collocation intervals.
+/// The problem of `maneuver` on `config`'s crane, on `intervals` collocation intervals:
+/// optimal_control::minimum_time_problem of plan_request_of (the planner's mapping), on the plant's
+/// model.
 [[nodiscard]] optimal_control::MinimumTimeProblem bound_problem(const StackConfig& config,
                                                                 const ManeuverConfig& maneuver, int intervals = 100);
 

@@ -1,6 +1,7 @@
 #pragma once
 // Figures of merit of one recorded maneuver (the demo's table and summary.json).
 
+#include <limits>
 #include <vector>
 
 namespace crane::stack {
@@ -34,6 +35,10 @@ struct ManeuverMetrics {
   double max_swing{0.0};              // [rad] max over the run of max(|phi|, |theta|)
   double residual_swing{0.0};         // [rad] same over the last residual_window
   double max_voltage{0.0};            // [V] max |applied voltage| over every drive
+  // [s] T*, the move's minimum time on the controllers' model, when its plan was the minimum-time
+  // bound (the reference's move_duration of a move that carries a feedback law); NaN otherwise.
+  // Set by the runners, not by evaluate_maneuver.
+  double minimum_time{std::numeric_limits<double>::quiet_NaN()};
 };
 
 /// The nearest-rank q-quantile of `values` (q in [0, 1]: 0 the smallest, 1 the largest, 0.5 the

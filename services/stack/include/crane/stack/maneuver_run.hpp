@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,13 +32,24 @@ struct ControllerChoice {
 };
 
 /// The demo's controller names: none | pd | delay1 | delay2 | fuzzy (anti-swing with PD tracking),
-/// gain_scheduling_partial | gain_scheduling_full (no anti-swing), auto (per maneuver the best
+/// gain_scheduling_partial | gain_scheduling_full (no anti-swing), follower (the minimum-time
+/// bound followed in closed loop: tracking law follower, no anti-swing), auto (per maneuver the best
 /// measured with the time-optimal profile: none for a trolley move, delay2 when the jib slews, both
 /// with acceleration feedforward). Throws std::invalid_argument for another name.
 [[nodiscard]] ControllerChoice choose_controller(std::string_view controller, const ManeuverConfig& maneuver,
                                                  bool acceleration_feedforward);
 
-/// MoveRequest.profile code of a profile name (step | trapezoid | zv | zvd | ei | time_optimal, the
+/// The demo's controller when none is named (crane_demo, crane_sim): follower, where it wins
+/// (issue 32: every demo maneuver of every crane kind within 1.2 T*; docs/optimal_control.md); with
+/// a profile asked for, the controller measured best for it: auto for time_optimal, delay1 for the
+/// others (`profile`: the asked profile's name, empty when none was asked for).
+[[nodiscard]] std::string default_controller(std::string_view profile);
+
+/// The profile a controller name runs with unless one is asked for: step for the gain-scheduling
+/// controllers (section 3.2), minimum_time for the follower; empty for the others.
+[[nodiscard]] std::optional<std::string_view> implied_profile(std::string_view controller);
+
+/// MoveRequest.profile code of a profile name (step | trapezoid | zv | zvd | ei | time_optimal | minimum_time, the
 /// IDL's PROFILE_* names). Throws std::invalid_argument for another name.
 [[nodiscard]] std::uint8_t profile_code(std::string_view profile);
 
@@ -73,6 +85,10 @@ struct CycleRecord {
 /// `bridge` (an overhead crane): the bridge's columns y, u_y, y_ref, V_y, friction_y, u_y_cmd follow.
 void write_csv(std::ostream& out, const std::vector<CycleRecord>& records, bool bridge = false);
 
+/// T* of a run from the reference of its first cycle (ManeuverMetrics::minimum_time): its
+/// move_duration when it carries a feedback law (a minimum-time plan), NaN otherwise.
+[[nodiscard]] double minimum_time_of(const protocol::Reference& first) noexcept;
+
 /// The figures of merit of the recorded move (throws std::invalid_argument when empty).
 [[nodiscard]] ManeuverMetrics evaluate(const std::vector<CycleRecord>& records, const ManeuverConfig& maneuver);
 
@@ -85,8 +101,9 @@ struct PrintedFigure {
   double value;
   int decimals;
 };
-/// The row's figures in the table's order (settle_s, settle_T, pos_err_mm, slew_err_mrad,
-/// max_swing_deg, resid_swing_deg, max_V[, bridge_err_mm]).
+/// The row's figures in the table's order (settle_s, settle_T, T*_s, settle/T*, pos_err_mm,
+/// slew_err_mrad, max_swing_deg, resid_swing_deg, max_V[, bridge_err_mm]); T* and the ratio are
+/// NaN ("-") unless the move ran a minimum-time plan (ManeuverMetrics::minimum_time).
 [[nodiscard]] std::vector<PrintedFigure> printed_figures(const ManeuverMetrics& metrics, double swing_period,
                                                          bool bridge = false);
 

@@ -19,9 +19,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include "crane/common/crane_signals.hpp"
 #include "crane/common/site.hpp"
+#include "crane/trajectory_planner/planned_path.hpp"
 #include "crane/trajectory_planner/shaped_profile.hpp"
 #include "crane/trajectory_planner/speed_reference.hpp"
 #include "crane/trajectory_planner/step_profile.hpp"
@@ -41,6 +43,7 @@ enum class ProfileKind {
   zvd,           // trapezoid convolved with a ZVD shaper
   ei,            // trapezoid convolved with an EI shaper
   time_optimal,  // time-optimal swing-free rest-to-rest (TimeOptimalProfile)
+  planned,       // a path planned outside the cycle (PlannedPath; start_planned()); start_move() refuses it
 };
 
 /// Travel limits of the crane, checked against every goal.
@@ -162,6 +165,13 @@ class TrajectoryPlanner {
   [[nodiscard]] GoalStatus start_move(const MoveGoal& goal,
                                       const common::CraneStateEstimate& current) noexcept;
 
+  /// Start the path `path` (planned_path.hpp) as move `request_id`: one segment, every axis on its
+  /// samples (`bridge_axis`: the path's bridge as this planner's trolley, the bridge's planner of an
+  /// overhead crane). rejected_nonfinite for a null, invalid or bridge-less (when asked) path;
+  /// rejected_invalid_limits for one longer than kMaxMoveDuration. Allocates nothing.
+  [[nodiscard]] GoalStatus start_planned(std::uint64_t request_id, const std::shared_ptr<const PlannedPath>& path,
+                                         bool bridge_axis = false) noexcept;
+
   /// Advance time by `dt` [s] (>= 0) and sample the reference at the new time.
   /// not_ready before the first hold()/start_move() (output untouched); rejected_nonfinite if dt is
   /// NaN/Inf or negative (time not advanced, output untouched).
@@ -190,6 +200,7 @@ class TrajectoryPlanner {
     StepProfile step;
     ShapedProfile shaped;
     TimeOptimalProfile time_optimal;
+    PlannedProfile planned;
     ProfileKind kind{ProfileKind::step};
     // Indexing by kind (not a stored pointer) keeps the planner safely copyable.
     [[nodiscard]] const AxisProfile& active() const noexcept {
@@ -199,6 +210,7 @@ class TrajectoryPlanner {
         case ProfileKind::zvd:
         case ProfileKind::ei: return shaped;
         case ProfileKind::time_optimal: return time_optimal;
+        case ProfileKind::planned: return planned;
         case ProfileKind::step: break;
       }
       return step;

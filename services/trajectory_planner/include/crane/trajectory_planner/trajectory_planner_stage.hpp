@@ -38,11 +38,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 
 #include "crane/common/stack_facts.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/trajectory_planner/planned_path.hpp"
 #include "crane/trajectory_planner/trajectory_planner.hpp"
 
 namespace crane::config {
@@ -130,6 +132,17 @@ class TrajectoryPlannerStage {
   /// code (rejected_speeds), or arriving in FULLAUTOMATIC (speeds_outside_manual).
   [[nodiscard]] std::uint64_t rejected_speeds() const noexcept { return rejected_speeds_; }
   [[nodiscard]] std::uint64_t speeds_outside_manual() const noexcept { return speeds_outside_manual_; }
+  /// A goal with the minimum-time profile (PROFILE_MINIMUM_TIME) waiting for its plan, or empty:
+  /// the crane holds where the move starts until provide_plan() hands the plan over (see the header).
+  [[nodiscard]] const std::optional<PlanRequest>& plan_request() const noexcept { return plan_request_; }
+  /// The plan of the waiting goal `request_id`, taken at the next step: its path starts then, and the
+  /// reference carries the path's law of each cycle; null (not solved) or a path start_planned()
+  /// refuses: the goal runs the time-optimal profile (unsolved_plans() counts it). Ignored for an id
+  /// that is not waiting (replaced, stopped, cancelled by a fault or a mode change meanwhile).
+  /// Allocates nothing (the path is shared).
+  void provide_plan(std::uint32_t request_id, std::shared_ptr<const PlannedPath> path) noexcept;
+  /// Minimum-time goals that ran the time-optimal profile for want of a plan.
+  [[nodiscard]] std::uint64_t unsolved_plans() const noexcept { return unsolved_plans_; }
   /// The operating mode the stage applies (an OPERATION_* code).
   [[nodiscard]] std::uint8_t operating_mode() const noexcept { return operating_mode_; }
   /// True while the speed reference (manual motion or a stop) drives the reference.
@@ -145,6 +158,15 @@ class TrajectoryPlannerStage {
   void record(const GoalOutcome& outcome) noexcept;
   protocol::MoveStatus* report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason = 0) noexcept;
   void abort_active(std::uint8_t reason) noexcept;
+  /// The plan request of `r` from the reference's `rest` (and the bridge's `bridge_rest` [m]); axes `r`
+  /// does not name stay there; the goal's rated limits, the sway limit heard.
+  [[nodiscard]] PlanRequest plan_of(const protocol::MoveRequest& r, const common::CraneStateEstimate& current,
+                                    const common::MotionReference& rest, double bridge_rest) const noexcept;
+  /// A minimum-time goal `r` that waits for its start cycle: its plan asked for now, from where the
+  /// reference rests (`current`: the estimate, for the axes `r` does not name).
+  void plan_ahead(const protocol::MoveRequest& r, const common::CraneStateEstimate& current) noexcept;
+  /// Drops a goal waiting for its plan, reported aborted for `reason`.
+  void cancel_plan(std::uint8_t reason) noexcept;
   /// Hands the running reference over to the speed reference with every speed 0; `stop_id` (0:
   /// none) is the stop request answered when at rest.
   void soft_stop(std::uint32_t stop_id) noexcept;
@@ -206,6 +228,15 @@ class TrajectoryPlannerStage {
   bool active_{false};               // a move of active_goal_ is under way (not yet arrived or aborted)
   std::uint64_t cycles_since_progress_{0};
   const protocol::CraneState* cycle_estimate_{nullptr};  // the step's estimate (header of the feedback)
+  // The minimum-time profile (planned_path.hpp).
+  double max_swing_{0.0};                         // [rad] the supervisor's sway limit (0: not heard yet)
+  std::optional<PlanRequest> plan_request_;       // a goal waiting for its plan
+  protocol::MoveRequest plan_fallback_{};         // that goal with the time-optimal profile
+  std::shared_ptr<const PlannedPath> plan_answer_;  // handed over by provide_plan
+  bool plan_answered_{false};
+  std::shared_ptr<const PlannedPath> planned_;    // the path whose law the reference carries
+  std::uint64_t planned_id_{0};
+  std::uint64_t unsolved_plans_{0};
 };
 
 }  // namespace crane::trajectory_planner

@@ -1,0 +1,85 @@
+#include "crane/optimal_control/planned_move.hpp"
+
+#include "crane/plant/crane_simulator.hpp"
+
+namespace crane::optimal_control {
+
+MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r, const common::StackFacts& facts,
+                                        const trajectory_planner::TrajectoryPlannerParams& planner, int intervals) {
+  MinimumTimeProblem problem;
+  problem.model = plant::make_crane_dynamics(facts.crane_kind, facts.crane, facts.bridge);
+  problem.trolley = {r.trolley_from,
+                     r.trolley_target,
+                     planner.trolley_min_position,
+                     planner.trolley_max_position,
+                     r.trolley_limits.max_velocity,
+                     r.trolley_limits.max_acceleration};
+  problem.trolley_friction = facts.crane.trolley_friction;
+  if (facts.crane_kind == common::CraneKind::overhead) {
+    problem.second = {r.bridge_from,
+                      r.bridge_target,
+                      planner.bridge_min_position,
+                      planner.bridge_max_position,
+                      r.bridge_limits.max_velocity,
+                      r.bridge_limits.max_acceleration};
+    problem.second_friction = facts.bridge.friction;
+  } else {
+    problem.second = {r.slew_from,
+                      r.slew_target,
+                      planner.slew_min_angle,
+                      planner.slew_max_angle,
+                      r.slew_limits.max_velocity,
+                      r.slew_limits.max_acceleration};
+    problem.second_friction = facts.crane.slew_friction;
+  }
+  problem.hoist = {r.cable_from,
+                   r.cable_target,
+                   planner.cable_min_length,
+                   planner.cable_max_length,
+                   r.cable_limits.max_velocity,
+                   r.cable_limits.max_acceleration};
+  problem.voltage_limit = facts.voltage_limit;
+  problem.max_swing = kBoundSwingFraction * r.max_swing;
+  problem.intervals = intervals;
+  validate(problem);
+  return problem;
+}
+
+std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const TrajectoryFollower& follower,
+                                                                   double sample_period, bool bridge,
+                                                                   double minimum_time) {
+  auto path = std::make_shared<trajectory_planner::PlannedPath>();
+  path->sample_period = sample_period;
+  path->minimum_time = minimum_time;
+  const std::size_t n = follower.samples() + 1;
+  for (auto* axis : {&path->trolley, &path->slew, &path->cable}) axis->resize(n);
+  if (bridge) path->bridge.resize(n);
+  path->laws.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const TrajectoryNode& node = follower.node(k);
+    const bool moving = follower.moving(k);
+    path->laws[k] = follower.law(k);
+    const common::TrajectoryFeedback& law = path->laws[k];
+    path->trolley[k] = {law.position[0], law.velocity[0], moving ? node.trolley_acceleration : 0.0};
+    const common::AxisReference second{law.position[2], law.velocity[2], moving ? node.second_acceleration : 0.0};
+    (bridge ? path->bridge[k] : path->slew[k]) = second;
+    path->cable[k] = {node.cable_length, node.cable_length_rate, moving ? node.hoist_acceleration : 0.0};
+  }
+  return path;
+}
+
+std::shared_ptr<const trajectory_planner::PlannedPath> plan_minimum_time_move(
+    const trajectory_planner::PlanRequest& request, const common::StackFacts& facts,
+    const trajectory_planner::TrajectoryPlannerParams& planner, const MovePlanning& planning, MinimumTimeResult* bound) {
+  const MinimumTimeProblem problem = minimum_time_problem(request, facts, planner, planning.intervals);
+  MinimumTimeResult result = solve_minimum_time(problem);
+  if (bound != nullptr) *bound = result;
+  if (!result.solved) return nullptr;
+  FollowerParams params = planning.follower;
+  params.sample_period = facts.sample_period;
+  params.voltage_limit = facts.voltage_limit;
+  const TrajectoryFollower follower(problem, result, params);
+  return planned_path(follower, facts.sample_period, facts.crane_kind == common::CraneKind::overhead, result.duration);
+}
+
+}  // namespace crane::optimal_control
