@@ -174,10 +174,10 @@ TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
   EXPECT_FALSE(reference.feedback_law);
   step(2);  // no plan yet: it holds
   EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
-  stage.provide_plan(99, synthetic_path());  // another id: ignored
+  stage.provide_plan(request.sequence + 1, synthetic_path());  // another request: ignored
   step(3);
   EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);
-  stage.provide_plan(3, synthetic_path());
+  stage.provide_plan(request.sequence, synthetic_path());
   for (std::uint64_t k = 4; k <= 13; ++k) {
     step(k);
     const double sample = static_cast<double>(k - 3);  // the first cycle of a move is at t = T_s
@@ -212,7 +212,7 @@ TEST(PlannerStage, AMinimumTimeGoalWithoutAPlanRunsTheTimeOptimalProfile) {
   step(0);
   const Request goal = minimum_time_goal(5, 0.55);
   step(1, std::span(&goal, 1));
-  stage.provide_plan(5, nullptr);  // not solved
+  stage.provide_plan(stage.plan_request()->sequence, nullptr);  // not solved
   step(2);
   EXPECT_EQ(stage.unsolved_plans(), 1U);
   EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
@@ -244,7 +244,7 @@ TEST(PlannerStage, AMinimumTimeGoalWaitingForItsCycleIsPlannedAheadAndStartsOnTi
   const Request goal = minimum_time_goal(8, 0.35, 20);
   step(1, std::span(&goal, 1));
   ASSERT_TRUE(stage.plan_request().has_value());  // asked at once, while it waits
-  stage.provide_plan(8, synthetic_path());
+  stage.provide_plan(stage.plan_request()->sequence, synthetic_path());
   for (std::uint64_t k = 2; k < 20; ++k) {
     step(k);
     EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING) << k;
@@ -294,11 +294,41 @@ TEST(PlannerStage, AWaitingMinimumTimeGoalIsPlannedOnceTheSwayLimitIsHeard) {
     if (k == 4) EXPECT_FALSE(stage.plan_request().has_value());
     if (k == 5) {
       ASSERT_TRUE(stage.plan_request().has_value());
-      stage.provide_plan(4, synthetic_path());
+      stage.provide_plan(stage.plan_request()->sequence, synthetic_path());
     }
   }
   const auto state = at_rest(30);
   ASSERT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, {}, {}, &status}, reference), common::StepStatus::ok);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+  EXPECT_TRUE(reference.feedback_law);
+}
+
+// A plan request cancelled meanwhile (a change of operating mode) and asked again for the same goal
+// is a new request: an answer to the old one is ignored, the crane does not wait for it for ever.
+TEST(PlannerStage, AGoalAskedAgainIsANewPlanRequest) {
+  auto stage = lab_planner();
+  protocol::Reference reference;
+  auto status = with_sway_limit(0);
+  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) {
+    const auto state = at_rest(k);
+    EXPECT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, goals, {}, &status}, reference), common::StepStatus::ok);
+  };
+  step(0);
+  const Request goal = minimum_time_goal(12, 0.35, 20);
+  step(1, std::span(&goal, 1));
+  ASSERT_TRUE(stage.plan_request().has_value());
+  const std::uint64_t first = stage.plan_request()->sequence;
+  status.operating_mode = protocol::SupervisorStatus::OPERATION_SEMIAUTOMATIC;
+  step(2);  // the mode change cancels the request; the goal, still waiting, is asked again
+  ASSERT_TRUE(stage.plan_request().has_value());
+  EXPECT_EQ(stage.plan_request()->request_id, 12U);
+  EXPECT_NE(stage.plan_request()->sequence, first);
+  stage.provide_plan(first, synthetic_path());  // the old request's answer
+  for (std::uint64_t k = 3; k < 20; ++k) step(k);
+  step(20);
+  EXPECT_EQ(reference.phase, protocol::Reference::PHASE_HOLDING);  // it waits for the new answer
+  stage.provide_plan(stage.plan_request()->sequence, synthetic_path());
+  step(21);
   EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
   EXPECT_TRUE(reference.feedback_law);
 }

@@ -70,7 +70,7 @@ struct InProcessStack::Stages {
   }
   double dt;
   MovePlanner plan_move;
-  std::uint32_t planned_request{0};  // the last plan request answered
+  std::uint64_t planned_sequence{0};  // the last plan request answered (PlanRequest::sequence)
   plant::PlantStage plant;
   state_estimator::StateEstimatorStage estimator;
   trajectory_planner::TrajectoryPlannerStage planner;
@@ -126,11 +126,11 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
   if (s.planner.step(cycle, s.reference) != common::StepStatus::ok) {
     throw std::runtime_error("in-process run: the planner did not answer cycle " + std::to_string(k));
   }
-  if (const auto& request = s.planner.plan_request(); request && request->request_id != s.planned_request) {
+  if (const auto& request = s.planner.plan_request(); request && request->sequence != s.planned_sequence) {
     // A minimum-time goal: solved here, in the cycle it arrived (the DDS planner node solves in
     // lockstep the same way, and on a worker thread in real time); its move starts next cycle.
-    s.planned_request = request->request_id;
-    s.planner.provide_plan(request->request_id, s.plan_move(*request));
+    s.planned_sequence = request->sequence;
+    s.planner.provide_plan(request->sequence, s.plan_move(*request));
   }
   if (s.anti_swing.step(s.estimate, previous, s.action) == common::StepStatus::rejected_nonfinite) {
     throw std::runtime_error("in-process run: the anti-swing law refused the estimate of cycle " + std::to_string(k));

@@ -79,16 +79,16 @@ class Planning {
 
   void poll(trajectory_planner::TrajectoryPlannerStage& stage) {
     if (worker_.valid() && worker_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-      stage.provide_plan(worker_id_, worker_.get());  // ignored if the request was dropped meanwhile
+      stage.provide_plan(worker_sequence_, worker_.get());  // ignored if the request was dropped meanwhile
     }
     const auto& request = stage.plan_request();
-    if (!request || request->request_id == started_id_ || worker_.valid()) return;
-    started_id_ = request->request_id;
+    if (!request || request->sequence == started_sequence_ || worker_.valid()) return;
+    started_sequence_ = request->sequence;
     if (lockstep_) {
-      stage.provide_plan(started_id_, plan(*request, facts_, params_));
+      stage.provide_plan(started_sequence_, plan(*request, facts_, params_));
       return;
     }
-    worker_id_ = started_id_;
+    worker_sequence_ = started_sequence_;
     worker_ = std::async(std::launch::async, [request = *request, facts = facts_, params = params_] {
       runtime::leave_realtime_this_thread();
       return plan(request, facts, params);
@@ -99,8 +99,8 @@ class Planning {
   bool lockstep_;
   common::StackFacts facts_;
   trajectory_planner::TrajectoryPlannerParams params_;
-  std::uint32_t started_id_{0};
-  std::uint32_t worker_id_{0};
+  std::uint64_t started_sequence_{0};
+  std::uint64_t worker_sequence_{0};
   std::future<std::shared_ptr<const trajectory_planner::PlannedPath>> worker_;
 };
 }  // namespace

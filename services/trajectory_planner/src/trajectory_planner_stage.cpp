@@ -268,15 +268,15 @@ void TrajectoryPlannerStage::plan_ahead(const protocol::MoveRequest& r, const co
       (zones_enabled_ != 0 && !params.site.zones.empty())) {
     return;
   }
-  const PlanRequest plan = plan_of(r, current, planner_.sample_now(),
-                                   bridge_ ? bridge_->planner.sample_now().trolley.position : 0.0);
-  plan_request_ = plan;
+  plan_request_ = plan_of(r, current, planner_.sample_now(),
+                         bridge_ ? bridge_->planner.sample_now().trolley.position : 0.0);
+  plan_request_->sequence = ++plan_sequence_;
   plan_answer_.reset();
   plan_answered_ = false;
 }
 
-void TrajectoryPlannerStage::provide_plan(std::uint32_t request_id, std::shared_ptr<const PlannedPath> path) noexcept {
-  if (!plan_request_ || plan_request_->request_id != request_id) return;
+void TrajectoryPlannerStage::provide_plan(std::uint64_t sequence, std::shared_ptr<const PlannedPath> path) noexcept {
+  if (!plan_request_ || plan_request_->sequence != sequence) return;
   plan_answer_ = std::move(path);
   plan_answered_ = true;
 }
@@ -521,6 +521,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       hold_for_plan(plan);
       active_ = false;
       plan_request_ = plan;
+      plan_request_->sequence = ++plan_sequence_;
       plan_fallback_ = r;
       plan_fallback_.profile = Request::PROFILE_TIME_OPTIMAL;
       plan_answered_ = false;

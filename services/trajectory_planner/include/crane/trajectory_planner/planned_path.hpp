@@ -55,7 +55,9 @@ class PlannedProfile final : public AxisProfile {
 
 /// What the planner stage asks to be planned: a goal with the minimum-time profile, from rest.
 struct PlanRequest {
-  std::uint32_t request_id{0};
+  std::uint64_t sequence{0};    // increases with every request the stage makes (a goal asked again, e.g.
+                                // after a mode change, gets a new one): provide_plan answers one
+  std::uint32_t request_id{0};  // the move request's
   double trolley_from{0.0}, slew_from{0.0}, cable_from{1.0};  // [m, rad, m] the rest it starts from
   double trolley_target{0.0}, slew_target{0.0}, cable_target{1.0};  // [m, rad, m]
   AxisLimits trolley_limits{}, slew_limits{}, cable_limits{};  // rated speed and acceleration (the goal's)

@@ -135,12 +135,12 @@ class TrajectoryPlannerStage {
   /// A goal with the minimum-time profile (PROFILE_MINIMUM_TIME) waiting for its plan, or empty:
   /// the crane holds where the move starts until provide_plan() hands the plan over (see the header).
   [[nodiscard]] const std::optional<PlanRequest>& plan_request() const noexcept { return plan_request_; }
-  /// The plan of the waiting goal `request_id`, taken at the next step: its path starts then, and the
-  /// reference carries the path's law of each cycle; null (not solved) or a path start_planned()
-  /// refuses: the goal runs the time-optimal profile (unsolved_plans() counts it). Ignored for an id
-  /// that is not waiting (replaced, stopped, cancelled by a fault or a mode change meanwhile).
-  /// Allocates nothing (the path is shared).
-  void provide_plan(std::uint32_t request_id, std::shared_ptr<const PlannedPath> path) noexcept;
+  /// The plan of request `sequence` (PlanRequest::sequence), taken at the next step: its path starts
+  /// then (or at the goal's start cycle), and the reference carries the path's law of each cycle;
+  /// null (not solved) or a path start_planned() refuses: the goal runs the time-optimal profile
+  /// (unsolved_plans() counts it). Ignored for a request that is no longer asked (replaced, stopped,
+  /// cancelled by a fault or a mode change meanwhile). Allocates nothing (the path is shared).
+  void provide_plan(std::uint64_t sequence, std::shared_ptr<const PlannedPath> path) noexcept;
   /// Minimum-time goals that ran the time-optimal profile for want of a plan.
   [[nodiscard]] std::uint64_t unsolved_plans() const noexcept { return unsolved_plans_; }
   /// The operating mode the stage applies (an OPERATION_* code).
@@ -231,6 +231,7 @@ class TrajectoryPlannerStage {
   // The minimum-time profile (planned_path.hpp).
   double max_swing_{0.0};                         // [rad] the supervisor's sway limit (0: not heard yet)
   std::optional<PlanRequest> plan_request_;       // a goal waiting for its plan
+  std::uint64_t plan_sequence_{0};                // the last PlanRequest::sequence given
   protocol::MoveRequest plan_fallback_{};         // that goal with the time-optimal profile
   std::shared_ptr<const PlannedPath> plan_answer_;  // handed over by provide_plan
   bool plan_answered_{false};
