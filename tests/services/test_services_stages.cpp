@@ -155,9 +155,8 @@ struct HeardPlanner {
 
 TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
   HeardPlanner p;
-  auto& stage = p.stage;
-  auto& reference = p.reference;
-  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  auto& [stage, reference, status] = p;
+  const auto step = [&p](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
   step(0);
   const Request goal = minimum_time_goal(3, 0.35);
   step(1, std::span(&goal, 1));
@@ -206,9 +205,8 @@ TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
 
 TEST(PlannerStage, AMinimumTimeGoalWithoutAPlanRunsTheTimeOptimalProfile) {
   HeardPlanner p;
-  auto& stage = p.stage;
-  auto& reference = p.reference;
-  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  auto& [stage, reference, status] = p;
+  const auto step = [&p](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
   step(0);
   const Request goal = minimum_time_goal(5, 0.55);
   step(1, std::span(&goal, 1));
@@ -237,9 +235,8 @@ TEST(PlannerStage, AMinimumTimeGoalWithoutAPlanRunsTheTimeOptimalProfile) {
 
 TEST(PlannerStage, AMinimumTimeGoalWaitingForItsCycleIsPlannedAheadAndStartsOnTime) {
   HeardPlanner p;
-  auto& stage = p.stage;
-  auto& reference = p.reference;
-  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
+  auto& [stage, reference, status] = p;
+  const auto step = [&p](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
   step(0);
   const Request goal = minimum_time_goal(8, 0.35, 20);
   step(1, std::span(&goal, 1));
@@ -291,7 +288,9 @@ TEST(PlannerStage, AWaitingMinimumTimeGoalIsPlannedOnceTheSwayLimitIsHeard) {
   for (std::uint64_t k = 2; k < 30; ++k) {
     const auto state = at_rest(k);
     (void)stage.step(trajectory_planner::PlannerCycle{&state, {}, {}, k >= 5 ? &status : nullptr}, reference);
-    if (k == 4) EXPECT_FALSE(stage.plan_request().has_value());
+    if (k == 4) {
+      EXPECT_FALSE(stage.plan_request().has_value());
+    }
     if (k == 5) {
       ASSERT_TRUE(stage.plan_request().has_value());
       stage.provide_plan(stage.plan_request()->sequence, synthetic_path());
@@ -306,13 +305,9 @@ TEST(PlannerStage, AWaitingMinimumTimeGoalIsPlannedOnceTheSwayLimitIsHeard) {
 // A plan request cancelled meanwhile (a change of operating mode) and asked again for the same goal
 // is a new request: an answer to the old one is ignored, the crane does not wait for it for ever.
 TEST(PlannerStage, AGoalAskedAgainIsANewPlanRequest) {
-  auto stage = lab_planner();
-  protocol::Reference reference;
-  auto status = with_sway_limit(0);
-  const auto step = [&](std::uint64_t k, std::span<const Request> goals = {}) {
-    const auto state = at_rest(k);
-    EXPECT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, goals, {}, &status}, reference), common::StepStatus::ok);
-  };
+  HeardPlanner p;
+  auto& [stage, reference, status] = p;
+  const auto step = [&p](std::uint64_t k, std::span<const Request> goals = {}) { p.step(k, goals); };
   step(0);
   const Request goal = minimum_time_goal(12, 0.35, 20);
   step(1, std::span(&goal, 1));
