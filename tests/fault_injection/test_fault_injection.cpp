@@ -737,14 +737,30 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
   int protective_stops = 0;  // moves the supervisor stopped itself before the command was typed
   for (int i = 0; i < 2 * kStops; ++i) {
     const bool via_relay = i % 2 == 0;
-    // To the far end of the planner's travel [0.2, 1.1] m from where the last stop left the trolley.
-    // The stops leave the load swinging, and the anti-swing law's action on top of the move can take
-    // the trolley past the supervisor's trolley_max_speed (a protective stop, fault
-    // trolley_overspeed): that move is not driving when the command would be typed; it is reset and
-    // moved again (at most 3 times a stop), and the count is printed.
+    // To 0.3 or 1.0 m, whichever is farther from where the last stop left the trolley: 10 cm inside
+    // the planner's travel [0.2, 1.1] m. The stops leave the load swinging, and the anti-swing law's
+    // action on top of the move can take the trolley past the supervisor's trolley_max_speed (a
+    // protective stop, fault trolley_overspeed): that move is not driving when the command would be
+    // typed; it is reset and moved again (at most 3 times a stop), and the count is printed. A
+    // --direct stop can come seconds late, after its move has ended: the swinging load then carries
+    // the trolley up to 12 cm past the goal (0.2 m once, 2026-11-25, in CI: to 0.0797 m, inside the
+    // supervisor's stop margin, trolley_travel latched, and every reset re-raised it while the load
+    // swung toward the limit). Hence the 10 cm, and a crane found faulted before its move is reset
+    // and counted the same way.
     for (int attempt = 0;; ++attempt) {
+      stack.run_for(0.2);  // a fault re-raised just after the reset is seen here
       const double at = stack.sensors().empty() ? 0.25 : stack.sensors().back().trolley_position();
-      ASSERT_TRUE(stack.start_move(at < 0.65 ? 1.1 : 0.2)) << "stop " << i << " from " << at << " m";
+      if (stack.status() && stack.status()->mode() == Status::MODE_FAULT) {
+        ASSERT_LT(attempt, 3) << "the supervisor kept the crane faulted before stop " << i << "\n"
+                              << recent_history(stack, hb::monotonic_time_ns());
+        ++protective_stops;
+        std::printf("[ note     ] stop %d: the crane was faulted before its move (faults 0x%x latched); reset\n", i,
+                    stack.status()->latched_faults());
+        ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
+        ASSERT_TRUE(stack.wait_ready(10.0)) << "after the protective stop before stop " << i;
+        continue;
+      }
+      ASSERT_TRUE(stack.start_move(at < 0.65 ? 1.0 : 0.3)) << "stop " << i << " from " << at << " m";
       stack.run_for(0.5);
       ASSERT_TRUE(stack.status().has_value());
       if (stack.status()->mode() != Status::MODE_FAULT) break;
@@ -781,7 +797,9 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
     // handshakes, which take seconds on a loaded machine (3162 ms once, 2026-11-24, in a CI
     // rehearsal): a figure (printed), and its bound the command's own --timeout (rc 0 above: it saw
     // the supervisor's answer within it).
-    if (via_relay) EXPECT_LT(ms, 3000.0) << "at once: no package check, no build";
+    if (via_relay) {
+      EXPECT_LT(ms, 3000.0) << "at once: no package check, no build";
+    }
     ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
     ASSERT_TRUE(stack.wait_ready(10.0)) << "after stop " << i;
   }
