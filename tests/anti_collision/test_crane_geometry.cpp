@@ -142,11 +142,13 @@ TEST(CraneGeometry, LoadAgainstLoad) {
   EXPECT_EQ(d.second, Part::load);
 }
 
-// The stopping travel by hand: trolley at 0.5 m/s, 0.5 m/s^2, reaction 0.1 s, ZV shaped on a
-// cable of g/1 m (omega = 1 rad/s, T = 2 pi s): 0.05 + 0.25 + 0.5 pi/2; the emergency stop at three
-// times the deceleration, no shaping: 0.05 + 0.25/3, and the load's swing v/omega.
+// The stopping travel by hand: trolley at 0.5 m/s, 0.5 m/s^2, reaction 0.1 s, ZV shaped (mean
+// delay T/4) on a cable of g/1 m (omega = 1 rad/s, T = 2 pi s): 0.05 + 0.25 + 0.5 pi/2; ZVD (T/2):
+// 0.05 + 0.25 + 0.5 pi; the emergency stop at three times the deceleration, no shaping:
+// 0.05 + 0.25/3, and the load's swing v/omega.
 TEST(CraneGeometry, StoppingTravelOfShapedAndEmergencyStops) {
-  const SiteCrane c = tower(0.0, 0.0, 40.0);
+  SiteCrane c = tower(0.0, 0.0, 40.0);
+  c.stopping.soft_stop_delay_periods = 0.25;  // ZV
   CraneMotion m;
   m.trolley = 20.0;
   m.trolley_velocity = -0.5;
@@ -159,10 +161,15 @@ TEST(CraneGeometry, StoppingTravelOfShapedAndEmergencyStops) {
   EXPECT_NEAR(hard.trolley, -(0.05 + 0.25 / 3.0), 1e-12);
   EXPECT_NEAR(hard.swing_radius, 0.5 / 1.0, 1e-12);  // v / omega
   SiteCrane unshaped = c;
-  unshaped.stopping.shaped_soft_stop = false;
+  unshaped.stopping.soft_stop_delay_periods = 0.0;
   const auto plain = stopping_travel(unshaped, m, StopKind::soft);
   EXPECT_NEAR(plain.trolley, -(0.05 + 0.25), 1e-12);
   EXPECT_NEAR(plain.swing_radius, 2.0 * 0.5, 1e-12);  // 2 L a / g
+  SiteCrane zvd = c;
+  zvd.stopping.soft_stop_delay_periods = 0.5;
+  const auto longer = stopping_travel(zvd, m, StopKind::soft);
+  EXPECT_NEAR(longer.trolley, -(0.05 + 0.25 + 0.5 * 2.0 * kPi / 2.0), 1e-12);
+  EXPECT_NEAR(longer.swing_radius, 0.5, 1e-12);  // L a / g, shaped
 }
 
 // The envelope contains the stop: the crane's parts at 200 poses along the same stop (slew and

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -38,7 +39,7 @@ std::string edited(const std::string& pattern, const std::string& replacement) {
 // The message of the ConfigError parsing `text` throws ("" when none).
 std::string refusal(const std::string& text) {
   try {
-    (void)parse_site_layout(text, "site.yaml");
+    (void)parse_site_layout(text, "site.yaml", std::filesystem::path(kSitePath).parent_path());
   } catch (const ConfigError& error) {
     return error.what();
   }
@@ -54,7 +55,10 @@ TEST(SiteLayout, ShippedSiteLoads) {
   EXPECT_EQ(site.cranes[2].priority, 1);
   EXPECT_EQ(site.cranes[1].domain_id, 12);
   EXPECT_DOUBLE_EQ(site.margins.stop, 0.05);
-  EXPECT_TRUE(site.cranes[0].stopping.shaped_soft_stop);
+  // From lab_tower_crane.yaml's manual.shaping: zvd, impulses 1/4, 1/2, 1/4 at 0, T/2, T.
+  EXPECT_NEAR(site.cranes[0].stopping.soft_stop_delay_periods, 0.5, 1e-12);
+  EXPECT_EQ(std::filesystem::path(site.cranes[0].config),
+            (std::filesystem::path(kSitePath).parent_path() / "lab_tower_crane.yaml").lexically_normal());
   ASSERT_EQ(site.zones.size(), 1u);
   EXPECT_TRUE(site.zones[0].fixed);
   EXPECT_EQ(find_crane(site, "tc3"), 2);
@@ -89,6 +93,13 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             0u);
   EXPECT_EQ(refusal(edited("bottom: 0.0", "bottom: 2.0")).rfind("site.yaml: site.zones[0] (site office)", 0), 0u)
       << refusal(edited("bottom: 0.0", "bottom: 2.0"));
+  // The crane's own config: missing, or not a stack config (its soft stop's shaper is read there).
+  const std::string missing = refusal(edited("config: lab_tower_crane.yaml", "config: no_such_crane.yaml"));
+  EXPECT_EQ(missing.rfind("site.yaml: site.cranes[0].config = \"no_such_crane.yaml\": the crane's config "
+                          "no_such_crane.yaml: ", 0), 0u) << missing;
+  EXPECT_EQ(refusal(edited("config: lab_tower_crane.yaml", "config: site_three_towers.yaml")),
+            "site.yaml: site.cranes[0].config = \"site_three_towers.yaml\": the crane's config "
+            "site_three_towers.yaml: missing field trajectory_planner");
 }
 
 // tc2 moved to 1.5 m from tc1: its jib (1.4 m, radius 0.05) reaches tc1's mast (radius 0.0566) with

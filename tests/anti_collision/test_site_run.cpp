@@ -28,7 +28,7 @@ const std::string kSource = CRANE_SOURCE_DIR;
 
 TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
-  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const StackConfig config = load_site_crane_config(site);
   double coordinated_total = 0.0;
   double serialized_total = 0.0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
@@ -58,7 +58,7 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
 // cable (2 m: 1.42 s) and one swing period of the drives' settling (2.84 s), 5.6 s in all.
 TEST(SiteRun, LostLinksAndARestartedSiteServiceKeepTheMarginAndStopInBoundedTime) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
-  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const StackConfig config = load_site_crane_config(site);
   const auto jobs = random_site_jobs(site, config, 2, 11);
   SiteRunOptions options;
   options.faults = {{0, 10.0, 5.0}, {1, 25.0, 5.0}, {2, 40.0, 5.0}, {kSiteService, 60.0, 3.0}};
@@ -84,7 +84,7 @@ TEST(SiteRun, LostLinksAndARestartedSiteServiceKeepTheMarginAndStopInBoundedTime
 // crane (the guard's containment does not stop healthy cranes).
 TEST(SiteRun, ACraneThatLeavesItsGrantIsBrakedByItsOwnGuard) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
-  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const StackConfig config = load_site_crane_config(site);
   const auto jobs = random_site_jobs(site, config, 2, 11);
   SiteRunOptions options;
   options.time_limit = 120.0;
@@ -106,7 +106,7 @@ TEST(SiteRun, ACraneThatLeavesItsGrantIsBrakedByItsOwnGuard) {
 TEST(SiteRun, ASiteOfOneCraneRunsAsThatCraneAlone) {
   auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   site.cranes.resize(1);
-  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const StackConfig config = load_site_crane_config(site);
   const auto jobs = random_site_jobs(site, config, 2, 7);
   const SiteOutcome on_site = run_site(site, config, jobs, in_mode(SiteMode::coordinated));
   const SiteOutcome alone = run_site(site, config, jobs, in_mode(SiteMode::solo));
@@ -119,7 +119,7 @@ TEST(SiteRun, ASiteOfOneCraneRunsAsThatCraneAlone) {
 
 TEST(SiteRun, JobListsMustMatchTheCranes) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
-  const StackConfig config = load_stack_config(kSource + "/deploy/config/lab_tower_crane.yaml");
+  const StackConfig config = load_site_crane_config(site);
   EXPECT_THROW((void)run_site(site, config, {{}}, {}), std::invalid_argument);
 }
 

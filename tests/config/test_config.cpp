@@ -610,9 +610,16 @@ TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
   message = error_of(edit_line(text_, "manual:", "swing_damping_ratio:", "swing_damping_ratio: 0.5").text);
   EXPECT_TRUE(contains(message, "trajectory_planner.manual.swing_damping_ratio = 0.5")) << message;
   EXPECT_TRUE(contains(message, "[0, 0.3]")) << message;
+  // The supervisor's model of the soft stop follows the shaper: two_hump_ei's mean delay is 3/4 of
+  // a period (impulses symmetric about 3/4 T), zvd's 1/2.
+  const std::string two_hump = edit_line(text_, "manual:", "shaping:", "shaping: two_hump_ei").text;
+  message = error_of(two_hump);
+  EXPECT_TRUE(contains(message, "test.yaml: supervisor.zone_stop_delay_periods = 0.5 does not describe the planner's "
+                                "soft stop: trajectory_planner.manual.shaping = two_hump_ei delays it by 0.75 swing "
+                                "periods")) << message;
   const auto calibrated = cfg::parse_stack_config(
-      edit_line(edit_line(text_, "manual:", "shaping:", "shaping: two_hump_ei").text, "manual:", "swing_length_offset:",
-                "swing_length_offset: 0.25")
+      edit_line(edit_line(two_hump, "supervisor:", "zone_stop_delay_periods:", "zone_stop_delay_periods: 0.75").text,
+                "manual:", "swing_length_offset:", "swing_length_offset: 0.25")
           .text,
       "test.yaml");
   EXPECT_EQ(calibrated.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::two_hump_ei);

@@ -241,6 +241,7 @@ TEST(SwingCalibration, ThePlannerLoadsTheResult) {
   const CalibrationOptions options;
   const ShaperRecommendation rec = recommend_shaper(fit, 1.0, options);
   const std::string lines = planner_manual_yaml(fit, rec, "run.csv");
+  const std::string supervisor_line = supervisor_yaml(fit, rec);
   std::ifstream in(std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_tower_crane.yaml");
   std::stringstream text;
   text << in.rdbuf();
@@ -258,6 +259,10 @@ TEST(SwingCalibration, ThePlannerLoadsTheResult) {
       inserted = true;
       continue;
     }
+    if (line.rfind("  zone_stop_delay_periods:", 0) == 0) {
+      edited += supervisor_line;
+      continue;
+    }
     edited += line + "\n";
   }
   ASSERT_TRUE(inserted);
@@ -267,6 +272,8 @@ TEST(SwingCalibration, ThePlannerLoadsTheResult) {
   EXPECT_NEAR(manual.swing_length_scale, 0.9951, 1e-12);
   EXPECT_NEAR(manual.swing_length_offset, 0.2566, 1e-12);
   EXPECT_NEAR(manual.swing_damping_ratio, 0.0012, 1e-12);
+  EXPECT_NEAR(config.supervisor.zone_stop_delay_periods,
+              tp::shaper_delay_periods(manual.shaping, manual.swing_damping_ratio), 1e-6);
 }
 
 // Closed loop through the whole stack in one process (stack::InProcessStack, every stage object and

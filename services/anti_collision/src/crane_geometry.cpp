@@ -112,8 +112,8 @@ StoppingTravel stopping_travel(const SiteCrane& crane, const CraneMotion& m, Sto
 
   const StoppingData& d = crane.stopping;
   const double factor = kind == StopKind::emergency ? d.brake_deceleration_factor : 1.0;
-  const bool shaped = kind == StopKind::soft && d.shaped_soft_stop;
-  const double shaping_delay = shaped ? 2.0 * std::numbers::pi / omega / 4.0 : 0.0;
+  const bool shaped = kind == StopKind::soft && d.soft_stop_delay_periods > 0.0;
+  const double shaping_delay = shaped ? d.soft_stop_delay_periods * 2.0 * std::numbers::pi / omega : 0.0;
   const double a_trolley = d.trolley_deceleration * factor;
   const double a_slew = d.slew_deceleration * factor;
   out.slew = sign(m.slew_rate) * travel(m.slew_rate, a_slew, d.reaction_time, shaping_delay);

@@ -6,6 +6,7 @@
 #include "crane/common/validation.hpp"
 #include "crane/config/config_document.hpp"
 #include "crane/config/yaml_section.hpp"
+#include "crane/trajectory_planner/speed_reference.hpp"
 #include "site_ranges.hpp"
 
 namespace crane::anti_collision {
@@ -21,14 +22,33 @@ StoppingData read_stopping(config::YamlSection s) {
   d.slew_deceleration = s.number("slew_deceleration", kDeceleration.lower, kDeceleration.upper);
   d.hoist_deceleration = s.number("hoist_deceleration", kDeceleration.lower, kDeceleration.upper);
   d.brake_deceleration_factor = s.number("brake_deceleration_factor", kBrakeFactor.lower, kBrakeFactor.upper);
-  d.shaped_soft_stop = s.flag("shaped_soft_stop");
   s.finish();
   return d;
 }
 
+// The soft stop's shaper delay of the crane whose stack config is `path`: its planner's
+// trajectory_planner.manual.shaping and swing_damping_ratio, read here and nowhere else on the site
+// (the crane's processes and crane::stack::load_stack_config validate the rest of that file).
+double soft_stop_delay_periods(const std::filesystem::path& path) {
+  const std::string name = path.filename().string();
+  try {
+    const YAML::Node root = config::parse_yaml_mapping(config::read_text_file(path.string()), name);
+    config::YamlSection document(root, "");
+    config::YamlSection planner = document.child("trajectory_planner");
+    config::YamlSection manual = planner.child("manual");
+    const auto shaping =
+        trajectory_planner::speed_shaping_from_string(manual.text("shaping"), manual.field("shaping"));
+    const double damping = manual.number("swing_damping_ratio", 0.0, 0.3);
+    return trajectory_planner::shaper_delay_periods(shaping, damping);
+  } catch (const ConfigError& error) {
+    throw ConfigError(std::string("the crane's config ") + name + ": " + error.what());
+  }
+}
+
 }  // namespace
 
-SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& source_name) {
+SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& source_name,
+                             const std::filesystem::path& directory) {
   const YAML::Node root = config::parse_yaml_mapping(yaml_text, source_name);
   SiteLayout layout;
   try {
@@ -76,6 +96,13 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
       crane.max_slew_rate = c.number("max_slew_rate", kSpeed.lower, kSpeed.upper);
       crane.max_hoist_speed = c.number("max_hoist_speed", kSpeed.lower, kSpeed.upper);
       crane.stopping = read_stopping(c.child("stopping"));
+      const std::string named = c.text("config");
+      crane.config = (directory / named).lexically_normal().string();
+      try {
+        crane.stopping.soft_stop_delay_periods = soft_stop_delay_periods(crane.config);
+      } catch (const ConfigError& error) {
+        throw ConfigError(c.field("config") + " = \"" + named + "\": " + error.what());
+      }
       crane.domain_id = c.integer("domain_id", 0, kMaxDomain);
       crane.priority = c.integer("priority", 0, kMaxPriority);
       c.finish();
@@ -93,7 +120,8 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
 }
 
 SiteLayout load_site_layout(const std::string& path) {
-  return parse_site_layout(config::read_text_file(path), std::filesystem::path(path).filename().string());
+  const std::filesystem::path file(path);
+  return parse_site_layout(config::read_text_file(path), file.filename().string(), file.parent_path());
 }
 
 }  // namespace crane::anti_collision

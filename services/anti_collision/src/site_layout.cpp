@@ -97,6 +97,8 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
                      kDeceleration.upper);
     require_in_range(p + ".stopping.brake_deceleration_factor", d.brake_deceleration_factor, kBrakeFactor.lower,
                      kBrakeFactor.upper);
+    require_in_range(p + ".stopping.soft_stop_delay_periods", d.soft_stop_delay_periods, kDelayPeriods.lower,
+                     kDelayPeriods.upper);
     if (c.domain_id < 0 || c.domain_id > kMaxDomain) {
       throw ConfigError(p + ".domain_id = " + std::to_string(c.domain_id) + " is out of range: must be in [0, " +
                         std::to_string(kMaxDomain) + "]");

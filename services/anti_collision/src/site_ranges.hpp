@@ -23,6 +23,7 @@ inline constexpr Range kSpeed{1.0e-3, 20.0};
 inline constexpr Range kReaction{0.0, 5.0};
 inline constexpr Range kDeceleration{1.0e-3, 50.0};
 inline constexpr Range kBrakeFactor{1.0, 100.0};
+inline constexpr Range kDelayPeriods{0.0, 3.0};  // [swing periods] as the supervisor's zone_stop_delay_periods
 inline constexpr Range kMargin{1.0e-3, 100.0};
 inline constexpr Range kDeadline{1.0e-3, 10.0};
 inline constexpr Range kOvershoot{0.0, 10.0};

@@ -110,14 +110,13 @@ struct SetResult {
   std::string error;
 };
 
-int demo(const std::string& site_path, const std::string& config_path, int sets, int jobs, std::uint64_t seed,
-         int threads, int faults) {
+int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults) {
   using namespace crane::stack;
   SiteLayout site;
   StackConfig config;
   try {
     site = load_site_layout(site_path);
-    config = load_stack_config(config_path);
+    config = load_site_crane_config(site);
   } catch (const crane::common::ConfigError& error) {
     std::cerr << error.what() << "\n";
     return 2;
@@ -251,12 +250,10 @@ int main(int argc, char** argv) {
   std::string site_path;
   CLI::App* check_command = app.add_subcommand("check", "validate a site file and print its pairs of cranes");
   check_command->add_option("--site", site_path, "the site file (deploy/config/site_three_towers.yaml)")->required();
-  std::string config_path;
   int sets = 10, jobs = 3, threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::uint64_t seed = 1;
   CLI::App* demo_command = app.add_subcommand("demo", "the simulated site: seeded job sets, coordinated vs serialized vs solo");
   demo_command->add_option("--site", site_path, "the site file")->required();
-  demo_command->add_option("--config", config_path, "every crane's stack config (deploy/config/lab_tower_crane.yaml)")->required();
   demo_command->add_option("--sets", sets, "job sets")->check(CLI::Range(1, 100000));
   demo_command->add_option("--jobs", jobs, "pick-and-place jobs per crane and set")->check(CLI::Range(1, 100));
   demo_command->add_option("--seed", seed, "the first set's seed");
@@ -265,6 +262,6 @@ int main(int argc, char** argv) {
   demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
   CLI11_PARSE(app, argc, argv);
   if (check_command->parsed()) return check(site_path);
-  if (demo_command->parsed()) return demo(site_path, config_path, sets, jobs, seed, threads, faults);
+  if (demo_command->parsed()) return demo(site_path, sets, jobs, seed, threads, faults);
   return 1;
 }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/common/validation.hpp"
 #include "crane/anti_collision/grant_guard.hpp"
 #include "crane/common/site.hpp"
 #include "crane/stack/in_process_stack.hpp"
@@ -471,6 +472,18 @@ const char* to_string(SiteMode mode) noexcept {
     case SiteMode::solo: return "solo";
   }
   return "?";
+}
+
+StackConfig load_site_crane_config(const ac::SiteLayout& site) {
+  if (site.cranes.empty()) throw common::ConfigError("site.cranes: the site has no crane");
+  for (std::size_t i = 1; i < site.cranes.size(); ++i) {
+    if (site.cranes[i].config != site.cranes[0].config) {
+      throw common::ConfigError("site.cranes[" + std::to_string(i) + "].config = " + site.cranes[i].config +
+                                " differs from site.cranes[0].config = " + site.cranes[0].config +
+                                ": the simulated site runs one crane config");
+    }
+  }
+  return load_stack_config(site.cranes[0].config);
 }
 
 SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, const std::vector<std::vector<SiteJob>>& jobs,

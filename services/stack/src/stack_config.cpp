@@ -1,15 +1,20 @@
 #include "crane/stack/stack_config.hpp"
 
+#include <cmath>
 #include <numbers>
 #include <stdexcept>
 
+#include "crane/common/validation.hpp"
 #include "crane/config/config_document.hpp"
+#include "crane/trajectory_planner/speed_reference.hpp"
 
 namespace crane::stack {
 
 namespace {
 
 using common::ConfigError;
+
+constexpr double kDelayPeriodsTolerance = 1e-3;  // [swing periods] a config's rounding of the shaper's mean delay
 
 ManeuverConfig read_maneuver(config::YamlSection& s, bool bridge) {
   constexpr double kDeg = std::numbers::pi / 180.0;
@@ -52,6 +57,18 @@ StackConfig read(const config::ConfigDocument& doc) {
   c.hardware_bridge = doc.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
     return hardware_bridge::read_params(block, facts, c.actuation);
   });
+  // One description of the soft stop: the supervisor's zone guard (and through it the site's
+  // stopping model, anti_collision::StoppingData) predicts a shaped stop's extra travel from
+  // zone_stop_delay_periods; the planner shapes the stop with manual.shaping. They must agree.
+  const auto& manual = c.trajectory_planner.manual;
+  const double shaper_delay = trajectory_planner::shaper_delay_periods(manual.shaping, manual.swing_damping_ratio);
+  if (!(std::abs(c.supervisor.zone_stop_delay_periods - shaper_delay) <= kDelayPeriodsTolerance)) {
+    throw ConfigError(doc.source_name() + ": supervisor.zone_stop_delay_periods = " +
+                      common::format_value(c.supervisor.zone_stop_delay_periods) +
+                      " does not describe the planner's soft stop: trajectory_planner.manual.shaping = " +
+                      trajectory_planner::to_string(manual.shaping) + " delays it by " +
+                      common::format_value(shaper_delay) + " swing periods (its mean, sum A_i t_i)");
+  }
   c.maneuvers = doc.read_root([](config::YamlSection& root, const common::StackFacts& facts) {
     std::vector<ManeuverConfig> maneuvers;
     const bool bridge = facts.crane_kind == common::CraneKind::overhead;

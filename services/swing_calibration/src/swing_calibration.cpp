@@ -489,6 +489,14 @@ std::string planner_manual_yaml(const SwingFit& fit, const ShaperRecommendation&
   return buffer;
 }
 
+std::string supervisor_yaml(const SwingFit& fit, const ShaperRecommendation& rec) {
+  const double delay = tp::shaper_delay_periods(speed_shaping(rec.rows[rec.recommended].kind),
+                                                std::min(fit.damping_ratio, 0.3));
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "  zone_stop_delay_periods: %.6f  # the shaper's mean delay, sum A_i t_i\n", delay);
+  return buffer;
+}
+
 std::string format_report(const SwingFit& fit, const ShaperRecommendation& rec, const CalibrationOptions& options) {
   std::ostringstream out;
   char line[512];

@@ -87,8 +87,12 @@ int main(int argc, char** argv) {
         cable_length > 0.0 ? cable_length : 0.5 * (fit.min_cable_length + fit.max_cable_length);
     const sc::ShaperRecommendation rec = sc::recommend_shaper(fit, design_length, options);
     const std::string report = sc::format_report(fit, rec, options);
-    const std::string yaml = sc::planner_manual_yaml(fit, rec, source.empty() ? data : source);
-    std::printf("%s\nfor the planner (trajectory_planner.manual in the config):\n%s", report.c_str(), yaml.c_str());
+    const std::string planner = sc::planner_manual_yaml(fit, rec, source.empty() ? data : source);
+    const std::string supervisor = sc::supervisor_yaml(fit, rec);
+    std::printf("%s\nfor the planner (trajectory_planner.manual in the config):\n%s"
+                "and for the supervisor (supervisor in the config: its model of the same soft stop):\n%s",
+                report.c_str(), planner.c_str(), supervisor.c_str());
+    const std::string yaml = "# trajectory_planner.manual:\n" + planner + "# supervisor:\n" + supervisor;
     if (!out.empty()) {
       write_outputs(out, record, fit, rec, report, yaml);
       std::printf("wrote %s/{report.txt,calibration.yaml,fit.csv,shapers.csv}\n", out.c_str());

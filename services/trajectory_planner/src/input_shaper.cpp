@@ -157,6 +157,12 @@ double InputShaper::time(std::size_t i) const noexcept {
   return times_[i];
 }
 
+double InputShaper::mean_delay() const noexcept {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < count_; ++i) sum += amplitudes_[i] * times_[i];
+  return sum;
+}
+
 double InputShaper::residual_vibration(double frequency, double damping_ratio) const noexcept {
   // V = exp(-zeta w t_N) sqrt(C^2 + S^2), C = sum A_i exp(zeta w t_i) cos(w_d t_i), S likewise.
   const double damped = frequency * std::sqrt(1.0 - damping_ratio * damping_ratio);

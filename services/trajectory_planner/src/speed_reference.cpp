@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace crane::trajectory_planner {
 namespace {
@@ -139,6 +140,27 @@ SpeedShaping speed_shaping_from_string(const std::string& text, const std::strin
   throw common::ConfigError(field + " = \"" + text + "\" is not a shaping: must be one of " + names);
 }
 
+namespace {
+ShaperKind shaper_kind(SpeedShaping shaping) noexcept {
+  switch (shaping) {
+    case SpeedShaping::zv: return ShaperKind::zv;
+    case SpeedShaping::ei: return ShaperKind::ei;
+    case SpeedShaping::mzv: return ShaperKind::mzv;
+    case SpeedShaping::two_hump_ei: return ShaperKind::two_hump_ei;
+    default: return ShaperKind::zvd;
+  }
+}
+}  // namespace
+
+double shaper_delay_periods(SpeedShaping shaping, double damping_ratio) {
+  if (shaping == SpeedShaping::none) return 0.0;
+  ShaperParams p;
+  p.kind = shaper_kind(shaping);
+  p.natural_frequency = 1.0;  // [rad/s]: the period is 2 pi s
+  p.damping_ratio = damping_ratio;
+  return InputShaper(p).mean_delay() / (2.0 * std::numbers::pi);
+}
+
 std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const ManualParams& params,
                                                    const SpeedBounds& bounds, double dt) const noexcept {
   std::array<InputShaper, 3> s{};  // identity shapers
@@ -147,13 +169,7 @@ std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const M
   const double cable = params.swing_length_scale * axes_[2].position() + params.swing_length_offset;
   if (!(cable > 0.0) || !(bounds.gravity > 0.0)) return s;
   ShaperParams p;
-  switch (shaping) {
-    case SpeedShaping::zv: p.kind = ShaperKind::zv; break;
-    case SpeedShaping::ei: p.kind = ShaperKind::ei; break;
-    case SpeedShaping::mzv: p.kind = ShaperKind::mzv; break;
-    case SpeedShaping::two_hump_ei: p.kind = ShaperKind::two_hump_ei; break;
-    default: p.kind = ShaperKind::zvd; break;
-  }
+  p.kind = shaper_kind(shaping);
   p.damping_ratio = params.swing_damping_ratio;
   p.natural_frequency = std::sqrt(bounds.gravity / cable);
   // A shaper longer than the history cannot be applied; the identity stays (cable beyond ~25 m at 100 Hz).

@@ -18,13 +18,14 @@
 // point can be between two samples (2 R sin(delta/4) of the slew step delta at the largest
 // radius R, plus half the trolley step), so the union of the samples contains the whole sweep.
 //   travel of an axis at speed v, deceleration a, reaction time t_r:
-//     s = |v| t_r + v^2 / (2 a)  (+ |v| T / 4 when the soft stop is ZV input shaped: the shaper's
-//     second half-impulse, T/2 later, leaves the mean stop T/4 later; T = 2 pi sqrt(L / g))
+//     s = |v| t_r + v^2 / (2 a)  (+ |v| k T when the soft stop is input shaped, k the shaper's mean
+//     delay sum A_i t_i in periods, StoppingData::soft_stop_delay_periods: ZV 1/4 (its second
+//     half-impulse T/2 later), ZVD 1/2; T = 2 pi sqrt(L / g))
 //   swing envelope (horizontal radius of the load about the sheave's vertical):
 //     L sin(A), A = sqrt(phi^2 + theta^2 + (phi'^2 + theta'^2) / omega^2), omega = sqrt(g / L)
 //     (the amplitude of the measured swing, small-angle pendulum), plus during the stop
-//     soft, shaped:   L a_h / g       (a ZV-shaped deceleration step never swings past its static
-//                                       deflection a_h / g)
+//     soft, shaped:   L a_h / g       (a deceleration step shaped by positive impulses (ZV, ZVD)
+//                                       never swings past its static deflection a_h / g)
 //     soft, unshaped: 2 L a_h / g     (a deceleration step overshoots to twice the deflection)
 //     emergency:      v_h / omega     (the brakes stop the trolley at once; the load keeps v_h)
 //   a_h, v_h: the sheave's horizontal deceleration and speed (trolley and r x slew rate).

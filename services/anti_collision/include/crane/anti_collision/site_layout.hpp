@@ -34,8 +34,11 @@ struct StoppingData {
   double slew_deceleration{0.5};      // [rad/s^2] a soft stop of the slew
   double hoist_deceleration{0.5};     // [m/s^2] a soft stop of the hoist
   double brake_deceleration_factor{3.0};  // emergency stop (brakes) decelerates this many times faster, >= 1
-  bool shaped_soft_stop{true};        // the soft stop is input shaped (ZV): it travels v T/4 further and
-                                      // leaves no residual swing (Singer & Seering 1990)
+  double soft_stop_delay_periods{0.5};  // [swing periods] the mean delay sum A_i t_i of the shaper of the
+                                        // soft stop, in [0, 3]: it travels v T times this further (zvd 0.5,
+                                        // zv 0.25) and leaves no residual swing (Singer & Seering 1990); 0:
+                                        // unshaped. The site file takes it from the crane's own config
+                                        // (trajectory_planner.manual.shaping), never from the site's.
 };
 
 /// One crane of the site.
@@ -61,6 +64,8 @@ struct SiteCrane {
   double max_slew_rate{1.0};          // [rad/s]
   double max_hoist_speed{0.2};        // [m/s]
   StoppingData stopping;
+  std::string config;                 // the crane's stack config (deploy/config/*.yaml): the path the site
+                                      // file names, relative to the site file's directory, resolved
   int domain_id{0};                   // the crane's own DDS domain, unique on the site, in [0, 232]
   int priority{0};                    // higher wins a conflict (0: none); see the site rules
 };

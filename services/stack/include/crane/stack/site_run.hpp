@@ -134,8 +134,14 @@ struct SiteOutcome {
   std::string guard_first;
 };
 
+/// The stack config every crane of the simulated site runs: the one the site file's cranes name
+/// (SiteCrane::config), loaded with load_stack_config. Throws common::ConfigError when the cranes
+/// name different configs ("site.cranes[1].config = ... differs from site.cranes[0].config = ...:
+/// the simulated site runs one crane config") or it does not load.
+[[nodiscard]] StackConfig load_site_crane_config(const anti_collision::SiteLayout& site);
+
 /// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`
-/// (its stack; the site file gives where it stands and its shape).
+/// (its stack, load_site_crane_config; the site file gives where it stands and its shape).
 [[nodiscard]] SiteOutcome run_site(const anti_collision::SiteLayout& site, const StackConfig& config,
                                    const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options);
 

@@ -8,6 +8,9 @@
 // value and the bound, e.g.
 //   "lab.yaml: crane.load_mass = -2 is out of range: must be in [0, 100000]"
 //   "lab.yaml: missing field tracking.proportional_gain"
+// One rule across blocks: supervisor.zone_stop_delay_periods must be the mean delay of the shaper
+// of trajectory_planner.manual.shaping (trajectory_planner::shaper_delay_periods, within 1e-3),
+// since both describe the one soft stop.
 
 #include <string>
 #include <vector>

@@ -145,6 +145,12 @@ struct ShaperRecommendation {
 [[nodiscard]] std::string planner_manual_yaml(const SwingFit& fit, const ShaperRecommendation& recommendation,
                                               const std::string& source);
 
+/// The supervisor's line that goes with them: `zone_stop_delay_periods`, the recommended shaper's
+/// mean delay in swing periods (trajectory_planner::shaper_delay_periods at the fitted damping),
+/// which the stack's config loader requires to match manual.shaping. Indented for the
+/// `supervisor:` block.
+[[nodiscard]] std::string supervisor_yaml(const SwingFit& fit, const ShaperRecommendation& recommendation);
+
 /// The table (fit and shapers) as printed by the tool.
 [[nodiscard]] std::string format_report(const SwingFit& fit, const ShaperRecommendation& recommendation,
                                         const CalibrationOptions& options);

@@ -74,6 +74,9 @@ class InputShaper {
   [[nodiscard]] double time(std::size_t i) const noexcept;
   /// Time of the last impulse [s]: the delay the shaper adds to a command.
   [[nodiscard]] double length() const noexcept { return times_[count_ - 1]; }
+  /// Mean delay [s], sum A_i t_i: how much later than the unshaped command the shaped one's
+  /// displacement comes, once both have ended (a shaped stop travels v * mean_delay() further).
+  [[nodiscard]] double mean_delay() const noexcept;
 
   /// Percentage residual vibration [-] of a mode of frequency `frequency` [rad/s] and damping
   /// `damping_ratio` [-] excited by the impulse train, relative to a single unit impulse

@@ -42,6 +42,13 @@ enum class SpeedShaping {
 [[nodiscard]] const char* to_string(SpeedShaping shaping) noexcept;
 /// Parses a config name; throws common::ConfigError naming `field`, the value and the names.
 [[nodiscard]] SpeedShaping speed_shaping_from_string(const std::string& text, const std::string& field);
+/// The mean delay of `shaping`'s shaper (InputShaper::mean_delay) in undamped swing periods
+/// 2 pi sqrt(L/g) [-], for a swing of damping ratio `damping_ratio` [-]: how much further a stop
+/// shaped with it travels, v T times this (zvd 0.5, zv 0.25, none 0; independent of L). It is the
+/// supervisor's zone_stop_delay_periods and the site's stopping model of the crane (stack_config.hpp
+/// checks the first against manual.shaping). Throws common::ConfigError for a damping ratio the
+/// shaper cannot be designed for (InputShaper's bounds).
+[[nodiscard]] double shaper_delay_periods(SpeedShaping shaping, double damping_ratio);
 
 /// One axis's rated motion. Units: [m], [m/s], [m/s^2] for the trolley and the hoist (cable
 /// length), [rad], [rad/s], [rad/s^2] for the slew.
