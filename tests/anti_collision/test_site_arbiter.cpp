@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
 #include <random>
 #include <stdexcept>
 
 #include "crane/anti_collision/airspace.hpp"
 #include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/anti_collision/site_service.hpp"
 #include "crane/common/validation.hpp"
 
 namespace {
@@ -351,6 +355,155 @@ TEST(GrantGuard, EachRuleByHand) {
   m.swing_in_plane = std::nan("");
   EXPECT_EQ(guard.check(m, 30.0).action, GrantAction::emergency_stop);
   EXPECT_THROW(GrantGuard(site, 2), std::out_of_range);
+}
+
+
+// The site service's protocol (site_service.hpp) over the same two towers: reports that carry
+// each crane's whole state, instructions numbered and sent again until carried out.
+CraneReport at_rest(std::size_t crane, Pose pose, std::uint32_t request_id = 0, std::vector<Pose> request = {}) {
+  CraneReport r;
+  r.crane = crane;
+  r.waypoints = {pose};
+  r.request_id = request_id;
+  r.request = std::move(request);
+  return r;
+}
+
+TEST(SiteService, AGrantIsHeldUntilCarriedOutThenFollowsTheCranesProgress) {
+  SiteService service(two_towers(), ArbiterMode::coordinated, 77);
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);  // nothing allowed by default
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  const Pose b_rest{kPi - 1.5, 0.5, 0.2};
+  const std::vector<Pose> b_leg{b_rest, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}};
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.0), "");
+  ASSERT_EQ(service.report(at_rest(1, b_rest, 5, b_leg), 0.0), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::rest);
+  auto orders = service.step(0.01);
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].crane, 1u);
+  EXPECT_EQ(orders[0].kind, Instruction::Kind::go);
+  EXPECT_EQ(orders[0].request_id, 5u);
+  EXPECT_EQ(orders[0].seq, 1u);
+  EXPECT_EQ(orders[0].waypoints.size(), 3u);
+  // B's next report was sent before it heard the grant: at rest, still asking for 5. The service
+  // keeps the path and does not take the request again.
+  ASSERT_EQ(service.report(at_rest(1, b_rest, 5, b_leg), 0.05), "");
+  EXPECT_EQ(service.arbiter().holding(1), Holding::path);
+  EXPECT_FALSE(service.arbiter().pending(1));
+  // Not carried out after kResendPeriod: sent again, the same seq.
+  EXPECT_TRUE(service.step(0.2).empty());
+  ASSERT_EQ(service.report(at_rest(1, b_rest, 5, b_leg), 0.45), "");  // still not heard
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.45), "");
+  orders = service.step(0.01 + SiteService::kResendPeriod);
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].seq, 1u);
+  // B carries it out: moving, past its first waypoint.
+  CraneReport moving;
+  moving.crane = 1;
+  moving.moving = true;
+  moving.waypoints = {b_leg[1], b_leg[2]};
+  moving.instruction_epoch = 77;
+  moving.instruction_seq = 1;
+  ASSERT_EQ(service.report(moving, 0.6), "");
+  EXPECT_EQ(service.arbiter().holding(1), Holding::path);
+  EXPECT_EQ(service.arbiter().held(1).count, 1u);  // the rest of the path: one box
+  EXPECT_TRUE(service.step(1.2).empty());           // carried out: not sent again
+  // A asks to turn under B's lowering load: it waits; B hoists up and rests, and A goes.
+  ASSERT_EQ(service.report(at_rest(0, a_rest, 9, {a_rest, {0.0, 0.5, 0.2}}), 1.3), "");
+  ASSERT_EQ(service.report(moving, 1.3), "");
+  EXPECT_TRUE(service.step(1.3).empty());
+  ASSERT_EQ(service.arbiter().waits_for(0).size(), 1u);
+  CraneReport done = at_rest(1, {kPi, 1.0, 0.2});
+  done.instruction_epoch = 77;
+  done.instruction_seq = 1;
+  ASSERT_EQ(service.report(done, 1.4), "");
+  EXPECT_EQ(service.arbiter().holding(1), Holding::rest);
+  orders = service.step(1.4);
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].crane, 0u);
+  EXPECT_EQ(orders[0].request_id, 9u);
+  EXPECT_EQ(orders[0].seq, 2u);
+}
+
+// A crane heard from for no longer than link_deadline is lost: the service holds its whole reach
+// and drops its request; it holds the pose's box again once the crane reports at rest. A report
+// from the crane moving, then, does not give it back its path.
+TEST(SiteService, ASilentCraneIsLostAndComesBackAtRest) {
+  SiteLayout s = two_towers();
+  s.link_deadline = 0.3;
+  SiteService service(s, ArbiterMode::coordinated, 3);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  ASSERT_EQ(service.report(at_rest(0, a_rest, 4, {a_rest, {-1.0, 0.5, 0.2}}), 0.0), "");
+  ASSERT_EQ(service.report(at_rest(1, {kPi - 1.5, 0.5, 0.2}), 0.0), "");
+  ASSERT_EQ(service.step(0.0).size(), 1u);  // A's leg granted
+  EXPECT_TRUE(service.heard(0, 0.3));
+  EXPECT_FALSE(service.heard(0, 0.31));
+  ASSERT_EQ(service.report(at_rest(1, {kPi - 1.5, 0.5, 0.2}), 0.25), "");
+  (void)service.step(0.31);
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
+  EXPECT_EQ(service.arbiter().holding(1), Holding::rest);  // heard at 0.25
+  CraneReport moving;
+  moving.crane = 0;
+  moving.moving = true;
+  moving.waypoints = {a_rest, {-1.0, 0.5, 0.2}};
+  moving.instruction_epoch = 3;
+  moving.instruction_seq = 1;
+  ASSERT_EQ(service.report(moving, 0.4), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
+  ASSERT_EQ(service.report(at_rest(0, {-1.2, 0.5, 0.2}), 0.5), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::rest);
+  EXPECT_DOUBLE_EQ(service.arbiter().held(0).boxes[0].slew_low, -1.2);
+}
+
+// A crane that moves while the service holds only its rest box has no grant: its whole reach is
+// held; a restarted service (another epoch) does not take a crane's echo of the old service's
+// instruction numbers for its own.
+TEST(SiteService, MovingWithoutAGrantAndARestartedService) {
+  SiteService service(two_towers(), ArbiterMode::coordinated, 1);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.0), "");
+  CraneReport rogue;
+  rogue.crane = 0;
+  rogue.moving = true;
+  rogue.waypoints = {a_rest, {0.0, 0.5, 0.2}};
+  ASSERT_EQ(service.report(rogue, 0.1), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
+  EXPECT_EQ(service.moves_without_grant(), 1u);
+
+  SiteService restarted(two_towers(), ArbiterMode::coordinated, 2);
+  CraneReport old_echo = at_rest(0, a_rest, 12, {a_rest, {-1.0, 0.5, 0.2}});
+  old_echo.instruction_epoch = 1;
+  old_echo.instruction_seq = 40;
+  ASSERT_EQ(restarted.report(old_echo, 0.0), "");
+  ASSERT_EQ(restarted.report(at_rest(1, {kPi - 1.5, 0.5, 0.2}), 0.0), "");
+  const auto orders = restarted.step(0.0);
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].seq, 1u);
+  // The same echo (epoch 1, seq 40) again: not this service's instruction 1, so the grant is kept.
+  ASSERT_EQ(restarted.report(old_echo, 0.1), "");
+  EXPECT_EQ(restarted.arbiter().holding(0), Holding::path);
+}
+
+// Malformed reports are refused with the field named, counted, and change nothing.
+TEST(SiteService, MalformedReportsAreRefused) {
+  SiteService service(two_towers(), ArbiterMode::coordinated, 5);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  EXPECT_EQ(service.report(at_rest(7, a_rest), 0.0), "site service: a report refused: crane 7 is not on the site (2 cranes)");
+  CraneReport empty = at_rest(0, a_rest);
+  empty.waypoints.clear();
+  EXPECT_EQ(service.report(empty, 0.0),
+            "site service: a report refused: waypoint_count = 0 is out of range: must be in [1, 9]");
+  EXPECT_NE(service.report(at_rest(0, {std::nan(""), 0.5, 0.2}), 0.0).find("waypoint[0] (slew nan rad"),
+            std::string::npos);
+  EXPECT_NE(service.report(at_rest(0, {0.0, 0.5, 0.0}), 0.0).find("cable length is not > 0"), std::string::npos);
+  EXPECT_EQ(service.report(at_rest(0, a_rest, 3, {a_rest}), 0.0),
+            "site service: a report refused: request_count = 1 is out of range: must be in [2, 9] with request_id 3");
+  EXPECT_NE(service.report(at_rest(0, a_rest, 3, {a_rest, {0.0, INFINITY, 0.2}}), 0.0).find("request[1]"),
+            std::string::npos);
+  EXPECT_EQ(service.reports_rejected(), 6u);
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
+  EXPECT_FALSE(service.heard(0, 0.0));
+  EXPECT_THROW(SiteService(two_towers(), ArbiterMode::coordinated, 0), std::invalid_argument);
 }
 
 }  // namespace

@@ -76,7 +76,9 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: site.margins.slow_down = 0.15 is out of range: must be > margins.stop = 0.2");
   EXPECT_EQ(refusal(edited("name: tc2", "name: tc1")), "site.yaml: site.cranes[1] (tc1).name is used by an earlier crane");
   EXPECT_EQ(refusal(edited("domain_id: 12", "domain_id: 11")),
-            "site.yaml: site.cranes[1] (tc2).domain_id is used by an earlier crane");
+            "site.yaml: site.cranes[1] (tc2).domain_id is used by the site (site.domain_id) or an earlier crane");
+  EXPECT_EQ(refusal(edited("domain_id: 10 ", "domain_id: 13 ")),
+            "site.yaml: site.cranes[2] (tc3).domain_id is used by the site (site.domain_id) or an earlier crane");
   EXPECT_EQ(refusal(edited("trolley_max: 1.30", "trolley_max: 1.50")),
             "site.yaml: site.cranes[0] (tc1).trolley_max = 1.5 is out of range: must be in [0, 1.4]");
   EXPECT_EQ(refusal(edited("hook_height_max: 2.3", "hook_height_max: 2.48")),

@@ -60,6 +60,7 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.margins.slow_down = margins.number("slow_down", kMargin.lower, kMargin.upper);
     layout.margins.stop = margins.number("stop", kMargin.lower, kMargin.upper);
     margins.finish();
+    layout.domain_id = s.integer("domain_id", 0, kMaxDomain);
     layout.link_deadline = s.number("link_deadline", kDeadline.lower, kDeadline.upper);
     config::YamlSection paths = s.child("paths");
     layout.paths.trolley_overshoot = paths.number("trolley_overshoot", kOvershoot.lower, kOvershoot.upper);

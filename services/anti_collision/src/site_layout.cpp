@@ -57,7 +57,11 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_in_range(prefix + ".paths.slew_tracking", layout.paths.slew_tracking, kOvershoot.lower, kOvershoot.upper);
 
   std::set<std::string> names;
-  std::set<int> domains;
+  if (layout.domain_id < 0 || layout.domain_id > kMaxDomain) {
+    throw ConfigError(prefix + ".domain_id = " + std::to_string(layout.domain_id) + " is out of range: must be in [0, " +
+                      std::to_string(kMaxDomain) + "]");
+  }
+  std::set<int> domains{layout.domain_id};
   for (std::size_t i = 0; i < layout.cranes.size(); ++i) {
     const SiteCrane& c = layout.cranes[i];
     if (c.name.empty()) throw ConfigError(prefix + ".cranes[" + std::to_string(i) + "].name is empty");
@@ -103,7 +107,9 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
       throw ConfigError(p + ".domain_id = " + std::to_string(c.domain_id) + " is out of range: must be in [0, " +
                         std::to_string(kMaxDomain) + "]");
     }
-    if (!domains.insert(c.domain_id).second) throw ConfigError(p + ".domain_id is used by an earlier crane");
+    if (!domains.insert(c.domain_id).second) {
+      throw ConfigError(p + ".domain_id is used by the site (" + prefix + ".domain_id) or an earlier crane");
+    }
     if (c.priority < 0 || c.priority > kMaxPriority) {
       throw ConfigError(p + ".priority = " + std::to_string(c.priority) + " is out of range: must be in [0, " +
                         std::to_string(kMaxPriority) + "]");

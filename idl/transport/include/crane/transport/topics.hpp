@@ -32,6 +32,13 @@ CRANE_TOPIC(SafetyStatus, SupervisorStatus_, "rt/crane/safety/status", QosKind::
 CRANE_TOPIC(SafetyCommand, SupervisorCommand_, "rt/crane/safety/command", QosKind::command);
 CRANE_TOPIC(LoopDiagnostics, LoopDiagnostics_, "rt/crane/diag/loop", QosKind::diagnostics);
 CRANE_TOPIC(OperatorSpeed, OperatorSpeed_, "rt/crane/operator/speed", QosKind::command);
+// The site of several cranes (issue 34), on the site's own domain (site file: domain_id), not a
+// crane's: each crane's state and requests, the site service's instructions and its heartbeat.
+// Reliable and volatile; each is sent again (reports and status at 10 Hz) so that a reader that
+// joins late, or a restarted service, learns the state from the next sample.
+CRANE_TOPIC(SiteReport, SiteReport_, "rt/site/report", QosKind::command);
+CRANE_TOPIC(SiteInstruction, SiteInstruction_, "rt/site/instruction", QosKind::command);
+CRANE_TOPIC(SiteStatus, SiteStatus_, "rt/site/status", QosKind::command);
 
 #undef CRANE_TOPIC
 
@@ -51,6 +58,14 @@ void for_each_topic(F&& f) {
   f.template operator()<SafetyCommand>();
   f.template operator()<LoopDiagnostics>();
   f.template operator()<OperatorSpeed>();
+}
+
+/// The site's topics (on the site's domain; for_each_topic lists a crane's).
+template <class F>
+void for_each_site_topic(F&& f) {
+  f.template operator()<SiteReport>();
+  f.template operator()<SiteInstruction>();
+  f.template operator()<SiteStatus>();
 }
 
 }  // namespace crane::transport::topics

@@ -96,6 +96,8 @@ struct SiteLayout {
   std::vector<SiteCrane> cranes;      // 1 to kMaxCranes
   std::vector<common::Zone> zones;    // fixed zones in the site frame (buildings, roads, neighbours' plots)
   Margins margins;
+  int domain_id{10};                  // the site's own DDS domain (the site service and every crane's site
+                                      // link: rt/site/*), in [0, 232], unlike every crane's
   double link_deadline{0.3};          // [s] a crane hears nothing from the site service this long: it stops
                                       // moving into shared airspace (the supervisor's rule)
   PathAllowance paths;

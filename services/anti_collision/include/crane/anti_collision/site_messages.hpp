@@ -1,0 +1,35 @@
+#pragma once
+// The site's messages (idl/crane_msgs.idl: SiteReport_, SiteInstruction_, SiteStatus_, as the
+// plain structs of crane/protocol/messages.hpp) to and from the site service's core
+// (site_service.hpp): one translation for the site_service process, each crane's site link and the
+// tests. The codes (STATE_*, KIND_*, HOLDING_*) are the IDL's.
+//
+// Errors: the from-message functions return "" or why the message cannot be read (a count beyond
+// its arrays, an unknown code), naming the field and the value; they never throw. Whatever else a
+// report may get wrong (non-finite values, counts below their minimum) SiteService::report refuses.
+
+#include <cstdint>
+#include <string>
+
+#include "crane/anti_collision/site_service.hpp"
+#include "crane/protocol/messages.hpp"
+
+namespace crane::anti_collision {
+
+/// `message` read into `report`. "" when read, else why not (`report` is then unspecified).
+[[nodiscard]] std::string from_message(const protocol::SiteReport& message, CraneReport& report);
+/// `report` written into `message` (its header and measured motion untouched). Waypoints beyond
+/// MAX_WAYPOINTS are dropped (a report that long is refused by SiteService::report anyway).
+void to_message(const CraneReport& report, protocol::SiteReport& message) noexcept;
+
+/// `order` of the service of `epoch` written into `message` (its header's seq is the order's).
+void to_message(const SiteOrder& order, std::uint32_t epoch, protocol::SiteInstruction& message) noexcept;
+/// `message` read into `order`. "" when read, else why not.
+[[nodiscard]] std::string from_message(const protocol::SiteInstruction& message, SiteOrder& order);
+
+/// What `service` holds, its counters and its epoch written into `message` (header untouched).
+void to_message(const SiteService& service, protocol::SiteStatus& message) noexcept;
+/// The IDL's HOLDING_* code of `holding`.
+[[nodiscard]] std::uint8_t holding_code(Holding holding) noexcept;
+
+}  // namespace crane::anti_collision

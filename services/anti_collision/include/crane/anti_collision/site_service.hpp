@@ -1,0 +1,104 @@
+#pragma once
+// The site service's protocol (issue 34, item 3; docs/site.md, "The site service on DDS"): what
+// the site_service process makes of each crane's reports (rt/site/report) before the site's rules
+// (site_arbiter.hpp) decide, and the instructions it sends back (rt/site/instruction). A core with
+// no clock, no DDS and no threads: the process and the tests drive it the same way.
+//
+// A report is a crane's whole state, sent at 10 Hz and on every change, so that a restarted
+// service learns everything from the next one:
+//   - at rest at a pose, or moving on its grant with the rest of its path from the last waypoint
+//     it reached;
+//   - the last instruction it carried out (the service's epoch and the instruction's seq);
+//   - the leg it asks for, at rest (request_id != 0, a new id a new request).
+// What the service does with it, by what it holds for the crane:
+//   whole reach (lost, or never heard): at rest -> holds the pose's box (SiteArbiter::rest);
+//       moving -> keeps the whole reach until the crane rests (a crane that lost its link stops);
+//   rest: at rest -> the pose's box; moving -> the whole reach (moving without a grant);
+//   path or yield: before the crane has carried out that instruction, nothing (it holds the
+//       path already); after, moving -> the rest of the path (SiteArbiter::progress), at rest ->
+//       the pose's box (the path is done).
+// A request id the service has not seen is a new request (SiteArbiter::request); a report with
+// none withdraws the pending one. step() marks every crane heard from for no longer than the
+// site's link_deadline as lost (it holds its whole reach, its request is dropped), runs the rules
+// and numbers the instructions; an instruction the crane has not carried out is sent again every
+// kResendPeriod.
+//
+// Errors: report() refuses a malformed report (an unknown crane, a waypoint count out of range, a
+// non-finite or non-positive cable length, a request of fewer than 2 waypoints) with a message
+// naming the field and the value, counts it and changes nothing; it never throws. The constructor
+// throws common::ConfigError for an invalid layout (validate()).
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+
+namespace crane::anti_collision {
+
+/// One crane's report, in the core's terms (rt/site/report).
+struct CraneReport {
+  std::size_t crane{0};                 // index in the site file
+  bool moving{false};                   // false: at rest at waypoints[0]
+  std::vector<Pose> waypoints;          // 1 to Airspace::kMaxBoxes + 1 (see the header)
+  std::uint32_t instruction_epoch{0};   // the last instruction carried out: its service's epoch
+  std::uint64_t instruction_seq{0};     // and its seq (0, 0: none)
+  std::uint32_t request_id{0};          // 0: no request
+  std::vector<Pose> request;            // request_id != 0: 2 to Airspace::kMaxBoxes + 1, from where it rests
+};
+
+/// One instruction to send (rt/site/instruction).
+struct SiteOrder {
+  std::size_t crane{0};
+  Instruction::Kind kind{Instruction::Kind::go};
+  std::uint32_t request_id{0};  // go: the request granted; yield: 0
+  std::uint64_t seq{0};         // the service's instruction counter, from 1
+  std::vector<Pose> waypoints;
+};
+
+class SiteService {
+ public:
+  static constexpr double kResendPeriod = 0.5;  // [s] an instruction not yet carried out is sent again
+
+  /// The service of `layout` in `mode`; `epoch` identifies this run (drawn at the process's start,
+  /// != 0). Throws common::ConfigError for an invalid layout, std::invalid_argument for epoch 0.
+  SiteService(SiteLayout layout, ArbiterMode mode, std::uint32_t epoch);
+
+  /// Applies `report`, heard at `time` [s] (see the header). Returns "" when applied, else why it
+  /// was refused ("site service: crane 7 is not on the site (3 cranes)").
+  [[nodiscard]] std::string report(const CraneReport& report, double time);
+  /// At `time` [s]: the silent cranes lost, the rules, the instructions to send (new ones and those
+  /// to send again).
+  [[nodiscard]] std::vector<SiteOrder> step(double time);
+
+  [[nodiscard]] const SiteArbiter& arbiter() const noexcept { return arbiter_; }
+  [[nodiscard]] std::uint32_t epoch() const noexcept { return epoch_; }
+  [[nodiscard]] std::uint64_t reports_rejected() const noexcept { return rejected_; }
+  /// Reports that showed a crane moving while the service held only its rest box.
+  [[nodiscard]] std::uint64_t moves_without_grant() const noexcept { return moves_without_grant_; }
+  /// True when crane `crane` was heard within link_deadline of `time`.
+  [[nodiscard]] bool heard(std::size_t crane, double time) const;
+
+ private:
+  struct Link {
+    double last_heard{-std::numeric_limits<double>::infinity()};
+    std::uint32_t pending_id{0};   // the request the arbiter holds
+    std::uint32_t granted_id{0};   // the last request granted
+    bool carried_out{true};        // the crane has carried out its last instruction
+    SiteOrder last_order;          // its last instruction (seq 0: none)
+    double last_sent{0.0};
+  };
+
+  SiteArbiter arbiter_;
+  std::uint32_t epoch_;
+  std::vector<Link> links_;
+  std::uint64_t seq_{0};
+  std::uint64_t rejected_{0};
+  std::uint64_t moves_without_grant_{0};
+};
+
+}  // namespace crane::anti_collision

@@ -1,0 +1,135 @@
+#include "crane/anti_collision/site_service.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace crane::anti_collision {
+namespace {
+
+// "" when every waypoint is finite with a positive cable length, else the first bad one named.
+std::string bad_waypoint(const std::vector<Pose>& waypoints, const char* field) {
+  for (std::size_t k = 0; k < waypoints.size(); ++k) {
+    const Pose& p = waypoints[k];
+    if (!std::isfinite(p.slew) || !std::isfinite(p.trolley) || !std::isfinite(p.cable_length) ||
+        !(p.cable_length > 0.0)) {
+      return std::string(field) + "[" + std::to_string(k) + "] (slew " + std::to_string(p.slew) + " rad, trolley " +
+             std::to_string(p.trolley) + " m, cable " + std::to_string(p.cable_length) +
+             " m) is not finite or its cable length is not > 0";
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+SiteService::SiteService(SiteLayout layout, ArbiterMode mode, std::uint32_t epoch)
+    : arbiter_(std::move(layout), mode), epoch_(epoch) {
+  if (epoch == 0) throw std::invalid_argument("site service: the epoch must not be 0");
+  links_.resize(arbiter_.size());
+}
+
+bool SiteService::heard(std::size_t crane, double time) const {
+  return time - links_.at(crane).last_heard <= arbiter_.layout().link_deadline;
+}
+
+std::string SiteService::report(const CraneReport& r, double time) {
+  const std::size_t max_waypoints = Airspace::kMaxBoxes + 1;
+  std::string why;
+  if (r.crane >= links_.size()) {
+    why = "crane " + std::to_string(r.crane) + " is not on the site (" + std::to_string(links_.size()) + " cranes)";
+  } else if (r.waypoints.empty() || r.waypoints.size() > max_waypoints) {
+    why = "waypoint_count = " + std::to_string(r.waypoints.size()) + " is out of range: must be in [1, " +
+          std::to_string(max_waypoints) + "]";
+  } else if (r.request_id != 0 && (r.request.size() < 2 || r.request.size() > max_waypoints)) {
+    why = "request_count = " + std::to_string(r.request.size()) + " is out of range: must be in [2, " +
+          std::to_string(max_waypoints) + "] with request_id " + std::to_string(r.request_id);
+  } else if (!std::isfinite(time)) {
+    why = "the arrival time is not finite";
+  } else {
+    why = bad_waypoint(r.waypoints, "waypoint");
+    if (why.empty() && r.request_id != 0) why = bad_waypoint(r.request, "request");
+  }
+  if (!why.empty()) {
+    ++rejected_;
+    return "site service: a report refused: " + why;
+  }
+
+  Link& link = links_[r.crane];
+  link.last_heard = time;
+  if (!link.carried_out && r.instruction_epoch == epoch_ && r.instruction_seq >= link.last_order.seq) {
+    link.carried_out = true;
+  }
+  const Pose& here = r.waypoints.front();
+  switch (arbiter_.holding(r.crane)) {
+    case Holding::whole_reach:
+      if (!r.moving) arbiter_.rest(r.crane, here);
+      break;
+    case Holding::rest:
+      if (r.moving) {
+        ++moves_without_grant_;
+        arbiter_.lost(r.crane);
+      } else {
+        arbiter_.rest(r.crane, here);
+      }
+      break;
+    case Holding::path:
+    case Holding::yield:
+      if (!link.carried_out) break;  // it has not heard, or not started, its instruction yet
+      if (r.moving) {
+        arbiter_.progress(r.crane, r.waypoints);
+      } else {
+        arbiter_.rest(r.crane, here);
+      }
+      break;
+  }
+
+  if (r.request_id == 0) {
+    if (link.pending_id != 0) arbiter_.withdraw(r.crane);
+    link.pending_id = 0;
+  } else if (r.request_id != link.pending_id && r.request_id != link.granted_id) {
+    arbiter_.request(r.crane, r.request, time);
+    link.pending_id = r.request_id;
+  }
+  return "";
+}
+
+std::vector<SiteOrder> SiteService::step(double time) {
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (heard(i, time)) continue;
+    if (arbiter_.holding(i) != Holding::whole_reach) arbiter_.lost(i);
+    if (links_[i].pending_id != 0) arbiter_.withdraw(i);
+    links_[i].pending_id = 0;
+  }
+  std::vector<SiteOrder> out;
+  for (Instruction& instruction : arbiter_.decide()) {
+    Link& link = links_[instruction.crane];
+    SiteOrder order;
+    order.crane = instruction.crane;
+    order.kind = instruction.kind;
+    order.seq = ++seq_;
+    order.waypoints = std::move(instruction.waypoints);
+    if (instruction.kind == Instruction::Kind::go) {
+      order.request_id = link.pending_id;
+      link.granted_id = link.pending_id;
+      link.pending_id = 0;
+    }
+    link.last_order = order;
+    link.carried_out = false;
+    link.last_sent = time;
+    out.push_back(std::move(order));
+  }
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    Link& link = links_[i];
+    const Holding h = arbiter_.holding(i);
+    if (link.carried_out || link.last_order.seq == 0 || (h != Holding::path && h != Holding::yield) ||
+        time - link.last_sent < kResendPeriod) {
+      continue;
+    }
+    link.last_sent = time;
+    out.push_back(link.last_order);
+  }
+  return out;
+}
+
+}  // namespace crane::anti_collision

@@ -1,0 +1,244 @@
+// The site service as a process on DDS (services/anti_collision/node/site_service_node.cpp): this
+// test's participant plays the three cranes of the shipped site on the site's topics and checks
+// what the process answers: a grant over DDS, its heartbeat, a silent crane's whole reach, a
+// malformed report refused without harm, and a service killed with -9 and started again (a new
+// epoch, a crane still moving held at its whole reach until it reports at rest). ctest runs it in
+// a private network namespace; the participants are bound to loopback.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "crane/anti_collision/site_messages.hpp"
+#include "crane/launch/process_group.hpp"
+#include "crane/protocol/dds.hpp"
+#include "crane/transport/participant.hpp"
+#include "crane/transport/topics.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace ac = crane::anti_collision;
+namespace tp = crane::transport::topics;
+using crane::protocol::SiteStatus;
+using Clock = std::chrono::steady_clock;
+
+const std::string kBin = CRANE_BIN_DIR;
+const std::string kSite = std::string(CRANE_SOURCE_DIR) + "/deploy/config/site_three_towers.yaml";
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::uint32_t kDomain = 61;
+
+// Each crane hook up, its jib pointed away from the others (slew pi: tc1 west, tc2 east, tc3 north).
+const ac::Pose kRest[3] = {{kPi, 0.5, 0.2}, {kPi, 0.5, 0.2}, {kPi, 0.5, 0.2}};
+
+class SiteProcess {
+ public:
+  SiteProcess() : dir_(fs::temp_directory_path() / ("crane_site_service_" + std::to_string(getpid()))) {
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    crane::transport::ParticipantOptions p;
+    p.name = "site_test_cranes";
+    p.domain_id = kDomain;
+    participant_ = std::make_unique<crane::transport::Participant>(p);
+    reports_ = participant_->make_writer<tp::SiteReport>();
+    instructions_ = participant_->make_recording_reader<tp::SiteInstruction>(&wakeup_, 256);
+    status_ = participant_->make_recording_reader<tp::SiteStatus>(&wakeup_, 256);
+    start();
+  }
+  ~SiteProcess() {
+    status_.reset();
+    instructions_.reset();
+    group_.stop_all();
+  }
+
+  pid_t start() {
+    crane::launch::ProcessSpec spec;
+    spec.name = "site_service";
+    spec.executable = kBin + "/site_service";
+    spec.arguments = {"--site", kSite, "--domain", std::to_string(kDomain)};
+    spec.log_path = (dir_ / ("site_service_" + std::to_string(++starts_) + ".log")).string();
+    pid_ = group_.start(spec);
+    return pid_;
+  }
+  void kill_hard() {
+    ::kill(pid_, SIGKILL);
+    for (int i = 0; i < 200 && !group_.poll(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+
+  void report(const ac::CraneReport& r) {
+    crane::protocol::SiteReport m;
+    ac::to_message(r, m);
+    tp::msgs::SiteReport_ out;
+    crane::protocol::to_dds(m, out);
+    reports_->write(out);
+  }
+  void report_raw(const crane::protocol::SiteReport& m) {
+    tp::msgs::SiteReport_ out;
+    crane::protocol::to_dds(m, out);
+    reports_->write(out);
+  }
+  // Takes what arrived for `seconds`, calling `tick` every 100 ms (the cranes' 10 Hz reports).
+  template <class Tick>
+  void run_for(double seconds, Tick&& tick) {
+    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    auto next_tick = Clock::now();
+    while (Clock::now() < until) {
+      if (Clock::now() >= next_tick) {
+        tick();
+        next_tick += std::chrono::milliseconds(100);
+      }
+      take();
+      wakeup_.wait_until(std::min(until, next_tick));
+    }
+    take();
+  }
+  // Runs until `done()` or `timeout` [s]; true when done.
+  template <class Tick, class Done>
+  bool run_until(double timeout, Tick&& tick, Done&& done) {
+    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+    while (Clock::now() < until) {
+      run_for(0.05, tick);
+      if (done()) return true;
+    }
+    return false;
+  }
+
+  const std::vector<crane::protocol::SiteInstruction>& instructions() const { return instructions_seen_; }
+  const std::optional<SiteStatus>& status() const { return last_status_; }
+  std::size_t statuses() const { return statuses_; }
+  double largest_status_gap() const { return largest_gap_; }
+  const fs::path& dir() const { return dir_; }
+
+ private:
+  void take() {
+    tp::msgs::SiteInstruction_ i;
+    while (instructions_->take_next(i)) {
+      crane::protocol::SiteInstruction m;
+      crane::protocol::from_dds(i, m);
+      instructions_seen_.push_back(m);
+    }
+    tp::msgs::SiteStatus_ s;
+    while (status_->take_next(s)) {
+      SiteStatus m;
+      crane::protocol::from_dds(s, m);
+      const auto now = Clock::now();
+      if (last_status_ && last_status_->epoch == m.epoch) {
+        largest_gap_ = std::max(largest_gap_, std::chrono::duration<double>(now - last_arrival_).count());
+      }
+      last_arrival_ = now;
+      last_status_ = m;
+      ++statuses_;
+    }
+  }
+
+  fs::path dir_;
+  crane::launch::ProcessGroup group_;
+  pid_t pid_{0};
+  int starts_{0};
+  crane::transport::Wakeup wakeup_;
+  std::unique_ptr<crane::transport::Participant> participant_;
+  std::unique_ptr<crane::transport::Writer<tp::SiteReport>> reports_;
+  std::unique_ptr<crane::transport::Reader<tp::SiteInstruction>> instructions_;
+  std::unique_ptr<crane::transport::Reader<tp::SiteStatus>> status_;
+  std::vector<crane::protocol::SiteInstruction> instructions_seen_;
+  std::optional<SiteStatus> last_status_;
+  std::size_t statuses_{0};
+  double largest_gap_{0.0};
+  Clock::time_point last_arrival_{};
+};
+
+ac::CraneReport at_rest(std::size_t crane, const ac::Pose& pose) {
+  ac::CraneReport r;
+  r.crane = crane;
+  r.waypoints = {pose};
+  return r;
+}
+
+TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNothing) {
+  SiteProcess site;
+  // tc1 asks to turn its jib 0.3 rad further from the others, hook up: clear of everything held.
+  const std::vector<ac::Pose> leg{kRest[0], {kPi - 0.3, 0.5, 0.2}};
+  bool tc3_reports = true;
+  ac::CraneReport tc1 = at_rest(0, kRest[0]);
+  tc1.request_id = 1;
+  tc1.request = leg;
+  const auto tick = [&] {
+    site.report(tc1);
+    site.report(at_rest(1, kRest[1]));
+    if (tc3_reports) site.report(at_rest(2, kRest[2]));
+  };
+  // The grant, over DDS (discovery first: the service holds every crane's whole reach until then).
+  ASSERT_TRUE(site.run_until(20.0, tick, [&] { return !site.instructions().empty(); }))
+      << "no instruction within 20 s; see " << site.dir();
+  const auto& go = site.instructions().front();
+  EXPECT_EQ(go.crane, 0);
+  EXPECT_EQ(go.kind, crane::protocol::SiteInstruction::KIND_GO);
+  EXPECT_EQ(go.request_id, 1u);
+  EXPECT_EQ(go.header.seq, 1u);
+  ASSERT_EQ(go.waypoint_count, 2);
+  EXPECT_DOUBLE_EQ(go.waypoint_slew[1], kPi - 0.3);
+  ASSERT_TRUE(site.run_until(5.0, tick, [&] {
+    return site.status() && site.status()->holding[0] == SiteStatus::HOLDING_PATH &&
+           site.status()->holding[1] == SiteStatus::HOLDING_REST && site.status()->holding[2] == SiteStatus::HOLDING_REST;
+  })) << "status: tc1 holding its path, the others their rest boxes; see " << site.dir();
+  const std::uint32_t epoch = site.status()->epoch;
+  EXPECT_EQ(go.epoch, epoch);
+  EXPECT_EQ(site.status()->crane_count, 3);
+
+  // tc1 carries it out: moving, then at rest at the leg's end.
+  tc1.request_id = 0;
+  tc1.request.clear();
+  tc1.moving = true;
+  tc1.waypoints = leg;
+  tc1.instruction_epoch = epoch;
+  tc1.instruction_seq = go.header.seq;
+  site.run_for(0.5, tick);
+  EXPECT_EQ(site.status()->holding[0], SiteStatus::HOLDING_PATH);
+  EXPECT_EQ(site.instructions().size(), 1u) << "carried out: not sent again";
+
+  // tc3 goes silent: past the link deadline (0.3 s) the service holds its whole reach; it reports
+  // again at rest and holds its rest box.
+  tc3_reports = false;
+  ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[2] == SiteStatus::HOLDING_WHOLE_REACH; }));
+  tc3_reports = true;
+  ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[2] == SiteStatus::HOLDING_REST; }));
+
+  // A malformed report (a NaN slew; a waypoint count beyond the arrays) is refused and counted;
+  // the service goes on.
+  crane::protocol::SiteReport bad;
+  bad.crane = 1;
+  bad.waypoint_count = 1;
+  bad.waypoint_slew[0] = std::nan("");
+  bad.waypoint_trolley[0] = 0.5;
+  bad.waypoint_cable_length[0] = 0.2;
+  site.report_raw(bad);
+  bad.waypoint_slew[0] = kPi;
+  bad.waypoint_count = 200;
+  site.report_raw(bad);
+  ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->reports_rejected == 2; }))
+      << "both counted; see " << site.dir();
+  EXPECT_EQ(site.status()->holding[1], SiteStatus::HOLDING_REST);
+  std::printf("[ figure   ] %zu statuses, the largest gap between two %.0f ms (sent at 10 Hz)\n", site.statuses(),
+              1e3 * site.largest_status_gap());
+
+  // kill -9 and start again: another epoch; tc1, still reporting moving, is held at its whole
+  // reach until it reports at rest.
+  site.kill_hard();
+  site.start();
+  ASSERT_TRUE(site.run_until(20.0, tick, [&] { return site.status()->epoch != epoch; })) << "see " << site.dir();
+  site.run_for(0.5, tick);
+  EXPECT_EQ(site.status()->holding[0], SiteStatus::HOLDING_WHOLE_REACH);
+  EXPECT_EQ(site.status()->holding[1], SiteStatus::HOLDING_REST);
+  tc1 = at_rest(0, leg.back());
+  ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[0] == SiteStatus::HOLDING_REST; }));
+}
+
+}  // namespace
