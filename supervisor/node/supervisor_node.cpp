@@ -23,6 +23,9 @@
 #include <string>
 #include <thread>
 
+#include "crane/anti_collision/grant_guard.hpp"
+#include "crane/anti_collision/site_file.hpp"
+#include "crane/anti_collision/site_messages.hpp"
 #include "crane/config/config_document.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -33,6 +36,77 @@ namespace {
 using namespace crane;
 using transport::topics::msgs::CycleHeader_;
 using Clock = std::chrono::steady_clock;
+
+// This crane's link to its site (--site, --site-crane; docs/site.md, "The crane's own guard"): a
+// participant on the site's domain that hears the site service's instructions to this crane and its
+// heartbeat, and the crane's guard (anti_collision::GrantGuard) that checks the measured motion
+// against the last grant every cycle. Translation and wiring only: the rules are the guard's.
+class SiteLink {
+ public:
+  SiteLink(const std::string& site_path, const std::string& crane_name, runtime::NodeOptions options)
+      : layout_(anti_collision::load_site_layout(site_path)),
+        crane_(anti_collision::find_crane(layout_, crane_name)),
+        guard_(layout_, crane_ < 0 ? 0 : static_cast<std::size_t>(crane_)) {
+    if (crane_ < 0) {
+      throw std::runtime_error("--site-crane " + crane_name + ": no crane of that name in " + site_path);
+    }
+    options.domain_id = static_cast<std::uint32_t>(layout_.domain_id);
+    participant_ = runtime::make_participant(options, "supervisor");
+    instructions_ = participant_->make_recording_reader<transport::topics::SiteInstruction>(nullptr, 64);
+    status_ = participant_->make_reader<transport::topics::SiteStatus>(nullptr);
+    spdlog::info("on site '{}' as {} (crane {} of {}), the site's domain {}: nothing moves before a grant",
+                 layout_.name, crane_name, crane_, layout_.cranes.size(), layout_.domain_id);
+  }
+
+  /// The guard's answer for the motion measured now (`time` [s], monotonic).
+  supervisor::SiteVerdict check(const anti_collision::CraneMotion& motion, double time) {
+    transport::topics::msgs::SiteInstruction_ dds_instruction;
+    while (instructions_->take_next(dds_instruction)) {
+      protocol::SiteInstruction message;
+      protocol::from_dds(dds_instruction, message);
+      guard_.heard(time);
+      if (message.crane != crane_) continue;
+      anti_collision::SiteOrder order;
+      const std::string why = anti_collision::from_message(message, order);
+      if (!why.empty()) {
+        spdlog::warn("site instruction ignored: {}", why);
+        continue;
+      }
+      if (message.epoch == epoch_ && order.seq <= seq_) continue;  // sent again
+      epoch_ = message.epoch;
+      seq_ = order.seq;
+      guard_.grant(anti_collision::path_airspace(order.waypoints, layout_.paths), time);
+      spdlog::info("site grant {} (epoch {}): {} through {} waypoints", order.seq, message.epoch,
+                   order.kind == anti_collision::Instruction::Kind::go ? "go" : "yield", order.waypoints.size());
+    }
+    transport::topics::msgs::SiteStatus_ dds_status;
+    while (status_->take_next(dds_status)) guard_.heard(time);
+    const anti_collision::GrantCheck c = guard_.check(motion, time);
+    // finish_path: the move under way ends at its waypoint inside the grant, sooner than a soft
+    // stop would (the planner is left to it).
+    const supervisor::SiteVerdict verdict = c.action == anti_collision::GrantAction::emergency_stop
+                                                ? supervisor::SiteVerdict::emergency_stop
+                                            : c.action == anti_collision::GrantAction::soft_stop
+                                                ? supervisor::SiteVerdict::soft_stop
+                                                : supervisor::SiteVerdict::proceed;
+    if (verdict != last_) {
+      spdlog::info("site guard: {} ({})", anti_collision::to_string(c.action), c.reason);
+      last_ = verdict;
+    }
+    return verdict;
+  }
+
+ private:
+  anti_collision::SiteLayout layout_;
+  int crane_;
+  anti_collision::GrantGuard guard_;
+  std::unique_ptr<transport::Participant> participant_;
+  std::unique_ptr<transport::Reader<transport::topics::SiteInstruction>> instructions_;
+  std::unique_ptr<transport::Reader<transport::topics::SiteStatus>> status_;
+  std::uint32_t epoch_{0};
+  std::uint64_t seq_{0};
+  supervisor::SiteVerdict last_{supervisor::SiteVerdict::proceed};
+};
 
 struct Watched {
   Clock::time_point last_sample{};
@@ -143,6 +217,13 @@ int main(int argc, char** argv) {
   app.add_option("--sensor-source", sensor_source,
                  "which sensor writer the launch mode expects: any | plant | bridge (another one is a fault)")
       ->check(CLI::IsMember({"any", "plant", "bridge"}));
+  std::string site_path, site_crane;
+  auto* site_option = app.add_option("--site", site_path,
+                                     "this crane is on a site (docs/site.md): the site file; its guard checks the site "
+                                     "service's grant every cycle")
+                          ->check(CLI::ExistingFile);
+  app.add_option("--site-crane", site_crane, "this crane's name in the site file")->needs(site_option);
+  site_option->needs(app.get_option("--site-crane"));
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "supervisor");
@@ -157,6 +238,9 @@ int main(int argc, char** argv) {
       if (!fault_log) throw std::runtime_error("cannot open the fault log " + fault_log_path);
     }
     supervisor::SupervisorStage stage(params);
+    std::optional<SiteLink> site;
+    if (!site_path.empty()) site.emplace(site_path, site_crane, options);
+    const auto started = Clock::now();
 
     auto participant = runtime::make_participant(options, "supervisor");
     transport::Wakeup wakeup;
@@ -251,6 +335,23 @@ int main(int argc, char** argv) {
       cycle.nonfinite_seen = nonfinite;
       nonfinite = false;
       cycle.nonfinite_rejected = static_cast<std::uint32_t>(counters.nonfinite_rejected);
+      if (site && cycle.sensors != nullptr) {
+        // Positions and swing as measured; the speeds the supervisor differentiates; the rates the
+        // estimator gives (0 before its first estimate).
+        const bool estimated = watched[static_cast<int>(Stage::state_estimator)].seen;
+        anti_collision::CraneMotion motion;
+        motion.slew = sensors_plain.slew_angle;
+        motion.slew_rate = stage.output().slew_rate;
+        motion.trolley = sensors_plain.trolley_position;
+        motion.trolley_velocity = stage.output().trolley_velocity;
+        motion.cable_length = sensors_plain.cable_length;
+        motion.cable_rate = estimated ? last_estimate.cable_length_rate() : 0.0;
+        motion.swing_in_plane = sensors_plain.swing_in_plane;
+        motion.swing_out_of_plane = sensors_plain.swing_out_of_plane;
+        motion.swing_in_plane_rate = estimated ? last_estimate.swing_in_plane_rate() : 0.0;
+        motion.swing_out_of_plane_rate = estimated ? last_estimate.swing_out_of_plane_rate() : 0.0;
+        cycle.site = site->check(motion, std::chrono::duration<double>(now - started).count());
+      }
       // One operator command per cycle; a second one waits for the next cycle (nothing is dropped).
       if (!pending_command && commands->take_next(command)) pending_command = true;
       if (pending_command) {

@@ -326,9 +326,18 @@ TEST(GrantGuard, EachRuleByHand) {
   m.slew = 0.0;
   // The link: the path reaches B's airspace (A's jib towards B), so once nothing was heard for
   // link_deadline the crane soft-stops; a message from the service in time keeps it going.
+  // The soft stop from 0.5 m/s, ZVD shaped on 0.2 m of cable (T = 2 pi sqrt(0.2 / 9.80665) =
+  // 0.8973 s): 0.5 x 0.1 + 0.5^2 / (2 x 0.5) + 0.5 x 0.8973 / 2 = 0.5243 m. From 0.4 m it ends at
+  // 0.924 m, inside the grant: the soft stop. From 0.6 m at 1.124 m, beyond it: the move goes on to
+  // its waypoint (1.0 m), the sooner rest inside the grant.
   ASSERT_TRUE(in_shared_airspace(site, 0, guard.granted()));
+  m.trolley = 0.4;
   EXPECT_EQ(guard.check(m, 10.0 + 0.9 * site.link_deadline).action, GrantAction::proceed);
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::soft_stop);
+  m.trolley = 0.6;
+  EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::finish_path);
+  EXPECT_NEAR(stopping_travel(site.cranes[0], m, StopKind::soft).trolley,
+              0.05 + 0.25 + 0.5 * 2.0 * kPi * std::sqrt(0.2 / kStandardGravity) / 2.0, 1e-9);
   guard.heard(10.0 + site.link_deadline);
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::proceed);
   // The same path turned away from B (slew pi: the load 0.3-1.0 m on the far side) is A's own

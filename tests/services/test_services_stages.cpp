@@ -685,11 +685,12 @@ TEST(FrictionCompensationStage, UsesTheReleasedFrictionOnlyWhileItsBitIsSet) {
 namespace {
 
 // The supervisor's warnings where a hard stop is not yet required (a limit approached too fast, a
-// zone ahead) are answered with the planner's soft stop: the goal is aborted naming the warning and
+// zone ahead, the site guard's lost link) are answered with the planner's soft stop: the goal is aborted naming the warning and
 // the reference decelerates from where it was, without a jump, to rest.
 TEST(PlannerStage, ASupervisorApproachWarningStopsTheGoalSoftly) {
   for (const std::uint32_t warning : {protocol::SupervisorStatus::WARNING_SPEED_LIMITED,
-                                      protocol::SupervisorStatus::WARNING_ZONE_APPROACH}) {
+                                      protocol::SupervisorStatus::WARNING_ZONE_APPROACH,
+                                      protocol::SupervisorStatus::WARNING_SITE}) {
     trajectory_planner::TrajectoryPlannerParams p;
     trajectory_planner::TrajectoryPlannerStage stage(p, 0.01);
     protocol::SupervisorStatus status;
@@ -717,6 +718,7 @@ TEST(PlannerStage, ASupervisorApproachWarningStopsTheGoalSoftly) {
       if (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED) {
         aborted = true;
         EXPECT_EQ(f.reason, warning == protocol::SupervisorStatus::WARNING_ZONE_APPROACH ? Feedback::REASON_ZONE
+                            : warning == protocol::SupervisorStatus::WARNING_SITE       ? Feedback::REASON_SITE
                                                                                          : Feedback::REASON_LIMIT_APPROACH);
       }
     }

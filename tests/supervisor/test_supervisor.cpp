@@ -927,6 +927,8 @@ TEST(SupervisorLimits, SingleWriterSourceAndLimitSwitchChecks) {
        sv::kFaultMultipleActuatorWriters},
       {"second sensor writer", [](sv::SupervisorInput& in) { in.sensor_writers = 2; }, sv::kFaultMultipleSensorWriters},
       {"limit switch", [](sv::SupervisorInput& in) { in.limit_switches = 0x2; }, sv::kFaultLimitSwitch},
+      {"the site guard's emergency stop", [](sv::SupervisorInput& in) { in.site = sv::SiteVerdict::emergency_stop; },
+       sv::kFaultSiteGrant},
       {"plant where the bridge is expected", [](sv::SupervisorInput& in) { in.sensor_source = 1; },
        sv::kFaultSensorSource},
   };
@@ -947,6 +949,29 @@ TEST(SupervisorLimits, SingleWriterSourceAndLimitSwitchChecks) {
     EXPECT_STREQ(sv::fault_name(c.fault), sv::fault_name(out.last_fault));
     expect_stopped(out);
   }
+}
+
+// The site guard (docs/site.md): its soft stop is a warning (the planner stops softly; the
+// brakes stay released), proceed and off change nothing, and its emergency stop is a fault (above).
+TEST(SupervisorLimits, TheSiteGuardsSoftStopIsAWarning) {
+  sv::Supervisor supervisor{sv::SupervisorParams{}};
+  const auto healthy = healthy_input();
+  step(supervisor, healthy);
+  ASSERT_TRUE(step(supervisor, healthy).brakes_released);
+  for (const auto verdict : {sv::SiteVerdict::off, sv::SiteVerdict::proceed}) {
+    auto in = healthy;
+    in.site = verdict;
+    const auto out = step(supervisor, in);
+    EXPECT_EQ(out.warnings & sv::kWarningSite, 0u);
+    EXPECT_TRUE(out.brakes_released);
+  }
+  auto in = healthy;
+  in.site = sv::SiteVerdict::soft_stop;
+  const auto out = step(supervisor, in);
+  EXPECT_NE(out.warnings & sv::kWarningSite, 0u);
+  EXPECT_EQ(out.active_faults, 0u);
+  EXPECT_TRUE(out.brakes_released);
+  EXPECT_EQ(step(supervisor, healthy).warnings & sv::kWarningSite, 0u);
 }
 
 TEST(SupervisorLimits, ArmAndResetAreRefusedWhileUnsafe) {

@@ -116,6 +116,9 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       if (o.lockstep) spec.arguments.push_back("--lockstep");
       spec.arguments.insert(spec.arguments.end(), {"--sensor-source", bridge ? "bridge" : "plant"});
       if (!o.fault_log_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--fault-log", o.fault_log_path});
+      if (!o.site_file.empty()) {
+        spec.arguments.insert(spec.arguments.end(), {"--site", o.site_file, "--site-crane", o.site_crane});
+      }
     }
     if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});

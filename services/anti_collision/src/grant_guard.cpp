@@ -34,6 +34,7 @@ const char* to_string(GrantAction action) noexcept {
   switch (action) {
     case GrantAction::proceed: return "proceed";
     case GrantAction::soft_stop: return "soft_stop";
+    case GrantAction::finish_path: return "finish_path";
     case GrantAction::emergency_stop: return "emergency_stop";
   }
   return "unknown";
@@ -93,6 +94,11 @@ GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {
     return {GrantAction::emergency_stop, "leaving its grant"};
   }
   if (must_leave_shared_airspace(time)) {
+    if (!soft_stop_stays_in_grant(m)) {
+      return {GrantAction::finish_path,
+              "link to the site service lost, its grant in shared airspace; a soft stop would leave the grant: the "
+              "move ends at its waypoint"};
+    }
     return {GrantAction::soft_stop, "link to the site service lost, its grant in shared airspace"};
   }
   double allowed = 0.0;

@@ -367,7 +367,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
   const auto& params = planner_.params();
 
   // The supervisor's view: operating mode, zones, faults, zone approach.
-  bool zone_warning = false, limit_warning = false;
+  bool zone_warning = false, limit_warning = false, site_warning = false;
   if (cycle.status != nullptr) {
     const auto& st = *cycle.status;
     const std::uint8_t mode = st.operating_mode;
@@ -385,6 +385,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     if (std::isfinite(st.max_swing) && st.max_swing > 0.0) max_swing_ = st.max_swing;
     zone_warning = (st.warnings & Status::WARNING_ZONE_APPROACH) != 0;
     limit_warning = (st.warnings & Status::WARNING_SPEED_LIMITED) != 0;
+    site_warning = (st.warnings & Status::WARNING_SITE) != 0;
   }
   if (supervisor_stopped_) {
     // The brakes hold the crane where it is and the drives are off: the running goal is over. The
@@ -402,9 +403,11 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     source_ = Source::profile;
     (void)planner_.hold(current);
     hold_bridge(estimate.bridge_position);
-  } else if ((zone_warning || limit_warning) && moving() && stop_id_ == 0) {
+  } else if ((zone_warning || limit_warning || site_warning) && moving() && stop_id_ == 0) {
     // The supervisor's first reaction where a hard stop is not yet required: this soft stop.
-    abort_active(zone_warning ? Feedback::REASON_ZONE : Feedback::REASON_LIMIT_APPROACH);
+    abort_active(zone_warning   ? Feedback::REASON_ZONE
+                 : site_warning ? Feedback::REASON_SITE
+                                : Feedback::REASON_LIMIT_APPROACH);
     soft_stop(0);
   }
 

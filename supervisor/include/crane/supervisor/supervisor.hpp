@@ -103,8 +103,9 @@ enum Fault : std::uint32_t {
   kFaultZone = StatusCodes::FAULT_ZONE,
   kFaultBridgeTravel = StatusCodes::FAULT_BRIDGE_TRAVEL,
   kFaultBridgeOverspeed = StatusCodes::FAULT_BRIDGE_OVERSPEED,
+  kFaultSiteGrant = StatusCodes::FAULT_SITE_GRANT,
 };
-inline constexpr int kFaultBits = 17;
+inline constexpr int kFaultBits = 18;
 /// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
 [[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
 
@@ -117,7 +118,13 @@ enum Warning : std::uint32_t {
   kWarningStageLate = StatusCodes::WARNING_STAGE_LATE,              // a stage is late (not fresh, or a DDS deadline missed):
                                                               // motion inhibited while it lasts, not yet dead
   kWarningZoneApproach = StatusCodes::WARNING_ZONE_APPROACH,        // the predicted stopping position is in a zone
+  kWarningSite = StatusCodes::WARNING_SITE,                         // the site guard asks for a soft stop
 };
+
+/// What the crane's guard of its site grant (anti_collision::GrantGuard, docs/site.md) answered
+/// this cycle: off when the crane is not on a site. emergency_stop raises kFaultSiteGrant (the
+/// brakes); soft_stop is kWarningSite (the planner stops softly).
+enum class SiteVerdict : std::uint8_t { off, proceed, soft_stop, emergency_stop };
 
 /// Operating modes after OPC 40020 (SupervisorStatus.operating_mode, the IDL's OPERATION_* codes).
 enum class OperatingMode : std::uint8_t {
@@ -273,6 +280,7 @@ struct SupervisorInput {
   Command command{Command::none};
   std::uint8_t command_operating_mode{0};  // set_operating_mode: an OPERATION_* code (others refused)
   std::uint8_t command_zone{0};            // enable_zone / disable_zone: index in site.zones (others refused)
+  SiteVerdict site{SiteVerdict::off};      // the site guard's answer for this cycle's motion
 };
 
 struct SupervisorOutput {

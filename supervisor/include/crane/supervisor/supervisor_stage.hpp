@@ -38,6 +38,7 @@ struct SupervisorCycle {
   std::uint32_t nonfinite_rejected{0};                  // samples rejected since start (carried in the status)
   const protocol::SupervisorCommand* command{nullptr};  // at most one operator command per cycle
   bool realtime{false};  // wall-clock cycles: a hardware bridge's sample stamp is when it read the encoders
+  SiteVerdict site{SiteVerdict::off};  // the site guard's answer on this cycle's motion (off: not on a site)
 };
 
 class SupervisorStage {

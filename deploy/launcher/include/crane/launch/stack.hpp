@@ -42,6 +42,8 @@ struct StackOptions {
   std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
                                       // hardware bridge on that board (see the file comment)
   std::string fault_log_path;         // supervisor --fault-log (optional)
+  std::string site_file;              // supervisor --site: the crane is on this site (docs/site.md); empty: none
+  std::string site_crane;             // supervisor --site-crane: its name in the site file
   bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
                                       // commands (deploy/crane estop, ...) over a local socket to a participant
                                       // already matched with the supervisor; off: they make a participant each

@@ -20,6 +20,9 @@
 //                      margins.slow_down of another crane's whole reach): the service now holds
 //                      this crane's whole reach, and the crane keeps out of shared airspace on its
 //                      own; a grant outside shared airspace is finished;
+//      finish_path     the same, when a soft stop decided now would end outside the grant
+//                      (soft_stop_stays_in_grant: a fast move near its goal, the shaped stop running
+//                      past it): the move under way ends at its waypoint, inside the grant, sooner;
 //   5. soft_stop       the load swings wider than the grant's allowance where the crane is (the
 //                      largest swing radius of the boxes that contain the pose);
 //   6. proceed.
@@ -51,8 +54,8 @@ inline constexpr double kContainmentTolerance = 0.02;
 /// True when `pose` lies within `tolerance` of at least one box of `airspace` on every axis.
 [[nodiscard]] bool contains(const Airspace& airspace, const Pose& pose, double tolerance = kContainmentTolerance) noexcept;
 
-enum class GrantAction : std::uint8_t { proceed, soft_stop, emergency_stop };
-/// "proceed", "soft_stop", "emergency_stop".
+enum class GrantAction : std::uint8_t { proceed, soft_stop, finish_path, emergency_stop };
+/// "proceed", "soft_stop", "finish_path", "emergency_stop".
 [[nodiscard]] const char* to_string(GrantAction action) noexcept;
 
 struct GrantCheck {
