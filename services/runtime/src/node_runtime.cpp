@@ -118,16 +118,19 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
     if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;
   }
   p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
-  p.security_directory = options.security_directory;
-  if (p.security_directory.empty()) {
-    if (const char* env = std::getenv("CRANE_SECURITY"); env != nullptr) p.security_directory = env;
-  }
+  p.security_directory = security_directory_of(options);
   p.identity = options.identity;
   check_network_security(p.loopback_only, p.profile_file, p.security_directory, options.insecure_lan);
   if (!p.security_directory.empty()) {
     spdlog::info("DDS Security: identity '{}' of {}", p.identity.empty() ? name : p.identity, p.security_directory);
   }
   return std::make_unique<transport::Participant>(p);
+}
+
+std::string security_directory_of(const NodeOptions& options) {
+  if (!options.security_directory.empty()) return options.security_directory;
+  const char* env = std::getenv("CRANE_SECURITY");
+  return env != nullptr ? env : "";
 }
 
 void configure_logging(const std::string& level, const std::string& process) {

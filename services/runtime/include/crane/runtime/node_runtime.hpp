@@ -92,6 +92,10 @@ void leave_realtime_this_thread() noexcept;
 /// std::runtime_error if DDS fails.
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name);
 
+/// The DDS Security material a participant of `options` uses: --security, else $CRANE_SECURITY,
+/// else "" (none).
+[[nodiscard]] std::string security_directory_of(const NodeOptions& options);
+
 /// Applies --log-level to spdlog's default logger; throws std::invalid_argument on an unknown level.
 void configure_logging(const std::string& level, const std::string& process);
 
