@@ -105,7 +105,12 @@ enum Fault : std::uint32_t {
   kFaultBridgeOverspeed = StatusCodes::FAULT_BRIDGE_OVERSPEED,
   kFaultSiteGrant = StatusCodes::FAULT_SITE_GRANT,
 };
-inline constexpr int kFaultBits = 18;
+/// How many FAULT_* bits the IDL defines (one bit each, from bit 0): counted from its codes.
+inline constexpr int kFaultBits = [] {
+  int count = 0;
+  for (const auto& code : StatusCodes::kCodes) count += code.group == "FAULT" ? 1 : 0;
+  return count;
+}();
 /// Name of one fault bit ("stage_silent", "trolley_travel", ...); "unknown" for other values.
 [[nodiscard]] const char* fault_name(std::uint32_t fault_bit) noexcept;
 
