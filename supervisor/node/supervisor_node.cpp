@@ -50,10 +50,7 @@ class SiteLink {
     if (crane_ < 0) {
       throw std::runtime_error("--site-crane " + crane_name + ": no crane of that name in " + site_path);
     }
-    if (!runtime::security_directory_of(options).empty()) {
-      throw std::runtime_error("--site with DDS Security: the site's topics (rt/site/*) have no permissions in the "
-                               "security material yet; run the site's supervisors and site_service without it");
-    }
+    runtime::require_site_without_security(options);
     options.domain_id = static_cast<std::uint32_t>(layout_.domain_id);
     participant_ = runtime::make_participant(options, "supervisor");
     instructions_ = participant_->make_recording_reader<transport::topics::SiteInstruction>(nullptr, 64);

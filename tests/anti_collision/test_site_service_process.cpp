@@ -6,7 +6,13 @@
 // a private network namespace; the participants are bound to loopback.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <iterator>
+#include <thread>
 
 #include <chrono>
 #include <cmath>
@@ -155,6 +161,28 @@ class SiteProcess {
   Clock::time_point last_arrival_{};
 };
 
+// crane_site_status with `arguments` (output and errors into `out`), the cranes reporting meanwhile;
+// its exit status.
+template <class Tick>
+int run_status(SiteProcess& site, Tick&& tick, const std::string& arguments, std::string& out) {
+  const std::string path = (site.dir() / "status.txt").string();
+  const std::string command = kBin + "/crane_site_status --site '" + kSite + "' " + arguments + " > '" + path + "' 2>&1";
+  std::FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return -1;
+  // The command runs in the background of popen; the cranes keep reporting until it ends.
+  std::atomic<bool> done{false};
+  int status = -1;
+  std::thread waiter([&] {
+    status = ::pclose(pipe);
+    done = true;
+  });
+  while (!done) site.run_for(0.1, tick);
+  waiter.join();
+  std::ifstream in(path);
+  out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 ac::CraneReport at_rest(std::size_t crane, const ac::Pose& pose) {
   ac::CraneReport r;
   r.crane = crane;
@@ -178,7 +206,7 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNoth
   // The grant, over DDS (discovery first: the service holds every crane's whole reach until then).
   ASSERT_TRUE(site.run_until(20.0, tick, [&] { return !site.instructions().empty(); }))
       << "no instruction within 20 s; see " << site.dir();
-  const auto& go = site.instructions().front();
+  const auto go = site.instructions().front();  // a copy: more arrive
   EXPECT_EQ(go.crane, 0);
   EXPECT_EQ(go.kind, crane::protocol::SiteInstruction::KIND_GO);
   EXPECT_EQ(go.request_id, 1u);
@@ -192,6 +220,18 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNoth
   const std::uint32_t epoch = site.status()->epoch;
   EXPECT_EQ(go.epoch, epoch);
   EXPECT_EQ(site.status()->crane_count, 3);
+  // deploy/crane site status (crane_site_status), a participant of its own, prints the same.
+  {
+    std::string out;
+    const int rc = run_status(site, tick, "--domain " + std::to_string(kDomain) + " --wait 1.5", out);
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_NE(out.find("site service epoch " + std::to_string(epoch)), std::string::npos) << out;
+    EXPECT_NE(out.find("tc1      path         -        -"), std::string::npos) << out;
+    EXPECT_NE(out.find("tc2      rest         -        -"), std::string::npos) << out;
+    EXPECT_NE(out.find("tc3      rest         -        -"), std::string::npos) << out;
+    EXPECT_EQ(run_status(site, tick, "--domain 59 --wait 0.5", out), 1) << out;
+    EXPECT_NE(out.find("no site service heard on domain 59 within 0.5 s"), std::string::npos) << out;
+  }
 
   // tc1 carries it out: moving, then at rest at the leg's end.
   tc1.request_id = 0;
@@ -200,9 +240,12 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNoth
   tc1.waypoints = leg;
   tc1.instruction_epoch = epoch;
   tc1.instruction_seq = go.header.seq;
-  site.run_for(0.5, tick);
+  site.run_for(0.3, tick);
+  const std::size_t sent = site.instructions().size();  // 1, and once more every 0.5 s until carried out
+  site.run_for(1.2, tick);
   EXPECT_EQ(site.status()->holding[0], SiteStatus::HOLDING_PATH);
-  EXPECT_EQ(site.instructions().size(), 1u) << "carried out: not sent again";
+  EXPECT_EQ(site.instructions().size(), sent) << "carried out: not sent again";
+  for (const auto& again : site.instructions()) EXPECT_EQ(again.header.seq, go.header.seq) << "sent again as it was";
 
   // tc3 goes silent: past the link deadline (0.3 s) the service holds its whole reach; it reports
   // again at rest and holds its rest box.

@@ -64,10 +64,7 @@ int main(int argc, char** argv) {
     const ac::ArbiterMode mode = mode_name == "serialized" ? ac::ArbiterMode::serialized : ac::ArbiterMode::coordinated;
     ac::SiteService service(layout, mode, draw_epoch());
 
-    if (!runtime::security_directory_of(options).empty()) {
-      throw std::runtime_error("DDS Security: the site's topics (rt/site/*) have no permissions in the security "
-                               "material yet; run site_service without it");
-    }
+    runtime::require_site_without_security(options);
     auto participant = runtime::make_participant(options, "site_service");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -9,8 +9,9 @@
 //       the two cranes at rest with the jibs pointed at each other (trolleys and hooks at the
 //       positions that bring them closest: the worst static case).
 //
-//   crane_site demo --site FILE --config CRANE.yaml [--sets N] [--jobs J] [--seed S] [--threads T]
-//       the simulated site (stack::run_site): N seeded random job sets of J pick-and-place jobs per
+//   crane_site demo --site FILE [--sets N] [--jobs J] [--seed S] [--threads T]
+//       the simulated site (stack::run_site, every crane with the stack config the site file names):
+//       N seeded random job sets of J pick-and-place jobs per
 //       crane, each run three ways, coordinated by the site service's rules, serialized (the
 //       baseline: one crane at a time in shared airspace) and solo (each crane alone); prints the
 //       first set per crane, then over all sets the minimum true distance between any two cranes'
