@@ -2,6 +2,7 @@
 // values; bad files are refused naming the field, the value and the bound (each rule of
 // validate(), hand-computed where it is geometry: the lower jib that reaches a higher crane's mast).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -18,6 +19,7 @@ namespace {
 
 using namespace crane::anti_collision;
 using crane::common::ConfigError;
+namespace fs = std::filesystem;
 
 const std::string kSitePath = std::string(CRANE_SOURCE_DIR) + "/deploy/config/site_three_towers.yaml";
 
@@ -95,13 +97,35 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             0u);
   EXPECT_EQ(refusal(edited("bottom: 0.0", "bottom: 2.0")).rfind("site.yaml: site.zones[0] (site office)", 0), 0u)
       << refusal(edited("bottom: 0.0", "bottom: 2.0"));
-  // The crane's own config: missing, or not a stack config (its soft stop's shaper is read there).
+  // The crane's own config: missing, not a stack config, or a stack config whose planner block the
+  // planner's own reader refuses (its message passed on).
   const std::string missing = refusal(edited("config: lab_tower_crane.yaml", "config: no_such_crane.yaml"));
-  EXPECT_EQ(missing.rfind("site.yaml: site.cranes[0].config = \"no_such_crane.yaml\": the crane's config "
-                          "no_such_crane.yaml: ", 0), 0u) << missing;
+  EXPECT_EQ(missing.rfind("site.yaml: site.cranes[0].config = \"no_such_crane.yaml\": the crane's config: ", 0), 0u)
+      << missing;
+  EXPECT_NE(missing.find("no_such_crane.yaml: cannot be read"), std::string::npos) << missing;
   EXPECT_EQ(refusal(edited("config: lab_tower_crane.yaml", "config: site_three_towers.yaml")),
-            "site.yaml: site.cranes[0].config = \"site_three_towers.yaml\": the crane's config "
-            "site_three_towers.yaml: missing field trajectory_planner");
+            "site.yaml: site.cranes[0].config = \"site_three_towers.yaml\": the crane's config: "
+            "site_three_towers.yaml: missing field crane");
+  const fs::path dir = fs::temp_directory_path() / ("crane_site_layout_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ifstream in(fs::path(kSitePath).parent_path() / "lab_tower_crane.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string damped = std::regex_replace(text.str(), std::regex("swing_damping_ratio: 0.0"),
+                                                  "swing_damping_ratio: 0.5", std::regex_constants::format_first_only);
+    std::ofstream(dir / "lab_tower_crane.yaml") << damped;
+  }
+  std::string damped_refusal;
+  try {
+    (void)parse_site_layout(shipped_text(), "site.yaml", dir);
+  } catch (const ConfigError& error) {
+    damped_refusal = error.what();
+  }
+  fs::remove_all(dir);
+  EXPECT_EQ(damped_refusal, "site.yaml: site.cranes[0].config = \"lab_tower_crane.yaml\": the crane's config: "
+                            "lab_tower_crane.yaml: trajectory_planner.manual.swing_damping_ratio = 0.5 is out of range: "
+                            "must be in [0, 0.3]");
 }
 
 // tc2 moved to 1.5 m from tc1: its jib (1.4 m, radius 0.05) reaches tc1's mast (radius 0.0566) with

@@ -7,6 +7,7 @@
 #include "crane/config/config_document.hpp"
 #include "crane/config/yaml_section.hpp"
 #include "crane/trajectory_planner/speed_reference.hpp"
+#include "crane/trajectory_planner/trajectory_planner_stage.hpp"
 #include "site_ranges.hpp"
 
 namespace crane::anti_collision {
@@ -26,22 +27,16 @@ StoppingData read_stopping(config::YamlSection s) {
   return d;
 }
 
-// The soft stop's shaper delay of the crane whose stack config is `path`: its planner's
-// trajectory_planner.manual.shaping and swing_damping_ratio, read here and nowhere else on the site
-// (the crane's processes and crane::stack::load_stack_config validate the rest of that file).
+// The soft stop's shaper delay of the crane whose stack config is `path`: its planner's block read by
+// the planner's own reader (trajectory_planner::read_params: every field and range checked there),
+// then manual.shaping and swing_damping_ratio; the site reads nothing else of that file.
 double soft_stop_delay_periods(const std::filesystem::path& path) {
-  const std::string name = path.filename().string();
   try {
-    const YAML::Node root = config::parse_yaml_mapping(config::read_text_file(path.string()), name);
-    config::YamlSection document(root, "");
-    config::YamlSection planner = document.child("trajectory_planner");
-    config::YamlSection manual = planner.child("manual");
-    const auto shaping =
-        trajectory_planner::speed_shaping_from_string(manual.text("shaping"), manual.field("shaping"));
-    const double damping = manual.number("swing_damping_ratio", 0.0, 0.3);
-    return trajectory_planner::shaper_delay_periods(shaping, damping);
+    const auto document = config::ConfigDocument::load(path.string());
+    const auto planner = document.read("trajectory_planner", trajectory_planner::read_params);
+    return trajectory_planner::shaper_delay_periods(planner.manual.shaping, planner.manual.swing_damping_ratio);
   } catch (const ConfigError& error) {
-    throw ConfigError(std::string("the crane's config ") + name + ": " + error.what());
+    throw ConfigError(std::string("the crane's config: ") + error.what());
   }
 }
 

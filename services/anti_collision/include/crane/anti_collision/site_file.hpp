@@ -14,11 +14,12 @@ namespace crane::anti_collision {
 
 /// Reads `path` (the `site:` block; see deploy/config/site_three_towers.yaml) and validates it.
 /// Each crane names its stack config (`config`, relative to the site file's directory), whose
-/// planner's soft-stop shaper (trajectory_planner.manual.shaping, swing_damping_ratio) gives the
-/// crane's StoppingData::soft_stop_delay_periods (trajectory_planner::shaper_delay_periods).
+/// planner block (read by trajectory_planner::read_params) gives, through its soft-stop shaper
+/// (manual.shaping, swing_damping_ratio), the crane's StoppingData::soft_stop_delay_periods
+/// (trajectory_planner::shaper_delay_periods).
 /// Throws common::ConfigError prefixed with the file name (file missing, YAML syntax naming the
 /// line, a field as in validate(), a crane's config that cannot be read or names no shaping:
-/// "site.yaml: site.cranes[0].config = "x.yaml": the crane's config x.yaml: ...").
+/// "site.yaml: site.cranes[0].config = "x.yaml": the crane's config: x.yaml: ...").
 [[nodiscard]] SiteLayout load_site_layout(const std::string& path);
 /// Same, from YAML text (tests); `source_name` prefixes the messages and the cranes' configs are
 /// found in `directory`.

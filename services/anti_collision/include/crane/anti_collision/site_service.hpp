@@ -80,7 +80,8 @@ class SiteService {
   [[nodiscard]] std::uint64_t reports_rejected() const noexcept { return rejected_; }
   /// Reports that showed a crane moving while the service held only its rest box.
   [[nodiscard]] std::uint64_t moves_without_grant() const noexcept { return moves_without_grant_; }
-  /// True when crane `crane` was heard within link_deadline of `time`.
+  /// True when crane `crane` was heard within link_deadline of `time`. std::out_of_range for a
+  /// crane index not on the site.
   [[nodiscard]] bool heard(std::size_t crane, double time) const;
 
  private:
