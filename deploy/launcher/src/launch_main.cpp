@@ -68,6 +68,18 @@ int main(int argc, char** argv) {
                  "--sim: the simulated load mass is this times the configured one (the controllers assume the "
                  "configuration; the online estimate, state_estimator.adaptation, finds it)")
       ->check(CLI::Range(0.0, 10.0));
+  auto* site_option = app.add_option("--site", stack.site_file,
+                                     "the crane is on this site (docs/site.md): its supervisor enforces its grant")
+                          ->check(CLI::ExistingFile);
+  auto* site_crane_option = app.add_option("--site-crane", stack.site_crane, "the crane's name in the site file");
+  site_option->needs(site_crane_option);
+  site_crane_option->needs(site_option);
+  app.add_option("--site-jobs", stack.site_jobs,
+                 "the crane's job file (crane_site jobs): a site_link process works through it under the site "
+                 "service's grants")
+      ->needs(site_option)
+      ->check(CLI::ExistingFile);
+  app.add_option("--site-summary", stack.site_summary, "the site link's figures as JSON (site_link --summary)");
   app.add_option("--log-dir", log_dir, "one <stage>.log per process");
   app.add_option("--ready-timeout", ready_timeout, "[s] longest wait for the stack to become ready");
   int realtime_priority = 70;
@@ -84,6 +96,9 @@ int main(int argc, char** argv) {
     runtime::configure_logging("info", "launch");
     std::filesystem::create_directories(log_dir);
     stack.config_path = std::filesystem::absolute(stack.config_path).string();
+    for (std::string* path : {&stack.site_file, &stack.site_jobs, &stack.site_summary}) {
+      if (!path->empty()) *path = std::filesystem::absolute(*path).string();
+    }
     // The whole configuration, validated before any stage starts (each stage would refuse it too).
     const crane::stack::StackConfig config = crane::stack::load_stack_config(stack.config_path);
     if (!config.maneuvers.empty()) {

@@ -34,6 +34,12 @@ std::vector<std::string> stack_process_names(const StackOptions& o) {
                                 "' is not a board: use shm:NAME (emulated board, plant behind it) or "
                                 "comedi:/dev/comediN (a DAQ board)");
   }
+  if (!o.site_jobs.empty()) {
+    if (o.site_file.empty() || o.site_crane.empty()) {
+      throw std::invalid_argument("a site link (site jobs '" + o.site_jobs + "') needs the site file and the crane's name");
+    }
+    names.push_back("site_link");
+  }
   return names;
 }
 
@@ -77,10 +83,11 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     spec.name = name;
     spec.executable = o.binary_directory + "/" + name;
     const auto vendor = vendor_of(o, name);
-    spec.arguments = {"--config", o.config_path, "--dds", vendor, "--domain", std::to_string(o.domain_id),
-                      "--log-level", o.log_level};
+    spec.arguments = {"--dds", vendor, "--domain", std::to_string(o.domain_id), "--log-level", o.log_level};
+    // The site link reads the crane's config from the site file; it works at normal priority.
+    if (name != "site_link") spec.arguments.insert(spec.arguments.begin(), {"--config", o.config_path});
     if (o.lan) spec.arguments.push_back("--lan");
-    if (o.realtime_priority > 0) {
+    if (o.realtime_priority > 0 && name != "site_link") {
       const int offset = name == "plant" || name == "hardware_bridge" ? 10 : name == "supervisor" ? 5 : 0;
       spec.arguments.insert(spec.arguments.end(),
                             {"--realtime-priority", std::to_string(std::min(o.realtime_priority + offset, 99))});
@@ -119,6 +126,11 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       if (!o.site_file.empty()) {
         spec.arguments.insert(spec.arguments.end(), {"--site", o.site_file, "--site-crane", o.site_crane});
       }
+    }
+    if (name == "site_link") {
+      spec.arguments.insert(spec.arguments.end(),
+                            {"--site", o.site_file, "--site-crane", o.site_crane, "--jobs", o.site_jobs});
+      if (!o.site_summary.empty()) spec.arguments.insert(spec.arguments.end(), {"--summary", o.site_summary});
     }
     if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});

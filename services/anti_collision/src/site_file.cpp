@@ -1,6 +1,12 @@
 #include "crane/anti_collision/site_file.hpp"
 
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <utility>
 
 #include "crane/common/validation.hpp"
@@ -118,6 +124,50 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
 SiteLayout load_site_layout(const std::string& path) {
   const std::filesystem::path file(path);
   return parse_site_layout(config::read_text_file(path), file.filename().string(), file.parent_path());
+}
+
+std::vector<SiteJob> load_site_jobs(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  std::istringstream text(config::read_text_file(path));
+  std::string line;
+  if (!std::getline(text, line) || line != kSiteJobsHeader) {
+    throw ConfigError(name + ": line 1 must be the header " + kSiteJobsHeader);
+  }
+  constexpr std::array<const char*, 6> kFields{"pick_slew_rad",  "pick_trolley_m",  "pick_cable_length_m",
+                                               "place_slew_rad", "place_trolley_m", "place_cable_length_m"};
+  std::vector<SiteJob> jobs;
+  for (int number = 2; std::getline(text, line); ++number) {
+    if (line.empty()) continue;
+    std::array<double, 6> v{};
+    std::size_t field = 0, begin = 0;
+    for (; field < v.size() && begin <= line.size(); ++field) {
+      const std::size_t end = std::min(line.find(',', begin), line.size());
+      const std::string cell = line.substr(begin, end - begin);
+      const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v[field]);
+      if (ec != std::errc() || ptr != cell.data() + cell.size() || !std::isfinite(v[field])) {
+        throw ConfigError(name + ": line " + std::to_string(number) + ": " + kFields[field] + " = '" + cell +
+                          "' is not a finite number");
+      }
+      begin = end + 1;
+    }
+    if (field != v.size() || begin <= line.size()) {
+      throw ConfigError(name + ": line " + std::to_string(number) + ": expected 6 fields (" + kSiteJobsHeader + ")");
+    }
+    jobs.push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}});
+  }
+  return jobs;
+}
+
+void write_site_jobs(const std::string& path, const std::vector<SiteJob>& jobs) {
+  std::ofstream out(path);
+  out << kSiteJobsHeader << '\n';
+  char row[256];
+  for (const SiteJob& j : jobs) {
+    std::snprintf(row, sizeof row, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", j.pick.slew, j.pick.trolley,
+                  j.pick.cable_length, j.place.slew, j.place.trolley, j.place.cable_length);
+    out << row;
+  }
+  if (!out) throw std::runtime_error("cannot write the jobs file " + path);
 }
 
 }  // namespace crane::anti_collision

@@ -53,6 +53,34 @@ std::string from_message(const SiteReport& m, CraneReport& r) {
   return "";
 }
 
+void set_motion(const CraneMotion& c, SiteReport& m) noexcept {
+  m.slew = c.slew;
+  m.trolley = c.trolley;
+  m.cable_length = c.cable_length;
+  m.slew_rate = c.slew_rate;
+  m.trolley_velocity = c.trolley_velocity;
+  m.cable_rate = c.cable_rate;
+  m.swing_in_plane = c.swing_in_plane;
+  m.swing_out_of_plane = c.swing_out_of_plane;
+  m.swing_in_plane_rate = c.swing_in_plane_rate;
+  m.swing_out_of_plane_rate = c.swing_out_of_plane_rate;
+}
+
+CraneMotion motion_of(const SiteReport& m) noexcept {
+  CraneMotion c;
+  c.slew = m.slew;
+  c.trolley = m.trolley;
+  c.cable_length = m.cable_length;
+  c.slew_rate = m.slew_rate;
+  c.trolley_velocity = m.trolley_velocity;
+  c.cable_rate = m.cable_rate;
+  c.swing_in_plane = m.swing_in_plane;
+  c.swing_out_of_plane = m.swing_out_of_plane;
+  c.swing_in_plane_rate = m.swing_in_plane_rate;
+  c.swing_out_of_plane_rate = m.swing_out_of_plane_rate;
+  return c;
+}
+
 void to_message(const CraneReport& r, SiteReport& m) noexcept {
   m.crane = static_cast<std::uint8_t>(r.crane);
   m.state = r.moving ? SiteReport::STATE_MOVING : SiteReport::STATE_AT_REST;

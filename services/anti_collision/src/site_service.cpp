@@ -61,35 +61,50 @@ std::string SiteService::report(const CraneReport& r, double time) {
     link.carried_out = true;
   }
   const Pose& here = r.waypoints.front();
+  const auto rest = [&] {
+    arbiter_.rest(r.crane, here);
+    link.rest_pose = here;
+    link.progress_count = 0;
+    dirty_ = true;
+  };
   switch (arbiter_.holding(r.crane)) {
     case Holding::whole_reach:
-      if (!r.moving) arbiter_.rest(r.crane, here);
+      if (!r.moving) rest();
       break;
     case Holding::rest:
       if (r.moving) {
         ++moves_without_grant_;
         arbiter_.lost(r.crane);
-      } else {
-        arbiter_.rest(r.crane, here);
+        dirty_ = true;
+      } else if (std::abs(here.slew - link.rest_pose.slew) > kRestTolerance ||
+                 std::abs(here.trolley - link.rest_pose.trolley) > kRestTolerance ||
+                 std::abs(here.cable_length - link.rest_pose.cable_length) > kRestTolerance) {
+        rest();  // it crept: the box follows
       }
       break;
     case Holding::path:
     case Holding::yield:
       if (!link.carried_out) break;  // it has not heard, or not started, its instruction yet
-      if (r.moving) {
-        arbiter_.progress(r.crane, r.waypoints);
-      } else {
-        arbiter_.rest(r.crane, here);
+      if (!r.moving) {
+        rest();
+      } else if (r.waypoints.size() != link.progress_count) {
+        arbiter_.progress(r.crane, r.waypoints);  // a waypoint reached: what it left is free
+        link.progress_count = r.waypoints.size();
+        dirty_ = true;
       }
       break;
   }
 
   if (r.request_id == 0) {
-    if (link.pending_id != 0) arbiter_.withdraw(r.crane);
+    if (link.pending_id != 0) {
+      arbiter_.withdraw(r.crane);
+      dirty_ = true;
+    }
     link.pending_id = 0;
   } else if (r.request_id != link.pending_id && r.request_id != link.granted_id) {
     arbiter_.request(r.crane, r.request, time);
     link.pending_id = r.request_id;
+    dirty_ = true;
   }
   return "";
 }
@@ -97,12 +112,22 @@ std::string SiteService::report(const CraneReport& r, double time) {
 std::vector<SiteOrder> SiteService::step(double time) {
   for (std::size_t i = 0; i < links_.size(); ++i) {
     if (heard(i, time)) continue;
-    if (arbiter_.holding(i) != Holding::whole_reach) arbiter_.lost(i);
-    if (links_[i].pending_id != 0) arbiter_.withdraw(i);
+    if (arbiter_.holding(i) != Holding::whole_reach) {
+      arbiter_.lost(i);
+      dirty_ = true;
+    }
+    if (links_[i].pending_id != 0) {
+      arbiter_.withdraw(i);
+      dirty_ = true;
+    }
     links_[i].pending_id = 0;
   }
   std::vector<SiteOrder> out;
-  for (Instruction& instruction : arbiter_.decide()) {
+  // The rules decide on what the service holds and is asked: only when that changed.
+  std::vector<Instruction> decided;
+  if (dirty_) decided = arbiter_.decide();
+  dirty_ = false;
+  for (Instruction& instruction : decided) {
     Link& link = links_[instruction.crane];
     SiteOrder order;
     order.crane = instruction.crane;

@@ -18,6 +18,12 @@
 //       parts (its distribution), the total times and their ratios, waits, yields and faults.
 //       --faults K injects K random link faults in each coordinated set (stack::random_link_faults)
 //       and prints the reaction times.
+//
+//   crane_site jobs --site FILE [--jobs J] [--seed S] --out DIR
+//       the demo's seeded job set S (the same jobs `demo --sets 1 --seed S` runs) written as one job
+//       file per crane, DIR/<crane>.csv, for each crane's site_link (--jobs) on DDS, and DIR/hosts.txt:
+//       a line per crane, "name domain_id config start_slew start_trolley" (where the simulated site
+//       starts it), for deploy/site_hosts.sh.
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -27,6 +33,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -243,6 +251,35 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
 }
 
+int write_jobs(const std::string& path, int jobs, std::uint64_t seed, const std::string& out) {
+  try {
+    const SiteLayout site = load_site_layout(path);
+    const auto config = crane::stack::load_site_crane_config(site);
+    const auto sets = crane::stack::random_site_jobs(site, config, jobs, seed);
+    std::filesystem::create_directories(out);
+    std::ofstream hosts(std::filesystem::path(out) / "hosts.txt");
+    for (std::size_t i = 0; i < site.cranes.size(); ++i) {
+      const SiteCrane& c = site.cranes[i];
+      const std::string file = (std::filesystem::path(out) / (c.name + ".csv")).string();
+      write_site_jobs(file, sets[i]);
+      std::printf("%s: %zu jobs -> %s\n", c.name.c_str(), sets[i].size(), file.c_str());
+      // Where it starts: where the simulated site starts it (site_start_pose).
+      const Pose start = site_start_pose(site, i, config.trajectory_planner.slew_min_angle,
+                                         config.trajectory_planner.slew_max_angle,
+                                         config.trajectory_planner.trolley_min_position + 0.1);
+      char line[512];
+      std::snprintf(line, sizeof line, "%s %d %s %.17g %.17g\n", c.name.c_str(), c.domain_id, c.config.c_str(), start.slew,
+                    start.trolley);
+      hosts << line;
+    }
+    if (!hosts) throw std::runtime_error("cannot write " + out + "/hosts.txt");
+    return 0;
+  } catch (const std::exception& error) {
+    std::cerr << error.what() << "\n";
+    return 2;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -261,8 +298,15 @@ int main(int argc, char** argv) {
   demo_command->add_option("--threads", threads, "sets run in parallel")->check(CLI::Range(1, 256));
   int faults = 0;
   demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
+  std::string out;
+  CLI::App* jobs_command = app.add_subcommand("jobs", "a seeded job set written as one job file per crane (site_link --jobs)");
+  jobs_command->add_option("--site", site_path, "the site file")->required();
+  jobs_command->add_option("--jobs", jobs, "pick-and-place jobs per crane")->check(CLI::Range(1, 100));
+  jobs_command->add_option("--seed", seed, "the set's seed (as crane_site demo's)");
+  jobs_command->add_option("--out", out, "the folder for <crane>.csv")->required();
   CLI11_PARSE(app, argc, argv);
   if (check_command->parsed()) return check(site_path);
+  if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) return demo(site_path, sets, jobs, seed, threads, faults);
   return 1;
 }

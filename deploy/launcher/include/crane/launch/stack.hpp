@@ -44,6 +44,10 @@ struct StackOptions {
   std::string fault_log_path;         // supervisor --fault-log (optional)
   std::string site_file;              // supervisor --site: the crane is on this site (docs/site.md); empty: none
   std::string site_crane;             // supervisor --site-crane: its name in the site file
+  std::string site_jobs;              // the crane's job file (crane_site jobs): a site_link process works through it
+                                      // under the site service's grants (site_file and site_crane required);
+                                      // empty: no site link
+  std::string site_summary;           // site_link --summary: its figures as JSON (optional)
   bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
                                       // commands (deploy/crane estop, ...) over a local socket to a participant
                                       // already matched with the supervisor; off: they make a participant each
@@ -53,8 +57,9 @@ struct StackOptions {
 };
 
 /// The processes of the stack in start order: supervisor first (then the operator relay, when
-/// options.operator_relay), the sensor writer (plant or hardware_bridge) last; with shm:NAME the plant behind the board comes just before the bridge.
-/// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH.
+/// options.operator_relay), the sensor writer (plant or hardware_bridge) last of the chain; with shm:NAME the plant behind the board comes just before the bridge; the site link after all (options.site_jobs).
+/// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH, and for
+/// site_jobs without site_file and site_crane.
 std::vector<ProcessSpec> stack_processes(const StackOptions& options);
 
 /// Names of the processes, in the order stack_processes() returns them.

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/site_layout.hpp"
 
 namespace crane::anti_collision {
@@ -25,5 +26,19 @@ namespace crane::anti_collision {
 /// found in `directory`.
 [[nodiscard]] SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& source_name,
                                            const std::filesystem::path& directory);
+
+/// The header line of a crane's job file: one job a line after it, pick and place, angles [rad]
+/// and lengths [m].
+inline constexpr const char* kSiteJobsHeader =
+    "pick_slew_rad,pick_trolley_m,pick_cable_length_m,place_slew_rad,place_trolley_m,place_cable_length_m";
+
+/// A crane's jobs from `path` (kSiteJobsHeader, then a job a line). Throws common::ConfigError
+/// prefixed with the file name: missing, another header, a line without 6 fields, a field that is
+/// not a finite number ("tc1.csv: line 3: place_trolley_m = 'x' is not a finite number"). Ranges
+/// are the site link's to check (CraneSiteLink).
+[[nodiscard]] std::vector<SiteJob> load_site_jobs(const std::string& path);
+/// Writes `jobs` to `path` in that format (17 significant digits: read back exactly). Throws
+/// std::runtime_error when the file cannot be written.
+void write_site_jobs(const std::string& path, const std::vector<SiteJob>& jobs);
 
 }  // namespace crane::anti_collision

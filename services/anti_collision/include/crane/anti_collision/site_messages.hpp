@@ -22,6 +22,11 @@ namespace crane::anti_collision {
 /// MAX_WAYPOINTS are dropped (a report that long is refused by SiteService::report anyway).
 void to_message(const CraneReport& report, protocol::SiteReport& message) noexcept;
 
+/// The measured motion of a report: written (the crane's site link) and read (the views, the
+/// distance monitor). Reading never fails; a non-finite value is the caller's to judge (is_finite).
+void set_motion(const CraneMotion& motion, protocol::SiteReport& message) noexcept;
+[[nodiscard]] CraneMotion motion_of(const protocol::SiteReport& message) noexcept;
+
 /// `order` of the service of `epoch` written into `message` (its header's seq is the order's).
 void to_message(const SiteOrder& order, std::uint32_t epoch, protocol::SiteInstruction& message) noexcept;
 /// `message` read into `order`. "" when read, else why not.

@@ -13,15 +13,17 @@
 // What the service does with it, by what it holds for the crane:
 //   whole reach (lost, or never heard): at rest -> holds the pose's box (SiteArbiter::rest);
 //       moving -> keeps the whole reach until the crane rests (a crane that lost its link stops);
-//   rest: at rest -> the pose's box; moving -> the whole reach (moving without a grant);
+//   rest: at rest -> the pose's box (moved with the crane when it crept more than kRestTolerance
+//       on an axis since the box was taken); moving -> the whole reach (moving without a grant);
 //   path or yield: before the crane has carried out that instruction, nothing (it holds the
-//       path already); after, moving -> the rest of the path (SiteArbiter::progress), at rest ->
-//       the pose's box (the path is done).
+//       path already); after, moving -> the rest of the path (SiteArbiter::progress, when it
+//       reached another waypoint), at rest -> the pose's box (the path is done).
 // A request id the service has not seen is a new request (SiteArbiter::request); a report with
 // none withdraws the pending one. step() marks every crane heard from for no longer than the
 // site's link_deadline as lost (it holds its whole reach, its request is dropped), runs the rules
-// and numbers the instructions; an instruction the crane has not carried out is sent again every
-// kResendPeriod.
+// when what the service holds or is asked changed since they last ran (SiteArbiter::decide: a
+// decision, as its counters count them) and numbers the instructions; an instruction the crane
+// has not carried out is sent again every kResendPeriod.
 //
 // Errors: report() refuses a malformed report (an unknown crane, a waypoint count out of range, a
 // non-finite or non-positive cable length, a request of fewer than 2 waypoints) with a message
@@ -63,6 +65,7 @@ struct SiteOrder {
 class SiteService {
  public:
   static constexpr double kResendPeriod = 0.5;  // [s] an instruction not yet carried out is sent again
+  static constexpr double kRestTolerance = 0.005;  // [m], [rad] a crane at rest that crept further gets a new box
 
   /// The service of `layout` in `mode`; `epoch` identifies this run (drawn at the process's start,
   /// != 0). Throws common::ConfigError for an invalid layout, std::invalid_argument for epoch 0.
@@ -92,6 +95,8 @@ class SiteService {
     bool carried_out{true};        // the crane has carried out its last instruction
     SiteOrder last_order;          // its last instruction (seq 0: none)
     double last_sent{0.0};
+    Pose rest_pose{};                // where its rest box was taken
+    std::size_t progress_count{0};   // waypoints left at its last progress (0: none yet)
   };
 
   SiteArbiter arbiter_;
@@ -100,6 +105,7 @@ class SiteService {
   std::uint64_t seq_{0};
   std::uint64_t rejected_{0};
   std::uint64_t moves_without_grant_{0};
+  bool dirty_{true};  // what the service holds or is asked changed since the rules last ran
 };
 
 }  // namespace crane::anti_collision

@@ -1,13 +1,12 @@
 #pragma once
 // A site of several cranes in lockstep, in one thread (issue 34, item 6; docs/site.md): one
 // in-process stack per crane (in_process_stack.hpp: the same stage objects as each crane's
-// processes, its own plant) and the site service's rules (anti_collision::SiteArbiter), cycle by
-// cycle. Each crane works through a queue of pick-and-place jobs; each job is two legs (to the
-// pick, to the place), and a leg is: hoist up to the travel height, travel (slew and trolley),
-// lower to the work height, hold `dwell` (hooking or unhooking), hoist up. A crane asks the
-// arbiter for the whole leg's path and starts it only when granted; it obeys a yield at once.
-// A move ends when its reference arrived and the crane has settled (trolley < 0.01 m/s, slew
-// < 0.01 rad/s, swing amplitude < 0.5 deg), or `settle_timeout` after the reference arrived.
+// processes, its own plant), each crane's side of the site protocol (anti_collision::CraneSiteLink,
+// the core the site_link process runs) and the site service's (anti_collision::SiteService, the
+// core the site_service process runs), stepped cycle by cycle. The messages the processes send
+// over DDS pass here every cycle: each crane's report to the service, the service's instructions,
+// its heartbeat. Each crane works through a queue of pick-and-place jobs (crane_site_link.hpp: the
+// legs, the requests, the moves waypoint by waypoint, settling and dwelling).
 //
 // The true distance between any two cranes is measured every cycle from the plants' states
 // (crane_geometry.hpp's capsules of jib, counter-jib and mast, the cable from the sheave to the
@@ -19,15 +18,12 @@
 // pair enters slow_down, stop or emergency_stop. On a run whose true distance never comes below
 // margins.stop, every one of them is a stop the grants made needless.
 //
-// A lost link (SiteRunOptions::faults): instructions to the crane and its reports are dropped. When
-// the link has been down for the site's link_deadline, the site service treats the crane as
-// holding its whole reach, and the crane, on its own, stops if the rest of its path is in shared
-// airspace (its GrantGuard's rule 4, grant_guard.hpp), else finishes it; then it waits at rest. It
-// stops with the planner's COMMAND_STOP (a soft stop), or, when that stop would run out of its
-// grant (soft_stop_stays_in_grant), by ending the move under way at its waypoint. When the link is back it reports where it rests and asks again for
-// the leg it was on. The guard's rules 1-3 brake a crane that leaves its grant (it then stays
-// braked, and the site service holds its whole reach); its swing rule is counted, not applied
-// (SiteOutcome::guard_*).
+// A lost link (SiteRunOptions::faults): the crane's reports, the instructions to it and the
+// heartbeat are dropped; a killed site service hears and sends nothing and restarts with no memory
+// (another epoch). What the crane and the service then do is their cores' (crane_site_link.hpp,
+// site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
+// braked and stops reporting, so the service holds its whole reach); its swing rule is counted,
+// not applied (SiteOutcome::guard_*).
 //
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
 // outside a crane's reach or a job list not one per crane.
@@ -38,22 +34,15 @@
 #include <string>
 #include <vector>
 
+#include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
 #include "crane/stack/stack_config.hpp"
 
 namespace crane::stack {
 
-/// A place a crane lifts from or sets down at, in its own coordinates.
-struct WorkPoint {
-  double slew{0.0};          // [rad]
-  double trolley{0.5};       // [m]
-  double cable_length{1.5};  // [m] at the work height
-};
-
-struct SiteJob {
-  WorkPoint pick;
-  WorkPoint place;
-};
+/// A place a crane lifts from or sets down at, and a pick-and-place job (crane_site_link.hpp).
+using WorkPoint = anti_collision::WorkPoint;
+using SiteJob = anti_collision::SiteJob;
 
 enum class SiteMode : std::uint8_t {
   coordinated,  // the site service's rules (SiteArbiter, coordinated)

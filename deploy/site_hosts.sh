@@ -1,0 +1,259 @@
+#!/usr/bin/env bash
+# A site of several cranes, each crane on its own host (issue 34, item 2; docs/site.md, "The site
+# on its own hosts"). On this machine a host is a network namespace with its own /dev/shm (so that
+# no DDS shared memory crosses between hosts), joined to the others by a veth pair through a
+# bridge: the site's network, 10.78.0.0/24. The bridge lives in a namespace of this script's own
+# (the site office, 10.78.0.1); the site service's host is 10.78.0.2, the cranes' 10.78.0.11, .12,
+# ... in the site file's order. Every namespace vanishes with this script; nothing is sent anywhere
+# else. On real hosts the same processes run from the systemd units (deploy/systemd).
+#
+# Each crane's host runs the crane's whole stack (crane_launch: the simulated plant in real time,
+# its supervisor enforcing its grant with --site) and its site link (crane_launch --site-jobs), on
+# its own DDS domain for the stack and the site's domain for rt/site/*; the site service's host runs
+# site_service. The office runs crane_site_status for the whole run: what the service holds and the
+# distance between the cranes from their reports (status.txt, status.json).
+#
+# Usage: site_hosts.sh BIN SITE OUT [--jobs J] [--seed S] [--dds fast|cyclone] [--until-done SECONDS]
+#                      [--fault SPEC ...]
+#   BIN   the build's bin folder; SITE the site file; OUT a folder for the logs and figures
+#   --jobs/--seed   the job set (crane_site jobs: the set `crane_site demo --sets 1 --seed S` runs)
+#   --until-done S  stop when every crane has done its jobs (exit 0 when every job is done, no crane
+#                   braked and the closest distance keeps the site's stop margin), or after S seconds
+#                   (exit 1); without it the site runs until SIGINT/SIGTERM (deploy/crane site start|stop)
+#   --fault SPEC    a fault between hosts, at START seconds after every crane is ready, for DURATION s
+#                   (whole seconds):
+#                     partition:HOST:START:DURATION   the host's link to the bridge down
+#                     loss:HOST:PERCENT:START:DURATION  that share of the packets to and from the host
+#                                                     dropped (tc netem, else nftables)
+#                     delay:HOST:MS:START:DURATION    packets to and from the host delayed (tc netem;
+#                                                     refused where the kernel has no sch_netem)
+#                     kill-service:START:DURATION     the site service killed with -9, started again
+#                                                     DURATION s later (a new epoch)
+#                   HOST is a crane's name or "site" (the service's host).
+# Exit status: 0 done and safe, 1 not (the reason printed), 2 bad usage or no namespaces here.
+set -euo pipefail
+
+usage() { sed -n '17,36p' "$0" >&2; exit 2; }
+[ $# -ge 3 ] || usage
+BIN=$(cd "$1" && pwd) SITE=$(realpath "$2") OUT=$3
+shift 3
+JOBS=1 SEED=1 DDS=cyclone UNTIL=0 FAULTS=()
+while [ $# -gt 0 ]; do
+  case $1 in
+    --jobs) JOBS=$2; shift 2 ;;
+    --seed) SEED=$2; shift 2 ;;
+    --dds) DDS=$2; shift 2 ;;
+    --until-done) UNTIL=$2; shift 2 ;;
+    --fault) FAULTS+=("$2"); shift 2 ;;
+    *) echo "site_hosts.sh: unknown option $1" >&2; usage ;;
+  esac
+done
+mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
+
+# This script in a network namespace of its own: the site office, where the bridge is.
+if [ "${CRANE_SITE_NETNS:-}" != 1 ]; then
+  unshare --net true 2>/dev/null || { echo "site_hosts.sh: cannot make network namespaces here (unshare --net)" >&2; exit 2; }
+  exec unshare --net env CRANE_SITE_NETNS=1 "$0" "$BIN" "$SITE" "$OUT" --jobs "$JOBS" --seed "$SEED" --dds "$DDS" \
+    --until-done "$UNTIL" ${FAULTS[@]+$(printf -- '--fault %s ' "${FAULTS[@]}")}
+fi
+
+declare -A HOLDER ADDRESS PIDS
+NAMES=()
+MONITOR=
+cleanup() {
+  [ -n "$MONITOR" ] && kill -INT "$MONITOR" 2>/dev/null && wait "$MONITOR" 2>/dev/null
+  local pid
+  for pid in "${PIDS[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+  for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
+  for pid in "${HOLDER[@]}"; do kill "$pid" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+ip link set lo up
+ip link add site0 type bridge
+ip link set site0 type bridge mcast_snooping 0
+ip addr add 10.78.0.1/24 dev site0
+ip link set site0 up multicast on
+ip route add 224.0.0.0/4 dev site0
+
+# A host: a network and mount namespace held by a sleeping process, /dev/shm its own, eth0 on the
+# bridge at 10.78.0.$2.
+make_host() {
+  local name=$1 address=10.78.0.$2
+  rm -f "$OUT/.ready_$name"
+  unshare --net --mount --propagation private sh -c "mount -t tmpfs tmpfs /dev/shm && touch '$OUT/.ready_$name' && exec sleep 1000000" &
+  HOLDER[$name]=$!
+  for _ in $(seq 50); do [ -e "$OUT/.ready_$name" ] && break; sleep 0.1; done
+  [ -e "$OUT/.ready_$name" ] || { echo "site_hosts.sh: host $name did not start" >&2; exit 1; }
+  rm -f "$OUT/.ready_$name"
+  ip link add "v-$name" type veth peer name eth0 netns "${HOLDER[$name]}"
+  ip link set "v-$name" master site0 up
+  on "$name" ip link set lo up multicast on
+  on "$name" ip addr add "$address/24" dev eth0
+  on "$name" ip link set eth0 up multicast on
+  on "$name" ip route add 224.0.0.0/4 dev eth0
+  ADDRESS[$name]=$address
+}
+on() { local name=$1; shift; nsenter -t "${HOLDER[$name]}" -n -m -- "$@"; }
+# In the background, appending to LOG: a simple command, so $! is nsenter's pid, and nsenter execs
+# the program (no fork for these namespaces): a signal to $! reaches the program itself.
+spawn() { local name=$1 log=$2; shift 2; nsenter -t "${HOLDER[$name]}" -n -m -- "$@" >> "$log" 2>&1 & }
+
+NET=(--lan --insecure-lan --dds "$DDS")  # the site's network without DDS Security (docs/site.md says why)
+"$BIN/crane_site" jobs --site "$SITE" --jobs "$JOBS" --seed "$SEED" --out "$OUT/jobs" > "$OUT/jobs.log"
+
+make_host site 2
+start_service() {
+  spawn site "$OUT/site_service.log" "$BIN/site_service" --site "$SITE" "${NET[@]}"
+  PIDS[site_service]=$!
+}
+start_service
+index=11
+while read -r name domain config slew trolley; do
+  NAMES+=("$name")
+  make_host "$name" "$index"
+  index=$((index + 1))
+  mkdir -p "$OUT/$name"
+  rm -f "$OUT/$name.json" "$OUT/$name/launch.log"
+  spawn "$name" "$OUT/$name/launch.log" "$BIN/crane_launch" --config "$config" --domain "$domain" "${NET[@]}" \
+    --initial-slew "$slew" --initial-trolley "$trolley" --site "$SITE" --site-crane "$name" \
+    --site-jobs "$OUT/jobs/$name.csv" --site-summary "$OUT/$name.json" --log-dir "$OUT/$name"
+  PIDS[$name]=$!
+done < "$OUT/jobs/hosts.txt"
+"$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --wait 86400 --json "$OUT/status.json" > "$OUT/status.txt" 2>&1 &
+MONITOR=$!
+echo "site: service on 10.78.0.2, cranes ${NAMES[*]} on 10.78.0.11-$((index - 1)); logs in $OUT"
+
+ms() { echo $(($(date +%s%N) / 1000000)); }
+# Every crane ready: its launcher reports its stages matched and alive.
+t0=$(ms)
+for name in "${NAMES[@]}"; do
+  until grep -q "all stages matched and alive" "$OUT/$name/launch.log" 2>/dev/null; do
+    kill -0 "${PIDS[$name]}" 2>/dev/null || { echo "site_hosts.sh: $name's stack stopped before it was ready (see $OUT/$name)"; exit 1; }
+    sleep 0.2
+  done
+done
+ready=$(ms)
+echo "every crane ready after $(awk -v ms=$((ready - t0)) 'BEGIN { printf "%.1f", ms / 1000 }') s"
+
+elapsed_ms() { echo $(($(ms) - ready)); }
+later() { [ "$(elapsed_ms)" -ge "$(($1 * 1000))" ]; }  # $1 whole seconds after ready
+# The faults: each applied at its start and undone at its end (state kept in FAULT_STATE).
+declare -A FAULT_STATE
+apply_fault() {  # index, spec, phase (on|off)
+  local i=$1 phase=$3 kind host value start duration
+  IFS=: read -r kind host value start duration <<< "$2"
+  case $kind in
+    partition)
+      duration=$start start=$value
+      if [ "$phase" = on ]; then ip link set "v-$host" down; else ip link set "v-$host" up; fi ;;
+    loss | delay)
+      if [ "$phase" = on ]; then
+        local arg=$([ "$kind" = loss ] && echo "loss $value%" || echo "delay ${value}ms")
+        if tc qdisc replace dev "v-$host" root netem $arg 2>/dev/null && on "$host" tc qdisc replace dev eth0 root netem $arg 2>/dev/null; then
+          FAULT_STATE[$i]=netem
+        elif [ "$kind" = loss ]; then
+          nft add table inet crane_fault_$i
+          nft add chain inet crane_fault_$i drop_in "{ type filter hook forward priority 0; }"
+          nft add rule inet crane_fault_$i drop_in iifname "v-$host" numgen random mod 100 "<" "$value" drop
+          nft add rule inet crane_fault_$i drop_in oifname "v-$host" numgen random mod 100 "<" "$value" drop
+          FAULT_STATE[$i]=nft
+        else
+          echo "site_hosts.sh: fault $2: this kernel has no sch_netem (tc netem): delay cannot be emulated here" >&2
+          exit 2
+        fi
+      elif [ "${FAULT_STATE[$i]:-}" = netem ]; then
+        tc qdisc del dev "v-$host" root 2>/dev/null || true
+        on "$host" tc qdisc del dev eth0 root 2>/dev/null || true
+      else
+        nft delete table inet crane_fault_$i 2>/dev/null || true
+      fi ;;
+    kill-service)
+      duration=$value start=$host
+      if [ "$phase" = on ]; then
+        kill -9 "${PIDS[site_service]}" 2>/dev/null || true
+        wait "${PIDS[site_service]}" 2>/dev/null || true
+      else
+        start_service
+      fi ;;
+    *) echo "site_hosts.sh: unknown fault $2" >&2; exit 2 ;;
+  esac
+  echo "$(awk -v ms="$(elapsed_ms)" 'BEGIN { printf "%.1f", ms / 1000 }') s: fault $2 $phase" | tee -a "$OUT/faults.log"
+}
+fault_times() {  # the spec's start and end, in whole seconds after ready
+  local kind a b c d
+  IFS=: read -r kind a b c d <<< "$1"
+  case $kind in
+    partition) echo "$b $((b + c))" ;;
+    kill-service) echo "$a $((a + b))" ;;
+    *) echo "$c $((c + d))" ;;
+  esac
+}
+declare -A FAULT_DONE
+all_done() {
+  local name
+  for name in "${NAMES[@]}"; do
+    [ -e "$OUT/$name.json" ] || return 1
+    /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); sys.exit(0 if j["jobs_done"] == j["jobs"] else 1)' "$OUT/$name.json" || return 1
+  done
+}
+while :; do
+  for name in "${!PIDS[@]}"; do
+    kill -0 "${PIDS[$name]}" 2>/dev/null && continue
+    [ "$name" = site_service ] && [ "${FAULT_DONE[service_down]:-}" = 1 ] && continue
+    echo "site_hosts.sh: $name stopped (see $OUT)"; exit 1
+  done
+  for i in "${!FAULTS[@]}"; do
+    read -r from to <<< "$(fault_times "${FAULTS[$i]}")"
+    if [ -z "${FAULT_DONE[$i]:-}" ] && later "$from"; then
+      FAULT_DONE[$i]=on
+      [[ ${FAULTS[$i]} == kill-service:* ]] && FAULT_DONE[service_down]=1
+      apply_fault "$i" "${FAULTS[$i]}" on
+    elif [ "${FAULT_DONE[$i]:-}" = on ] && later "$to"; then
+      FAULT_DONE[$i]=off
+      apply_fault "$i" "${FAULTS[$i]}" off
+      [[ ${FAULTS[$i]} == kill-service:* ]] && FAULT_DONE[service_down]=0
+    fi
+  done
+  if [ "$UNTIL" != 0 ]; then
+    faults_over=1
+    for i in "${!FAULTS[@]}"; do [ "${FAULT_DONE[$i]:-}" = off ] || faults_over=0; done
+    if [ "$faults_over" = 1 ] && all_done; then break; fi
+    if later "$UNTIL"; then echo "site_hosts.sh: not every job done within $UNTIL s"; break; fi
+  fi
+  sleep 0.2
+done
+run_time=$(elapsed_ms)
+kill -INT "$MONITOR" 2>/dev/null && wait "$MONITOR" 2>/dev/null || true
+MONITOR=
+cat "$OUT/status.txt"
+/usr/bin/python3 - "$OUT" "$SITE" "$run_time" "${NAMES[@]}" <<'PY'
+import json, re, sys
+out, site, run_time, names = sys.argv[1], sys.argv[2], float(sys.argv[3]) / 1000.0, sys.argv[4:]
+stop = float(re.search(r"^\s*stop:\s*([0-9.]+)", open(site).read(), re.M).group(1))
+problems = []
+print("crane  jobs  finish_s  waiting_s  yields  halts  phase")
+for name in names:
+    try:
+        s = json.load(open(out + "/" + name + ".json"))
+    except (OSError, ValueError):
+        problems.append(name + ": no summary"); continue
+    print("%-6s %d/%d %9.1f %10.1f %7d %6d  %s" % (name, s["jobs_done"], s["jobs"], s["finish_time_s"], s["waiting_time_s"],
+                                                s["yields"], s["halts"], s["phase"]))
+    if s["jobs_done"] != s["jobs"]: problems.append("%s did %d of %d jobs" % (name, s["jobs_done"], s["jobs"]))
+    if s["phase"] == "braked": problems.append(name + " was braked")
+    if s["reactions_s"]:
+        print("       link losses: reactions [ms] " + " ".join("%.0f" % (1e3 * r) for r in s["reactions_s"]))
+try:
+    status = json.load(open(out + "/status.json"))
+    d = status.get("min_distance_m")
+    print("[ figure   ] site on %d hosts: run %.1f s after ready, closest reported distance %s (stop margin %.3f m)"
+          % (len(names) + 1, run_time, "%.3f m, %s" % (d, status["closest"]) if d is not None else "none", stop))
+    if d is None or d < stop: problems.append("closest distance %s below the stop margin %.3f m" % (d, stop))
+except (OSError, ValueError):
+    problems.append("no status from the site office")
+for p in problems: print("FAILED: " + p)
+sys.exit(1 if problems else 0)
+PY

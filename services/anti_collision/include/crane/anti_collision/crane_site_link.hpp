@@ -1,0 +1,206 @@
+#pragma once
+// A crane's side of the site protocol (issue 34, items 2-4; docs/site.md, "Each crane's site
+// link"): what turns the crane's queue of pick-and-place jobs into requests to the site service,
+// the service's instructions into goals for the crane's planner, and the crane's state into its
+// reports. A core with no clock, no DDS and no threads: the site_link process (one per crane, on
+// the crane's host) and the tests drive it the same way; the other side of the protocol is
+// site_service.hpp.
+//
+// A job is two legs (to the pick, to the place), and a leg is: hoist up to the travel height,
+// travel (slew and trolley), lower to the work height, hold `dwell` (hooking or unhooking), hoist
+// up. The crane asks for the whole leg (its report's request, from where it rests) and starts it
+// only when the service's go for that request arrives; a yield it obeys at once (hook up, through
+// the waypoints it is given; it asks again afterwards). It moves waypoint by waypoint: the goal to
+// the next waypoint (COMMAND_MOVE, every axis named, the trapezoid profile) once the reference of
+// the goal before has arrived and the crane has settled (trolley and slew under 0.01 m/s and
+// rad/s, hoist under 0.01 m/s, swing amplitude under 0.5 deg) or `settle_timeout` after the
+// reference arrived. A goal the planner has not answered (answered(): its MoveStatus_, or the
+// in-process planner's outcome) is sent again every kGoalResendPeriod.
+//
+// Its report (report()) is its whole state: at rest at its pose, or moving with the rest of its
+// path from the last waypoint it reached; the last instruction it carried out (the epoch and seq
+// of the go or yield it started); the leg it asks for while it waits at rest. A crane braked by its
+// supervisor (a latched fault) stops reporting and asking, for good: the service then holds its
+// whole reach, as for a crane that went silent.
+//
+// The link: the crane hears the service (heard(): its heartbeat, any instruction) and keeps its
+// own GrantGuard (grant_guard.hpp) on what it was granted. When nothing was heard for the site's
+// link_deadline, the service holds this crane's whole reach; on its own, the crane then
+//   - moving on a path in shared airspace (the guard's rule 4): stops. A soft stop (the planner's
+//     COMMAND_STOP), or, when a soft stop decided now would run out of the grant (a fast slew near
+//     its goal, GrantGuard::soft_stop_stays_in_grant), the move under way ends at its waypoint and
+//     no further one starts; then it waits at rest;
+//   - moving on a path outside shared airspace: finishes it, then waits at rest;
+//   - at rest: waits.
+// When the service is heard again, a crane waiting at rest reports where it rests and asks again
+// for the leg it was on. Before it first hears the service, a crane waits at rest: it asks for
+// nothing (that is no loss: reactions() counts none).
+//
+// Errors: the constructor throws std::out_of_range for a crane index not on the site and
+// std::invalid_argument for a job outside the site file's ranges of the crane (slew, trolley, cable
+// length from its hook range) or non-positive dwell, settle timeout, slew acceleration, gravity or
+// travel cable length. instruction() ignores an instruction to another crane, one of an epoch and
+// seq already taken, and one of fewer than 2 waypoints (returns false); step() never throws.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/grant_guard.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+#include "crane/anti_collision/site_service.hpp"
+#include "crane/protocol/messages.hpp"
+
+namespace crane::anti_collision {
+
+/// A place a crane lifts from or sets down at, in its own coordinates.
+struct WorkPoint {
+  double slew{0.0};          // [rad]
+  double trolley{0.5};       // [m]
+  double cable_length{1.5};  // [m] at the work height
+};
+
+struct SiteJob {
+  WorkPoint pick;
+  WorkPoint place;
+};
+
+struct CraneLinkParams {
+  double travel_cable_length{0.2};  // [m] the cable's length while travelling, hook up (the planner's shortest)
+  double dwell{1.0};                // [s] at the pick and at the place
+  double settle_timeout{8.0};       // [s] after the reference arrived
+  double slew_acceleration{1.0};    // [rad/s^2] of every move (MoveRequest::slew_max_acceleration)
+  double gravity{9.81};             // [m/s^2] (the swing amplitude of the settle test)
+};
+
+/// [s] a goal the planner has not taken is sent again after this long.
+inline constexpr double kGoalResendPeriod = 1.0;
+
+class CraneSiteLink {
+ public:
+  enum class Phase : std::uint8_t {
+    resting,   // at rest, about to ask (or to finish: no legs left)
+    asking,    // at rest, its request reported, waiting for the go
+    moving,    // on a granted path or a yield
+    dwelling,  // at the work height, hooking or unhooking
+    halting,   // stopping, the link lost (its path in shared airspace)
+    halted,    // at rest, waiting for the link
+    done,      // every job done, at rest (it may still be told to yield)
+    braked,    // its supervisor latched a fault: silent for good
+  };
+
+  /// Crane `crane` of `layout` (copied) with its `jobs`, in order. Its goals to the planner get
+  /// request ids from `first_goal_id` up (the planner takes only ids above the last it took).
+  /// Throws as the header says.
+  CraneSiteLink(const SiteLayout& layout, std::size_t crane, const CraneLinkParams& params, std::vector<SiteJob> jobs,
+                std::uint32_t first_goal_id);
+
+  /// Any message from the site service heard at `time` [s] (its status heartbeat, an instruction
+  /// to any crane): the link is alive.
+  void heard(double time) noexcept;
+  /// An instruction of the service of `epoch` heard at `time` [s]. Taken (true) when it is to this
+  /// crane, newer than the last taken (another epoch, or a higher seq), and the crane can carry it
+  /// out: a go for the request it waits with, or a yield while it waits at rest or is done. Else
+  /// ignored (false; an instruction sent again, one to another crane, a go for an old request).
+  bool instruction(const SiteOrder& order, std::uint32_t epoch, double time);
+  /// The planner answered the goal `goal_id` (accepted, refused, arrived: any answer): it is not
+  /// sent again.
+  void answered(std::uint32_t goal_id) noexcept;
+
+  /// One cycle at `time` [s]: the crane's estimate, its planner's reference, and whether its
+  /// supervisor has a latched fault. Returns the goal to send the planner now, if any (a move to
+  /// the next waypoint, a soft stop, or a goal sent again).
+  [[nodiscard]] std::optional<protocol::MoveRequest> step(double time, const protocol::CraneState& estimate,
+                                                          const protocol::Reference& reference, bool braked);
+
+  /// The report to send now; none once braked (see the header) or before the first step.
+  [[nodiscard]] std::optional<CraneReport> report() const;
+  /// True when the report changed since the last call (send it now, not only at the period).
+  [[nodiscard]] bool report_changed() noexcept;
+
+  [[nodiscard]] Phase phase() const noexcept { return phase_; }
+  [[nodiscard]] std::size_t crane() const noexcept { return crane_; }
+  [[nodiscard]] int jobs_done() const noexcept { return jobs_done_; }
+  [[nodiscard]] std::size_t jobs() const noexcept { return legs_.size() / 2; }
+  [[nodiscard]] double finish_time() const noexcept { return finish_time_; }    // [s] its last job done
+  [[nodiscard]] double waiting_time() const noexcept { return waiting_time_; }  // [s] asking, summed
+  [[nodiscard]] int yields() const noexcept { return yields_; }
+  [[nodiscard]] int unsettled_moves() const noexcept { return unsettled_moves_; }
+  [[nodiscard]] int halts() const noexcept { return halts_; }
+  [[nodiscard]] int halts_at_waypoint() const noexcept { return halts_at_waypoint_; }
+  /// [s] from each link loss that lasted link_deadline to the crane safe: at rest after its stop,
+  /// or still on a path outside shared airspace, or at rest already.
+  [[nodiscard]] const std::vector<double>& reactions() const noexcept { return reactions_; }
+  [[nodiscard]] const GrantGuard& guard() const noexcept { return guard_; }
+  /// The path it moves on (its first waypoint where it started) and the waypoint it moves to.
+  [[nodiscard]] const std::vector<Pose>& path() const noexcept { return path_; }
+  [[nodiscard]] std::size_t waypoint() const noexcept { return waypoint_; }
+  [[nodiscard]] bool yielding() const noexcept { return yielding_; }
+
+  /// The crane is told to move to `to` without asking (a test of its guard: a crane that
+  /// disobeys). Returns the goal.
+  [[nodiscard]] protocol::MoveRequest disobey(const Pose& to, const Pose& here);
+
+ private:
+  struct Leg {
+    WorkPoint at;
+    bool place{false};  // the job's second leg: the job is done when it ends
+  };
+  protocol::MoveRequest move_to(const Pose& to);
+  void rest_at(const Pose& here, double time);
+
+  SiteLayout layout_;
+  std::size_t crane_;
+  CraneLinkParams params_;
+  GrantGuard guard_;
+  std::vector<Leg> legs_;
+  std::size_t next_leg_{0};
+  Phase phase_{Phase::resting};
+  std::uint32_t goal_id_;            // the last goal's request id
+  double goal_sent_{0.0};            // [s] when it was last sent
+  bool goal_taken_{true};            // the planner answered it
+  std::optional<protocol::MoveRequest> goal_;  // the last goal
+  bool link_lost_{true};             // nothing heard yet counts as lost (no loss to react to)
+  double lost_from_{0.0};            // [s] the last message heard before the loss
+  std::vector<Pose> path_;           // the granted path or yield, path_[0] where it started
+  std::size_t waypoint_{0};          // the waypoint being moved to
+  bool yielding_{false};
+  bool start_next_{false};           // the move to waypoint_ + 1 starts at the next step
+  std::optional<double> arrived_at_; // [s] the reference arrived
+  double dwell_until_{0.0};
+  double asked_at_{0.0};
+  std::uint32_t request_id_{0};      // the leg asked for (0: none)
+  std::uint32_t requests_{0};        // requests made
+  bool stepped_{false};
+  std::vector<Pose> request_;
+  Pose pose_{};                      // the measured pose (the last step's)
+  std::uint32_t carried_epoch_{0};
+  std::uint64_t carried_seq_{0};
+  bool changed_{true};
+  int jobs_done_{0};
+  double finish_time_{0.0};
+  double waiting_time_{0.0};
+  int yields_{0};
+  int unsettled_moves_{0};
+  int halts_{0};
+  int halts_at_waypoint_{0};
+  std::vector<double> reactions_;
+  double halt_from_{0.0};
+};
+
+/// [-] "resting", "asking", ...
+[[nodiscard]] const char* to_string(CraneSiteLink::Phase phase) noexcept;
+
+/// The estimator's state as the site's geometry takes it.
+[[nodiscard]] CraneMotion motion_of(const protocol::CraneState& estimate) noexcept;
+
+/// Where crane `crane` of `layout` waits when a site starts: its jib turned away from the site's
+/// centre (the mean of the bases; slew 0 for a site of one crane) within its slew range and
+/// [slew_min + 0.1, slew_max - 0.1] of the planner's (`planner_slew_min`, `planner_slew_max`
+/// [rad]), its trolley at `trolley` [m]. std::out_of_range for a crane index not on the site.
+[[nodiscard]] Pose site_start_pose(const SiteLayout& layout, std::size_t crane, double planner_slew_min,
+                                   double planner_slew_max, double trolley);
+
+}  // namespace crane::anti_collision

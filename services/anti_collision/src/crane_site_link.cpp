@@ -1,0 +1,351 @@
+#include "crane/anti_collision/crane_site_link.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace crane::anti_collision {
+namespace {
+
+using Request = protocol::MoveRequest;
+
+constexpr double kSettledSpeed = 0.01;    // [m/s], [rad/s]
+constexpr double kSettledSwing = 0.0087;  // [rad] (0.5 deg) swing amplitude
+
+Pose pose_of(const protocol::CraneState& e) noexcept { return {e.slew_angle, e.trolley_position, e.cable_length}; }
+
+// The drives at rest (the swing may still decay).
+bool at_rest(const protocol::CraneState& e) noexcept {
+  return std::abs(e.trolley_velocity) < kSettledSpeed && std::abs(e.slew_rate) < kSettledSpeed &&
+         std::abs(e.cable_length_rate) < kSettledSpeed;
+}
+
+bool settled(const protocol::CraneState& e, double gravity) noexcept {
+  const double omega2 = gravity / std::max(e.cable_length, 0.01);
+  const double amplitude = std::sqrt(e.swing_in_plane * e.swing_in_plane + e.swing_out_of_plane * e.swing_out_of_plane +
+                                     (e.swing_in_plane_rate * e.swing_in_plane_rate +
+                                      e.swing_out_of_plane_rate * e.swing_out_of_plane_rate) / omega2);
+  return at_rest(e) && amplitude < kSettledSwing;
+}
+
+void check_point(const SiteCrane& c, const WorkPoint& w, std::size_t job, const char* which) {
+  const auto refuse = [&](const char* field, double value, double low, double high) {
+    throw std::invalid_argument("crane " + c.name + " job " + std::to_string(job) + " " + which + "." + field + " = " +
+                                std::to_string(value) + " is outside [" + std::to_string(low) + ", " +
+                                std::to_string(high) + "]");
+  };
+  if (!(w.slew >= c.slew_min && w.slew <= c.slew_max)) refuse("slew", w.slew, c.slew_min, c.slew_max);
+  if (!(w.trolley >= c.trolley_min && w.trolley <= c.trolley_max)) refuse("trolley", w.trolley, c.trolley_min, c.trolley_max);
+  const double shortest = c.jib_height - c.hook_height_max;
+  const double longest = c.jib_height - c.hook_height_min;
+  if (!(w.cable_length >= shortest - 1e-9 && w.cable_length <= longest + 1e-9)) {
+    refuse("cable_length", w.cable_length, shortest, longest);
+  }
+}
+
+}  // namespace
+
+const char* to_string(CraneSiteLink::Phase phase) noexcept {
+  using P = CraneSiteLink::Phase;
+  switch (phase) {
+    case P::resting: return "resting";
+    case P::asking: return "asking";
+    case P::moving: return "moving";
+    case P::dwelling: return "dwelling";
+    case P::halting: return "halting";
+    case P::halted: return "halted";
+    case P::done: return "done";
+    case P::braked: return "braked";
+  }
+  return "?";
+}
+
+CraneMotion motion_of(const protocol::CraneState& e) noexcept {
+  CraneMotion m;
+  m.slew = e.slew_angle;
+  m.slew_rate = e.slew_rate;
+  m.trolley = e.trolley_position;
+  m.trolley_velocity = e.trolley_velocity;
+  m.cable_length = e.cable_length;
+  m.cable_rate = e.cable_length_rate;
+  m.swing_in_plane = e.swing_in_plane;
+  m.swing_out_of_plane = e.swing_out_of_plane;
+  m.swing_in_plane_rate = e.swing_in_plane_rate;
+  m.swing_out_of_plane_rate = e.swing_out_of_plane_rate;
+  return m;
+}
+
+Pose site_start_pose(const SiteLayout& layout, std::size_t crane, double planner_slew_min, double planner_slew_max,
+                     double trolley) {
+  const SiteCrane& c = layout.cranes.at(crane);
+  const std::size_t n = layout.cranes.size();
+  double cx = 0.0, cy = 0.0;
+  for (const auto& other : layout.cranes) {
+    cx += other.base[0] / static_cast<double>(n);
+    cy += other.base[1] / static_cast<double>(n);
+  }
+  const double away = n > 1 ? std::atan2(c.base[1] - cy, c.base[0] - cx) : 0.0;
+  const double low = std::max(c.slew_min, planner_slew_min) + 0.1;
+  const double high = std::min(c.slew_max, planner_slew_max) - 0.1;
+  const double slew = std::clamp(std::remainder(away - c.slew_zero_heading, 2.0 * std::numbers::pi), low, high);
+  return {slew, trolley, c.jib_height - c.hook_height_max};
+}
+
+CraneSiteLink::CraneSiteLink(const SiteLayout& layout, std::size_t crane, const CraneLinkParams& params,
+                             std::vector<SiteJob> jobs, std::uint32_t first_goal_id)
+    : layout_(layout), crane_(crane), params_(params), guard_(layout, crane), goal_id_(first_goal_id) {
+  const auto positive = [](const char* field, double value) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument(std::string("site link: ") + field + " = " + std::to_string(value) + " must be > 0");
+    }
+  };
+  positive("travel_cable_length", params.travel_cable_length);
+  positive("dwell", params.dwell);
+  positive("settle_timeout", params.settle_timeout);
+  positive("slew_acceleration", params.slew_acceleration);
+  positive("gravity", params.gravity);
+  const SiteCrane& c = layout_.cranes.at(crane_);
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    check_point(c, jobs[j].pick, j, "pick");
+    check_point(c, jobs[j].place, j, "place");
+    legs_.push_back({jobs[j].pick, false});
+    legs_.push_back({jobs[j].place, true});
+  }
+}
+
+void CraneSiteLink::heard(double time) noexcept { guard_.heard(time); }
+
+void CraneSiteLink::answered(std::uint32_t goal_id) noexcept {
+  if (goal_ && goal_->request_id == goal_id) goal_taken_ = true;
+}
+
+bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, double time) {
+  if (order.crane != crane_ || order.waypoints.size() < 2) return false;
+  guard_.heard(time);
+  if (epoch == carried_epoch_ && order.seq <= carried_seq_) return false;  // sent again, or older
+  const bool go = order.kind == Instruction::Kind::go;
+  if (go ? (phase_ != Phase::asking || order.request_id != request_id_)
+         : (phase_ != Phase::asking && phase_ != Phase::done)) {
+    return false;
+  }
+  yielding_ = !go;
+  if (yielding_) ++yields_;
+  waiting_time_ += phase_ == Phase::asking ? time - asked_at_ : 0.0;
+  path_ = order.waypoints;
+  // The site file's hook range is the planner's cable range to its rounding (3.0 - 2.8 m).
+  for (Pose& p : path_) {
+    if (std::abs(p.cable_length - params_.travel_cable_length) < 1e-9) p.cable_length = params_.travel_cable_length;
+  }
+  guard_.grant(path_airspace(path_, layout_.paths), time);
+  carried_epoch_ = epoch;
+  carried_seq_ = order.seq;
+  request_id_ = 0;
+  request_.clear();
+  waypoint_ = 0;
+  phase_ = Phase::moving;
+  start_next_ = true;
+  changed_ = true;
+  return true;
+}
+
+Request CraneSiteLink::move_to(const Pose& to) {
+  Request r{};
+  r.request_id = ++goal_id_;
+  r.profile = Request::PROFILE_TRAPEZOID;
+  r.command = Request::COMMAND_MOVE;
+  // Every axis named: an axis left out keeps its measured position as its target, which the
+  // planner refuses when it reads a hair outside its range (a hoist at its top: 0.19999 m).
+  r.axes = Request::AXIS_SLEW | Request::AXIS_TROLLEY | Request::AXIS_HOIST;
+  r.trolley_target = to.trolley;
+  r.slew_target = to.slew;
+  r.cable_length_target = to.cable_length;
+  r.slew_max_acceleration = params_.slew_acceleration;
+  return r;
+}
+
+void CraneSiteLink::rest_at(const Pose& here, double time) {
+  guard_.grant(rest_airspace(here, layout_.paths), time);
+  changed_ = true;
+  if (next_leg_ == legs_.size()) {
+    phase_ = Phase::done;
+    return;
+  }
+  const WorkPoint& w = legs_[next_leg_].at;
+  const double up = params_.travel_cable_length;
+  std::vector<Pose> path{here};
+  if (here.cable_length > up + 1e-3) path.push_back({here.slew, here.trolley, up});
+  path.push_back({w.slew, w.trolley, up});
+  path.push_back({w.slew, w.trolley, w.cable_length});
+  path.push_back({w.slew, w.trolley, up});
+  request_ = std::move(path);
+  request_id_ = ++requests_;  // a new id: a new request
+  phase_ = Phase::asking;
+  asked_at_ = time;
+}
+
+Request CraneSiteLink::disobey(const Pose& to, const Pose& here) {
+  phase_ = Phase::moving;
+  start_next_ = false;
+  arrived_at_.reset();
+  path_ = {here, to};
+  waypoint_ = 1;
+  yielding_ = true;  // its leg is not a job's
+  request_id_ = 0;
+  request_.clear();
+  goal_ = move_to(to);
+  goal_taken_ = true;
+  changed_ = true;
+  return *goal_;
+}
+
+std::optional<Request> CraneSiteLink::step(double time, const protocol::CraneState& estimate,
+                                           const protocol::Reference& reference, bool braked) {
+  if (phase_ == Phase::braked) return std::nullopt;
+  pose_ = pose_of(estimate);
+  stepped_ = true;
+  if (braked) {
+    phase_ = Phase::braked;
+    changed_ = true;
+    return std::nullopt;
+  }
+  std::optional<Request> goal;
+  const bool lost = guard_.link_lost(time);
+  if (link_lost_ && !lost) {
+    // Back: a crane waiting at rest reports where it rests and asks again.
+    link_lost_ = false;
+    if (phase_ == Phase::halted || phase_ == Phase::asking) phase_ = Phase::resting;
+    if (phase_ == Phase::done) guard_.grant(rest_airspace(pose_, layout_.paths), time);
+    changed_ = true;
+  } else if (!link_lost_ && lost) {
+    link_lost_ = true;
+    lost_from_ = time - layout_.link_deadline;
+    if (phase_ == Phase::moving || phase_ == Phase::dwelling) {
+      std::vector<Pose> rest{pose_};
+      rest.insert(rest.end(), path_.begin() + static_cast<std::ptrdiff_t>(std::min(waypoint_, path_.size() - 1)),
+                  path_.end());
+      // The crane holds only what is ahead of it; its guard's rule 4 decides. A path longer than
+      // an airspace holds is not checked: the crane stops.
+      guard_.progress(path_airspace(rest, layout_.paths));
+      if (rest.size() > Airspace::kMaxBoxes + 1 || guard_.must_leave_shared_airspace(time)) {
+        phase_ = Phase::halting;
+        halt_from_ = lost_from_;
+        arrived_at_.reset();
+        ++halts_;
+        if (start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate))) {
+          Request stop{};
+          stop.request_id = ++goal_id_;
+          stop.command = Request::COMMAND_STOP;
+          goal_ = stop;
+          goal_taken_ = false;
+          goal_sent_ = time;
+          goal = stop;
+        } else {
+          ++halts_at_waypoint_;  // a soft stop would run out of the grant: the move under way ends at its waypoint
+        }
+        start_next_ = false;
+        changed_ = true;
+        return goal;
+      }
+      reactions_.push_back(time - lost_from_);  // it keeps to its own airspace
+    } else if (phase_ != Phase::done && phase_ != Phase::halting) {
+      if (phase_ == Phase::asking || phase_ == Phase::resting) phase_ = Phase::halted;
+      reactions_.push_back(time - lost_from_);  // at rest already
+      changed_ = true;
+    }
+  }
+
+  if (phase_ == Phase::resting && !link_lost_) rest_at(pose_, time);
+
+  if (phase_ == Phase::dwelling && time >= dwell_until_ - 1e-9) {
+    phase_ = Phase::moving;
+    start_next_ = true;
+  }
+  if (phase_ == Phase::moving && start_next_) {
+    start_next_ = false;
+    if (waypoint_ > 0) {
+      // What the crane left behind is free for the others (its report says so).
+      guard_.progress(path_airspace(std::vector<Pose>(path_.begin() + static_cast<std::ptrdiff_t>(waypoint_), path_.end()),
+                                    layout_.paths));
+      changed_ = true;
+    }
+    ++waypoint_;
+    goal_ = move_to(path_[waypoint_]);
+    goal_taken_ = false;
+    goal_sent_ = time;
+    arrived_at_.reset();
+    return goal_;
+  }
+
+  // A goal the planner has not answered is sent again.
+  if (goal_ && !goal_taken_ && time - goal_sent_ >= kGoalResendPeriod - 1e-9) {
+    goal_sent_ = time;
+    goal = goal_;
+  }
+
+  if (phase_ == Phase::halting) {
+    // A soft stop's reference moves until it arrives; a crane settling at a waypoint holds at once.
+    if (reference.phase != protocol::Reference::PHASE_MOVING && at_rest(estimate)) {
+      yielding_ = false;
+      reactions_.push_back(time - halt_from_);
+      phase_ = link_lost_ ? Phase::halted : Phase::resting;
+      changed_ = true;
+    }
+    return goal;
+  }
+  if (phase_ != Phase::moving) return goal;
+  if (!goal_ || reference.request_id != goal_->request_id || reference.phase != protocol::Reference::PHASE_ARRIVED) {
+    return goal;
+  }
+  if (!arrived_at_) arrived_at_ = time;
+  const bool timed_out = time - *arrived_at_ >= params_.settle_timeout - 1e-9;
+  if (!settled(estimate, params_.gravity) && !timed_out) return goal;
+  if (timed_out) ++unsettled_moves_;
+  if (waypoint_ + 1 < path_.size()) {
+    if (!yielding_ && waypoint_ + 2 == path_.size()) {  // at the work height
+      phase_ = Phase::dwelling;
+      dwell_until_ = time + params_.dwell;
+    } else {
+      start_next_ = true;
+    }
+    return goal;
+  }
+  if (!yielding_) {
+    if (legs_[next_leg_].place) {
+      ++jobs_done_;
+      finish_time_ = time;
+    }
+    ++next_leg_;
+  }
+  yielding_ = false;
+  phase_ = Phase::resting;
+  changed_ = true;
+  return goal;
+}
+
+std::optional<CraneReport> CraneSiteLink::report() const {
+  if (phase_ == Phase::braked || !stepped_) return std::nullopt;
+  CraneReport r;
+  r.crane = crane_;
+  r.moving = phase_ == Phase::moving || phase_ == Phase::dwelling || phase_ == Phase::halting;
+  if (r.moving) {
+    // The rest of its path from the last waypoint it reached.
+    const std::size_t reached = waypoint_ == 0 ? 0 : (start_next_ || phase_ == Phase::dwelling ? waypoint_ : waypoint_ - 1);
+    r.waypoints.assign(path_.begin() + static_cast<std::ptrdiff_t>(std::min(reached, path_.size() - 1)), path_.end());
+  } else {
+    r.waypoints = {pose_};
+  }
+  r.instruction_epoch = carried_epoch_;
+  r.instruction_seq = carried_seq_;
+  if (phase_ == Phase::asking) {
+    r.request_id = request_id_;
+    r.request = request_;
+  }
+  return r;
+}
+
+bool CraneSiteLink::report_changed() noexcept { return std::exchange(changed_, false); }
+
+}  // namespace crane::anti_collision

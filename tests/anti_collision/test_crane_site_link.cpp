@@ -1,0 +1,390 @@
+// A crane's side of the site protocol (crane_site_link.hpp), driven by hand: the request of a leg
+// computed by hand from where the crane rests, the go taken once and only for its request, the
+// moves waypoint by waypoint as the reference arrives and the crane settles, the dwell at the work
+// height, the job counted, the yield, a goal sent again until the planner answers, the lost link
+// (a soft stop in shared airspace, the move ended at its waypoint when a soft stop would leave the
+// grant, the path finished outside it), the brakes, and bad jobs and job files refused.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "crane/anti_collision/crane_site_link.hpp"
+#include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/anti_collision/site_file.hpp"
+#include "crane/common/validation.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace crane::anti_collision;
+using crane::protocol::CraneState;
+using crane::protocol::MoveRequest;
+using crane::protocol::Reference;
+
+const std::string kSite = std::string(CRANE_SOURCE_DIR) + "/deploy/config/site_three_towers.yaml";
+constexpr std::uint32_t kFirstGoal = 500;
+constexpr std::uint32_t kEpoch = 77;
+
+// tc1 (base (0, 0), slew 0 along +x toward tc2 at (2, 0)) resting at slew 0, trolley 0.3 m, cable
+// 0.2 m (hook up), with one job: pick at (slew 0, trolley 0.9 m, cable 1.5 m) in shared airspace,
+// place at (slew -1.5, 0.5 m, 1.2 m).
+class Link : public ::testing::Test {
+ protected:
+  Link() : layout_(load_site_layout(kSite)) {
+    params_.travel_cable_length = 0.2;
+    params_.dwell = 1.0;
+    params_.settle_timeout = 8.0;
+    SiteJob job;
+    job.pick = {0.0, 0.9, 1.5};
+    job.place = {-1.5, 0.5, 1.2};
+    link_.emplace(layout_, 0, params_, std::vector<SiteJob>{job}, kFirstGoal);
+    at({0.0, 0.3, 0.2});
+  }
+  // The estimate at rest at `p`, settled.
+  void at(const Pose& p) {
+    estimate_ = CraneState{};
+    estimate_.slew_angle = p.slew;
+    estimate_.trolley_position = p.trolley;
+    estimate_.cable_length = p.cable_length;
+  }
+  std::optional<MoveRequest> step() {
+    link_->heard(t_);
+    auto g = link_->step(t_, estimate_, reference_, false);
+    t_ += 0.01;
+    return g;
+  }
+  // The planner answers `goal`, runs it and arrives; the crane rests at its target, settled.
+  void arrive(const MoveRequest& goal) {
+    link_->answered(goal.request_id);
+    reference_.request_id = goal.request_id;
+    reference_.phase = Reference::PHASE_ARRIVED;
+    at({goal.slew_target, goal.trolley_target, goal.cable_length_target});
+  }
+  SiteOrder go(std::uint64_t seq) {
+    const auto r = link_->report();
+    SiteOrder o;
+    o.crane = 0;
+    o.kind = Instruction::Kind::go;
+    o.request_id = r->request_id;
+    o.seq = seq;
+    o.waypoints = r->request;
+    return o;
+  }
+  // Steps until a goal comes (at most `seconds`).
+  std::optional<MoveRequest> next_goal(double seconds = 0.5) {
+    for (double until = t_ + seconds; t_ < until;) {
+      if (auto g = step()) return g;
+    }
+    return std::nullopt;
+  }
+
+  SiteLayout layout_;
+  CraneLinkParams params_;
+  std::optional<CraneSiteLink> link_;
+  CraneState estimate_{};
+  Reference reference_{};
+  double t_{0.0};
+};
+
+void expect_pose(const Pose& p, double slew, double trolley, double cable) {
+  EXPECT_DOUBLE_EQ(p.slew, slew);
+  EXPECT_DOUBLE_EQ(p.trolley, trolley);
+  EXPECT_DOUBLE_EQ(p.cable_length, cable);
+}
+
+TEST_F(Link, AsksForItsLegAndMovesOnlyOnTheGoForIt) {
+  EXPECT_FALSE(link_->report().has_value()) << "no report before the first step";
+  EXPECT_FALSE(step().has_value());
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  auto r = link_->report();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_FALSE(r->moving);
+  ASSERT_EQ(r->waypoints.size(), 1u);
+  expect_pose(r->waypoints[0], 0.0, 0.3, 0.2);
+  // Hook up already: travel at 0.2 m of cable, lower to the pick's 1.5 m, hoist up again.
+  ASSERT_NE(r->request_id, 0u);
+  ASSERT_EQ(r->request.size(), 4u);
+  expect_pose(r->request[0], 0.0, 0.3, 0.2);
+  expect_pose(r->request[1], 0.0, 0.9, 0.2);
+  expect_pose(r->request[2], 0.0, 0.9, 1.5);
+  expect_pose(r->request[3], 0.0, 0.9, 0.2);
+  EXPECT_EQ(r->instruction_seq, 0u);
+
+  // A go for another request, and a yield-less go to another crane: ignored, nothing moves.
+  SiteOrder wrong = go(1);
+  wrong.request_id += 1;
+  EXPECT_FALSE(link_->instruction(wrong, kEpoch, t_));
+  SiteOrder other = go(1);
+  other.crane = 1;
+  EXPECT_FALSE(link_->instruction(other, kEpoch, t_));
+  EXPECT_FALSE(step().has_value());
+
+  const SiteOrder order = go(2);
+  EXPECT_TRUE(link_->instruction(order, kEpoch, t_));
+  EXPECT_FALSE(link_->instruction(order, kEpoch, t_)) << "the same instruction sent again is not taken twice";
+  const auto g = step();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(g->request_id, kFirstGoal + 1);
+  EXPECT_EQ(g->command, MoveRequest::COMMAND_MOVE);
+  EXPECT_EQ(g->axes, MoveRequest::AXIS_SLEW | MoveRequest::AXIS_TROLLEY | MoveRequest::AXIS_HOIST);
+  EXPECT_DOUBLE_EQ(g->trolley_target, 0.9);
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 0.2);
+  r = link_->report();
+  EXPECT_TRUE(r->moving);
+  EXPECT_EQ(r->instruction_epoch, kEpoch);
+  EXPECT_EQ(r->instruction_seq, 2u);
+  EXPECT_EQ(r->request_id, 0u) << "moving, it asks for nothing";
+  EXPECT_EQ(r->waypoints.size(), 4u) << "the whole path ahead until it reaches waypoint 1";
+}
+
+TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
+  (void)step();
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  // Arrived but swinging 1 deg: no next move until it settles.
+  arrive(*g);
+  estimate_.swing_in_plane = 0.0175;
+  EXPECT_FALSE(next_goal(1.0).has_value());
+  estimate_.swing_in_plane = 0.0;
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 1.5);
+  EXPECT_EQ(link_->report()->waypoints.size(), 3u) << "it reached waypoint 1: the rest of the path from there";
+  // At the work height: the dwell (1 s), then up.
+  arrive(*g);
+  const double reached = t_;
+  g = next_goal(2.0);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(t_ - reached, 1.0, 0.02);
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 0.2);
+  arrive(*g);
+  EXPECT_FALSE(next_goal(0.05).has_value());
+  EXPECT_EQ(link_->jobs_done(), 0) << "the pick is the job's first leg";
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  const auto r = link_->report();
+  ASSERT_EQ(r->request.size(), 4u);
+  expect_pose(r->request[1], -1.5, 0.5, 0.2);
+  expect_pose(r->request[2], -1.5, 0.5, 1.2);
+  // The place: the job is done when its last move settles.
+  ASSERT_TRUE(link_->instruction(go(5), kEpoch, t_));
+  for (int move = 0; move < 3; ++move) {
+    g = next_goal(2.0);
+    ASSERT_TRUE(g.has_value()) << "move " << move;
+    arrive(*g);
+  }
+  (void)step();
+  EXPECT_EQ(link_->jobs_done(), 1);
+  (void)step();
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::done) << "at rest with no leg left, the next cycle";
+  EXPECT_EQ(link_->report()->request_id, 0u);
+  EXPECT_EQ(link_->unsettled_moves(), 0);
+}
+
+TEST_F(Link, ASwingThatDoesNotSettleEndsTheMoveAtTheSettleTimeout) {
+  (void)step();
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  arrive(*g);
+  estimate_.swing_in_plane = 0.05;
+  const double arrived = t_;
+  g = next_goal(10.0);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(t_ - arrived, params_.settle_timeout, 0.02);
+  EXPECT_EQ(link_->unsettled_moves(), 1);
+}
+
+TEST_F(Link, AGoalIsSentAgainUntilThePlannerAnswers) {
+  (void)step();
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  const auto first = step();
+  ASSERT_TRUE(first.has_value());
+  const double sent = t_ - 0.01;
+  const auto again = next_goal(1.5);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->request_id, first->request_id);
+  EXPECT_NEAR(t_ - 0.01 - sent, kGoalResendPeriod, 0.011);
+  link_->answered(first->request_id);
+  EXPECT_FALSE(next_goal(2.0).has_value());
+}
+
+TEST_F(Link, AYieldIsObeyedAtRestAndTheLegAskedAgainWithANewRequest) {
+  (void)step();
+  const std::uint32_t asked = link_->report()->request_id;
+  SiteOrder y;
+  y.crane = 0;
+  y.kind = Instruction::Kind::yield;
+  y.seq = 3;
+  y.waypoints = {{0.0, 0.3, 0.2}, {-0.5, 0.3, 0.2}};
+  ASSERT_TRUE(link_->instruction(y, kEpoch, t_));
+  EXPECT_EQ(link_->yields(), 1);
+  EXPECT_EQ(link_->report()->request_id, 0u) << "yielding withdraws its request";
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->slew_target, -0.5);
+  arrive(*g);
+  (void)next_goal(0.05);
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  const auto r = link_->report();
+  EXPECT_NE(r->request_id, asked);
+  expect_pose(r->request[0], -0.5, 0.3, 0.2);
+  EXPECT_EQ(link_->jobs_done(), 0);
+}
+
+TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
+  (void)step();
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  link_->answered(g->request_id);
+  reference_.request_id = g->request_id;
+  reference_.phase = Reference::PHASE_MOVING;
+  // Half way out along the jib, slowly: nothing heard from now on.
+  at({0.0, 0.6, 0.2});
+  estimate_.trolley_velocity = 0.1;
+  const double last_heard = t_ - 0.01;
+  std::optional<MoveRequest> stop;
+  for (int k = 0; k < 100 && !stop; ++k) {
+    stop = link_->step(t_, estimate_, reference_, false);
+    t_ += 0.01;
+  }
+  ASSERT_TRUE(stop.has_value());
+  EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
+  EXPECT_NEAR(t_ - 0.01 - last_heard, layout_.link_deadline, 0.011);
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
+  EXPECT_EQ(link_->halts(), 1);
+  // The stop ends: at rest, it waits for the link.
+  reference_.phase = Reference::PHASE_ARRIVED;
+  at({0.0, 0.62, 0.2});
+  (void)link_->step(t_, estimate_, reference_, false);
+  t_ += 0.01;
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halted);
+  ASSERT_EQ(link_->reactions().size(), 1u);
+  EXPECT_NEAR(link_->reactions()[0], t_ - 0.01 - last_heard, 0.011);
+  // Heard again: it reports where it rests and asks again for the leg.
+  (void)step();
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  expect_pose(link_->report()->request[0], 0.0, 0.62, 0.2);
+}
+
+TEST_F(Link, ALostLinkEndsTheMoveAtItsWaypointWhenASoftStopWouldLeaveTheGrant) {
+  (void)step();
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  link_->answered(g->request_id);
+  reference_.request_id = g->request_id;
+  reference_.phase = Reference::PHASE_MOVING;
+  // 1 cm before its goal at 0.5 m/s: a soft stop runs far past the box's end.
+  at({0.0, 0.89, 0.2});
+  estimate_.trolley_velocity = 0.5;
+  std::optional<MoveRequest> stop;
+  for (int k = 0; k < 100; ++k) {
+    if (auto s = link_->step(t_, estimate_, reference_, false)) stop = s;
+    t_ += 0.01;
+  }
+  EXPECT_FALSE(stop.has_value()) << "no soft stop, no next move";
+  EXPECT_EQ(link_->halts_at_waypoint(), 1);
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
+}
+
+TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {
+  // The other two cranes moved 10 m away: nothing tc1 does is in shared airspace (on the shipped
+  // lab site every path of every crane is: its counter-jib alone reaches the others).
+  SiteLayout apart = layout_;
+  apart.cranes[1].base = {10.0, 0.0};
+  apart.cranes[2].base = {10.0, 5.0};
+  SiteJob away;
+  away.pick = {-1.6, 0.4, 0.6};
+  away.place = {-1.5, 0.3, 0.6};
+  link_.emplace(apart, 0, params_, std::vector<SiteJob>{away}, kFirstGoal);
+  at({-1.5, 0.3, 0.2});
+  (void)step();
+  ASSERT_FALSE(in_shared_airspace(apart, 0, path_airspace(link_->report()->request, apart.paths)));
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  link_->answered(g->request_id);
+  for (int k = 0; k < 100; ++k) {
+    if (auto s = link_->step(t_, estimate_, reference_, false)) ASSERT_NE(s->command, MoveRequest::COMMAND_STOP);
+    t_ += 0.01;
+  }
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
+  EXPECT_EQ(link_->halts(), 0);
+  ASSERT_EQ(link_->reactions().size(), 1u) << "safe at once: its path is its own";
+}
+
+TEST_F(Link, ABrakedCraneStopsReportingForGood) {
+  (void)step();
+  ASSERT_TRUE(link_->report().has_value());
+  EXPECT_FALSE(link_->step(t_, estimate_, reference_, true).has_value());
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::braked);
+  EXPECT_FALSE(link_->report().has_value());
+  EXPECT_FALSE(step().has_value());
+  EXPECT_FALSE(link_->report().has_value());
+}
+
+TEST(CraneSiteLinkJobs, JobsOutsideTheCranesRangesAreRefusedNamingTheField) {
+  const SiteLayout layout = load_site_layout(kSite);
+  const CraneLinkParams params;
+  const auto refused = [&](const SiteJob& job) -> std::string {
+    try {
+      CraneSiteLink link(layout, 0, params, {job}, 1);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  SiteJob job;
+  job.place.trolley = 1.5;
+  EXPECT_EQ(refused(job), "crane tc1 job 0 place.trolley = 1.500000 is outside [0.050000, 1.300000]");
+  job = SiteJob{};
+  job.pick.cable_length = 2.5;  // tc1's hook reaches 0.5 m: 2.0 m of cable at most
+  EXPECT_EQ(refused(job), "crane tc1 job 0 pick.cable_length = 2.500000 is outside [0.200000, 2.000000]");
+  job = SiteJob{};
+  job.pick.slew = std::nan("");
+  EXPECT_NE(refused(job).find("pick.slew = nan"), std::string::npos);
+  EXPECT_THROW(CraneSiteLink(layout, 3, params, {}, 1), std::out_of_range);
+  CraneLinkParams bad = params;
+  bad.dwell = 0.0;
+  EXPECT_THROW(CraneSiteLink(layout, 0, bad, {}, 1), std::invalid_argument);
+}
+
+TEST(CraneSiteLinkJobs, AJobFileIsReadBackExactlyAndBadFilesAreRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("crane_site_jobs_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::vector<SiteJob> jobs{{{0.1, 0.2, 0.3}, {-1.0 / 3.0, 1.0 / 7.0, 1.2345678901234567}},
+                                  {{2.0, 0.9, 1.5}, {-2.5, 0.05, 2.0}}};
+  write_site_jobs((dir / "tc1.csv").string(), jobs);
+  const auto back = load_site_jobs((dir / "tc1.csv").string());
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].place.slew, jobs[0].place.slew);
+  EXPECT_EQ(back[0].place.trolley, jobs[0].place.trolley);
+  EXPECT_EQ(back[0].place.cable_length, jobs[0].place.cable_length);
+  EXPECT_EQ(back[1].pick.trolley, 0.9);
+  const auto message = [&](const std::string& text) -> std::string {
+    std::ofstream(dir / "bad.csv") << text;
+    try {
+      (void)load_site_jobs((dir / "bad.csv").string());
+    } catch (const crane::common::ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string header = std::string(kSiteJobsHeader) + "\n";
+  EXPECT_EQ(message("slew,trolley\n"), std::string("bad.csv: line 1 must be the header ") + kSiteJobsHeader);
+  EXPECT_EQ(message(header + "0,0.5,1,0,0.5,x\n"), "bad.csv: line 2: place_cable_length_m = 'x' is not a finite number");
+  EXPECT_EQ(message(header + "0,0.5,1,0,0.5\n"),
+            std::string("bad.csv: line 2: expected 6 fields (") + kSiteJobsHeader + ")");
+  EXPECT_EQ(message(header + "0,0.5,1,0,0.5,1,2\n"),
+            std::string("bad.csv: line 2: expected 6 fields (") + kSiteJobsHeader + ")");
+  EXPECT_EQ(message(header + "0,inf,1,0,0.5,1\n"), "bad.csv: line 2: pick_trolley_m = 'inf' is not a finite number");
+  EXPECT_THROW((void)load_site_jobs((dir / "missing.csv").string()), crane::common::ConfigError);
+  fs::remove_all(dir);
+}
+
+}  // namespace
