@@ -203,6 +203,15 @@ Request CraneSiteLink::disobey(const Pose& to, const Pose& here) {
 
 std::optional<Request> CraneSiteLink::step(double time, const protocol::CraneState& estimate,
                                            const protocol::Reference& reference, bool braked) {
+  auto goal = advance(time, estimate, reference, braked);
+  // At rest with legs left, it asks in the same cycle: its report never shows it idle between two
+  // legs (the service would take it for an idle crane in the way and tell it to yield).
+  if (phase_ == Phase::resting && !link_lost_) rest_at(pose_, time);
+  return goal;
+}
+
+std::optional<Request> CraneSiteLink::advance(double time, const protocol::CraneState& estimate,
+                                              const protocol::Reference& reference, bool braked) {
   if (phase_ == Phase::braked) return std::nullopt;
   pose_ = pose_of(estimate);
   stepped_ = true;
@@ -256,8 +265,6 @@ std::optional<Request> CraneSiteLink::step(double time, const protocol::CraneSta
       changed_ = true;
     }
   }
-
-  if (phase_ == Phase::resting && !link_lost_) rest_at(pose_, time);
 
   if (phase_ == Phase::dwelling && time >= dwell_until_ - 1e-9) {
     phase_ = Phase::moving;

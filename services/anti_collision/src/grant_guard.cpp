@@ -75,7 +75,13 @@ bool GrantGuard::must_leave_shared_airspace(double time) const noexcept {
 bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m) const noexcept {
   if (!has_grant_ || !is_finite(m)) return false;
   const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
-  return contains(granted_, {m.slew + stop.slew, m.trolley + stop.trolley, m.cable_length + stop.cable});
+  // The predicted end, carried kContainmentTolerance further along each axis that moves, inside
+  // with no tolerance: the tolerance is the drives' tracking, not the stopping model's error.
+  const auto beyond = [](double travel) { return travel > 0.0 ? kContainmentTolerance : travel < 0.0 ? -kContainmentTolerance : 0.0; };
+  return contains(granted_,
+                  {m.slew + stop.slew + beyond(stop.slew), m.trolley + stop.trolley + beyond(stop.trolley),
+                   m.cable_length + stop.cable + beyond(stop.cable)},
+                  0.0);
 }
 
 GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {

@@ -148,6 +148,8 @@ class CraneSiteLink {
     WorkPoint at;
     bool place{false};  // the job's second leg: the job is done when it ends
   };
+  std::optional<protocol::MoveRequest> advance(double time, const protocol::CraneState& estimate,
+                                               const protocol::Reference& reference, bool braked);
   protocol::MoveRequest move_to(const Pose& to);
   void rest_at(const Pose& here, double time);
 
