@@ -40,7 +40,9 @@ using Clock = std::chrono::steady_clock;
 // This crane's link to its site (--site, --site-crane; docs/site.md, "The crane's own guard"): a
 // participant on the site's domain that hears the site service's instructions to this crane and its
 // heartbeat, and the crane's guard (anti_collision::GrantGuard) that checks the measured motion
-// against the last grant every cycle. Translation and wiring only: the rules are the guard's.
+// against the last grant every cycle; the crane's own reports (its site link's) narrow the grant
+// to the rest of the path as it reaches each waypoint. Translation and wiring only: the rules are
+// the guard's.
 class SiteLink {
  public:
   SiteLink(const std::string& site_path, const std::string& crane_name, runtime::NodeOptions options)
@@ -55,6 +57,7 @@ class SiteLink {
     participant_ = runtime::make_participant(options, "supervisor");
     instructions_ = participant_->make_recording_reader<transport::topics::SiteInstruction>(nullptr, 64);
     status_ = participant_->make_reader<transport::topics::SiteStatus>(nullptr);
+    reports_ = participant_->make_recording_reader<transport::topics::SiteReport>(nullptr, 64);
     spdlog::info("on site '{}' as {} (crane {} of {}), the site's domain {}: nothing moves before a grant",
                  layout_.name, crane_name, crane_, layout_.cranes.size(), layout_.domain_id);
   }
@@ -77,11 +80,38 @@ class SiteLink {
       epoch_ = message.epoch;
       seq_ = order.seq;
       guard_.grant(anti_collision::path_airspace(order.waypoints, layout_.paths), time);
+      granted_ = order.waypoints;
+      progressed_ = granted_.size();
       spdlog::info("site grant {} (epoch {}): {} through {} waypoints", order.seq, message.epoch,
                    order.kind == anti_collision::Instruction::Kind::go ? "go" : "yield", order.waypoints.size());
     }
     transport::topics::msgs::SiteStatus_ dds_status;
     while (status_->take_next(dds_status)) guard_.heard(time);
+    // The crane's own progress (its site link's reports): moving on this grant, the rest of the
+    // path from the last waypoint it reached. Taken only when it is the tail of the granted
+    // waypoints, shorter than the last taken: the guard's grant only narrows.
+    transport::topics::msgs::SiteReport_ dds_report;
+    while (reports_->take_next(dds_report)) {
+      if (dds_report.crane() != crane_ || dds_report.state() != protocol::SiteReport::STATE_MOVING ||
+          dds_report.instruction_epoch() != epoch_ || dds_report.instruction_seq() != seq_) {
+        continue;
+      }
+      protocol::SiteReport message;
+      protocol::from_dds(dds_report, message);
+      anti_collision::CraneReport report;
+      if (!anti_collision::from_message(message, report).empty()) continue;
+      const std::size_t n = report.waypoints.size();
+      if (n == 0 || n >= progressed_ || n > granted_.size()) continue;
+      bool tail = true;
+      for (std::size_t k = 0; k < n && tail; ++k) {
+        const anti_collision::Pose& a = report.waypoints[k];
+        const anti_collision::Pose& b = granted_[granted_.size() - n + k];
+        tail = a.slew == b.slew && a.trolley == b.trolley && a.cable_length == b.cable_length;
+      }
+      if (!tail) continue;
+      guard_.progress(anti_collision::path_airspace(report.waypoints, layout_.paths));
+      progressed_ = n;
+    }
     const anti_collision::GrantCheck c = guard_.check(motion, time);
     // finish_path: the move under way ends at its waypoint inside the grant, sooner than a soft
     // stop would (the planner is left to it).
@@ -104,6 +134,9 @@ class SiteLink {
   std::unique_ptr<transport::Participant> participant_;
   std::unique_ptr<transport::Reader<transport::topics::SiteInstruction>> instructions_;
   std::unique_ptr<transport::Reader<transport::topics::SiteStatus>> status_;
+  std::unique_ptr<transport::Reader<transport::topics::SiteReport>> reports_;
+  std::vector<anti_collision::Pose> granted_;  // the last grant's waypoints
+  std::size_t progressed_{0};                  // waypoints the guard holds of it (granted_.size(): all)
   std::uint32_t epoch_{0};
   std::uint64_t seq_{0};
   supervisor::SiteVerdict last_{supervisor::SiteVerdict::proceed};

@@ -338,13 +338,18 @@ TEST(GrantGuard, EachRuleByHand) {
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::finish_path);
   EXPECT_NEAR(stopping_travel(site.cranes[0], m, StopKind::soft).trolley,
               0.05 + 0.25 + 0.5 * 2.0 * kPi * std::sqrt(0.2 / kStandardGravity) / 2.0, 1e-9);
-  // The predicted stop needs the containment tolerance (0.02 m) to spare: ending at 0.99 m (from
-  // 0.4657 m), 0.01 m inside the box's end (1.0 m), is too close for a model that takes the speed
-  // as constant; ending at 0.97 m (from 0.4457 m), 0.03 m inside, is not.
+  // The predicted stop must end the containment tolerance (0.02 m) inside the box: ending at 0.99 m
+  // (from 0.4657 m), 0.01 m inside the box's end (1.0 m), is too close for a model that takes the
+  // speed as constant; ending at 0.97 m (from 0.4457 m), 0.03 m inside, is not. A slew and a hoist
+  // at rest (their speeds' noise) do not count: the cable's interval has no width.
+  m.slew_rate = 1e-4;
+  m.cable_rate = -1e-4;
   m.trolley = 0.99 - 0.5243;
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::finish_path);
   m.trolley = 0.97 - 0.5243;
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::soft_stop);
+  m.slew_rate = 0.0;
+  m.cable_rate = 0.0;
   m.trolley = 0.6;
   guard.heard(10.0 + site.link_deadline);
   EXPECT_EQ(guard.check(m, 10.0 + 1.1 * site.link_deadline).action, GrantAction::proceed);

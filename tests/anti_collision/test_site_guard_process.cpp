@@ -76,6 +76,7 @@ class SiteCrane {
     site_ = std::make_unique<crane::transport::Participant>(site_side);
     instruction_writer_ = site_->make_writer<tp::SiteInstruction>();
     site_status_writer_ = site_->make_writer<tp::SiteStatus>();
+    report_writer_ = site_->make_writer<tp::SiteReport>();
   }
   ~SiteCrane() {
     status_reader_.reset();
@@ -122,18 +123,35 @@ class SiteCrane {
     return status_ && status_->stages_alive == Status::STAGES_ALL &&
            (status_->mode == Status::MODE_READY || status_->mode == Status::MODE_OPERATING) && status_->brakes_released;
   }
-  // The site service's grant to tc1: from (slew 0, `from` m) to (0, `to` m), cable 1 m.
-  void grant(double from, double to) {
+  // The site service's grant to tc1: from (slew 0, `from` m) to (0, `to` m), cable 1 m, through
+  // (0, `via` m) when given.
+  void grant(double from, double to, std::optional<double> via = std::nullopt) {
     ac::SiteOrder order;
     order.crane = 0;
     order.seq = ++seq_;
     order.request_id = static_cast<std::uint32_t>(seq_);
     order.waypoints = {{0.0, from, 1.0}, {0.0, to, 1.0}};
+    if (via) order.waypoints.insert(order.waypoints.begin() + 1, {0.0, *via, 1.0});
+    granted_ = order.waypoints;
     crane::protocol::SiteInstruction m;
     ac::to_message(order, kEpoch, m);
     tp::msgs::SiteInstruction_ out;
     crane::protocol::to_dds(m, out);
     instruction_writer_->write(out);
+  }
+  // tc1's report as its site link sends it, moving on the last grant, the waypoints from `from` on.
+  void report_progress(std::size_t from) {
+    ac::CraneReport r;
+    r.crane = 0;
+    r.moving = true;
+    r.waypoints.assign(granted_.begin() + static_cast<std::ptrdiff_t>(from), granted_.end());
+    r.instruction_epoch = kEpoch;
+    r.instruction_seq = seq_;
+    crane::protocol::SiteReport m{};
+    ac::to_message(r, m);
+    tp::msgs::SiteReport_ out;
+    crane::protocol::to_dds(m, out);
+    report_writer_->write(out);
   }
   void move(double target, double speed = 0.3) {
     tp::msgs::MoveRequest_ goal;
@@ -178,6 +196,8 @@ class SiteCrane {
   std::unique_ptr<crane::transport::Writer<tp::SafetyCommand>> command_writer_;
   std::unique_ptr<crane::transport::Writer<tp::SiteInstruction>> instruction_writer_;
   std::unique_ptr<crane::transport::Writer<tp::SiteStatus>> site_status_writer_;
+  std::unique_ptr<crane::transport::Writer<tp::SiteReport>> report_writer_;
+  std::vector<ac::Pose> granted_;
   std::optional<Status> status_;
   double trolley_{0.0};
   std::vector<crane::protocol::MoveStatus> moves_;
@@ -246,6 +266,30 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
     }
   }
   EXPECT_TRUE(aborted_for_site) << "the planner's soft stop names the site";
+
+  // 4. The crane's progress narrows its guard's grant: granted from where it rests out to 0.75 m
+  // and back to 0.65 m, it reaches 0.75 m and its site link reports the rest of the path from
+  // there; a move back to where it started (inside the first segment's box, outside the rest's:
+  // 0.75 -> 0.65 m holds [0.61, 0.86] m with the tracking and overshoot allowances) is braked.
+  crane.heartbeat = true;
+  const double from = crane.trolley();
+  crane.grant(from, 0.65, 0.75);
+  ASSERT_TRUE(crane.wait(10.0, [&] { return crane.ready() && crane.status()->mode == Status::MODE_READY; }))
+      << "the soft stop did not end; see " << crane.dir();
+  crane.move(0.75);
+  ASSERT_TRUE(crane.wait(20.0, [&] {
+    return std::fabs(crane.trolley() - 0.75) < 0.02 && std::fabs(crane.status()->trolley_velocity) < 0.01;
+  })) << "the move to 0.75 m did not end; trolley " << crane.trolley() << " m; see " << crane.dir();
+  ASSERT_EQ(crane.status()->latched_faults & Status::FAULT_SITE_GRANT, 0u);
+  crane.report_progress(1);
+  crane.run_for(0.3);
+  crane.move(from + 0.02, 0.2);
+  ASSERT_TRUE(crane.wait(10.0, [&] { return (crane.status()->latched_faults & Status::FAULT_SITE_GRANT) != 0; }))
+      << "a move back into the part of its path the crane had left was not braked; trolley " << crane.trolley()
+      << " m; see " << crane.dir();
+  std::printf("[ figure   ] back into what it had left (0.75 -> %.3f m): braked at %.3f m\n", from + 0.02,
+              crane.trolley());
+  EXPECT_GT(crane.trolley(), 0.61 - 0.1) << "braked near the narrowed box's edge";
 }
 
 }  // namespace

@@ -75,13 +75,17 @@ bool GrantGuard::must_leave_shared_airspace(double time) const noexcept {
 bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m) const noexcept {
   if (!has_grant_ || !is_finite(m)) return false;
   const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
-  // The predicted end, carried kContainmentTolerance further along each axis that moves, inside
-  // with no tolerance: the tolerance is the drives' tracking, not the stopping model's error.
-  const auto beyond = [](double travel) { return travel > 0.0 ? kContainmentTolerance : travel < 0.0 ? -kContainmentTolerance : 0.0; };
-  return contains(granted_,
-                  {m.slew + stop.slew + beyond(stop.slew), m.trolley + stop.trolley + beyond(stop.trolley),
-                   m.cable_length + stop.cable + beyond(stop.cable)},
-                  0.0);
+  // The predicted end inside the box by kContainmentTolerance on each axis the stop carries further
+  // than that (carried 2 x kContainmentTolerance further, then contained with the tolerance): the
+  // tolerance is the drives' tracking, not the stopping model's error. An axis at rest (its
+  // measured speed's noise) is contained as it stands.
+  const auto beyond = [](double travel) {
+    return travel > kContainmentTolerance ? 2.0 * kContainmentTolerance
+           : travel < -kContainmentTolerance ? -2.0 * kContainmentTolerance
+                                             : 0.0;
+  };
+  return contains(granted_, {m.slew + stop.slew + beyond(stop.slew), m.trolley + stop.trolley + beyond(stop.trolley),
+                             m.cable_length + stop.cable + beyond(stop.cable)});
 }
 
 GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {

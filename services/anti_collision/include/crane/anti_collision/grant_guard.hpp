@@ -89,11 +89,11 @@ class GrantGuard {
   /// Rule 4 alone: the link is lost at `time` and the grant is in shared airspace.
   [[nodiscard]] bool must_leave_shared_airspace(double time) const noexcept;
   /// True when a soft stop decided now (stopping_travel(..., StopKind::soft): shaped when the
-  /// crane's stopping data says so) ends inside the grant with kContainmentTolerance to spare on
-  /// each axis it moves (the end carried that much further, then contained with no tolerance: the
-  /// tolerance is for the drives' tracking, and a stop decided while the drive still accelerates
-  /// runs further than the model, which takes the speed as constant: 0.26 rad against 0.237
-  /// predicted from 0.41 rad/s, a seeded lost-link case of the simulated site). When it would not
+  /// crane's stopping data says so) ends inside the grant, and inside a box by kContainmentTolerance
+  /// on each axis the stop carries further than that (the tolerance is for the drives' tracking;
+  /// a stop decided while the drive still accelerates runs further than the model, which takes
+  /// the speed as constant: 0.26 rad against 0.237 predicted from 0.41 rad/s, a seeded lost-link
+  /// case of the simulated site). When it would not
   /// (a fast slew near its goal: the shaped stop runs past it), the crane's move to its next
   /// waypoint is the shorter way to rest inside what it holds.
   [[nodiscard]] bool soft_stop_stays_in_grant(const CraneMotion& motion) const noexcept;
