@@ -11,7 +11,8 @@
 # its supervisor enforcing its grant with --site) and its site link (crane_launch --site-jobs), on
 # its own DDS domain for the stack and the site's domain for rt/site/*; the site service's host runs
 # site_service. The office runs crane_site_status for the whole run: what the service holds and the
-# distance between the cranes from their reports (status.txt, status.json).
+# distance between the cranes from their reports (status.txt, status.json); and crane_web --site,
+# the Foxglove WebSocket view of the site's topics (ws://10.78.0.1:8765 from the office).
 #
 # Usage: site_hosts.sh BIN SITE OUT [--jobs J] [--seed S] [--dds fast|cyclone] [--until-done SECONDS]
 #                      [--fault SPEC ...]
@@ -124,6 +125,12 @@ while read -r name domain config slew trolley; do
 done < "$OUT/jobs/hosts.txt"
 "$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --wait 86400 --json "$OUT/status.json" > "$OUT/status.txt" 2>&1 &
 MONITOR=$!
+# The Foxglove view of the site from the office (crane_web --site: the site's topics, every crane's
+# reports among them), on the site's network; its /metrics count what it forwarded.
+first_config=$(awk 'NR == 1 { print $3 }' "$OUT/jobs/hosts.txt")
+"$BIN/crane_web" --config "$first_config" --site "$SITE" "${NET[@]}" --domain 0 --bind 10.78.0.1 --port 8765 \
+  > "$OUT/crane_web.log" 2>&1 &
+PIDS[crane_web]=$!
 echo "site: service on 10.78.0.2, cranes ${NAMES[*]} on 10.78.0.11-$((index - 1)); logs in $OUT"
 
 ms() { echo $(($(date +%s%N) / 1000000)); }
@@ -226,6 +233,8 @@ while :; do
   sleep 0.2
 done
 run_time=$(elapsed_ms)
+/usr/bin/python3 -c 'import sys, urllib.request; sys.stdout.write(urllib.request.urlopen("http://10.78.0.1:8765/metrics", timeout=5).read().decode())' \
+  > "$OUT/crane_web_metrics.txt" 2>&1 || true
 kill -INT "$MONITOR" 2>/dev/null && wait "$MONITOR" 2>/dev/null || true
 MONITOR=
 cat "$OUT/status.txt"
@@ -254,6 +263,16 @@ try:
     if d is None or d < stop: problems.append("closest distance %s below the stop margin %.3f m" % (d, stop))
 except (OSError, ValueError):
     problems.append("no status from the site office")
+# The Foxglove view (crane_web --site in the office) forwarded the site's topics.
+try:
+    metrics = open(out + "/crane_web_metrics.txt").read()
+except OSError:
+    metrics = ""
+forwarded = {t: int(float(n)) for t, n in re.findall(r'crane_topic_samples_received_total\{topic="(rt/site/[a-z]+)"\} ([0-9.e+]+)', metrics)}
+print("[ figure   ] the office's Foxglove server (crane_web --site) forwarded " +
+      ", ".join("%s %d" % (t, n) for t, n in sorted(forwarded.items())))
+for topic in ("rt/site/report", "rt/site/status", "rt/site/instruction"):
+    if forwarded.get(topic, 0) == 0: problems.append("crane_web forwarded no sample of " + topic)
 for p in problems: print("FAILED: " + p)
 sys.exit(1 if problems else 0)
 PY

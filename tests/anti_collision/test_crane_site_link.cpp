@@ -77,6 +77,27 @@ class Link : public ::testing::Test {
     o.waypoints = r->request;
     return o;
   }
+  // Asks, is granted, and its first move is under way at `here` with `velocity` [m/s] along the jib.
+  void moving_at(const Pose& here, double velocity) {
+    (void)step();
+    ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+    const auto g = step();
+    ASSERT_TRUE(g.has_value());
+    link_->answered(g->request_id);
+    reference_.request_id = g->request_id;
+    reference_.phase = Reference::PHASE_MOVING;
+    at(here);
+    estimate_.trolley_velocity = velocity;
+  }
+  // Steps with nothing heard for `cycles` cycles; the last goal sent, if any.
+  std::optional<MoveRequest> silent(int cycles, bool until_goal) {
+    std::optional<MoveRequest> last;
+    for (int k = 0; k < cycles && !(until_goal && last); ++k) {
+      if (auto g = link_->step(t_, estimate_, reference_, false)) last = g;
+      t_ += 0.01;
+    }
+    return last;
+  }
   // Steps until a goal comes (at most `seconds`).
   std::optional<MoveRequest> next_goal(double seconds = 0.5) {
     for (double until = t_ + seconds; t_ < until;) {
@@ -239,21 +260,10 @@ TEST_F(Link, AYieldIsObeyedAtRestAndTheLegAskedAgainWithANewRequest) {
 }
 
 TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
-  (void)step();
-  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
-  auto g = step();
-  link_->answered(g->request_id);
-  reference_.request_id = g->request_id;
-  reference_.phase = Reference::PHASE_MOVING;
   // Half way out along the jib, slowly: nothing heard from now on.
-  at({0.0, 0.6, 0.2});
-  estimate_.trolley_velocity = 0.1;
+  moving_at({0.0, 0.6, 0.2}, 0.1);
   const double last_heard = t_ - 0.01;
-  std::optional<MoveRequest> stop;
-  for (int k = 0; k < 100 && !stop; ++k) {
-    stop = link_->step(t_, estimate_, reference_, false);
-    t_ += 0.01;
-  }
+  const auto stop = silent(100, true);
   ASSERT_TRUE(stop.has_value());
   EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
   EXPECT_NEAR(t_ - 0.01 - last_heard, layout_.link_deadline, 0.011);
@@ -274,21 +284,9 @@ TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
 }
 
 TEST_F(Link, ALostLinkEndsTheMoveAtItsWaypointWhenASoftStopWouldLeaveTheGrant) {
-  (void)step();
-  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
-  auto g = step();
-  link_->answered(g->request_id);
-  reference_.request_id = g->request_id;
-  reference_.phase = Reference::PHASE_MOVING;
   // 1 cm before its goal at 0.5 m/s: a soft stop runs far past the box's end.
-  at({0.0, 0.89, 0.2});
-  estimate_.trolley_velocity = 0.5;
-  std::optional<MoveRequest> stop;
-  for (int k = 0; k < 100; ++k) {
-    if (auto s = link_->step(t_, estimate_, reference_, false)) stop = s;
-    t_ += 0.01;
-  }
-  EXPECT_FALSE(stop.has_value()) << "no soft stop, no next move";
+  moving_at({0.0, 0.89, 0.2}, 0.5);
+  EXPECT_FALSE(silent(100, false).has_value()) << "no soft stop, no next move";
   EXPECT_EQ(link_->halts_at_waypoint(), 1);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
 }
@@ -309,10 +307,8 @@ TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {
   ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
   auto g = step();
   link_->answered(g->request_id);
-  for (int k = 0; k < 100; ++k) {
-    if (auto s = link_->step(t_, estimate_, reference_, false)) ASSERT_NE(s->command, MoveRequest::COMMAND_STOP);
-    t_ += 0.01;
-  }
+  const auto after = silent(100, false);
+  EXPECT_FALSE(after.has_value() && after->command == MoveRequest::COMMAND_STOP);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
   EXPECT_EQ(link_->halts(), 0);
   ASSERT_EQ(link_->reactions().size(), 1u) << "safe at once: its path is its own";

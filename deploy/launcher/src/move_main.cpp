@@ -68,14 +68,6 @@ struct MoveOptions {
   std::string config;                   // the stack's configuration (names the zones)
 };
 
-// Request ids only increase (the planner ignores one not above the last it took): tenths of a
-// second since 2025-01-01, unique per move typed by an operator and good for 13 years in 32 bits.
-std::uint32_t fresh_request_id() {
-  const auto now = std::chrono::system_clock::now().time_since_epoch();
-  const auto tenths = std::chrono::duration_cast<std::chrono::milliseconds>(now).count() / 100 - 17356896000LL;
-  return static_cast<std::uint32_t>(std::max<long long>(tenths, 1));
-}
-
 std::string reason_name(std::uint8_t reason) {
   return std::string(protocol::code_name(Feedback::kCodes, "REASON", reason));
 }
@@ -194,7 +186,7 @@ int run_stop(const MoveOptions& o, const runtime::NodeOptions& node) {
   runtime::install_stop_handlers(&wakeup);
   auto goals = participant->make_writer<tp::Goal>();
   auto feedback = participant->make_recording_reader<tp::MoveStatus>(&wakeup, 64);
-  const std::uint32_t id = fresh_request_id();
+  const std::uint32_t id = runtime::fresh_request_id();
   protocol::MoveRequest request;
   request.request_id = id;
   request.command = protocol::MoveRequest::COMMAND_STOP;
@@ -254,7 +246,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
   auto safety = participant->make_reader<tp::SafetyStatus>(nullptr);
   const bool tty = isatty(STDOUT_FILENO) != 0 && !o.json;
 
-  const std::uint32_t id = fresh_request_id();
+  const std::uint32_t id = runtime::fresh_request_id();
   const protocol::MoveRequest request = build_request(o, id);
   tp::msgs::MoveRequest_ message;
   protocol::to_dds(request, message);

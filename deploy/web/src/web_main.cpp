@@ -19,6 +19,10 @@
 // kind, travel and no-go zones from --config, the file the stack runs with: site_view.hpp), /about
 // (what this is) and /metrics (the Prometheus text format, web_metrics.hpp: per topic, the
 // supervisor, each process, the server). A client that reads nothing is closed (--close-stalled).
+// With --site FILE, a second read-only participant on the site's domain (the site file's
+// domain_id) forwards the site's topics too (transport::topics::for_each_site_topic: every
+// crane's reports with its pose, the site service's instructions and status), channels after the
+// bus's: a Foxglove client on any host sees every crane of the site.
 //   crane_web --operators FILE --new-operator NAME   appends an operator and prints its token once.
 // Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start (port in use, DDS...); a bad option:
 // CLI11's message and code.
@@ -41,6 +45,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "crane/anti_collision/site_file.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/protocol/idl_schema.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -56,13 +61,16 @@ using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 
-/// One advertised channel per topic of the bus, ids 1..N in the topic table's order.
-std::vector<web::Channel> bus_channels() {
+/// One advertised channel per topic of the bus, ids 1..N in the topic table's order; with a site,
+/// then one per site topic (transport::topics::for_each_site_topic), N+1.. .
+std::vector<web::Channel> bus_channels(bool with_site) {
   std::vector<web::Channel> channels;
-  tp::for_each_topic([&]<class Topic>() {
+  const auto add = [&]<class Topic>() {
     channels.push_back(web::Channel{static_cast<std::uint32_t>(channels.size() + 1), Topic::name, "cdr",
                                     Topic::type_name, "omgidl", std::string(protocol::kIdlSchema)});
-  });
+  };
+  tp::for_each_topic(add);
+  if (with_site) tp::for_each_site_topic(add);
   return channels;
 }
 
@@ -97,6 +105,11 @@ int main(int argc, char** argv) {
   runtime::add_security_options(app, node);
   std::string config_path;
   app.add_option("--config", config_path, "the stack's configuration (YAML): the crane and the no-go zones the page draws")
+      ->check(CLI::ExistingFile);
+  std::string site_path;
+  app.add_option("--site", site_path,
+                 "the crane's site file (docs/site.md): the site's topics (rt/site/report, instruction, status) too, "
+                 "from the site's DDS domain")
       ->check(CLI::ExistingFile);
   std::string assets = CRANE_WEB_ASSETS_DIR;
   app.add_option("--assets", assets, "folder of the operator page (index.html, crane_view.js)");
@@ -163,6 +176,14 @@ int main(int argc, char** argv) {
     // With operators, every login and every published command is logged (the audit trail).
     runtime::configure_logging(auth ? "info" : "warn", "crane_web");
     auto participant = runtime::make_participant(node, "crane_web");
+    // The site's topics come from the site's own domain (read-only, like the bus).
+    std::unique_ptr<transport::Participant> site_participant;
+    if (!site_path.empty()) {
+      runtime::require_site_without_security(node);
+      runtime::NodeOptions site_node = node;
+      site_node.domain_id = static_cast<std::uint32_t>(anti_collision::load_site_layout(site_path).domain_id);
+      site_participant = runtime::make_participant(site_node, "crane_web");
+    }
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
 
@@ -173,7 +194,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "crane_web: no operator page in %s (index.html, crane_view.js): / describes the server\n",
                    assets.c_str());
     }
-    const auto channels = bus_channels();
+    const auto channels = bus_channels(site_participant != nullptr);
     std::vector<std::string> topic_names;
     for (const auto& c : channels) topic_names.push_back(c.topic);
     web::WebMetrics metrics(topic_names);
@@ -288,9 +309,10 @@ int main(int argc, char** argv) {
     std::vector<std::function<void()>> drains;
     std::vector<std::shared_ptr<void>> readers;
     std::uint32_t channel_id = 0;
-    tp::for_each_topic([&]<class T>() {
+    transport::Participant* source = participant.get();
+    const auto forward_topic = [&]<class T>() {
       const std::uint32_t id = ++channel_id;
-      auto reader = std::shared_ptr(participant->make_recording_reader<T>(&wakeup, 64));
+      auto reader = std::shared_ptr(source->make_recording_reader<T>(&wakeup, 64));
       readers.push_back(reader);
       const std::size_t topic_index = id - 1;
       drains.push_back([reader, id, topic_index, &server, &metrics] {
@@ -316,7 +338,12 @@ int main(int argc, char** argv) {
           server.publish(id, receive_ns, std::move(bytes));
         }
       });
-    });
+    };
+    tp::for_each_topic(forward_topic);
+    if (site_participant) {
+      source = site_participant.get();
+      tp::for_each_site_topic(forward_topic);
+    }
 
     server.start();
     std::printf("crane_web: ws://%s:%u (subprotocol %s), %zu channels; Ctrl-C to stop\n",

@@ -42,14 +42,6 @@ using Status = protocol::SupervisorStatus;
 constexpr auto kCycle = std::chrono::milliseconds(10);
 constexpr double kReportPeriod = 0.1;  // [s] 10 Hz, and on every change
 
-// Request ids only increase (the planner takes none at or below the last it took): tenths of a
-// second since 2025-01-01 times 16, room for 16 goals a tenth before a later start could repeat one.
-std::uint32_t first_goal_id() {
-  const auto now = std::chrono::system_clock::now().time_since_epoch();
-  const auto tenths = std::chrono::duration_cast<std::chrono::milliseconds>(now).count() / 100 - 17356896000LL;
-  return static_cast<std::uint32_t>(std::max<long long>(tenths, 1) * 16 % 0xF0000000LL);
-}
-
 void write_summary(const std::string& path, const std::string& name, const ac::CraneSiteLink& link) {
   if (path.empty()) return;
   nlohmann::json j{{"crane", name},
@@ -95,8 +87,9 @@ int main(int argc, char** argv) {
     const auto planner = document.read("trajectory_planner", trajectory_planner::read_params);
     params.travel_cable_length = planner.cable_min_length;
     params.gravity = document.facts().crane.gravity;
+    // Its goals count up from a fresh id (one goal a waypoint: far fewer than ten a second).
     ac::CraneSiteLink link(layout, static_cast<std::size_t>(index), params, ac::load_site_jobs(jobs_path),
-                           first_goal_id());
+                           runtime::fresh_request_id());
 
     runtime::require_site_without_security(options);
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(me.domain_id);

@@ -194,6 +194,12 @@ void install_stop_handlers(transport::Wakeup* wakeup) {
 
 bool stop_requested() noexcept { return g_stop.load(); }
 
+std::uint32_t fresh_request_id() noexcept {
+  const auto now = std::chrono::system_clock::now().time_since_epoch();
+  const auto tenths = std::chrono::duration_cast<std::chrono::milliseconds>(now).count() / 100 - 17356896000LL;
+  return static_cast<std::uint32_t>(std::max<long long>(tenths, 1));
+}
+
 builtin_interfaces::msg::dds_::Time_ now_stamp() noexcept {
   timespec ts{};
   clock_gettime(CLOCK_REALTIME, &ts);

@@ -120,6 +120,12 @@ void install_stop_handlers(transport::Wakeup* wakeup);
 [[nodiscard]] std::int64_t to_nanoseconds(const builtin_interfaces::msg::dds_::Time_& stamp) noexcept;
 [[nodiscard]] std::int64_t now_nanoseconds() noexcept;
 
+/// A MoveRequest_ id above every id a client took before (the planner ignores an id not above the
+/// last it took): tenths of a second since 2025-01-01, from the wall clock. A client that sends
+/// several goals counts up from it, and stays below a later client's first id as long as it sends
+/// fewer than ten a second on average. Good for 13 years in 32 bits.
+[[nodiscard]] std::uint32_t fresh_request_id() noexcept;
+
 /// Fills header.stamp = now, header.seq, header.origin.
 void stamp_header(msgs::CycleHeader_& header, std::uint64_t seq, const builtin_interfaces::msg::dds_::Time_& origin) noexcept;
 
