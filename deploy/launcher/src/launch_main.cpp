@@ -80,6 +80,9 @@ int main(int argc, char** argv) {
       ->needs(site_option)
       ->check(CLI::ExistingFile);
   app.add_option("--site-summary", stack.site_summary, "the site link's figures as JSON (site_link --summary)");
+  app.add_option("--site-slew-speed", stack.site_slew_speed,
+                 "[rad/s] the site link's moves slew at most this fast (0: the crane's rated slew rate)")
+      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--log-dir", log_dir, "one <stage>.log per process");
   app.add_option("--ready-timeout", ready_timeout, "[s] longest wait for the stack to become ready");
   int realtime_priority = 70;

@@ -131,6 +131,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       spec.arguments.insert(spec.arguments.end(),
                             {"--site", o.site_file, "--site-crane", o.site_crane, "--jobs", o.site_jobs});
       if (!o.site_summary.empty()) spec.arguments.insert(spec.arguments.end(), {"--summary", o.site_summary});
+      if (o.site_slew_speed > 0.0) spec.arguments.insert(spec.arguments.end(), {"--slew-speed", number(o.site_slew_speed)});
     }
     if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});

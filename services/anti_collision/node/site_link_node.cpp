@@ -76,6 +76,8 @@ int main(int argc, char** argv) {
   app.add_option("--dwell", params.dwell, "[s] at the pick and at the place")->check(CLI::Range(0.0, 600.0));
   app.add_option("--slew-acceleration", params.slew_acceleration, "[rad/s^2] of every move")
       ->check(CLI::Range(0.01, 10.0));
+  app.add_option("--slew-speed", params.slew_speed, "[rad/s] of every move (0: the crane's rated slew rate)")
+      ->check(CLI::Range(0.0, 10.0));
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "site_link");

@@ -107,6 +107,9 @@ CraneSiteLink::CraneSiteLink(const SiteLayout& layout, std::size_t crane, const 
   positive("settle_timeout", params.settle_timeout);
   positive("slew_acceleration", params.slew_acceleration);
   positive("gravity", params.gravity);
+  if (!(params.slew_speed >= 0.0) || !std::isfinite(params.slew_speed)) {
+    throw std::invalid_argument("site link: slew_speed = " + std::to_string(params.slew_speed) + " must be >= 0");
+  }
   const SiteCrane& c = layout_.cranes.at(crane_);
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     check_point(c, jobs[j].pick, j, "pick");
@@ -163,6 +166,7 @@ Request CraneSiteLink::move_to(const Pose& to) {
   r.slew_target = to.slew;
   r.cable_length_target = to.cable_length;
   r.slew_max_acceleration = params_.slew_acceleration;
+  r.slew_max_velocity = params_.slew_speed;
   return r;
 }
 

@@ -48,6 +48,7 @@ struct StackOptions {
                                       // under the site service's grants (site_file and site_crane required);
                                       // empty: no site link
   std::string site_summary;           // site_link --summary: its figures as JSON (optional)
+  double site_slew_speed{0.0};        // site_link --slew-speed [rad/s]: 0, the crane's rated slew rate
   bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
                                       // commands (deploy/crane estop, ...) over a local socket to a participant
                                       // already matched with the supervisor; off: they make a participant each

@@ -72,6 +72,7 @@ struct CraneLinkParams {
   double dwell{1.0};                // [s] at the pick and at the place
   double settle_timeout{8.0};       // [s] after the reference arrived
   double slew_acceleration{1.0};    // [rad/s^2] of every move (MoveRequest::slew_max_acceleration)
+  double slew_speed{0.0};           // [rad/s] of every move (MoveRequest::slew_max_velocity); 0: the crane's rated
   double gravity{9.81};             // [m/s^2] (the swing amplitude of the settle test)
 };
 
