@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 
@@ -96,20 +97,17 @@ class SiteLink {
           dds_report.instruction_epoch() != epoch_ || dds_report.instruction_seq() != seq_) {
         continue;
       }
-      protocol::SiteReport message;
-      protocol::from_dds(dds_report, message);
-      anti_collision::CraneReport report;
-      if (!anti_collision::from_message(message, report).empty()) continue;
-      const std::size_t n = report.waypoints.size();
-      if (n == 0 || n >= progressed_ || n > granted_.size()) continue;
+      // Read in place from the message (no allocation in the cycle): the tail of granted_ or nothing.
+      const std::size_t n = dds_report.waypoint_count();
+      if (n == 0 || n >= progressed_ || n > granted_.size() || n > dds_report.waypoint_slew().size()) continue;
+      const std::span<const anti_collision::Pose> rest = std::span<const anti_collision::Pose>(granted_).last(n);
       bool tail = true;
       for (std::size_t k = 0; k < n && tail; ++k) {
-        const anti_collision::Pose& a = report.waypoints[k];
-        const anti_collision::Pose& b = granted_[granted_.size() - n + k];
-        tail = a.slew == b.slew && a.trolley == b.trolley && a.cable_length == b.cable_length;
+        tail = dds_report.waypoint_slew()[k] == rest[k].slew && dds_report.waypoint_trolley()[k] == rest[k].trolley &&
+               dds_report.waypoint_cable_length()[k] == rest[k].cable_length;
       }
       if (!tail) continue;
-      guard_.progress(anti_collision::path_airspace(report.waypoints, layout_.paths));
+      guard_.progress(anti_collision::path_airspace(rest, layout_.paths));
       progressed_ = n;
     }
     const anti_collision::GrantCheck c = guard_.check(motion, time);
