@@ -1,7 +1,8 @@
 // A crane's side of the site protocol (crane_site_link.hpp), driven by hand: the request of a leg
 // computed by hand from where the crane rests, the go taken once and only for its request, the
 // moves waypoint by waypoint as the reference arrives and the crane settles, the dwell at the work
-// height, the job counted, the yield, a goal sent again until the planner answers, the lost link
+// height, the job counted, the yield, a goal sent again until the planner answers, a move the
+// planner ends short sent again and at last given up, the lost link
 // (a soft stop in shared airspace, the move ended at its waypoint when a soft stop would leave the
 // grant, the path finished outside it), the brakes, and bad jobs and job files refused.
 #include <gtest/gtest.h>
@@ -26,6 +27,7 @@ namespace fs = std::filesystem;
 using namespace crane::anti_collision;
 using crane::protocol::CraneState;
 using crane::protocol::MoveRequest;
+using crane::protocol::MoveStatus;
 using crane::protocol::Reference;
 
 const std::string kSite = std::string(CRANE_SOURCE_DIR) + "/deploy/config/site_three_towers.yaml";
@@ -60,9 +62,16 @@ class Link : public ::testing::Test {
     t_ += 0.01;
     return g;
   }
+  // The planner's feedback on goal `id`.
+  void answer(std::uint32_t id, std::uint8_t result = MoveStatus::RESULT_MOVING) {
+    MoveStatus s{};
+    s.request_id = id;
+    s.result = result;
+    link_->move_status(s, t_);
+  }
   // The planner answers `goal`, runs it and arrives; the crane rests at its target, settled.
   void arrive(const MoveRequest& goal) {
-    link_->answered(goal.request_id);
+    answer(goal.request_id, MoveStatus::RESULT_ARRIVED);
     reference_.request_id = goal.request_id;
     reference_.phase = Reference::PHASE_ARRIVED;
     at({goal.slew_target, goal.trolley_target, goal.cable_length_target});
@@ -83,7 +92,7 @@ class Link : public ::testing::Test {
     ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
     const auto g = step();
     ASSERT_TRUE(g.has_value());
-    link_->answered(g->request_id);
+    answer(g->request_id);
     reference_.request_id = g->request_id;
     reference_.phase = Reference::PHASE_MOVING;
     at(here);
@@ -232,8 +241,64 @@ TEST_F(Link, AGoalIsSentAgainUntilThePlannerAnswers) {
   ASSERT_TRUE(again.has_value());
   EXPECT_EQ(again->request_id, first->request_id);
   EXPECT_NEAR(t_ - 0.01 - sent, kGoalResendPeriod, 0.011);
-  link_->answered(first->request_id);
+  answer(first->request_id);
   EXPECT_FALSE(next_goal(2.0).has_value());
+}
+
+TEST_F(Link, AMoveThePlannerEndsShortIsSentAgainOnceTheCraneRestsAndAtLastGivenUp) {
+  // Its supervisor's soft stop (a swing or a limit approached) ends the first move, 0.3 m short.
+  moving_at({0.0, 0.6, 0.2}, 0.1);
+  const std::uint32_t first = kFirstGoal + 1;
+  answer(first - 1, MoveStatus::RESULT_ABORTED);
+  EXPECT_EQ(link_->aborted_moves(), 0) << "feedback on an older goal is not about this move";
+  answer(first, MoveStatus::RESULT_ABORTED);
+  EXPECT_EQ(link_->aborted_moves(), 1);
+  const double ended = t_;
+  // Still stopping: nothing is sent.
+  reference_.request_id = 0;
+  EXPECT_FALSE(next_goal(2.0).has_value());
+  // At rest and settled: the same move again (a new id), a resend period after the abort at the
+  // earliest.
+  reference_.phase = Reference::PHASE_HOLDING;
+  at({0.0, 0.62, 0.2});
+  auto again = next_goal(2.0);
+  ASSERT_TRUE(again.has_value()) << "a move ended short must not leave the link waiting for good";
+  EXPECT_GT(again->request_id, first);
+  EXPECT_EQ(again->command, MoveRequest::COMMAND_MOVE);
+  EXPECT_DOUBLE_EQ(again->trolley_target, 0.9);
+  EXPECT_DOUBLE_EQ(again->cable_length_target, 0.2);
+  EXPECT_GE(t_ - 0.01 - ended, 2.0 - 1e-9);
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
+  EXPECT_TRUE(link_->report()->moving) << "it still holds its path";
+  // Refused (the mode changed) and then aborted again: the third time it gives up.
+  answer(again->request_id, MoveStatus::RESULT_REJECTED);
+  const double refused = t_;
+  again = next_goal(2.0);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_NEAR(t_ - 0.01 - refused, kGoalResendPeriod, 0.011);
+  answer(again->request_id, MoveStatus::RESULT_ABORTED);
+  EXPECT_FALSE(next_goal(3.0).has_value());
+  EXPECT_EQ(link_->aborted_moves(), kMoveAttempts);
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::aborted);
+  const auto r = link_->report();
+  EXPECT_FALSE(r->moving) << "at rest where it stopped: the service frees the rest of its path";
+  ASSERT_EQ(r->waypoints.size(), 1u);
+  expect_pose(r->waypoints[0], 0.0, 0.62, 0.2);
+  EXPECT_EQ(r->request_id, 0u) << "it asks for nothing more";
+  EXPECT_EQ(link_->jobs_done(), 0);
+  // It still obeys a yield, and rests again where that ends.
+  SiteOrder y;
+  y.crane = 0;
+  y.kind = Instruction::Kind::yield;
+  y.seq = 9;
+  y.waypoints = {{0.0, 0.62, 0.2}, {-0.5, 0.62, 0.2}};
+  ASSERT_TRUE(link_->instruction(y, kEpoch, t_));
+  const auto g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  (void)next_goal(0.05);
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::aborted);
+  EXPECT_EQ(link_->report()->request_id, 0u);
 }
 
 TEST_F(Link, AYieldIsObeyedAtRestAndTheLegAskedAgainWithANewRequest) {
@@ -306,7 +371,7 @@ TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {
   ASSERT_FALSE(in_shared_airspace(apart, 0, path_airspace(link_->report()->request, apart.paths)));
   ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
   auto g = step();
-  link_->answered(g->request_id);
+  answer(g->request_id);
   const auto after = silent(100, false);
   EXPECT_FALSE(after.has_value() && after->command == MoveRequest::COMMAND_STOP);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);

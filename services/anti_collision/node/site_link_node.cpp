@@ -54,6 +54,7 @@ void write_summary(const std::string& path, const std::string& name, const ac::C
                    {"unsettled_moves", link.unsettled_moves()},
                    {"halts", link.halts()},
                    {"halts_at_waypoint", link.halts_at_waypoint()},
+                   {"aborted_moves", link.aborted_moves()},
                    {"reactions_s", link.reactions()}};
   const std::string tmp = path + ".tmp";
   std::ofstream(tmp) << j.dump(1) << '\n';
@@ -131,7 +132,16 @@ int main(int argc, char** argv) {
       tp::msgs::SupervisorStatus_ s;
       if (statuses->take_latest(s)) protocol::from_dds(s, status.emplace());
       tp::msgs::MoveStatus_ m;
-      while (move_statuses->take_next(m)) link.answered(m.request_id());
+      while (move_statuses->take_next(m)) {
+        protocol::MoveStatus feedback;
+        protocol::from_dds(m, feedback);
+        const int aborted = link.aborted_moves();
+        link.move_status(feedback, now);
+        if (link.aborted_moves() != aborted) {
+          spdlog::warn("the planner ended move {} short (result {}, reason {}): sent again once the crane rests, "
+                       "{} attempts at a waypoint", feedback.request_id, feedback.result, feedback.reason, ac::kMoveAttempts);
+        }
+      }
       tp::msgs::SiteStatus_ beat;
       while (site_status->take_next(beat)) link.heard(now);
       tp::msgs::SiteInstruction_ dds_instruction;
@@ -176,6 +186,7 @@ int main(int argc, char** argv) {
           spdlog::info("{} -> {}", ac::to_string(phase), ac::to_string(link.phase()));
         }
         phase = link.phase();
+        write_summary(summary_path, crane_name, link);
       }
       if (link.jobs_done() != jobs_done) {
         jobs_done = link.jobs_done();

@@ -59,6 +59,7 @@ const char* to_string(CraneSiteLink::Phase phase) noexcept {
     case P::halted: return "halted";
     case P::done: return "done";
     case P::braked: return "braked";
+    case P::aborted: return "aborted";
   }
   return "?";
 }
@@ -121,8 +122,16 @@ CraneSiteLink::CraneSiteLink(const SiteLayout& layout, std::size_t crane, const 
 
 void CraneSiteLink::heard(double time) noexcept { guard_.heard(time); }
 
-void CraneSiteLink::answered(std::uint32_t goal_id) noexcept {
-  if (goal_ && goal_->request_id == goal_id) goal_taken_ = true;
+void CraneSiteLink::move_status(const protocol::MoveStatus& status, double time) noexcept {
+  if (!goal_ || goal_->request_id != status.request_id) return;
+  goal_taken_ = true;
+  const bool ended_short =
+      status.result == protocol::MoveStatus::RESULT_ABORTED || status.result == protocol::MoveStatus::RESULT_REJECTED;
+  if (ended_short && goal_->command == Request::COMMAND_MOVE && phase_ == Phase::moving && !ended_short_at_) {
+    ended_short_at_ = time;
+    stopped_at_.reset();
+    ++aborted_moves_;
+  }
 }
 
 bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, double time) {
@@ -131,7 +140,7 @@ bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, dou
   if (epoch == carried_epoch_ && order.seq <= carried_seq_) return false;  // sent again, or older
   const bool go = order.kind == Instruction::Kind::go;
   if (go ? (phase_ != Phase::asking || order.request_id != request_id_)
-         : (phase_ != Phase::asking && phase_ != Phase::done)) {
+         : (phase_ != Phase::asking && phase_ != Phase::done && phase_ != Phase::aborted)) {
     return false;
   }
   yielding_ = !go;
@@ -148,6 +157,8 @@ bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, dou
   request_id_ = 0;
   request_.clear();
   waypoint_ = 0;
+  attempts_ = 0;
+  ended_short_at_.reset();
   phase_ = Phase::moving;
   start_next_ = true;
   changed_ = true;
@@ -229,7 +240,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
   if (link_lost_ && !lost) {
     // Back: a crane waiting at rest reports where it rests and asks again.
     link_lost_ = false;
-    if (phase_ == Phase::halted || phase_ == Phase::asking) phase_ = Phase::resting;
+    if (phase_ == Phase::halted || phase_ == Phase::asking) phase_ = gave_up_ ? Phase::aborted : Phase::resting;
     if (phase_ == Phase::done) guard_.grant(rest_airspace(pose_, layout_.paths), time);
     changed_ = true;
   } else if (!link_lost_ && lost) {
@@ -246,6 +257,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         phase_ = Phase::halting;
         halt_from_ = lost_from_;
         arrived_at_.reset();
+        ended_short_at_.reset();
         ++halts_;
         if (start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate))) {
           Request stop{};
@@ -263,7 +275,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         return goal;
       }
       reactions_.push_back(time - lost_from_);  // it keeps to its own airspace
-    } else if (phase_ != Phase::done && phase_ != Phase::halting) {
+    } else if (phase_ != Phase::done && phase_ != Phase::halting && phase_ != Phase::aborted) {
       if (phase_ == Phase::asking || phase_ == Phase::resting) phase_ = Phase::halted;
       reactions_.push_back(time - lost_from_);  // at rest already
       changed_ = true;
@@ -283,6 +295,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
       changed_ = true;
     }
     ++waypoint_;
+    attempts_ = 0;
     goal_ = move_to(path_[waypoint_]);
     goal_taken_ = false;
     goal_sent_ = time;
@@ -301,12 +314,39 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
     if (reference.phase != protocol::Reference::PHASE_MOVING && at_rest(estimate)) {
       yielding_ = false;
       reactions_.push_back(time - halt_from_);
-      phase_ = link_lost_ ? Phase::halted : Phase::resting;
+      phase_ = link_lost_ ? Phase::halted : gave_up_ ? Phase::aborted : Phase::resting;
       changed_ = true;
     }
     return goal;
   }
   if (phase_ != Phase::moving) return goal;
+  if (ended_short_at_) {
+    // The move ended short: once the crane rests and has settled, the move is sent again, or, the
+    // last attempt spent, the crane rests where it is.
+    if (reference.phase == protocol::Reference::PHASE_MOVING || !at_rest(estimate)) {
+      stopped_at_.reset();
+      return goal;
+    }
+    if (!stopped_at_) stopped_at_ = time;
+    const bool calm = settled(estimate, params_.gravity) || time - *stopped_at_ >= params_.settle_timeout - 1e-9;
+    if (!calm || time - *ended_short_at_ < kGoalResendPeriod - 1e-9) return goal;
+    ended_short_at_.reset();
+    stopped_at_.reset();
+    if (++attempts_ >= kMoveAttempts) {
+      gave_up_ = true;
+      yielding_ = false;
+      goal_.reset();
+      phase_ = Phase::aborted;
+      guard_.grant(rest_airspace(pose_, layout_.paths), time);
+      changed_ = true;
+      return goal;
+    }
+    goal_ = move_to(path_[waypoint_]);
+    goal_taken_ = false;
+    goal_sent_ = time;
+    arrived_at_.reset();
+    return goal_;
+  }
   if (!goal_ || reference.request_id != goal_->request_id || reference.phase != protocol::Reference::PHASE_ARRIVED) {
     return goal;
   }
@@ -331,7 +371,8 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
     ++next_leg_;
   }
   yielding_ = false;
-  phase_ = Phase::resting;
+  phase_ = gave_up_ ? Phase::aborted : Phase::resting;
+  if (gave_up_) guard_.grant(rest_airspace(pose_, layout_.paths), time);
   changed_ = true;
   return goal;
 }

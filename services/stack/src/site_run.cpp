@@ -168,8 +168,8 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       brake.command = protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP;
       c.stack->step(goal[i] && !estop[i] ? std::span(&*goal[i], 1) : std::span<const Request>(), {},
                     estop[i] ? &brake : nullptr);
+      for (const auto& status : c.stack->planner().move_statuses()) c.link->move_status(status, t);
       for (const auto& outcome : c.stack->planner().goal_outcomes()) {
-        c.link->answered(outcome.request_id);
         if (outcome.status != trajectory_planner::GoalStatus::accepted) {
           throw std::runtime_error("site run: " + site.cranes[i].name + "'s planner refused a move at " + std::to_string(t) +
                                    " s: " + trajectory_planner::goal_status_name(outcome.status) + " (targets: slew " +

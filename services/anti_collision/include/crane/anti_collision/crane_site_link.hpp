@@ -14,8 +14,17 @@
 // the next waypoint (COMMAND_MOVE, every axis named, the trapezoid profile) once the reference of
 // the goal before has arrived and the crane has settled (trolley and slew under 0.01 m/s and
 // rad/s, hoist under 0.01 m/s, swing amplitude under 0.5 deg) or `settle_timeout` after the
-// reference arrived. A goal the planner has not answered (answered(): its MoveStatus_, or the
-// in-process planner's outcome) is sent again every kGoalResendPeriod.
+// reference arrived. A goal the planner has not answered (move_status(): its MoveStatus_) is sent
+// again every kGoalResendPeriod.
+//
+// A move its planner ends short (MoveStatus_ RESULT_ABORTED: the supervisor's soft stop for swing,
+// a speed or zone limit approached, its site guard; or RESULT_REJECTED) leaves the crane inside its
+// grant, short of its waypoint. Once the crane is at rest and settled (or settle_timeout after it
+// came to rest), and no sooner than kGoalResendPeriod after the abort, the move to that waypoint is
+// sent again as a new goal; after kMoveAttempts ended short at one waypoint the link gives up: the
+// crane rests where it stopped (phase aborted), reports its rest pose (the service frees the rest
+// of its path) and asks for nothing more, an operator's matter (aborted_moves() counts them); it
+// still obeys a yield, and rests again where that ends.
 //
 // Its report (report()) is its whole state: at rest at its pose, or moving with the rest of its
 // path from the last waypoint it reached; the last instruction it carried out (the epoch and seq
@@ -78,6 +87,8 @@ struct CraneLinkParams {
 
 /// [s] a goal the planner has not taken is sent again after this long.
 inline constexpr double kGoalResendPeriod = 1.0;
+/// Moves to one waypoint its planner may end short (aborted, rejected) before the link gives up.
+inline constexpr int kMoveAttempts = 3;
 
 class CraneSiteLink {
  public:
@@ -90,6 +101,7 @@ class CraneSiteLink {
     halted,    // at rest, waiting for the link
     done,      // every job done, at rest (it may still be told to yield)
     braked,    // its supervisor latched a fault: silent for good
+    aborted,   // its planner ended kMoveAttempts moves to one waypoint short: at rest, asks for nothing more
   };
 
   /// Crane `crane` of `layout` (copied) with its `jobs`, in order. Its goals to the planner get
@@ -103,12 +115,13 @@ class CraneSiteLink {
   void heard(double time) noexcept;
   /// An instruction of the service of `epoch` heard at `time` [s]. Taken (true) when it is to this
   /// crane, newer than the last taken (another epoch, or a higher seq), and the crane can carry it
-  /// out: a go for the request it waits with, or a yield while it waits at rest or is done. Else
+  /// out: a go for the request it waits with, or a yield while it waits at rest, is done or gave up. Else
   /// ignored (false; an instruction sent again, one to another crane, a go for an old request).
   bool instruction(const SiteOrder& order, std::uint32_t epoch, double time);
-  /// The planner answered the goal `goal_id` (accepted, refused, arrived: any answer): it is not
-  /// sent again.
-  void answered(std::uint32_t goal_id) noexcept;
+  /// The planner's feedback on a goal (rt/crane/planner/move_status): any answer to the last goal
+  /// means it is not sent again; RESULT_ABORTED or RESULT_REJECTED of the move under way means it
+  /// ended short (see the header). Feedback on any other goal is ignored.
+  void move_status(const protocol::MoveStatus& status, double time) noexcept;
 
   /// One cycle at `time` [s]: the crane's estimate, its planner's reference, and whether its
   /// supervisor has a latched fault. Returns the goal to send the planner now, if any (a move to
@@ -131,6 +144,8 @@ class CraneSiteLink {
   [[nodiscard]] int unsettled_moves() const noexcept { return unsettled_moves_; }
   [[nodiscard]] int halts() const noexcept { return halts_; }
   [[nodiscard]] int halts_at_waypoint() const noexcept { return halts_at_waypoint_; }
+  /// Moves its planner ended short (aborted or rejected), each sent again or, the last, given up.
+  [[nodiscard]] int aborted_moves() const noexcept { return aborted_moves_; }
   /// [s] from each link loss that lasted link_deadline to the crane safe: at rest after its stop,
   /// or still on a path outside shared airspace, or at rest already.
   [[nodiscard]] const std::vector<double>& reactions() const noexcept { return reactions_; }
@@ -170,8 +185,12 @@ class CraneSiteLink {
   std::vector<Pose> path_;           // the granted path or yield, path_[0] where it started
   std::size_t waypoint_{0};          // the waypoint being moved to
   bool yielding_{false};
+  bool gave_up_{false};              // phase aborted, or a yield from it
   bool start_next_{false};           // the move to waypoint_ + 1 starts at the next step
   std::optional<double> arrived_at_; // [s] the reference arrived
+  std::optional<double> ended_short_at_;  // [s] the planner ended the move under way short
+  std::optional<double> stopped_at_;      // [s] the crane came to rest after that
+  int attempts_{0};                  // moves to waypoint_ ended short
   double dwell_until_{0.0};
   double asked_at_{0.0};
   std::uint32_t request_id_{0};      // the leg asked for (0: none)
@@ -189,6 +208,7 @@ class CraneSiteLink {
   int unsettled_moves_{0};
   int halts_{0};
   int halts_at_waypoint_{0};
+  int aborted_moves_{0};
   std::vector<double> reactions_;
   double halt_from_{0.0};
 };
