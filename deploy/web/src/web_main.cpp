@@ -16,7 +16,9 @@
 // operator's name. HTTP on the same port: / the operator page (deploy/web/www: views, plots, mode
 // and faults over the same protocol, and the controls for a logged-in operator), POST /login (the
 // token as the body: sets the session cookie), POST /logout, GET /whoami, /site.json (the crane's
-// kind, travel and no-go zones from --config, the file the stack runs with: site_view.hpp), /about
+// kind, travel and no-go zones from --config, the file the stack runs with: site_view.hpp),
+// with --site the site page (/site.html, /site_view.js) and its view (/site/view.json, rebuilt
+// every 200 ms: site_page.hpp; 404 without --site), /about
 // (what this is) and /metrics (the Prometheus text format, web_metrics.hpp: per topic, the
 // supervisor, each process, the server). A client that reads nothing is closed (--close-stalled).
 // With --site FILE, a second read-only participant on the site's domain (the site file's
@@ -36,9 +38,11 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <algorithm>
 #include <functional>
 #include <sstream>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -52,6 +56,7 @@
 #include "crane/transport/cdr.hpp"
 #include "crane/web/foxglove_server.hpp"
 #include "crane/web/operator_auth.hpp"
+#include "crane/web/site_page.hpp"
 #include "crane/web/site_view.hpp"
 #include "crane/web/web_metrics.hpp"
 
@@ -60,6 +65,8 @@ namespace {
 using namespace crane;
 namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
+/// How often the site page's view (/site/view.json) is rebuilt.
+constexpr auto kSiteViewPeriod = std::chrono::milliseconds(200);
 
 /// One advertised channel per topic of the bus, ids 1..N in the topic table's order; with a site,
 /// then one per site topic (transport::topics::for_each_site_topic), N+1.. .
@@ -178,10 +185,13 @@ int main(int argc, char** argv) {
     auto participant = runtime::make_participant(node, "crane_web");
     // The site's topics come from the site's own domain (read-only, like the bus).
     std::unique_ptr<transport::Participant> site_participant;
+    std::unique_ptr<anti_collision::SiteWatch> site_watch;  // the site page's (/site/view.json)
     if (!site_path.empty()) {
       runtime::require_site_without_security(node);
       runtime::NodeOptions site_node = node;
-      site_node.domain_id = static_cast<std::uint32_t>(anti_collision::load_site_layout(site_path).domain_id);
+      auto layout = anti_collision::load_site_layout(site_path);
+      site_node.domain_id = static_cast<std::uint32_t>(layout.domain_id);
+      site_watch = std::make_unique<anti_collision::SiteWatch>(std::move(layout));
       site_participant = runtime::make_participant(site_node, "crane_web");
     }
     transport::Wakeup wakeup;
@@ -190,6 +200,11 @@ int main(int argc, char** argv) {
     // The operator page: its two files, read once (deploy/web/www).
     const std::string page = file_text(assets + "/index.html");
     const std::string page_script = file_text(assets + "/crane_view.js");
+    const std::string site_page = file_text(assets + "/site.html");
+    const std::string site_page_script = file_text(assets + "/site_view.js");
+    // The site page's view, rebuilt by the main loop every kSiteViewPeriod, served as it stands.
+    std::mutex site_view_mutex;
+    std::string site_view = R"j({"error": "no site view yet"})j";
     if (page.empty() || page_script.empty()) {
       std::fprintf(stderr, "crane_web: no operator page in %s (index.html, crane_view.js): / describes the server\n",
                    assets.c_str());
@@ -206,6 +221,8 @@ int main(int argc, char** argv) {
       server_options.publishable = {{tp::Goal::name, tp::Goal::type_name},
                                     {tp::SafetyCommand::name, tp::SafetyCommand::type_name}};
     }
+    const auto started = Clock::now();
+    const auto seconds_since_start = [started] { return std::chrono::duration<double>(Clock::now() - started).count(); };
     const auto seconds_now = [] {
       return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
     };
@@ -279,6 +296,22 @@ int main(int argc, char** argv) {
         response.status = 200;
         response.content_type = "application/json";
         response.body = site;
+      } else if (path == "/site/view.json" || path == "/site.html" || path == "/site_view.js") {
+        if (!site_watch) {
+          response.status = 404;
+          response.content_type = "application/json";
+          response.body = R"j({"error": "this server watches no site (started without --site)"})j";
+        } else if (path == "/site/view.json") {
+          response.status = 200;
+          response.content_type = "application/json";
+          const std::lock_guard lock(site_view_mutex);
+          response.body = site_view;
+        } else {
+          const bool html = path == "/site.html";
+          response.status = (html ? site_page : site_page_script).empty() ? 404 : 200;
+          response.content_type = html ? "text/html; charset=utf-8" : "text/javascript; charset=utf-8";
+          response.body = html ? site_page : site_page_script;
+        }
       } else if (path == "/metrics") {
         response.status = 200;
         response.content_type = "text/plain; version=0.0.4; charset=utf-8";
@@ -315,7 +348,7 @@ int main(int argc, char** argv) {
       auto reader = std::shared_ptr(source->make_recording_reader<T>(&wakeup, 64));
       readers.push_back(reader);
       const std::size_t topic_index = id - 1;
-      drains.push_back([reader, id, topic_index, &server, &metrics] {
+      drains.push_back([reader, id, topic_index, &server, &metrics, &site_watch, &seconds_since_start] {
         typename T::Message m;
         while (reader->take_next(m)) {
           const auto receive_ns = static_cast<std::uint64_t>(runtime::now_nanoseconds());
@@ -324,6 +357,19 @@ int main(int argc, char** argv) {
             continue;
           }
           metrics.sample(topic_index);
+          if constexpr (std::is_same_v<T, tp::SiteReport> || std::is_same_v<T, tp::SiteStatus> ||
+                        std::is_same_v<T, tp::SiteInstruction>) {
+            typename protocol::PlainOf<typename T::Message>::type plain;
+            protocol::from_dds(m, plain);
+            const double now = seconds_since_start();
+            if constexpr (std::is_same_v<T, tp::SiteReport>) {
+              (void)site_watch->report(plain, now);
+            } else if constexpr (std::is_same_v<T, tp::SiteStatus>) {
+              site_watch->status(plain, now);
+            } else {
+              (void)site_watch->instruction(plain);
+            }
+          }
           if constexpr (std::is_same_v<T, tp::SafetyStatus> || std::is_same_v<T, tp::LoopDiagnostics>) {
             typename protocol::PlainOf<typename T::Message>::type plain;
             protocol::from_dds(m, plain);
@@ -351,14 +397,21 @@ int main(int argc, char** argv) {
                 std::string(web::kSubprotocol).c_str(), channels.size());
     std::fflush(stdout);
     auto window_start = Clock::now();
+    auto next_site_view = Clock::now();
     while (!runtime::stop_requested()) {
       for (auto& d : drains) d();
       const auto now = Clock::now();
+      if (site_watch && now >= next_site_view) {
+        std::string view = web::site_page_json(*site_watch, seconds_since_start()).dump();
+        const std::lock_guard lock(site_view_mutex);
+        site_view = std::move(view);
+        next_site_view = now + kSiteViewPeriod;
+      }
       if (now - window_start >= std::chrono::seconds(1)) {
         metrics.update_rates(std::chrono::duration<double>(now - window_start).count());
         window_start = now;
       }
-      wakeup.wait_until(now + std::chrono::milliseconds(100));
+      wakeup.wait_until(std::min(now + std::chrono::milliseconds(100), site_watch ? next_site_view : now + std::chrono::hours(1)));
     }
     server.stop();
     return 0;

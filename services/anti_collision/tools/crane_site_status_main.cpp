@@ -17,15 +17,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <limits>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
-#include <vector>
 
-#include "crane/anti_collision/crane_geometry.hpp"
-#include "crane/anti_collision/site_messages.hpp"
-
+#include "crane/anti_collision/site_watch.hpp"
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -78,39 +73,22 @@ int main(int argc, char** argv) {
     auto reader = participant->make_reader<tp::SiteStatus>(&wakeup);
     auto report_reader = participant->make_recording_reader<tp::SiteReport>(&wakeup, 256);
     const std::size_t n = layout.cranes.size();
-    std::optional<SiteStatus> last;
-    std::vector<std::optional<protocol::SiteReport>> reports(n);
-    std::vector<std::uint64_t> heard(n, 0);
-    double closest = std::numeric_limits<double>::infinity();
-    std::string closest_parts = "-";
+    anti_collision::SiteWatch watch(layout);
     const auto start = Clock::now();
     const auto until = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait));
-    const auto pair_distance = [&](std::size_t i, std::size_t j) {
-      const auto a = anti_collision::envelope(layout.cranes[i], anti_collision::motion_of(*reports[i]),
-                                              anti_collision::StopKind::none);
-      const auto b = anti_collision::envelope(layout.cranes[j], anti_collision::motion_of(*reports[j]),
-                                              anti_collision::StopKind::none);
-      return anti_collision::distance(a, b);
-    };
     const auto take = [&] {
+      const double now = std::chrono::duration<double>(Clock::now() - start).count();
       tp::msgs::SiteStatus_ sample;
-      while (reader->take_next(sample)) protocol::from_dds(sample, last.emplace());
+      while (reader->take_next(sample)) {
+        SiteStatus status;
+        protocol::from_dds(sample, status);
+        watch.status(status, now);
+      }
       tp::msgs::SiteReport_ report;
       while (report_reader->take_next(report)) {
-        if (report.crane() >= n) continue;
-        protocol::from_dds(report, reports[report.crane()].emplace());
-        ++heard[report.crane()];
-        for (std::size_t j = 0; j < n; ++j) {
-          if (j == report.crane() || !reports[j]) continue;
-          const std::size_t i = std::min<std::size_t>(j, report.crane()), k = std::max<std::size_t>(j, report.crane());
-          const auto d = pair_distance(i, k);
-          if (d.distance < closest) {
-            closest = d.distance;
-            closest_parts = layout.cranes[i].name + "." + anti_collision::to_string(d.first) + "-" + layout.cranes[k].name +
-                            "." + anti_collision::to_string(d.second) + " at " +
-                            std::to_string(std::chrono::duration<double>(Clock::now() - start).count()) + " s";
-          }
-        }
+        protocol::SiteReport message;
+        protocol::from_dds(report, message);
+        (void)watch.report(message, now);
       }
     };
     while (Clock::now() < until && !runtime::stop_requested()) {
@@ -118,6 +96,8 @@ int main(int argc, char** argv) {
       wakeup.wait_until(until);
     }
     take();
+    const auto& last = watch.last_status();
+    const auto& cranes = watch.cranes();
     if (!last) {
       std::fprintf(stderr, "no site service heard on domain %u within %g s\n", options.domain_id, wait);
       return 1;
@@ -133,37 +113,36 @@ int main(int argc, char** argv) {
                 "slew_deg trolley_m cable_m");
     for (std::size_t i = 0; i < n && i < last->holding.size(); ++i) {
       const std::string holding(protocol::code_name(SiteStatus::kCodes, "HOLDING", last->holding[i]));
-      const std::string state = !reports[i] ? "-"
-                                : reports[i]->state == protocol::SiteReport::STATE_MOVING ? "moving"
-                                                                                         : "at_rest";
+      const auto& report = cranes[i].report;
+      const std::string state = !report ? "-"
+                                : report->state == protocol::SiteReport::STATE_MOVING ? "moving"
+                                                                                     : "at_rest";
       char pose[96] = "-";
-      if (reports[i]) {
-        std::snprintf(pose, sizeof pose, "%8.1f %9.3f %7.3f", reports[i]->slew * 180.0 / 3.14159265358979323846,
-                      reports[i]->trolley, reports[i]->cable_length);
+      if (report) {
+        std::snprintf(pose, sizeof pose, "%8.1f %9.3f %7.3f", report->slew * 180.0 / 3.14159265358979323846,
+                      report->trolley, report->cable_length);
       }
       std::printf("%-8s %-12s %-8s %-10s %-9s %s\n", layout.cranes[i].name.c_str(), holding.c_str(),
                   last->pending[i] ? "waiting" : "-", waits_for(layout, last->waits_for[i]).c_str(), state.c_str(), pose);
-      out["cranes"].push_back({{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", heard[i]},
+      out["cranes"].push_back({{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
                                {"state", state}});
     }
     std::printf("yields %llu, unresolved waits %llu, reports refused %llu\n",
                 static_cast<unsigned long long>(last->yields), static_cast<unsigned long long>(last->unresolved),
                 static_cast<unsigned long long>(last->reports_rejected));
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t j = i + 1; j < n; ++j) {
-        if (!reports[i] || !reports[j]) continue;
-        const auto d = pair_distance(i, j);
-        std::printf("%s-%s: %.3f m (%s-%s)\n", layout.cranes[i].name.c_str(), layout.cranes[j].name.c_str(), d.distance,
-                    anti_collision::to_string(d.first), anti_collision::to_string(d.second));
-        out["pairs"].push_back({{"cranes", layout.cranes[i].name + "-" + layout.cranes[j].name}, {"distance_m", d.distance}});
-      }
+    for (const auto& pair : watch.distances()) {
+      const auto& d = pair.distance;
+      const std::string names = layout.cranes[pair.first].name + "-" + layout.cranes[pair.second].name;
+      std::printf("%s: %.3f m (%s-%s)\n", names.c_str(), d.distance, anti_collision::to_string(d.first),
+                  anti_collision::to_string(d.second));
+      out["pairs"].push_back({{"cranes", names}, {"distance_m", d.distance}});
     }
-    if (std::isfinite(closest)) {
-      std::printf("closest over %.1f s: %.3f m, %s (stop margin %.3f m)\n",
-                  std::chrono::duration<double>(Clock::now() - start).count(), closest, closest_parts.c_str(),
-                  layout.margins.stop);
-      out["min_distance_m"] = closest;
-      out["closest"] = closest_parts;
+    if (std::isfinite(watch.closest())) {
+      std::printf("closest over %.1f s: %.3f m, %s at %.3f s (stop margin %.3f m)\n",
+                  std::chrono::duration<double>(Clock::now() - start).count(), watch.closest(),
+                  watch.closest_parts().c_str(), watch.closest_time(), layout.margins.stop);
+      out["min_distance_m"] = watch.closest();
+      out["closest"] = watch.closest_parts() + " at " + std::to_string(watch.closest_time()) + " s";
     }
     out["yields"] = last->yields;
     out["unresolved"] = last->unresolved;

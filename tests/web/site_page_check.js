@@ -1,0 +1,152 @@
+// crane_web's site page (deploy/web/www/site.html) and its view (/site/view.json) against other
+// computations (tests/web/site_page_test.sh runs it):
+//   1. the view: every crane of the site reported, the site service heard, one pair per two cranes;
+//   2. each pair's distance equals what crane_site_status (another process on the site's domain)
+//      prints for it, and is no more than this file's own bound from the parts the view gives:
+//      the closest of points sampled along each two capsules' axes, less both radii;
+//   3. the page in Debian's chromium, headless (puppeteer-core): it drew every crane (its load's
+//      pixel in the crane's colour, not the background), the held and requested airspace the view
+//      has, a row per pair coloured by its band, the service's epoch; a screenshot.
+//
+//   node site_page_check.js URL SCREENSHOT.png CRANE_SITE_STATUS SITE_FILE
+// Exit 1 on a difference.
+"use strict";
+const puppeteer = require("puppeteer-core");
+const http = require("http");
+const { execFileSync } = require("child_process");
+const fs = require("fs");
+const os = require("os");
+const path = require("path");
+
+const [url, screenshot, statusTool, siteFile] = process.argv.slice(2);
+const httpUrl = url.replace(/^ws:/, "http:");
+
+function getJson(p) {
+  return new Promise((resolve, reject) => {
+    http.get(httpUrl + p, { agent: false }, (res) => {
+      let body = "";
+      res.on("data", (d) => (body += d));
+      res.on("end", () => (res.statusCode === 200 ? resolve(JSON.parse(body)) : reject(new Error(`${p}: HTTP ${res.statusCode}`))));
+    }).on("error", reject);
+  });
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const sub = (a, b) => a.map((v, i) => v - b[i]);
+const norm = (a) => Math.hypot(...a);
+
+// The smallest distance between points sampled along the two axes (an upper bound of the
+// segments' distance: the capsules' distance can only be smaller).
+function sampledDistance(p, q) {
+  let best = Infinity;
+  const n = 200;
+  for (let i = 0; i <= n; ++i) {
+    const a = p.a.map((v, k) => v + (p.b[k] - v) * (i / n));
+    for (let j = 0; j <= n; ++j) {
+      const b = q.a.map((v, k) => v + (q.b[k] - v) * (j / n));
+      best = Math.min(best, norm(sub(a, b)));
+    }
+  }
+  return best - p.radius - q.radius;
+}
+
+async function main() {
+  const problems = [];
+  // 1. The view, once everything was heard.
+  let view = null;
+  for (let k = 0; k < 100; ++k) {
+    view = await getJson("/site/view.json").catch(() => null);
+    if (view && view.service && view.cranes.every((c) => c.state !== "silent") &&
+        view.pairs.length === (view.cranes.length * (view.cranes.length - 1)) / 2) break;
+    await sleep(200);
+  }
+  if (!view || !view.service) throw new Error("no view with the service heard: " + JSON.stringify(view));
+  const n = view.cranes.length;
+  if (n < 2) problems.push(`${n} cranes in the view`);
+  for (const c of view.cranes) if (c.state === "silent") problems.push(`${c.name} not heard`);
+  console.log(`[ figure ] site page view: ${n} cranes (${view.cranes.map((c) => c.name + " " + c.holding).join(", ")}), ` +
+              `${view.pairs.length} pairs, service epoch ${view.service.epoch}`);
+
+  // 2. The distances: crane_site_status's, and a bound of this file's own.
+  const out = path.join(os.tmpdir(), `site_status_${process.pid}.json`);
+  execFileSync(statusTool, ["--site", siteFile, "--wait", "2", "--json", out], { stdio: ["ignore", "inherit", "inherit"] });
+  const status = JSON.parse(fs.readFileSync(out, "utf8"));
+  fs.unlinkSync(out);
+  const byName = Object.fromEntries(view.cranes.map((c) => [c.name, c]));
+  for (const p of view.pairs) {
+    const name = p.cranes.join("-");
+    const theirs = status.pairs.find((q) => q.cranes === name);
+    if (!theirs) { problems.push(`crane_site_status has no pair ${name}`); continue; }
+    if (Math.abs(theirs.distance_m - p.distance) > 1e-9) {
+      problems.push(`${name}: the view's ${p.distance} m, crane_site_status's ${theirs.distance_m} m`);
+    }
+    let bound = Infinity;
+    for (const a of byName[p.cranes[0]].parts) for (const b of byName[p.cranes[1]].parts) bound = Math.min(bound, sampledDistance(a, b));
+    if (!(p.distance <= bound + 1e-9)) problems.push(`${name}: the view's ${p.distance} m exceeds the sampled parts' ${bound} m`);
+    if (p.distance < bound - 0.01) problems.push(`${name}: the view's ${p.distance} m is far below the sampled parts' ${bound} m`);
+    const band = p.distance < view.margins.stop ? "stop" : p.distance < view.margins.slow_down ? "slow_down"
+               : p.distance < view.margins.warning ? "warning" : "clear";
+    if (band !== p.band) problems.push(`${name}: band ${p.band}, by the margins ${band}`);
+    console.log(`[ figure ] ${name}: ${p.distance.toFixed(4)} m (${p.parts.join("-")}), crane_site_status ` +
+                `${theirs.distance_m.toFixed(4)} m, sampled parts ${bound.toFixed(4)} m, band ${p.band}`);
+  }
+
+  // 3. The page.
+  const browser = await puppeteer.launch({
+    executablePath: "/usr/bin/chromium",
+    headless: true,
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+  });
+  try {
+    const page = await browser.newPage();
+    await page.setViewport({ width: 1400, height: 800 });
+    const errors = [];
+    page.on("pageerror", (e) => errors.push(String(e)));
+    await page.goto(httpUrl + "/site.html", { waitUntil: "load", timeout: 20000 });
+    await page.waitForFunction(() => window.siteView && window.siteView.views >= 3 && window.siteView.drawn, { timeout: 20000 });
+    const seen = await page.evaluate(() => {
+      const s = window.siteView;
+      s.draw();
+      const ctx = document.getElementById("plan").getContext("2d");
+      const pixel = (p) => Array.from(ctx.getImageData(Math.round(p[0]), Math.round(p[1]), 1, 1).data);
+      return {
+        cranes: s.drawn.cranes.map((c) => ({ name: c.name, held: c.held, requested: c.requested, load: c.load_px && pixel(c.load_px) })),
+        view: s.view,
+        rows: Array.from(document.querySelectorAll("#pairs tr")).slice(1).map((tr) => tr.className),
+        craneRows: document.querySelectorAll("#cranes tr").length - 1,
+        service: document.getElementById("service").textContent,
+      };
+    });
+    if (errors.length) problems.push("page errors: " + errors.join("; "));
+    if (seen.cranes.length !== n) problems.push(`the page drew ${seen.cranes.length} cranes of ${n}`);
+    seen.cranes.forEach((c, i) => {
+      const v = seen.view.cranes[i];
+      if (!c.load) problems.push(`${c.name}: no load drawn`);
+      else if (c.load[3] < 200 || (c.load[0] > 240 && c.load[1] > 240 && c.load[2] > 240)) {
+        problems.push(`${c.name}: its load's pixel is background (${c.load})`);
+      }
+      if (c.held !== v.held.length || c.requested !== v.requested.length) {
+        problems.push(`${c.name}: drew ${c.held} held and ${c.requested} requested boxes, the view has ${v.held.length} and ${v.requested.length}`);
+      }
+    });
+    const asked = seen.view.cranes.filter((c) => c.requested.length > 0 || c.holding === "path");
+    if (asked.length === 0) problems.push("no crane asks for or holds a path: the test's --ask was not seen");
+    if (seen.craneRows !== n) problems.push(`${seen.craneRows} crane rows`);
+    if (seen.rows.length !== seen.view.pairs.length || seen.rows.some((c, i) => c !== seen.view.pairs[i].band)) {
+      problems.push(`pair rows ${JSON.stringify(seen.rows)} against bands ${JSON.stringify(seen.view.pairs.map((p) => p.band))}`);
+    }
+    if (!seen.service.includes("epoch " + seen.view.service.epoch)) problems.push(`status line '${seen.service}'`);
+    console.log(`[ figure ] site page: ${seen.cranes.length} cranes drawn (${seen.cranes.map((c) => `${c.name} held ${c.held} requested ${c.requested}`).join(", ")}), ` +
+                `${seen.rows.length} pair rows (${seen.rows.join(", ")}), '${seen.service}'`);
+    await page.screenshot({ path: screenshot, fullPage: true });
+  } finally {
+    await browser.close();
+  }
+  if (problems.length) {
+    for (const p of problems) console.log("FAIL: " + p);
+    process.exit(1);
+  }
+  console.log("site page: every check passed");
+}
+
+main().catch((e) => { console.error(e); process.exit(1); });
