@@ -30,11 +30,17 @@
 #                                                     refused where the kernel has no sch_netem)
 #                     kill-service:START:DURATION     the site service killed with -9, started again
 #                                                     DURATION s later (a new epoch)
-#                   HOST is a crane's name or "site" (the service's host).
+#                     stop-host:CRANE:START           the crane's host stopped for good: every process
+#                                                     on it killed with -9 and its link down (a power
+#                                                     cut); the others then keep out of its whole reach
+#                   HOST is a crane's name or "site" (the service's host). With a host stopped, the
+#                   run ends once the faults are over and every other crane has done its jobs or has
+#                   waited at rest for 15 s (for the stopped crane's reach); it is safe when no crane
+#                   was braked and the closest distance keeps the stop margin.
 # Exit status: 0 done and safe, 1 not (the reason printed), 2 bad usage or no namespaces here.
 set -euo pipefail
 
-usage() { sed -n '17,36p' "$0" >&2; exit 2; }
+usage() { sed -n '17,42p' "$0" >&2; exit 2; }
 [ $# -ge 3 ] || usage
 BIN=$(cd "$1" && pwd) SITE=$(realpath "$2") OUT=$3
 shift 3
@@ -107,8 +113,19 @@ NET=(--lan --insecure-lan --dds "$DDS")
 # in real time on one small machine miss cycles, and a long slew at the rated rate then overshot the
 # supervisor's overspeed limit (slew_overspeed, 2 of 6 runs on this 2-core machine under other load).
 SLEW_SPEED=0.7  # the site's network without DDS Security (docs/site.md says why)
+rm -f "$OUT/site_service.log" "$OUT/faults.log"
 "$BIN/crane_site" jobs --site "$SITE" --jobs "$JOBS" --seed "$SEED" --out "$OUT/jobs" > "$OUT/jobs.log"
 
+# The office's watchers first, so that they hear every instruction (rt/site/instruction keeps no
+# history for late joiners).
+"$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --wait 86400 --json "$OUT/status.json" > "$OUT/status.txt" 2>&1 &
+MONITOR=$!
+# The Foxglove view of the site from the office (crane_web --site: the site's topics, every crane's
+# reports among them), on the site's network; its /metrics count what it forwarded.
+first_config=$(awk 'NR == 1 { print $3 }' "$OUT/jobs/hosts.txt")
+"$BIN/crane_web" --config "$first_config" --site "$SITE" "${NET[@]}" --domain 0 --bind 10.78.0.1 --port 8765 \
+  > "$OUT/crane_web.log" 2>&1 &
+PIDS[crane_web]=$!
 make_host site 2
 start_service() {
   spawn site "$OUT/site_service.log" "$BIN/site_service" --site "$SITE" "${NET[@]}"
@@ -120,22 +137,14 @@ while read -r name domain config slew trolley; do
   NAMES+=("$name")
   make_host "$name" "$index"
   index=$((index + 1))
+  rm -rf "$OUT/$name" "$OUT/$name.json"  # a run dir used before: its logs start afresh
   mkdir -p "$OUT/$name"
-  rm -f "$OUT/$name.json" "$OUT/$name/launch.log"
   spawn "$name" "$OUT/$name/launch.log" "$BIN/crane_launch" --config "$config" --domain "$domain" "${NET[@]}" \
     --initial-slew "$slew" --initial-trolley "$trolley" --site "$SITE" --site-crane "$name" \
     --site-jobs "$OUT/jobs/$name.csv" --site-summary "$OUT/$name.json" --site-slew-speed "$SLEW_SPEED" \
     --log-dir "$OUT/$name"
   PIDS[$name]=$!
 done < "$OUT/jobs/hosts.txt"
-"$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --wait 86400 --json "$OUT/status.json" > "$OUT/status.txt" 2>&1 &
-MONITOR=$!
-# The Foxglove view of the site from the office (crane_web --site: the site's topics, every crane's
-# reports among them), on the site's network; its /metrics count what it forwarded.
-first_config=$(awk 'NR == 1 { print $3 }' "$OUT/jobs/hosts.txt")
-"$BIN/crane_web" --config "$first_config" --site "$SITE" "${NET[@]}" --domain 0 --bind 10.78.0.1 --port 8765 \
-  > "$OUT/crane_web.log" 2>&1 &
-PIDS[crane_web]=$!
 echo "site: service on 10.78.0.2, cranes ${NAMES[*]} on 10.78.0.11-$((index - 1)); logs in $OUT"
 
 ms() { echo $(($(date +%s%N) / 1000000)); }
@@ -182,6 +191,21 @@ apply_fault() {  # index, spec, phase (on|off)
       else
         nft delete table inet crane_fault_$i 2>/dev/null || true
       fi ;;
+    stop-host)
+      if [ "$phase" = on ]; then
+        local net victim
+        [ -n "${HOLDER[$host]:-}" ] || { echo "site_hosts.sh: fault $2: no host $host" >&2; exit 2; }
+        net=$(readlink "/proc/${HOLDER[$host]}/ns/net")
+        [ -n "$net" ] || { echo "site_hosts.sh: fault $2: host $host has no network namespace" >&2; exit 2; }
+        STOPPED[$host]=1
+        for victim in /proc/[0-9]*; do
+          victim=${victim#/proc/}
+          [ "$victim" = "${HOLDER[$host]}" ] && continue
+          [ "$(readlink "/proc/$victim/ns/net" 2>/dev/null)" = "$net" ] && kill -9 "$victim" 2>/dev/null || true
+        done
+        ip link set "v-$host" down
+        wait "${PIDS[$host]}" 2>/dev/null || true
+      fi ;;
     kill-service)
       duration=$value start=$host
       if [ "$phase" = on ]; then
@@ -200,21 +224,29 @@ fault_times() {  # the spec's start and end, in whole seconds after ready
   case $kind in
     partition) echo "$b $((b + c))" ;;
     kill-service) echo "$a $((a + b))" ;;
+    stop-host) echo "$b $b" ;;
     *) echo "$c $((c + d))" ;;
   esac
 }
-declare -A FAULT_DONE
+declare -A FAULT_DONE=() STOPPED=()
+# Every crane whose host runs has done its jobs; with a host stopped, or waits at rest ("asking").
 all_done() {
-  local name
+  local name waiting_ok=0
+  [ ${#STOPPED[@]} -gt 0 ] && waiting_ok=1
   for name in "${NAMES[@]}"; do
+    [ -n "${STOPPED[$name]:-}" ] && continue
     [ -e "$OUT/$name.json" ] || return 1
-    /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); sys.exit(0 if j["jobs_done"] == j["jobs"] else 1)' "$OUT/$name.json" || return 1
+    /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1]))
+sys.exit(0 if j["jobs_done"] == j["jobs"] or (sys.argv[2] == "1" and j["phase"] in ("asking", "done")) else 1)' \
+      "$OUT/$name.json" "$waiting_ok" || return 1
   done
 }
+settled_since=  # [ms] since when all_done has held (with a host stopped: 15 s of it ends the run)
 while :; do
   for name in "${!PIDS[@]}"; do
     kill -0 "${PIDS[$name]}" 2>/dev/null && continue
     [ "$name" = site_service ] && [ "${FAULT_DONE[service_down]:-}" = 1 ] && continue
+    [ -n "${STOPPED[$name]:-}" ] && continue
     echo "site_hosts.sh: $name stopped (see $OUT)"; exit 1
   done
   for i in "${!FAULTS[@]}"; do
@@ -232,7 +264,13 @@ while :; do
   if [ "$UNTIL" != 0 ]; then
     faults_over=1
     for i in "${!FAULTS[@]}"; do [ "${FAULT_DONE[$i]:-}" = off ] || faults_over=0; done
-    if [ "$faults_over" = 1 ] && all_done; then break; fi
+    if [ "$faults_over" = 1 ] && all_done; then
+      [ ${#STOPPED[@]} -eq 0 ] && break
+      settled_since=${settled_since:-$(elapsed_ms)}
+      [ $(($(elapsed_ms) - settled_since)) -ge 15000 ] && break
+    else
+      settled_since=
+    fi
     if later "$UNTIL"; then echo "site_hosts.sh: not every job done within $UNTIL s"; break; fi
   fi
   sleep 0.2
@@ -243,20 +281,26 @@ run_time=$(elapsed_ms)
 kill -INT "$MONITOR" 2>/dev/null && wait "$MONITOR" 2>/dev/null || true
 MONITOR=
 cat "$OUT/status.txt"
-/usr/bin/python3 - "$OUT" "$SITE" "$run_time" "${NAMES[@]}" <<'PY'
+/usr/bin/python3 - "$OUT" "$SITE" "$run_time" "${!STOPPED[*]}" "${NAMES[@]}" <<'PY'
 import json, re, sys
-out, site, run_time, names = sys.argv[1], sys.argv[2], float(sys.argv[3]) / 1000.0, sys.argv[4:]
+out, site, run_time, stopped, names = sys.argv[1], sys.argv[2], float(sys.argv[3]) / 1000.0, sys.argv[4].split(), sys.argv[5:]
 stop = float(re.search(r"^\s*stop:\s*([0-9.]+)", open(site).read(), re.M).group(1))
 problems = []
-print("crane  jobs  finish_s  waiting_s  yields  halts  phase")
+print("crane  jobs  finish_s  waiting_s  yields  halts  aborted  phase")
 for name in names:
     try:
         s = json.load(open(out + "/" + name + ".json"))
     except (OSError, ValueError):
         problems.append(name + ": no summary"); continue
-    print("%-6s %d/%d %9.1f %10.1f %7d %6d  %s" % (name, s["jobs_done"], s["jobs"], s["finish_time_s"], s["waiting_time_s"],
-                                                s["yields"], s["halts"], s["phase"]))
-    if s["jobs_done"] != s["jobs"]: problems.append("%s did %d of %d jobs" % (name, s["jobs_done"], s["jobs"]))
+    print("%-6s %d/%d %9.1f %10.1f %7d %6d %8d  %s" % (name, s["jobs_done"], s["jobs"], s["finish_time_s"], s["waiting_time_s"],
+                                                     s["yields"], s["halts"], s.get("aborted_moves", 0), s["phase"]))
+    if name in stopped:
+        print("       its host was stopped (every process killed with -9)")
+        continue
+    if s["jobs_done"] != s["jobs"] and not (stopped and s["phase"] in ("asking", "done")):
+        problems.append("%s did %d of %d jobs" % (name, s["jobs_done"], s["jobs"]))
+    elif s["jobs_done"] != s["jobs"]:
+        print("       waits at rest (the stopped crane's whole reach is held)")
     if s["phase"] == "braked": problems.append(name + " was braked")
     if s["reactions_s"]:
         print("       link losses: reactions [ms] " + " ".join("%.0f" % (1e3 * r) for r in s["reactions_s"]))

@@ -465,6 +465,30 @@ TEST(Stack, CraneTopicListsMeasuresEchoesAndRecords) {
               hz["receive"]["jitter_p99_ms"].get<double>());
   EXPECT_NEAR(hz["receive"]["rate_hz"].get<double>(), 100.0, 5.0);
 
+  // The realtime plant stamps each sample with its cycle's scheduled instant, however late it
+  // runs: consecutive stamps 10 ms apart per seq (the supervisor differentiates positions over
+  // them; with publish times, a late sample then one on time read as a crane up to 4x faster).
+  ASSERT_EQ(run("echo rt/crane/hw/sensors --count 300", logs / "sensors.jsonl"), 0);
+  std::ifstream sensors_file(logs / "sensors.jsonl");
+  std::optional<std::pair<std::uint64_t, std::int64_t>> previous;
+  double worst_us = 0.0;
+  int intervals = 0;
+  for (std::string line; std::getline(sensors_file, line);) {
+    const auto sample = nlohmann::json::parse(line);
+    const auto& header = sample["header"];
+    const std::uint64_t seq = header["seq"].get<std::uint64_t>();
+    const std::int64_t ns = header["stamp"]["sec"].get<std::int64_t>() * 1000000000LL + header["stamp"]["nanosec"].get<std::int64_t>();
+    if (previous && seq > previous->first) {
+      const double off_us = std::abs(static_cast<double>(ns - previous->second) / 1e3 - 1e4 * static_cast<double>(seq - previous->first));
+      worst_us = std::max(worst_us, off_us);
+      ++intervals;
+    }
+    previous = {seq, ns};
+  }
+  std::printf("[ figure   ] the realtime plant's sensor stamps: %d intervals, worst %.1f us off seq x 10 ms\n", intervals, worst_us);
+  EXPECT_GE(intervals, 250);
+  EXPECT_LT(worst_us, 5.0) << "stamps jitter: the supervisor's velocities would too";
+
   ASSERT_EQ(run("echo rt/crane/safety/status --count 1", logs / "echo.json"), 0);
   std::ifstream echo_file(logs / "echo.json");
   const auto status = nlohmann::json::parse(echo_file);

@@ -43,8 +43,9 @@
 // estimator: the supervisor does not trust the control processes. The interval between two samples
 // is their measurement times' difference when the input gives them (SupervisorInput::sensor_time: a
 // hardware bridge in realtime, whose cycles jitter: a read 2 ms late is a 20 % faster velocity over
-// the nominal 10 ms), within [kMinMeasuredInterval, kMaxMeasuredInterval] x the nominal one, and
-// their seq difference x sample_period otherwise (a simulated plant's samples are exactly that).
+// the nominal 10 ms; the simulated plant stamps each with its cycle's scheduled instant), within
+// [kMinMeasuredInterval, kMaxMeasuredInterval] x the nominal one, and their seq difference x
+// sample_period otherwise.
 
 #include <array>
 #include <cstdint>
