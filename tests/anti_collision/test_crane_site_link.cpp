@@ -14,6 +14,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crane/anti_collision/crane_site_link.hpp"
@@ -84,6 +85,15 @@ class Link : public ::testing::Test {
     o.request_id = r->request_id;
     o.seq = seq;
     o.waypoints = r->request;
+    return o;
+  }
+  // The service tells crane 0 to yield through `waypoints`.
+  static SiteOrder yield(std::uint64_t seq, std::vector<Pose> waypoints) {
+    SiteOrder o;
+    o.crane = 0;
+    o.kind = Instruction::Kind::yield;
+    o.seq = seq;
+    o.waypoints = std::move(waypoints);
     return o;
   }
   // Asks, is granted, and its first move is under way at `here` with `velocity` [m/s] along the jib.
@@ -287,12 +297,7 @@ TEST_F(Link, AMoveThePlannerEndsShortIsSentAgainOnceTheCraneRestsAndAtLastGivenU
   EXPECT_EQ(r->request_id, 0u) << "it asks for nothing more";
   EXPECT_EQ(link_->jobs_done(), 0);
   // It still obeys a yield, and rests again where that ends.
-  SiteOrder y;
-  y.crane = 0;
-  y.kind = Instruction::Kind::yield;
-  y.seq = 9;
-  y.waypoints = {{0.0, 0.62, 0.2}, {-0.5, 0.62, 0.2}};
-  ASSERT_TRUE(link_->instruction(y, kEpoch, t_));
+  ASSERT_TRUE(link_->instruction(yield(9, {{0.0, 0.62, 0.2}, {-0.5, 0.62, 0.2}}), kEpoch, t_));
   const auto g = next_goal();
   ASSERT_TRUE(g.has_value());
   arrive(*g);
@@ -304,12 +309,7 @@ TEST_F(Link, AMoveThePlannerEndsShortIsSentAgainOnceTheCraneRestsAndAtLastGivenU
 TEST_F(Link, AYieldIsObeyedAtRestAndTheLegAskedAgainWithANewRequest) {
   (void)step();
   const std::uint32_t asked = link_->report()->request_id;
-  SiteOrder y;
-  y.crane = 0;
-  y.kind = Instruction::Kind::yield;
-  y.seq = 3;
-  y.waypoints = {{0.0, 0.3, 0.2}, {-0.5, 0.3, 0.2}};
-  ASSERT_TRUE(link_->instruction(y, kEpoch, t_));
+  ASSERT_TRUE(link_->instruction(yield(3, {{0.0, 0.3, 0.2}, {-0.5, 0.3, 0.2}}), kEpoch, t_));
   EXPECT_EQ(link_->yields(), 1);
   EXPECT_EQ(link_->report()->request_id, 0u) << "yielding withdraws its request";
   auto g = step();
