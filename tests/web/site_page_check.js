@@ -4,7 +4,11 @@
 //   2. each pair's distance equals what crane_site_status (another process on the site's domain)
 //      prints for it, and is no more than this file's own bound from the parts the view gives:
 //      the closest of points sampled along each two capsules' axes, less both radii;
-//   3. the page in Debian's chromium, headless (puppeteer-core): it drew every crane (its load's
+//   3. the site's scene for Foxglove's 3D panel, as Foxglove's own client (@foxglove/ws-protocol)
+//      receives it: a JSON foxglove.SceneUpdate with an entity per crane whose load sphere is where
+//      the view's load is, a line loop per box the view holds and asks for, and a text per pair
+//      naming the view's distance;
+//   4. the page in Debian's chromium, headless (puppeteer-core): it drew every crane (its load's
 //      pixel in the crane's colour, not the background), the held and requested airspace the view
 //      has, a row per pair coloured by its band, the service's epoch; a screenshot.
 //
@@ -12,6 +16,8 @@
 // Exit 1 on a difference.
 "use strict";
 const puppeteer = require("puppeteer-core");
+const { FoxgloveClient } = require("@foxglove/ws-protocol");
+const WebSocket = require("ws");
 const http = require("http");
 const { execFileSync } = require("child_process");
 const fs = require("fs");
@@ -91,7 +97,52 @@ async function main() {
                 `${theirs.distance_m.toFixed(4)} m, sampled parts ${bound.toFixed(4)} m, band ${p.band}`);
   }
 
-  // 3. The page.
+  // 3. The scene, as Foxglove's client gets it (the view fetched again right after: the cranes
+  // stand still, so both describe the same site).
+  const scene = await new Promise((resolve, reject) => {
+    const client = new FoxgloveClient({ ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
+    const timer = setTimeout(() => { client.close(); reject(new Error("no /site/scene message within 10 s")); }, 10000);
+    let subscription = null;
+    client.on("advertise", (channels) => {
+      const ch = channels.find((c) => c.topic === "/site/scene");
+      if (!ch) return;
+      if (ch.encoding !== "json" || ch.schemaName !== "foxglove.SceneUpdate" || ch.schemaEncoding !== "jsonschema") {
+        problems.push(`/site/scene advertised as ${ch.encoding} ${ch.schemaName} ${ch.schemaEncoding}`);
+      }
+      JSON.parse(ch.schema);  // a JSON schema that parses
+      subscription = client.subscribe(ch.id);
+    });
+    client.on("message", ({ subscriptionId, data }) => {
+      if (subscriptionId !== subscription) return;
+      clearTimeout(timer);
+      client.close();
+      resolve(JSON.parse(new TextDecoder().decode(data)));
+    });
+  });
+  const now = await getJson("/site/view.json");
+  for (const c of now.cranes) {
+    const e = scene.entities.find((x) => x.id === "crane/" + c.name);
+    if (!e) { problems.push(`scene: no entity for ${c.name}`); continue; }
+    if (e.frame_id !== "site") problems.push(`scene: ${c.name} in frame ${e.frame_id}`);
+    const load = c.parts.find((p) => p.part === "load");
+    const sphere = e.spheres[0];
+    if (!sphere || Math.abs(sphere.pose.position.x - load.a[0]) > 1e-9 || Math.abs(sphere.pose.position.y - load.a[1]) > 1e-9) {
+      problems.push(`scene: ${c.name}'s load sphere ${JSON.stringify(sphere && sphere.pose.position)} is not the view's load ${load.a}`);
+    }
+    const loops = e.lines.filter((l) => l.type === 1).length;
+    if (loops !== c.held.length + c.requested.length) {
+      problems.push(`scene: ${c.name} has ${loops} line loops, the view ${c.held.length} held + ${c.requested.length} requested boxes`);
+    }
+  }
+  const texts = (scene.entities.find((x) => x.id === "site/distances") || { texts: [] }).texts.map((t) => t.text);
+  for (const p of now.pairs) {
+    const words = `${p.cranes.join("-")} ${p.distance.toFixed(3)} m`;
+    if (!texts.some((t) => t.startsWith(words))) problems.push(`scene: no text '${words}' among ${JSON.stringify(texts)}`);
+  }
+  console.log(`[ figure ] site scene over Foxglove's client: ${scene.entities.length} entities, ` +
+              `${scene.entities.reduce((n, e) => n + e.lines.length, 0)} lines, distances ${JSON.stringify(texts)}`);
+
+  // 4. The page.
   const browser = await puppeteer.launch({
     executablePath: "/usr/bin/chromium",
     headless: true,

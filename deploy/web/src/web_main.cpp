@@ -18,7 +18,8 @@
 // token as the body: sets the session cookie), POST /logout, GET /whoami, /site.json (the crane's
 // kind, travel and no-go zones from --config, the file the stack runs with: site_view.hpp),
 // with --site the site page (/site.html, /site_view.js) and its view (/site/view.json, rebuilt
-// every 200 ms: site_page.hpp; 404 without --site), /about
+// every 200 ms: site_page.hpp; 404 without --site; and the site's scene for Foxglove's 3D panel on
+// the channel /site/scene), /about
 // (what this is) and /metrics (the Prometheus text format, web_metrics.hpp: per topic, the
 // supervisor, each process, the server). A client that reads nothing is closed (--close-stalled).
 // With --site FILE, a second read-only participant on the site's domain (the site file's
@@ -69,7 +70,8 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kSiteViewPeriod = std::chrono::milliseconds(200);
 
 /// One advertised channel per topic of the bus, ids 1..N in the topic table's order; with a site,
-/// then one per site topic (transport::topics::for_each_site_topic), N+1.. .
+/// then one per site topic (transport::topics::for_each_site_topic), N+1.., and the site's scene
+/// (JSON, foxglove.SceneUpdate) last.
 std::vector<web::Channel> bus_channels(bool with_site) {
   std::vector<web::Channel> channels;
   const auto add = [&]<class Topic>() {
@@ -77,7 +79,13 @@ std::vector<web::Channel> bus_channels(bool with_site) {
                                     Topic::type_name, "omgidl", std::string(protocol::kIdlSchema)});
   };
   tp::for_each_topic(add);
-  if (with_site) tp::for_each_site_topic(add);
+  if (with_site) {
+    tp::for_each_site_topic(add);
+    // The site's scene for Foxglove's 3D panel, last (site_page.hpp).
+    channels.push_back(web::Channel{static_cast<std::uint32_t>(channels.size() + 1), std::string(web::kSceneTopic),
+                                    "json", std::string(web::kSceneSchemaName), "jsonschema",
+                                    std::string(web::scene_json_schema())});
+  }
   return channels;
 }
 
@@ -403,8 +411,16 @@ int main(int argc, char** argv) {
       const auto now = Clock::now();
       if (site_watch && now >= next_site_view) {
         std::string view = web::site_page_json(*site_watch, seconds_since_start()).dump();
-        const std::lock_guard lock(site_view_mutex);
-        site_view = std::move(view);
+        {
+          const std::lock_guard lock(site_view_mutex);
+          site_view = std::move(view);
+        }
+        const auto stamp_ns = runtime::now_nanoseconds();
+        const std::string scene = web::site_scene_json(*site_watch, stamp_ns).dump();
+        const auto scene_index = channels.size() - 1;
+        metrics.sample(scene_index);
+        server.publish(channels.back().id, static_cast<std::uint64_t>(stamp_ns),
+                       std::make_shared<std::vector<std::uint8_t>>(scene.begin(), scene.end()));
         next_site_view = now + kSiteViewPeriod;
       }
       if (now - window_start >= std::chrono::seconds(1)) {

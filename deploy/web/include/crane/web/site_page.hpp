@@ -23,7 +23,19 @@
 // envelope); held, requested: one plan outline per box of the airspace (plan_outline), the held
 // one as SiteWatch::held says; band: the margin the distance is under (margins.stop first).
 
+//
+// The same for Foxglove's 3D panel: site_scene_json, a foxglove.SceneUpdate (JSON encoding) on
+// crane_web's channel kSceneTopic, frame "site" (the site frame): one entity per crane
+// ("crane/tc1": the mast a cylinder, jib and counter-jib a line list as thick as their capsules,
+// the cable a line, the load a sphere of its swing envelope, what the service holds a line loop
+// at the jib's height per box, what it asks for a thinner one 5 cm above, a text with the name,
+// state and holding) and one with the pairs' distances ("site/distances": a text per pair over
+// the middle of the two masts, coloured by its band) and the fixed zones ("site/zones": a line
+// loop each on the ground). Entities are replaced by id at each update (lifetime 0).
+
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <string_view>
 
 #include "crane/anti_collision/site_watch.hpp"
 
@@ -32,5 +44,15 @@ namespace crane::web {
 /// The site page's view of `watch` at `time` [s] (the clock the watch was fed with). Allocates;
 /// does not throw beyond std::bad_alloc.
 [[nodiscard]] nlohmann::json site_page_json(const anti_collision::SiteWatch& watch, double time);
+
+/// crane_web's channel of the site's scene (with --site), its schema's name and its JSON schema
+/// (the fields site_scene_json writes, Foxglove's SceneUpdate message definition).
+inline constexpr std::string_view kSceneTopic = "/site/scene";
+inline constexpr std::string_view kSceneSchemaName = "foxglove.SceneUpdate";
+[[nodiscard]] std::string_view scene_json_schema() noexcept;
+
+/// The scene of `watch` (see the header), stamped `stamp_ns` [ns since the epoch]. Allocates;
+/// does not throw beyond std::bad_alloc.
+[[nodiscard]] nlohmann::json site_scene_json(const anti_collision::SiteWatch& watch, std::int64_t stamp_ns);
 
 }  // namespace crane::web
