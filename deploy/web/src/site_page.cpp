@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -63,11 +64,10 @@ json loops(const ac::SiteCrane& crane, const ac::Airspace& airspace, double z, d
   return out;
 }
 
+// The margin a distance between two cranes at rest is under: the site's rule (classify) with no
+// motion to stop, so the emergency-stop envelope is not in question.
 const char* band(double distance, const ac::Margins& m) noexcept {
-  if (!(distance >= m.stop)) return "stop";
-  if (distance < m.slow_down) return "slow_down";
-  if (distance < m.warning) return "warning";
-  return "clear";
+  return ac::to_string(ac::classify(distance, std::numeric_limits<double>::infinity(), m));
 }
 
 }  // namespace

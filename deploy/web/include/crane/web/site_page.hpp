@@ -21,7 +21,8 @@
 //
 // parts: crane_geometry.hpp's capsules at the reported pose (the load as its measured swing
 // envelope); held, requested: one plan outline per box of the airspace (plan_outline), the held
-// one as SiteWatch::held says; band: the margin the distance is under (margins.stop first).
+// one as SiteWatch::held says; band: the margin the distance is under, the site's rule
+// (anti_collision::classify) for cranes at rest ("emergency_stop" only for a NaN distance).
 
 //
 // The same for Foxglove's 3D panel: site_scene_json, a foxglove.SceneUpdate (JSON encoding) on
