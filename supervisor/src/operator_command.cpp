@@ -173,8 +173,9 @@ std::string format_status(const Status& s, const Estimate* estimate, bool json) 
   appendf(text, "operating mode  %s\n", operating.c_str());
   appendf(text, "zones enforced  %s%s\n", zone_list(s.zones_enabled).c_str(),
           (s.warnings & Status::WARNING_ZONE_APPROACH) ? " (approaching one: soft stop)" : "");
-  appendf(text, "motion          %s, brakes %s\n", s.motion_enabled ? "enabled" : "disabled",
-          s.brakes_released ? "released" : "engaged");
+  appendf(text, "motion          %s, brakes %s%s\n", s.motion_enabled ? "enabled" : "disabled",
+          s.brakes_released ? "released" : "engaged",
+          (s.warnings & Status::WARNING_DRIVES_BRAKED) ? " (the drives report them on: braked under way)" : "");
   appendf(text, "active faults   %s\n", s.active_faults ? fault_list(s.active_faults).c_str() : "none");
   appendf(text, "latched faults  %s\n", s.latched_faults ? fault_list(s.latched_faults).c_str() : "none");
   appendf(text, "faults raised   %u, last: %s at cycle %llu\n", s.fault_count,

@@ -419,7 +419,16 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     mode_ = Mode::standby;
   }
 
-  const bool enabled = chain_healthy && (mode_ == Mode::ready || mode_ == Mode::operating);
+  const bool may_operate = mode_ == Mode::ready || mode_ == Mode::operating;
+  const bool enabled = chain_healthy && may_operate;
+  // The drives braked under way (kWarningDrivesBraked): after they ran in this spell of
+  // ready/operating, the latest sample reports the brakes on.
+  if (!may_operate) {
+    drives_ran_ = false;
+  } else if (in.sensors_valid) {
+    if (in.brakes_engaged && drives_ran_) warnings |= kWarningDrivesBraked;
+    if (!in.brakes_engaged) drives_ran_ = true;
+  }
   out.mode = mode_;
   out.motion_enabled = enabled;
   // The brakes open one cycle after the drives were enabled, with the chain still alive.

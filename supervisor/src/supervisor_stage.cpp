@@ -89,6 +89,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.cable_length = sensors.cable_length;
   in.limit_switches = sensors.limit_switches;
   in.emergency_stop_input = sensors.emergency_stop_input;
+  in.brakes_engaged = sensors.brakes_engaged;
   in.actuators_valid = cycle.actuators != nullptr;
   in.actuator_seq = actuators.header.seq;
   in.trolley_voltage = actuators.trolley_voltage;

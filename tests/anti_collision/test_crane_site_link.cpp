@@ -64,10 +64,12 @@ class Link : public ::testing::Test {
     return g;
   }
   // The planner's feedback on goal `id`.
-  void answer(std::uint32_t id, std::uint8_t result = MoveStatus::RESULT_MOVING) {
+  void answer(std::uint32_t id, std::uint8_t result = MoveStatus::RESULT_MOVING,
+              std::uint8_t reason = MoveStatus::REASON_NONE) {
     MoveStatus s{};
     s.request_id = id;
     s.result = result;
+    s.reason = reason;
     link_->move_status(s, t_);
   }
   // The planner answers `goal`, runs it and arrives; the crane rests at its target, settled.
@@ -280,6 +282,13 @@ TEST_F(Link, AMoveThePlannerEndsShortIsSentAgainOnceTheCraneRestsAndAtLastGivenU
   EXPECT_GE(t_ - 0.01 - ended, 2.0 - 1e-9);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
   EXPECT_TRUE(link_->report()->moving) << "it still holds its path";
+  // Braked under way (a stalled chain), as often as it may be: sent again each time, and no attempt.
+  for (int braked = 0; braked < 2 * kMoveAttempts; ++braked) {
+    answer(again->request_id, MoveStatus::RESULT_ABORTED, MoveStatus::REASON_BRAKED);
+    again = next_goal(2.0);
+    ASSERT_TRUE(again.has_value()) << "a crane that only stalls is never given up on";
+    EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
+  }
   // Refused (the mode changed) and then aborted again: the third time it gives up.
   answer(again->request_id, MoveStatus::RESULT_REJECTED);
   const double refused = t_;
@@ -288,7 +297,7 @@ TEST_F(Link, AMoveThePlannerEndsShortIsSentAgainOnceTheCraneRestsAndAtLastGivenU
   EXPECT_NEAR(t_ - 0.01 - refused, kGoalResendPeriod, 0.011);
   answer(again->request_id, MoveStatus::RESULT_ABORTED);
   EXPECT_FALSE(next_goal(3.0).has_value());
-  EXPECT_EQ(link_->aborted_moves(), kMoveAttempts);
+  EXPECT_EQ(link_->aborted_moves(), kMoveAttempts + 2 * kMoveAttempts);
   ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::aborted);
   const auto r = link_->report();
   EXPECT_FALSE(r->moving) << "at rest where it stopped: the service frees the rest of its path";

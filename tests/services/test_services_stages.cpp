@@ -729,6 +729,97 @@ TEST(PlannerStage, ASupervisorApproachWarningStopsTheGoalSoftly) {
   }
 }
 
+// The drives braked under way (WARNING_DRIVES_BRAKED): the goal pauses. The reference holds the
+// measured position at once, while the brakes stay on and while the load still swings (above
+// kResumeSwing); then the rest of the goal (the waypoint not yet passed, the target) starts from
+// there with the same id, and arrives; no abort. Braked once the goal has arrived, the reference stays the arrived one (its request id and
+// phase: what a client waits for). A stop request while paused ends the goal where it is.
+TEST(PlannerStage, DrivesBrakedUnderWayPauseTheGoalWhereTheCraneStoppedAndGoOnWhenTheyOpen) {
+  trajectory_planner::TrajectoryPlannerParams p;
+  trajectory_planner::TrajectoryPlannerStage stage(p, 0.01);
+  protocol::SupervisorStatus status;
+  status.mode = protocol::SupervisorStatus::MODE_OPERATING;
+  status.operating_mode = protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC;
+  protocol::Reference reference;
+  Request goal = trolley_goal(1, 1.1);
+  goal.waypoint_count = 1;  // out to 0.5 m first, then to 1.1 m
+  goal.waypoint_trolley[0] = 0.5;
+  goal.waypoint_slew[0] = 0.0;
+  goal.waypoint_cable_length[0] = 1.0;
+  std::vector<Feedback> feedback;
+  double stopped_at = 0.0, furthest = 0.0, braked_at = 0.0;
+  for (std::uint64_t k = 0; k < 1500; ++k) {
+    auto estimate = at_rest(k);
+    // The crane follows its reference, except while the brakes hold it (cycles 180-184, on the
+    // second segment, and 1300-1319, after the goal arrived).
+    const bool brakes = (k >= 180 && k < 185) || (k >= 1300 && k < 1320);
+    if (k == 0) stopped_at = estimate.trolley_position;
+    if (k > 0 && (!brakes || k == 180 || k == 1300)) stopped_at = reference.trolley_position;
+    estimate.trolley_position = stopped_at;
+    if (k == 180) braked_at = stopped_at;
+    // The brakes' jolt swings the load: 3 deg until cycle 230, then settled.
+    if (k >= 185 && k < 230) estimate.swing_in_plane = 0.05;
+    status.warnings = brakes ? protocol::SupervisorStatus::WARNING_DRIVES_BRAKED : 0U;
+    const std::vector<Request> now = k == 0 ? std::vector<Request>{goal} : std::vector<Request>{};
+    const trajectory_planner::PlannerCycle cycle{&estimate, now, {}, &status};
+    ASSERT_EQ(stage.step(cycle, reference), common::StepStatus::ok);
+    for (const auto& f : stage.move_statuses()) feedback.push_back(f);
+    if (k >= 180 && k < 230) {  // held while braked, and while the load still swings
+      EXPECT_NEAR(reference.trolley_position, braked_at, 1e-12) << "cycle " << k;
+      EXPECT_EQ(reference.trolley_velocity, 0.0) << "cycle " << k;
+    }
+    if (k > 230 && k < 1300) {
+      EXPECT_GE(reference.trolley_position, stopped_at - 1e-12) << "it goes on outward, never back to the waypoint";
+      EXPECT_GE(reference.trolley_position, braked_at - 1e-12) << "cycle " << k;
+    }
+    furthest = std::max(furthest, reference.trolley_position);
+    if (k >= 1200) {
+      EXPECT_EQ(reference.phase, protocol::Reference::PHASE_ARRIVED) << "cycle " << k;
+      EXPECT_EQ(reference.request_id, 1U) << "cycle " << k;
+    }
+  }
+  std::printf("braked at %.3f m on the way from the waypoint (0.5 m) to 1.1 m\n", braked_at);
+  EXPECT_GT(braked_at, 0.55) << "on the second segment";
+  EXPECT_LT(braked_at, 1.0);
+  bool arrived = false;
+  for (const auto& f : feedback) {
+    if (f.request_id != 1) continue;
+    EXPECT_NE(f.result, Feedback::RESULT_ABORTED) << "paused, not aborted";
+    arrived = arrived || f.result == Feedback::RESULT_ARRIVED;
+  }
+  EXPECT_TRUE(arrived);
+  EXPECT_NEAR(reference.trolley_position, 1.1, 1e-9);
+  EXPECT_LE(furthest, 1.1 + 1e-9);
+
+  // Braked again on a new goal; a stop request while paused ends it there.
+  const Request next = trolley_goal(2, 0.3);
+  Request stop;
+  stop.request_id = 3;
+  stop.command = Request::COMMAND_STOP;
+  feedback.clear();
+  double held = 0.0;
+  for (std::uint64_t k = 1500; k < 1800; ++k) {
+    auto estimate = at_rest(k);
+    if (k == 1560) held = reference.trolley_position;
+    estimate.trolley_position = k < 1560 ? reference.trolley_position : held;
+    status.warnings = k >= 1560 && k < 1600 ? protocol::SupervisorStatus::WARNING_DRIVES_BRAKED : 0U;
+    const std::vector<Request> now = k == 1500 ? std::vector<Request>{next} : k == 1580 ? std::vector<Request>{stop}
+                                                                                       : std::vector<Request>{};
+    const trajectory_planner::PlannerCycle cycle{&estimate, now, {}, &status};
+    ASSERT_EQ(stage.step(cycle, reference), common::StepStatus::ok);
+    for (const auto& f : stage.move_statuses()) feedback.push_back(f);
+  }
+  bool stopped = false;
+  for (const auto& f : feedback) {
+    if (f.request_id == 2 && f.result == Feedback::RESULT_ABORTED) stopped = f.reason == Feedback::REASON_STOPPED;
+    if (f.request_id == 2) {
+      EXPECT_NE(f.result, Feedback::RESULT_ARRIVED);
+    }
+  }
+  EXPECT_TRUE(stopped) << "the stop request ends the paused goal";
+  EXPECT_NEAR(reference.trolley_position, held, 1e-12) << "where the brakes stopped it: the goal did not go on";
+}
+
 }  // namespace
 
 namespace {

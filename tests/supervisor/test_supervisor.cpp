@@ -269,6 +269,43 @@ TEST(Supervisor, LateStageThatRecoversLatchesNothing) {
   EXPECT_EQ(out.fault_count, 0U);
 }
 
+// The drives braked under way: brakes on while the supervisor lets the crane move (the actuation
+// gate's watchdog after a stalled chain, or a late stage) is warned of for as long as they stay on,
+// once the drives have run in this spell of ready/operating; not at start-up, nor in a fault.
+TEST(Supervisor, DrivesBrakedUnderWayAreWarnedOfOnceTheyHaveRun) {
+  auto supervisor = ready_supervisor();
+  auto in = healthy_input();
+  in.brakes_engaged = true;  // the gate has not yet opened them: start-up, no warning
+  EXPECT_EQ(step(supervisor, in).warnings & sv::kWarningDrivesBraked, 0U);
+  in.brakes_engaged = false;
+  EXPECT_EQ(step(supervisor, in).warnings & sv::kWarningDrivesBraked, 0U);
+  in.brakes_engaged = true;  // the gate's watchdog: braked under way
+  for (int k = 0; k < 3; ++k) {
+    const auto out = step(supervisor, in);
+    EXPECT_TRUE(out.warnings & sv::kWarningDrivesBraked) << "cycle " << k;
+    EXPECT_TRUE(out.brakes_released) << "a warning: motion stays permitted";
+    EXPECT_EQ(out.latched_faults, 0U);
+  }
+  in.brakes_engaged = false;
+  EXPECT_EQ(step(supervisor, in).warnings & sv::kWarningDrivesBraked, 0U) << "cleared when they open";
+  // A late stage inhibits motion: the brakes it engages are braked under way too.
+  auto late = in;
+  late.brakes_engaged = true;
+  late.stages[static_cast<std::size_t>(sv::Stage::tracking)].seconds_since_sample = 0.06;
+  const auto late_out = step(supervisor, late);
+  EXPECT_TRUE(late_out.warnings & sv::kWarningStageLate);
+  EXPECT_TRUE(late_out.warnings & sv::kWarningDrivesBraked);
+  // A fault: the brakes are the supervisor's own doing, no warning; after the reset, the drives
+  // must run again before braking is warned of.
+  auto fault = in;
+  fault.brakes_engaged = true;
+  fault.swing_in_plane = 1.0;
+  EXPECT_EQ(step(supervisor, fault).warnings & sv::kWarningDrivesBraked, 0U);
+  fault.swing_in_plane = 0.0;
+  EXPECT_EQ(step(supervisor, with_command(fault, sv::Command::reset)).warnings & sv::kWarningDrivesBraked, 0U);
+  EXPECT_EQ(step(supervisor, fault).warnings & sv::kWarningDrivesBraked, 0U) << "not run since the fault";
+}
+
 TEST(Supervisor, TravelLimitCheckedOnlyOnceSensorsValid) {
   // Limits [0.05, 1.30] m.
   auto supervisor = ready_supervisor();

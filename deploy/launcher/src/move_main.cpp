@@ -303,6 +303,7 @@ int run(const MoveOptions& o, const runtime::NodeOptions& node) {
                        : f.reason == Feedback::REASON_ZONE    ? "approaching a no-go zone (a soft stop)"
                        : f.reason == Feedback::REASON_LIMIT_APPROACH ? "approaching a travel limit too fast (a soft stop)"
                        : f.reason == Feedback::REASON_MANUAL_MOTION ? "the operator's stick took over"
+                       : f.reason == Feedback::REASON_BRAKED ? "the drives were braked under way (a stalled command chain)"
                                                                    : reason_name(f.reason);
         break;
       }

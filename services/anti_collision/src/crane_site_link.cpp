@@ -129,6 +129,8 @@ void CraneSiteLink::move_status(const protocol::MoveStatus& status, double time)
       status.result == protocol::MoveStatus::RESULT_ABORTED || status.result == protocol::MoveStatus::RESULT_REJECTED;
   if (ended_short && goal_->command == Request::COMMAND_MOVE && phase_ == Phase::moving && !ended_short_at_) {
     ended_short_at_ = time;
+    ended_braked_ = status.result == protocol::MoveStatus::RESULT_ABORTED &&
+                    status.reason == protocol::MoveStatus::REASON_BRAKED;
     stopped_at_.reset();
     ++aborted_moves_;
   }
@@ -332,7 +334,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
     if (!calm || time - *ended_short_at_ < kGoalResendPeriod - 1e-9) return goal;
     ended_short_at_.reset();
     stopped_at_.reset();
-    if (++attempts_ >= kMoveAttempts) {
+    if (!ended_braked_ && ++attempts_ >= kMoveAttempts) {
       gave_up_ = true;
       yielding_ = false;
       goal_.reset();

@@ -56,6 +56,8 @@ struct InProcessStack::Stages {
   Stages(const StackConfig& cfg, const InProcessOptions& o)
       : dt(cfg.facts.sample_period),
         plan_move(o.plan_move),
+        lost_from(o.lost_commands_from),
+        lost_until(o.lost_commands_from + o.lost_commands),
         plant(plant_stage_params(cfg, o)),
         estimator(cfg.state_estimator),
         planner(cfg.trajectory_planner, dt),
@@ -70,6 +72,7 @@ struct InProcessStack::Stages {
   }
   double dt;
   MovePlanner plan_move;
+  std::uint64_t lost_from, lost_until;  // cycles [lost_from, lost_until) lose their command
   std::uint64_t planned_sequence{0};  // the last plan request answered (PlanRequest::sequence)
   plant::PlantStage plant;
   state_estimator::StateEstimatorStage estimator;
@@ -143,7 +146,9 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
   s.observed.command = command;
   s.supervisor.step(s.observed, s.status);
   if (k == 0) s.gating = s.status;  // cycle 0 is gated by the status of cycle 0, cycle k by that of k - 1
-  if (s.plant.step(supervisor::lockstep_gate_input(k, s.dt, &s.actuators, s.gating)) != common::StepStatus::ok) {
+  const bool lost = k >= s.lost_from && k < s.lost_until;
+  if (s.plant.step(supervisor::lockstep_gate_input(k, s.dt, lost ? nullptr : &s.actuators, s.gating)) !=
+      common::StepStatus::ok) {
     ++s.plant_step_failures;
   }
   s.gating = s.status;

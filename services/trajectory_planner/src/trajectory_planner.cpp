@@ -223,6 +223,10 @@ const TrajectoryPlanner::Segment& TrajectoryPlanner::segment_at(double time_in_m
   return segments_[segment_count_ - 1];
 }
 
+std::size_t TrajectoryPlanner::segment_index() const noexcept {
+  return phase_ == MovePhase::holding ? 0 : static_cast<std::size_t>(&segment_at(time_in_move_) - segments_.data());
+}
+
 common::MotionReference TrajectoryPlanner::sample_now() const noexcept {
   const Segment& s = segment_at(time_in_move_);
   const double t = time_in_move_ - s.start_time;

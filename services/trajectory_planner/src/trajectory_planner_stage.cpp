@@ -77,6 +77,13 @@ const char* goal_status_name(GoalStatus s) noexcept {
   return "unknown";
 }
 
+// [rad] the larger swing amplitude of the two planes, sqrt(angle^2 + (rate / w)^2), w = sqrt(g / L).
+double swing_amplitude(const common::CraneStateEstimate& s, double gravity) noexcept {
+  const double w = std::sqrt(gravity / std::max(s.cable_length, 1e-3));
+  return std::max(std::hypot(s.swing_in_plane, s.swing_in_plane_rate / w),
+                  std::hypot(s.swing_out_of_plane, s.swing_out_of_plane_rate / w));
+}
+
 MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current, const ManualParams& rated) noexcept {
   MoveGoal g;
   g.trolley_limits = {rated.trolley.rated_speed, rated.trolley.acceleration};
@@ -218,6 +225,7 @@ void TrajectoryPlannerStage::report_rest(protocol::MoveStatus& s) const noexcept
 void TrajectoryPlannerStage::abort_active(std::uint8_t reason) noexcept {
   if (active_) report(static_cast<std::uint32_t>(active_goal_.request_id), protocol::MoveStatus::RESULT_ABORTED, reason);
   active_ = false;
+  paused_.reset();
 }
 
 void TrajectoryPlannerStage::cancel_plan(std::uint8_t reason) noexcept {
@@ -287,6 +295,7 @@ bool TrajectoryPlannerStage::moving() const noexcept {
 }
 
 void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id) noexcept {
+  paused_.reset();
   if (source_ == Source::profile) {
     speed_.start(planner_.sample_now());
     if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
@@ -367,7 +376,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
   const auto& params = planner_.params();
 
   // The supervisor's view: operating mode, zones, faults, zone approach.
-  bool zone_warning = false, limit_warning = false, site_warning = false;
+  bool zone_warning = false, limit_warning = false, site_warning = false, braked = false;
   if (cycle.status != nullptr) {
     const auto& st = *cycle.status;
     const std::uint8_t mode = st.operating_mode;
@@ -376,6 +385,8 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       if (moving()) {
         abort_active(Feedback::REASON_MODE);
         soft_stop(0);
+      } else if (paused_) {
+        abort_active(Feedback::REASON_MODE);  // braked under way, at rest: it ends there
       }
       operating_mode_ = mode;
     }
@@ -386,6 +397,65 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     zone_warning = (st.warnings & Status::WARNING_ZONE_APPROACH) != 0;
     limit_warning = (st.warnings & Status::WARNING_SPEED_LIMITED) != 0;
     site_warning = (st.warnings & Status::WARNING_SITE) != 0;
+    braked = (st.warnings & Status::WARNING_DRIVES_BRAKED) != 0;
+  }
+  if (braked && !supervisor_stopped_ && moving()) {
+    // The drives were braked under way (the actuation gate's watchdog after a stalled chain, or a
+    // late stage): the brakes stopped the crane where it is. The goal pauses: the reference holds
+    // the measured position while they stay on, so that when they open the tracking law does not
+    // chase a reference that ran on (at full voltage: twice the planned speed); the rest of the
+    // goal starts again from there (below). A reference at rest (arrived, holding) is left as it
+    // is: nothing runs on, and a client waits for its arrival.
+    if (source_ == Source::speed) {
+      // Operator speeds (or a soft stop): the speed reference starts again from rest where the
+      // crane is; the stick still held drives it on from there, shaped (a soft stop is at rest).
+      common::MotionReference here;
+      here.trolley.position = current.trolley_position;
+      here.slew.position = current.slew_angle;
+      here.cable_length.position = current.cable_length;
+      speed_.start(here);
+      if (bridge_) {
+        common::MotionReference bridge_here;
+        bridge_here.trolley.position = estimate.bridge_position;
+        bridge_here.cable_length.position = current.cable_length;
+        bridge_->speed.start(bridge_here);
+      }
+    } else {
+      if (active_ && !bridge_) {
+        MoveGoal rest = active_goal_;
+        const std::size_t passed = std::min(planner_.segment_index(), rest.waypoint_count);
+        for (std::size_t i = passed; i < rest.waypoint_count; ++i) rest.waypoints[i - passed] = rest.waypoints[i];
+        rest.waypoint_count -= passed;
+        paused_ = rest;
+        paused_seq_ = seq;
+      } else {
+        abort_active(Feedback::REASON_BRAKED);  // an overhead crane's goal (its bridge) ends here
+      }
+      cancel_plan(Feedback::REASON_BRAKED);
+      (void)planner_.hold(current);
+      hold_bridge(estimate.bridge_position);
+    }
+  } else if (paused_ && (supervisor_stopped_ || zone_warning || limit_warning || site_warning)) {
+    // Paused at rest, and now a reason to stop: the goal ends here, with that reason.
+    abort_active(supervisor_stopped_ ? Feedback::REASON_FAULT
+                 : zone_warning      ? Feedback::REASON_ZONE
+                 : site_warning      ? Feedback::REASON_SITE
+                                     : Feedback::REASON_LIMIT_APPROACH);
+  } else if (paused_ && braked) {
+    paused_seq_ = seq;  // still held by the brakes (at rest: moving() is false)
+  } else if (paused_ && seq > paused_seq_ + kResumeTimeoutCycles) {
+    abort_active(Feedback::REASON_BRAKED);  // the swing did not settle: a client sends the goal again
+  } else if (paused_ && swing_amplitude(current, params.gravity) < kResumeSwing) {
+    // The brakes are open again and the swing they caused has settled (the reference holds
+    // meanwhile, the anti-swing law damps it): the rest of the goal, from where the crane stopped.
+    const MoveGoal rest = *paused_;
+    paused_.reset();
+    if (planner_.start_move(rest, current) != GoalStatus::accepted) {
+      abort_active(Feedback::REASON_BRAKED);
+      (void)planner_.hold(current);
+    } else {
+      cycles_since_progress_ = kProgressCycles;  // a progress report at this cycle's end
+    }
   }
   if (supervisor_stopped_) {
     // The brakes hold the crane where it is and the drives are off: the running goal is over. The
@@ -495,6 +565,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       bridge_->target = bridge_goal.trolley_target;
     }
     if (active_ && active_goal_.request_id != goal.request_id) abort_active(Feedback::REASON_REPLACED);
+    paused_.reset();
     source_ = Source::profile;
     stop_id_ = 0;
     active_goal_ = goal;
@@ -653,8 +724,9 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     require_neutral_ = false;
   }
   if (commanding && source_ == Source::profile) {
-    if (active_ && output_.phase == MovePhase::moving) abort_active(Feedback::REASON_MANUAL_MOTION);
+    if (active_ && (output_.phase == MovePhase::moving || paused_)) abort_active(Feedback::REASON_MANUAL_MOTION);
     active_ = false;
+    paused_.reset();
     speed_.start(planner_.sample_now());
     if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
     source_ = Source::speed;

@@ -15,6 +15,13 @@
 //    (the drives hold the load before the brakes let go);
 //  - a stage that is not fresh is late: motion is inhibited while it lasts (drives off, brakes on,
 //    warning kWarningStageLate), with no fault, so a few late cycles that recover latch nothing;
+//  - the drives braked under way: in ready/operating, once a sensor sample has reported the brakes
+//    released, a sample reporting them engaged (the actuation gate's command watchdog after a
+//    stalled chain, or motion inhibited by a late stage) raises warning kWarningDrivesBraked for as
+//    long as they stay on. The planner answers by pausing the goal where the brakes stopped the
+//    crane (it goes on once they are open and the swing has settled): a reference that ran on
+//    meanwhile would otherwise be chased at full voltage when the brakes open (both drives at
+//    about twice their speed: docs/site.md);
 //  - a stage silent for longer than stage_dead_timeout, or whose writer is gone (unmatched), is
 //    dead: protective stop (fault stage_silent). So is a limit exceeded, a non-finite value or a
 //    second writer: brakes engaged, drives at zero; the fault stays latched until an explicit
@@ -125,6 +132,7 @@ enum Warning : std::uint32_t {
                                                               // motion inhibited while it lasts, not yet dead
   kWarningZoneApproach = StatusCodes::WARNING_ZONE_APPROACH,        // the predicted stopping position is in a zone
   kWarningSite = StatusCodes::WARNING_SITE,                         // the site guard asks for a soft stop
+  kWarningDrivesBraked = StatusCodes::WARNING_DRIVES_BRAKED,        // brakes on in ready/operating after the drives ran
 };
 
 /// What the crane's guard of its site grant (anti_collision::GrantGuard, docs/site.md) answered
@@ -282,6 +290,7 @@ struct SupervisorInput {
   int sensor_writers{1};              // writers matched on the sensors topic
   int actuator_writers{1};            // writers matched on the actuators topic
   bool nonfinite_seen{false};         // a watched sample was rejected for NaN/Inf since last step
+  bool brakes_engaged{true};          // SensorSample_.brakes_engaged of the latest sample (the brakes as applied)
   bool move_in_progress{false};       // the planner reports a move (ready -> operating)
   Command command{Command::none};
   std::uint8_t command_operating_mode{0};  // set_operating_mode: an OPERATION_* code (others refused)
@@ -404,6 +413,7 @@ class Supervisor {
   std::uint8_t operating_mode_{StatusCodes::OPERATION_FULLAUTOMATIC};
   std::uint32_t zones_enabled_{0};
   bool drives_enabled_previous_{false};
+  bool drives_ran_{false};  // in ready/operating, a sample reported the brakes released (kWarningDrivesBraked)
   // Velocity from successive sensor samples.
   bool have_previous_sample_{false};
   std::uint64_t previous_sensor_seq_{0};

@@ -24,7 +24,9 @@
 // sent again as a new goal; after kMoveAttempts ended short at one waypoint the link gives up: the
 // crane rests where it stopped (phase aborted), reports its rest pose (the service frees the rest
 // of its path) and asks for nothing more, an operator's matter (aborted_moves() counts them); it
-// still obeys a yield, and rests again where that ends.
+// still obeys a yield, and rests again where that ends. A move ended because the drives were
+// braked under way (REASON_BRAKED: a stalled command chain, not a refusal of the move) is sent
+// again the same way but is not an attempt: the link never gives up on a crane that only stalls.
 //
 // Its report (report()) is its whole state: at rest at its pose, or moving with the rest of its
 // path from the last waypoint it reached; the last instruction it carried out (the epoch and seq
@@ -189,6 +191,7 @@ class CraneSiteLink {
   bool start_next_{false};           // the move to waypoint_ + 1 starts at the next step
   std::optional<double> arrived_at_; // [s] the reference arrived
   std::optional<double> ended_short_at_;  // [s] the planner ended the move under way short
+  bool ended_braked_{false};              // ... because the drives were braked (not an attempt)
   std::optional<double> stopped_at_;      // [s] the crane came to rest after that
   int attempts_{0};                  // moves to waypoint_ ended short
   double dwell_until_{0.0};

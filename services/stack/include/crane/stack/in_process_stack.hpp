@@ -47,6 +47,11 @@ struct InProcessOptions {
   // How a minimum-time goal (PROFILE_MINIMUM_TIME) is planned when the planner asks (empty: the
   // planner node's way, optimal_control::plan_minimum_time_move with MovePlanning{}).
   MovePlanner plan_move{};
+  // A stalled command chain, for fault tests: from cycle `lost_commands_from` on, for
+  // `lost_commands` cycles, no actuator command reaches the plant (the stages still run); the
+  // plant's actuation gate holds the last one, then its command watchdog brakes (actuation_gate.hpp).
+  std::uint64_t lost_commands_from{0};
+  std::uint64_t lost_commands{0};
 };
 
 /// The plant stage of a run: the configured simulator and actuation gate, at rest at the options'

@@ -193,6 +193,9 @@ class TrajectoryPlanner {
   [[nodiscard]] const TrajectoryPlannerParams& params() const noexcept { return params_; }
   /// Planned duration [s] of the current move (0 while holding).
   [[nodiscard]] double move_duration() const noexcept { return move_duration_; }
+  /// The segment of the current move the reference is on: 0 .. its waypoint count (the waypoints
+  /// before it are passed); 0 while holding.
+  [[nodiscard]] std::size_t segment_index() const noexcept;
 
  private:
   struct Axis {

@@ -32,6 +32,17 @@
 //  - when the supervisor reports a fault or an emergency stop, a running goal is aborted (fault) and
 //    goals are refused; when it lets the crane move again, the reference holds the measured
 //    position, so a reset resumes nothing;
+//  - when it warns that the drives were braked under way (WARNING_DRIVES_BRAKED: a stalled command
+//    chain, no fault), the goal pauses: the reference holds the measured position, where the
+//    brakes stopped the crane, and when they are open and the swing they caused has settled below
+//    kResumeSwing, the rest of the goal (the waypoints not yet passed, the targets) starts again
+//    from there with the goal's id and profile (a minimum-time goal: time-optimal); not settled
+//    kResumeTimeoutCycles after they opened, the goal ends there (REASON_BRAKED). So the tracking
+//    law never chases a reference that ran on during the stall. Under operator speeds (or a soft
+//    stop) the speed reference starts again from rest where the crane is, and the stick still held
+//    drives it on from there. A goal the planner cannot start again (an overhead crane's: its
+//    bridge), or a stop reason while paused (a stop request, a mode change, a fault, a zone, the
+//    site), ends it there (REASON_BRAKED, or that reason);
 //  - no-go zones (zone_paths.hpp): a goal inside one is refused (REASON_ZONE, value the zone's
 //    index), others are planned around; operator speeds are held back so that the load can always
 //    come to rest outside every zone (SpeedReference).
@@ -105,6 +116,14 @@ class TrajectoryPlannerStage {
  public:
   static constexpr std::size_t kMaxGoalsPerCycle = 8;  // outcomes kept per step; more are counted
   static constexpr std::uint64_t kProgressCycles = 10; // a moving request's progress every 10 cycles
+  /// [rad] a goal paused by the brakes (WARNING_DRIVES_BRAKED) goes on once they are open and the
+  /// load's swing amplitude (either plane: sqrt(angle^2 + (rate / w)^2), w = sqrt(g / L)) is below
+  /// this: the brakes' jolt swings it, and a move started into that swing (the anti-swing law's
+  /// correction on top of the profile) overspeeds the drives.
+  static constexpr double kResumeSwing = 0.017;
+  /// [cycles] a paused goal whose swing has not settled this long after the brakes opened ends
+  /// there (REASON_BRAKED): a client sends it again.
+  static constexpr std::uint64_t kResumeTimeoutCycles = 1000;
 
   /// Throws common::ConfigError for invalid params (TrajectoryPlanner's constructor) or a
   /// sample_period that is not positive and finite.
@@ -226,6 +245,10 @@ class TrajectoryPlannerStage {
   std::size_t status_count_{0};
   MoveGoal active_goal_{};           // the request being executed (targets for the distances to go)
   bool active_{false};               // a move of active_goal_ is under way (not yet arrived or aborted)
+  // The drives braked under way (WARNING_DRIVES_BRAKED): the rest of active_goal_ (the waypoints
+  // not yet passed, the targets), started again from the measured position when the brakes open.
+  std::optional<MoveGoal> paused_;
+  std::uint64_t paused_seq_{0};  // the last cycle the brakes held the paused goal
   std::uint64_t cycles_since_progress_{0};
   const protocol::CraneState* cycle_estimate_{nullptr};  // the step's estimate (header of the feedback)
   // The minimum-time profile (planned_path.hpp).
