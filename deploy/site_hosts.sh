@@ -15,8 +15,11 @@
 # the Foxglove WebSocket view of the site's topics (ws://10.78.0.1:8765 from the office).
 #
 # Usage: site_hosts.sh BIN SITE OUT [--jobs J] [--seed S] [--dds fast|cyclone] [--until-done SECONDS]
-#                      [--fault SPEC ...]
+#                      [--security DIR] [--fault SPEC ...]
 #   BIN   the build's bin folder; SITE the site file; OUT a folder for the logs and figures
+#   --security DIR  DDS Security on every domain (deploy/crane security init's material: each process
+#                   its own identity, the office's tools the monitor's); without it the site's
+#                   network runs --insecure-lan
 #   --jobs/--seed   the job set (crane_site jobs: the set `crane_site demo --sets 1 --seed S` runs)
 #   --until-done S  stop when every crane has done its jobs (exit 0 when every job is done, no crane
 #                   braked and the closest distance keeps the site's stop margin), or after S seconds
@@ -40,17 +43,18 @@
 # Exit status: 0 done and safe, 1 not (the reason printed), 2 bad usage or no namespaces here.
 set -euo pipefail
 
-usage() { sed -n '17,42p' "$0" >&2; exit 2; }
+usage() { sed -n '17,43p' "$0" >&2; exit 2; }
 [ $# -ge 3 ] || usage
 BIN=$(cd "$1" && pwd) SITE=$(realpath "$2") OUT=$3
 shift 3
-JOBS=1 SEED=1 DDS=cyclone UNTIL=0 FAULTS=()
+JOBS=1 SEED=1 DDS=cyclone UNTIL=0 FAULTS=() SECURITY=
 while [ $# -gt 0 ]; do
   case $1 in
     --jobs) JOBS=$2; shift 2 ;;
     --seed) SEED=$2; shift 2 ;;
     --dds) DDS=$2; shift 2 ;;
     --until-done) UNTIL=$2; shift 2 ;;
+    --security) SECURITY=$(realpath "$2"); shift 2 ;;
     --fault) FAULTS+=("$2"); shift 2 ;;
     *) echo "site_hosts.sh: unknown option $1" >&2; usage ;;
   esac
@@ -62,7 +66,7 @@ OUT=$(cd "$OUT" && pwd)
 if [ "${CRANE_SITE_NETNS:-}" != 1 ]; then
   unshare --net true 2>/dev/null || { echo "site_hosts.sh: cannot make network namespaces here (unshare --net)" >&2; exit 2; }
   exec unshare --net env CRANE_SITE_NETNS=1 "$0" "$BIN" "$SITE" "$OUT" --jobs "$JOBS" --seed "$SEED" --dds "$DDS" \
-    --until-done "$UNTIL" ${FAULTS[@]+$(printf -- '--fault %s ' "${FAULTS[@]}")}
+    --until-done "$UNTIL" ${SECURITY:+--security "$SECURITY"} ${FAULTS[@]+$(printf -- '--fault %s ' "${FAULTS[@]}")}
 fi
 
 declare -A HOLDER ADDRESS PIDS
@@ -109,6 +113,7 @@ on() { local name=$1; shift; nsenter -t "${HOLDER[$name]}" -n -m -- "$@"; }
 spawn() { local name=$1 log=$2; shift 2; nsenter -t "${HOLDER[$name]}" -n -m -- "$@" >> "$log" 2>&1 & }
 
 NET=(--lan --insecure-lan --dds "$DDS")
+[ -n "$SECURITY" ] && NET=(--lan --security "$SECURITY" --dds "$DDS")
 # The cranes' slew at most 0.7 rad/s, two thirds of the lab crane's rated 1.05: several whole stacks
 # in real time on one small machine miss cycles, and a long slew at the rated rate then overshot the
 # supervisor's overspeed limit (slew_overspeed, 2 of 6 runs on this 2-core machine under other load).

@@ -53,7 +53,6 @@ class SiteLink {
     if (crane_ < 0) {
       throw std::runtime_error("--site-crane " + crane_name + ": no crane of that name in " + site_path);
     }
-    runtime::require_site_without_security(options);
     options.domain_id = static_cast<std::uint32_t>(layout_.domain_id);
     participant_ = runtime::make_participant(options, "supervisor");
     instructions_ = participant_->make_recording_reader<transport::topics::SiteInstruction>(nullptr, 64);

@@ -19,6 +19,11 @@
 #                   rest on Fast DDS): FAILS with the Debian packages (see the case; not in ctest)
 #   veth            the identities case across two namespaces joined by a veth pair (stack --lan
 #                   --security in A; the outsider, monitor and operator in B, all --lan)
+#   site            the site's domain secured (docs/site.md, "Security"): the site service and a
+#                   crane's stack with its guard and site link, each its own identity, hear each
+#                   other (the crane is granted, the service and the monitor hear its reports); a
+#                   participant without credentials hears nothing of the site; a site service run
+#                   with the monitor's identity may not write instructions
 # The identities and veth cases run the stack and the tools on CRANE_SECURITY_DDS (fast, default,
 # or cyclone; ctest runs veth on cyclone: docs/deployment.md, "Security").
 #   cost            end-to-end latency (sensor sample -> actuator command, the plant's p99 over 6 s,
@@ -36,9 +41,11 @@ ip link set lo up && ip link set lo multicast on
 rm -rf "$OUT/$CASE"
 mkdir -p "$OUT/$CASE"
 W=$OUT/$CASE
-STACK= HOLDER=
+STACK= HOLDER= SERVICE= WRITER=
 cleanup() {
   [ -n "$STACK" ] && kill -INT "$STACK" 2>/dev/null && wait "$STACK" 2>/dev/null
+  [ -n "$SERVICE" ] && kill -INT "$SERVICE" 2>/dev/null && wait "$SERVICE" 2>/dev/null
+  [ -n "$WRITER" ] && kill -INT "$WRITER" 2>/dev/null && wait "$WRITER" 2>/dev/null
   [ -n "$HOLDER" ] && kill "$HOLDER" 2>/dev/null
   return 0
 }
@@ -81,9 +88,10 @@ material)
   rm -rf "$MATERIAL"
   bash "$ROOT/deploy/security/endpoint_graph.sh" "$BIN" "$CONFIG" "$W/graph"
   /usr/bin/python3 "$ROOT/deploy/security/crane_security.py" init --out "$MATERIAL" --days 2 \
-    --graph "$W/graph/graph_sim.json" "$W/graph/graph_board.json" | tee "$W/init.txt"
+    --graph "$W/graph/graph_sim.json" "$W/graph/graph_board.json" "$W/graph/graph_site.json" \
+    "$W/graph/graph_site_domain.json" | tee "$W/init.txt"
   for who in supervisor state_estimator trajectory_planner anti_swing tracking friction_compensation plant \
-             hardware_bridge launcher monitor operator; do
+             hardware_bridge launcher site_service site_link monitor operator; do
     check "identity $who: certificate, key, signed permissions" \
       test -s "$MATERIAL/$who/cert.pem" -a -s "$MATERIAL/$who/key.pem" -a -s "$MATERIAL/$who/permissions.p7s"
   done
@@ -92,6 +100,17 @@ material)
   check "trajectory_planner may publish reference, move status, diagnostics only" \
     grep -q "^trajectory_planner *publishes rt/crane/diag/loop, rt/crane/planner/move_status, rt/crane/planner/reference$" "$W/init.txt"
   check "monitor publishes nothing" grep -q "^monitor *publishes nothing$" "$W/init.txt"
+  # The site's topics (docs/site.md): the service writes the instructions and its status, a crane's
+  # site link its reports and its crane's goals; the supervisor only reads the site.
+  check "site_service may publish the site's instructions and status only" \
+    grep -q "^site_service *publishes rt/site/instruction, rt/site/status$" "$W/init.txt"
+  check "site_link may publish its crane's goals and its site reports only" \
+    grep -q "^site_link *publishes rt/crane/planner/goal, rt/site/report$" "$W/init.txt"
+  check "supervisor may read the site's instructions" \
+    grep -q "<topic>rt/site/instruction</topic>" "$MATERIAL/supervisor/permissions.xml"
+  check "supervisor may not write to the site" \
+    python3 -c 'import re,sys; x=open(sys.argv[1]).read(); p=re.search(r"<publish>.*?</publish>", x, re.S); sys.exit(1 if p and "rt/site/" in p.group(0) else 0)' \
+    "$MATERIAL/supervisor/permissions.xml"
   check "governance signed by the CA" openssl smime -verify -in "$MATERIAL/governance.p7s" -CAfile "$MATERIAL/ca/ca.pem" -out /dev/null
   ;;
 identities | veth)
@@ -146,6 +165,56 @@ print(sum(len(e["writers"]) + len(e["readers"]) for e in t.values()))' "$W/outsi
   check "the operator's goal moved the trolley to 0.9 m (within 5 mm)" \
     /usr/bin/python3 -c 'import sys; sys.exit(abs(float(sys.argv[1]) - 0.9) > 0.005)' "$x3"
   stop_stack
+  ;;
+site)
+  export CRANE_DDS=${CRANE_SECURITY_DDS:-fast}
+  SITE=$ROOT/deploy/config/site_two_towers.yaml
+  SITE_DOMAIN=$(sed -n 's/^  domain_id: *\([0-9]*\).*/\1/p' "$SITE")
+  "$BIN/crane_site" jobs --site "$SITE" --jobs 1 --seed 1 --out "$W/jobs" > /dev/null
+  # 1. A site service with the monitor's identity: its instruction writer is refused.
+  timeout 30 "$BIN/site_service" --site "$SITE" --security "$MATERIAL" --identity monitor > "$W/rogue_service.log" 2>&1 \
+    && rogue_rc=0 || rogue_rc=$?
+  echo "site_service as monitor: exit $rogue_rc: $(grep -m1 -i "writer" "$W/rogue_service.log" || tail -1 "$W/rogue_service.log")"
+  check "a site service with the monitor's identity cannot write instructions" grep -qi "cannot create a writer" "$W/rogue_service.log"
+  # 2. The service and tc1's stack (its supervisor's guard, its site link), each its own identity;
+  # tc2 at rest where its jobs start, its reports played with the site link's identity (the site's
+  # crane reports: tests/web/site_reports_writer), so that the service may grant tc1 its first leg.
+  "$BIN/site_service" --site "$SITE" --security "$MATERIAL" > "$W/site_service.log" 2>&1 &
+  SERVICE=$!
+  tc2_at=$(awk '$1 == "tc2" { printf "tc2:%s:%s:0.2", $4, $5 }' "$W/jobs/hosts.txt")
+  "$BIN/site_reports_writer" --site "$SITE" --security "$MATERIAL" --identity site_link --seconds 60 --at "$tc2_at" \
+    > "$W/tc2_reports.log" 2>&1 &
+  WRITER=$!
+  start_stack site --security "$MATERIAL" --dds "$CRANE_DDS" --site "$SITE" --site-crane tc1 \
+    --site-jobs "$W/jobs/tc1.csv" --site-summary "$W/tc1.json"
+  # The monitor (crane_site_status's default identity) and an outsider listen side by side.
+  "$BIN/crane_site_status" --site "$SITE" --security "$MATERIAL" --wait 8 --json "$W/monitor.json" > "$W/monitor.txt" 2>&1 \
+    & monitor=$!
+  "$BIN/crane_site_status" --site "$SITE" --wait 8 --json "$W/outsider.json" > "$W/outsider.txt" 2>&1 && outsider_rc=0 \
+    || outsider_rc=$?
+  wait "$monitor" && monitor_rc=0 || monitor_rc=$?
+  "$BIN/crane_topic" list --wait 3 --json --domain "$SITE_DOMAIN" > "$W/outsider_list.json" || true
+  stop_stack
+  kill -INT "$SERVICE" "$WRITER"
+  wait "$SERVICE" || true
+  wait "$WRITER" || true
+  SERVICE= WRITER=
+  reports=$(/usr/bin/python3 -c 'import json,sys
+try: s = json.load(open(sys.argv[1]))
+except (OSError, ValueError): s = {"cranes": []}
+print(sum(c["reports"] for c in s["cranes"] if c["name"] == "tc1"))' "$W/monitor.json")
+  echo "monitor: exit $monitor_rc, $reports reports of tc1 heard in 8 s; $(grep -m1 "^tc1 " "$W/monitor.txt" || true)"
+  check "the monitor hears the site service's status" test "$monitor_rc" -eq 0
+  check "the monitor hears tc1's reports (> 40 in 8 s, at 10 Hz)" test "$reports" -gt 40
+  check "the site service hears tc1" grep -q "crane tc1: reporting" "$W/site_service.log"
+  check "tc1's supervisor hears the service's instructions (a grant)" grep -q "site grant" "$W/logs_site/supervisor.log"
+  n_outsider=$(/usr/bin/python3 -c 'import json,sys
+try: t = json.load(open(sys.argv[1]))
+except ValueError: t = {}
+print(sum(len(e["writers"]) + len(e["readers"]) for e in t.values()))' "$W/outsider_list.json")
+  echo "outsider (no credentials): exit $outsider_rc ($(tail -1 "$W/outsider.txt")); $n_outsider endpoints of the site discovered"
+  check "a participant without credentials hears no site status" test "$outsider_rc" -eq 1
+  check "a participant without credentials discovers none of the site's endpoints" test "$n_outsider" -eq 0
   ;;
 refused_files)
   refuse() {  # DESCRIPTION FILE_EXPECTED_IN_MESSAGE DIR COMMAND...

@@ -195,7 +195,6 @@ int main(int argc, char** argv) {
     std::unique_ptr<transport::Participant> site_participant;
     std::unique_ptr<anti_collision::SiteWatch> site_watch;  // the site page's (/site/view.json)
     if (!site_path.empty()) {
-      runtime::require_site_without_security(node);
       runtime::NodeOptions site_node = node;
       auto layout = anti_collision::load_site_layout(site_path);
       site_node.domain_id = static_cast<std::uint32_t>(layout.domain_id);

@@ -94,7 +94,6 @@ int main(int argc, char** argv) {
     ac::CraneSiteLink link(layout, static_cast<std::size_t>(index), params, ac::load_site_jobs(jobs_path),
                            runtime::fresh_request_id());
 
-    runtime::require_site_without_security(options);
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(me.domain_id);
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

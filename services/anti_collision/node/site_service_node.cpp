@@ -64,7 +64,6 @@ int main(int argc, char** argv) {
     const ac::ArbiterMode mode = mode_name == "serialized" ? ac::ArbiterMode::serialized : ac::ArbiterMode::coordinated;
     ac::SiteService service(layout, mode, draw_epoch());
 
-    runtime::require_site_without_security(options);
     auto participant = runtime::make_participant(options, "site_service");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);

@@ -133,12 +133,6 @@ std::string security_directory_of(const NodeOptions& options) {
   return env != nullptr ? env : "";
 }
 
-void require_site_without_security(const NodeOptions& options) {
-  if (security_directory_of(options).empty()) return;
-  throw std::runtime_error("DDS Security on a site's domain: the site's topics (rt/site/*) have no permissions in the "
-                           "security material yet; run the site's processes without --security and $CRANE_SECURITY");
-}
-
 void configure_logging(const std::string& level, const std::string& process) {
   const auto parsed = spdlog::level::from_str(level);
   if (parsed == spdlog::level::off && level != "off") {

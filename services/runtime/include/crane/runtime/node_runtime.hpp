@@ -95,10 +95,6 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
 /// The DDS Security material a participant of `options` uses: --security, else $CRANE_SECURITY,
 /// else "" (none).
 [[nodiscard]] std::string security_directory_of(const NodeOptions& options);
-/// A participant on a site's domain (rt/site/*: site_service, a supervisor with --site,
-/// crane_site_status): throws std::runtime_error when `options` ask for DDS Security, whose
-/// material has no permissions for the site's topics yet (docs/site.md).
-void require_site_without_security(const NodeOptions& options);
 
 /// Applies --log-level to spdlog's default logger; throws std::invalid_argument on an unknown level.
 void configure_logging(const std::string& level, const std::string& process);
