@@ -195,7 +195,7 @@ TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) 
   };
   const Move moves[] = {{0.3, 0.9, -1.2, 1.3}, {1.0, 0.3, -1.2, 1.3}, {0.2, 1.0, 0.5, 0.0}};
   int runs = 0, paused_moves = 0;
-  double peak_trolley = 0.0, peak_slew = 0.0, worst_residual = 0.0, worst_error = 0.0, longest = 0.0;
+  double peak_trolley = 0.0, peak_slew = 0.0, worst_residual = 0.0, worst_error = 0.0, longest = 0.0, peak_swing = 0.0;
   for (const Move& m : moves) {
     for (const std::uint64_t lost : {4U, 10U, 20U}) {
       for (std::uint64_t from = 320; from < 700; from += 40) {
@@ -220,6 +220,7 @@ TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) 
           const auto& p = s.plant().simulator().state();
           peak_trolley = std::max(peak_trolley, std::abs(p.trolley_velocity));
           peak_slew = std::max(peak_slew, std::abs(p.slew_rate));
+          peak_swing = std::max(peak_swing, swing_of(s));
           warned = warned || (s.status().warnings & Status::WARNING_DRIVES_BRAKED) != 0;
           for (const auto& f : s.planner().move_statuses()) {
             aborted = aborted || f.result == Feedback::RESULT_ABORTED;
@@ -246,9 +247,9 @@ TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) 
   }
   std::printf("stalled chain: %d runs, %d moves paused by the brakes, all arrived (the longest reference %.2f s), "
               "peak trolley speed %.3f m/s (limit %.1f), peak slew rate %.3f rad/s (limit %.1f), worst final error "
-              "%.4f, worst swing 14 s after the start %.3f deg\n",
+              "%.4f, peak swing %.2f deg, worst swing 14 s after the start %.3f deg\n",
               runs, paused_moves, longest, peak_trolley, config.supervisor.trolley_max_speed, peak_slew,
-              config.supervisor.slew_max_rate, worst_error, worst_residual * kDeg);
+              config.supervisor.slew_max_rate, worst_error, peak_swing * kDeg, worst_residual * kDeg);
   EXPECT_GT(paused_moves, runs / 2) << "the windows fall mostly inside the moves";
   EXPECT_LT(peak_trolley, config.supervisor.trolley_max_speed);
   EXPECT_LT(peak_slew, config.supervisor.slew_max_rate);
