@@ -77,12 +77,14 @@ const char* goal_status_name(GoalStatus s) noexcept {
   return "unknown";
 }
 
+namespace {
 // [rad] the larger swing amplitude of the two planes, sqrt(angle^2 + (rate / w)^2), w = sqrt(g / L).
 double swing_amplitude(const common::CraneStateEstimate& s, double gravity) noexcept {
   const double w = std::sqrt(gravity / std::max(s.cable_length, 1e-3));
   return std::max(std::hypot(s.swing_in_plane, s.swing_in_plane_rate / w),
                   std::hypot(s.swing_out_of_plane, s.swing_out_of_plane_rate / w));
 }
+}  // namespace
 
 MoveGoal to_goal(const Request& r, const common::CraneStateEstimate& current, const ManualParams& rated) noexcept {
   MoveGoal g;
