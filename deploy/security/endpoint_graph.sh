@@ -59,7 +59,7 @@ graph sim
 graph board --hardware "shm:crane_security_graph_$$"
 
 # The site's domain: its service, and a crane of it with its guard and its site link.
-SITE_DOMAIN=$(sed -n 's/^  domain_id: *\([0-9]*\).*/\1/p' "$SITE")
+SITE_DOMAIN=$("$BIN/crane_site" check --site "$SITE" | sed -n "s/^site '.*' on domain \([0-9]*\):.*/\1/p")
 "$BIN/crane_site" jobs --site "$SITE" --jobs 1 --seed 1 --out "$OUT/site_jobs" > /dev/null
 crane=$(awk 'NR == 1 { print $1 }' "$OUT/site_jobs/hosts.txt")
 [ -n "$SITE_DOMAIN" ] && [ -n "$crane" ] || { echo "endpoint_graph: no domain_id or crane in $SITE" >&2; exit 1; }

@@ -109,7 +109,7 @@ material)
   check "supervisor may read the site's instructions" \
     grep -q "<topic>rt/site/instruction</topic>" "$MATERIAL/supervisor/permissions.xml"
   check "supervisor may not write to the site" \
-    python3 -c 'import re,sys; x=open(sys.argv[1]).read(); p=re.search(r"<publish>.*?</publish>", x, re.S); sys.exit(1 if p and "rt/site/" in p.group(0) else 0)' \
+    /usr/bin/python3 -c 'import re,sys; x=open(sys.argv[1]).read(); p=re.search(r"<publish>.*?</publish>", x, re.S); sys.exit(1 if p and "rt/site/" in p.group(0) else 0)' \
     "$MATERIAL/supervisor/permissions.xml"
   check "governance signed by the CA" openssl smime -verify -in "$MATERIAL/governance.p7s" -CAfile "$MATERIAL/ca/ca.pem" -out /dev/null
   ;;
@@ -169,7 +169,7 @@ print(sum(len(e["writers"]) + len(e["readers"]) for e in t.values()))' "$W/outsi
 site)
   export CRANE_DDS=${CRANE_SECURITY_DDS:-fast}
   SITE=$ROOT/deploy/config/site_two_towers.yaml
-  SITE_DOMAIN=$(sed -n 's/^  domain_id: *\([0-9]*\).*/\1/p' "$SITE")
+  SITE_DOMAIN=$("$BIN/crane_site" check --site "$SITE" | sed -n "s/^site '.*' on domain \([0-9]*\):.*/\1/p")
   "$BIN/crane_site" jobs --site "$SITE" --jobs 1 --seed 1 --out "$W/jobs" > /dev/null
   # 1. A site service with the monitor's identity: its instruction writer is refused.
   timeout 30 "$BIN/site_service" --site "$SITE" --security "$MATERIAL" --identity monitor > "$W/rogue_service.log" 2>&1 \
