@@ -370,11 +370,12 @@ int main(int argc, char** argv) {
       if (out.safe_state_reason != logged_reason) {
         if (out.safe_state_reason == hb::SafeStateReason::none) {
           spdlog::info("cycle {}: commands applied, brakes released", seq);
-        } else if (out.safe_state_reason == hb::SafeStateReason::watchdog) {
+        } else if (started) {
           // The gate's rule on this process's clock: a punctual cycle trips on a command at most
-          // watchdog_timeout old; a late wake-up (the OS's) adds its lateness.
-          spdlog::warn("cycle {}: outputs safe (watchdog): last valid command {:.2f} ms old, this cycle {:.2f} ms late",
-                       seq, (in.time - core.last_command_arrival()) * 1e3, late_ms);
+          // watchdog_timeout old; a late wake-up (the OS's) adds its lateness. Another reason (a stale
+          // or disabling status) may come first; the age is printed for every reason.
+          spdlog::warn("cycle {}: outputs safe ({}): last valid command {:.2f} ms old, this cycle {:.2f} ms late", seq,
+                       hb::reason_name(out.safe_state_reason), (in.time - core.last_command_arrival()) * 1e3, late_ms);
         } else {
           spdlog::warn("cycle {}: outputs safe ({})", seq, hb::reason_name(out.safe_state_reason));
         }
