@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +16,11 @@
 
 namespace crane::stack {
 namespace {
+
+double checked_probability(double p) {
+  common::require_in_range("InProcessOptions.lost_command_probability", p, 0.0, 1.0);
+  return p;
+}
 
 anti_swing::AntiSwingStageParams anti_swing_params(const StackConfig& cfg, const InProcessOptions& o) {
   auto p = cfg.anti_swing;
@@ -58,6 +64,8 @@ struct InProcessStack::Stages {
         plan_move(o.plan_move),
         lost_from(o.lost_commands_from),
         lost_until(o.lost_commands_from + o.lost_commands),
+        lost_probability(checked_probability(o.lost_command_probability)),
+        lost_random(o.lost_command_seed),
         plant(plant_stage_params(cfg, o)),
         estimator(cfg.state_estimator),
         planner(cfg.trajectory_planner, dt),
@@ -73,6 +81,8 @@ struct InProcessStack::Stages {
   double dt;
   MovePlanner plan_move;
   std::uint64_t lost_from, lost_until;  // cycles [lost_from, lost_until) lose their command
+  double lost_probability;               // and each other cycle with this probability
+  std::mt19937_64 lost_random;
   std::uint64_t planned_sequence{0};  // the last plan request answered (PlanRequest::sequence)
   plant::PlantStage plant;
   state_estimator::StateEstimatorStage estimator;
@@ -146,7 +156,8 @@ void InProcessStack::step(std::span<const protocol::MoveRequest> goals, std::spa
   s.observed.command = command;
   s.supervisor.step(s.observed, s.status);
   if (k == 0) s.gating = s.status;  // cycle 0 is gated by the status of cycle 0, cycle k by that of k - 1
-  const bool lost = k >= s.lost_from && k < s.lost_until;
+  const bool lost = (k >= s.lost_from && k < s.lost_until) ||
+                    (s.lost_probability > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(s.lost_random) < s.lost_probability);
   if (s.plant.step(supervisor::lockstep_gate_input(k, s.dt, lost ? nullptr : &s.actuators, s.gating)) !=
       common::StepStatus::ok) {
     ++s.plant_step_failures;

@@ -52,6 +52,11 @@ struct InProcessOptions {
   // plant's actuation gate holds the last one, then its command watchdog brakes (actuation_gate.hpp).
   std::uint64_t lost_commands_from{0};
   std::uint64_t lost_commands{0};
+  // A starved machine's chain, for fault tests: each cycle's command is lost with this probability
+  // [0, 1] (seeded, independent per cycle; late past the plant's deadline), in addition to the
+  // window above. Throws std::invalid_argument outside [0, 1].
+  double lost_command_probability{0.0};
+  std::uint64_t lost_command_seed{1};
 };
 
 /// The plant stage of a run: the configured simulator and actuation gate, at rest at the options'
