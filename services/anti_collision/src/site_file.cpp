@@ -33,16 +33,71 @@ StoppingData read_stopping(config::YamlSection s) {
   return d;
 }
 
-// The soft stop's shaper delay of the crane whose stack config is `path`: its planner's block read by
-// the planner's own reader (trajectory_planner::read_params: every field and range checked there),
-// then manual.shaping and swing_damping_ratio; the site reads nothing else of that file.
-double soft_stop_delay_periods(const std::filesystem::path& path) {
+// The planner's block of the crane whose stack config is `path`, read by the planner's own reader
+// (trajectory_planner::read_params: every field and range checked there; the cable range from the
+// config's crane block).
+trajectory_planner::TrajectoryPlannerParams crane_planner(const std::filesystem::path& path) {
   try {
-    const auto document = config::ConfigDocument::load(path.string());
-    const auto planner = document.read("trajectory_planner", trajectory_planner::read_params);
-    return trajectory_planner::shaper_delay_periods(planner.manual.shaping, planner.manual.swing_damping_ratio);
+    return config::ConfigDocument::load(path.string()).read("trajectory_planner", trajectory_planner::read_params);
   } catch (const ConfigError& error) {
     throw ConfigError(std::string("the crane's config: ") + error.what());
+  }
+}
+
+// What the site file says of a crane against what its own config lets it do. The site's airspace
+// (its whole reach, a lost crane's) must hold every pose the crane's planner may command: the
+// planner's trolley travel and slew range, and the hook heights of its cable range under the site's
+// jib_height. Its soft stops must be no quicker than the planner's, which makes them (a stop
+// modelled quicker than it is ends short of where the crane rests). Each pair is checked where the
+// values live; throws ConfigError naming the site's field, both values and the config's field.
+void require_within_site(const std::string& prefix, const SiteCrane& crane,
+                         const trajectory_planner::TrajectoryPlannerParams& planner, const std::string& config_name) {
+  const auto fail = [&](const char* field, double site_value, const char* relation, const std::string& config_field,
+                        double config_value, const char* why) {
+    char text[512];
+    std::snprintf(text, sizeof text, " = %.6g %s the crane's config %s = %.6g (%s): %s", site_value, relation,
+                  config_field.c_str(), config_value, config_name.c_str(), why);
+    throw ConfigError(prefix + "." + field + text);
+  };
+  constexpr const char* kReach = "the site would not hold all of the crane's reach";
+  if (crane.trolley_min > planner.trolley_min_position) {
+    fail("trolley_min", crane.trolley_min, "is above", "trajectory_planner.trolley_min_position",
+         planner.trolley_min_position, kReach);
+  }
+  if (crane.trolley_max < planner.trolley_max_position) {
+    fail("trolley_max", crane.trolley_max, "is below", "trajectory_planner.trolley_max_position",
+         planner.trolley_max_position, kReach);
+  }
+  if (crane.slew_min > planner.slew_min_angle) {
+    fail("slew_min", crane.slew_min, "is above", "trajectory_planner.slew_min_angle", planner.slew_min_angle, kReach);
+  }
+  if (crane.slew_max < planner.slew_max_angle) {
+    fail("slew_max", crane.slew_max, "is below", "trajectory_planner.slew_max_angle", planner.slew_max_angle, kReach);
+  }
+  constexpr double kHeightTolerance = 1e-9;  // [m] jib_height - cable length in floating point
+  const double lowest = crane.jib_height - planner.cable_max_length;
+  if (crane.hook_height_min > lowest + kHeightTolerance) {
+    fail("hook_height_min", crane.hook_height_min, "is above jib_height less", "crane.max_cable_length",
+         planner.cable_max_length, kReach);
+  }
+  const double highest = crane.jib_height - planner.cable_min_length;
+  if (crane.hook_height_max < highest - kHeightTolerance) {
+    fail("hook_height_max", crane.hook_height_max, "is below jib_height less", "crane.min_cable_length",
+         planner.cable_min_length, kReach);
+  }
+  constexpr const char* kStop = "the site would predict the crane's soft stop shorter than the planner makes it";
+  const auto& d = crane.stopping;
+  if (d.trolley_deceleration > planner.manual.trolley.acceleration) {
+    fail("stopping.trolley_deceleration", d.trolley_deceleration, "is above",
+         "trajectory_planner.manual.trolley_acceleration", planner.manual.trolley.acceleration, kStop);
+  }
+  if (d.slew_deceleration > planner.manual.slew.acceleration) {
+    fail("stopping.slew_deceleration", d.slew_deceleration, "is above", "trajectory_planner.manual.slew_acceleration",
+         planner.manual.slew.acceleration, kStop);
+  }
+  if (d.hoist_deceleration > planner.manual.hoist.acceleration) {
+    fail("stopping.hoist_deceleration", d.hoist_deceleration, "is above",
+         "trajectory_planner.manual.hoist_acceleration", planner.manual.hoist.acceleration, kStop);
   }
 }
 
@@ -72,6 +127,9 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.paths.slew_tracking = paths.number("slew_tracking", kOvershoot.lower, kOvershoot.upper);
     paths.finish();
     for (auto& z : s.list("zones")) layout.zones.push_back(config::read_zone(z));
+    // Each crane's planner block and the config's name as the site file gives it: checked against the
+    // site's description once the site's own structure is (validate).
+    std::vector<std::pair<trajectory_planner::TrajectoryPlannerParams, std::string>> planners;
     for (auto& c : s.list("cranes")) {
       SiteCrane crane;
       crane.name = c.text("name");
@@ -94,17 +152,20 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
       crane.hook_height_min = c.number("hook_height_min", kHook.lower, kHook.upper);
       crane.hook_height_max = c.number("hook_height_max", kHook.lower, kHook.upper);
       crane.load_radius = c.number("load_radius", kLoadRadius.lower, kLoadRadius.upper);
-      crane.max_trolley_speed = c.number("max_trolley_speed", kSpeed.lower, kSpeed.upper);
-      crane.max_slew_rate = c.number("max_slew_rate", kSpeed.lower, kSpeed.upper);
-      crane.max_hoist_speed = c.number("max_hoist_speed", kSpeed.lower, kSpeed.upper);
       crane.stopping = read_stopping(c.child("stopping"));
       const std::string named = c.text("config");
       crane.config = (directory / named).lexically_normal().string();
+      trajectory_planner::TrajectoryPlannerParams planner;
       try {
-        crane.stopping.soft_stop_delay_periods = soft_stop_delay_periods(crane.config);
+        planner = crane_planner(crane.config);
       } catch (const ConfigError& error) {
         throw ConfigError(c.field("config") + " = \"" + named + "\": " + error.what());
       }
+      // The soft stop's shaper: the mean delay sum A_i t_i of the planner's manual.shaping, in swing
+      // periods (the site file has no field of its own for it).
+      crane.stopping.soft_stop_delay_periods =
+          trajectory_planner::shaper_delay_periods(planner.manual.shaping, planner.manual.swing_damping_ratio);
+      planners.emplace_back(std::move(planner), named);
       crane.domain_id = c.integer("domain_id", 0, kMaxDomain);
       crane.priority = c.integer("priority", 0, kMaxPriority);
       c.finish();
@@ -113,6 +174,11 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     s.finish();
     document.finish();
     validate(layout, "site");
+    for (std::size_t i = 0; i < layout.cranes.size(); ++i) {
+      const SiteCrane& crane = layout.cranes[i];
+      require_within_site("site.cranes[" + std::to_string(i) + "] (" + crane.name + ")", crane, planners[i].first,
+                          planners[i].second);
+    }
   } catch (const ConfigError& error) {
     throw ConfigError(source_name + ": " + error.what());
   } catch (const YAML::Exception& error) {

@@ -88,9 +88,6 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
     require_in_range(p + ".hook_height_min", c.hook_height_min, kHook.lower, kHook.upper);
     require_in_range(p + ".hook_height_max", c.hook_height_max, c.hook_height_min, c.jib_height - c.load_radius);
     require_in_range(p + ".load_radius", c.load_radius, kLoadRadius.lower, kLoadRadius.upper);
-    require_in_range(p + ".max_trolley_speed", c.max_trolley_speed, kSpeed.lower, kSpeed.upper);
-    require_in_range(p + ".max_slew_rate", c.max_slew_rate, kSpeed.lower, kSpeed.upper);
-    require_in_range(p + ".max_hoist_speed", c.max_hoist_speed, kSpeed.lower, kSpeed.upper);
     const StoppingData& d = c.stopping;
     require_in_range(p + ".stopping.reaction_time", d.reaction_time, kReaction.lower, kReaction.upper);
     require_in_range(p + ".stopping.trolley_deceleration", d.trolley_deceleration, kDeceleration.lower,

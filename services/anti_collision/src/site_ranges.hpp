@@ -19,7 +19,6 @@ inline constexpr Range kTrolley{0.0, 200.0};
 inline constexpr Range kSlewTravel{-10.0, 10.0};  // [rad] a slew limited by cables may turn more than once
 inline constexpr Range kHook{-100.0, 500.0};
 inline constexpr Range kLoadRadius{0.0, 50.0};
-inline constexpr Range kSpeed{1.0e-3, 20.0};
 inline constexpr Range kReaction{0.0, 5.0};
 inline constexpr Range kDeceleration{1.0e-3, 50.0};
 inline constexpr Range kBrakeFactor{1.0, 100.0};

@@ -60,9 +60,6 @@ struct SiteCrane {
   double hook_height_min{0.0};        // [m] lowest the load's centre goes above the ground
   double hook_height_max{1.5};        // [m] highest, below jib_height
   double load_radius{0.1};            // [m] radius of a sphere enclosing the load and the hook block
-  double max_trolley_speed{0.5};      // [m/s] the drives' rated speeds (stopping distances)
-  double max_slew_rate{1.0};          // [rad/s]
-  double max_hoist_speed{0.2};        // [m/s]
   StoppingData stopping;
   std::string config;                 // the crane's stack config (deploy/config/*.yaml): the path the site
                                       // file names, relative to the site file's directory, resolved
