@@ -255,4 +255,49 @@ TEST(AntiSwing, BadParamsThrowNamingField) {
   p = {};
   p.kind = static_cast<as::AntiSwingKind>(9);
   expect_throw(p, "kind");
+  p = {};
+  p.short_cable.enabled = true;
+  p.short_cable.full_gain_length = p.short_cable.short_length;
+  expect_throw(p, "short_cable.full_gain_length");
+  p = {};
+  p.short_cable.enabled = true;
+  p.short_cable.short_length = 0.0;
+  expect_throw(p, "short_cable.short_length");
+  p = {};
+  p.short_cable.enabled = true;
+  p.short_cable.gain = std::nan("");
+  expect_throw(p, "short_cable.delay_gain");
+  p = {};
+  p.short_cable.short_length = 0.0;  // disabled: not checked
+  EXPECT_NO_THROW(as::AntiSwing{p});
+}
+
+// K_del at short cables (ShortCableGain): gain at and below short_length, delay_gain at and above
+// full_gain_length, linear between, on both axes; disabled, delay_gain at every length. Both actions
+// on a constant swing of 0.01 rad, read after the delay.
+TEST(AntiSwing, TheShortCableGainFollowsTheCableLength) {
+  const auto actions = [](const as::AntiSwingParams& params, double cable_length) {
+    as::AntiSwing law(params);
+    CraneStateEstimate e;
+    e.swing_in_plane = 0.01;
+    e.swing_out_of_plane = 0.01;
+    e.cable_length = cable_length;
+    as::AntiSwingOutput out;
+    for (int k = 0; k < 400; ++k) (void)law.step(e, out);
+    return std::pair{out.trolley_action, out.slew_action};
+  };
+  as::AntiSwingParams p;
+  p.delay_gain = -90.0;
+  p.short_cable = {true, 0.25, 0.4, -75.0};
+  const struct {
+    double L, gain;
+  } cases[] = {{0.15, -75.0}, {0.25, -75.0}, {0.3, -80.0}, {0.325, -82.5}, {0.4, -90.0}, {1.0, -90.0}};
+  for (const auto& c : cases) {
+    const auto [trolley, slew] = actions(p, c.L);
+    EXPECT_NEAR(trolley, c.gain * 0.01, 1e-12) << "L = " << c.L;
+    EXPECT_NEAR(slew, c.gain * 0.01, 1e-12) << "L = " << c.L;
+  }
+  p.short_cable.enabled = false;
+  EXPECT_NEAR(actions(p, 0.2).first, -0.9, 1e-12);
+  EXPECT_NEAR(actions(p, 0.2).second, -0.9, 1e-12);
 }

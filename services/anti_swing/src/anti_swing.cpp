@@ -32,6 +32,12 @@ AntiSwingParams validated(const AntiSwingParams& params) {
   common::require_greater("anti_swing.gravity", params.gravity, 0.0);
   common::require_greater("anti_swing.min_cable_length", params.min_cable_length, 0.0);
   common::require_greater("anti_swing.max_cable_length", params.max_cable_length, params.min_cable_length);
+  if (params.short_cable.enabled) {
+    const auto& g = params.short_cable;
+    common::require_greater("anti_swing.short_cable.short_length", g.short_length, 0.0);
+    common::require_greater("anti_swing.short_cable.full_gain_length", g.full_gain_length, g.short_length);
+    common::require_finite("anti_swing.short_cable.delay_gain", g.gain);
+  }
   const double longest = params.normalized_delay *
                          swing_period(params.max_cable_length, params.gravity) / params.sample_period;
   if (!(longest < AntiSwing::kMaxDelaySamples)) {
@@ -41,6 +47,15 @@ AntiSwingParams validated(const AntiSwingParams& params) {
         " samples at max_cable_length: must be < " + std::to_string(AntiSwing::kMaxDelaySamples));
   }
   return params;
+}
+
+// K_del at cable length `L` [m] (ShortCableGain).
+double short_cable_delay_gain(const AntiSwingParams& params, double L) noexcept {
+  const auto& g = params.short_cable;
+  if (!g.enabled || L >= g.full_gain_length) return params.delay_gain;
+  if (L <= g.short_length) return g.gain;
+  const double s = (L - g.short_length) / (g.full_gain_length - g.short_length);
+  return g.gain + s * (params.delay_gain - g.gain);
 }
 
 int capacity_for(const AntiSwingParams& params) {
@@ -110,7 +125,7 @@ common::StepStatus AntiSwing::step(const common::CraneStateEstimate& estimate,
       const int delay = std::min(static_cast<int>(std::lround(samples)), size - 1);
       output.delay_samples = delay;
       if (count_ <= delay) return common::StepStatus::not_ready;
-      const double k_del = params_.delay_gain;
+      const double k_del = short_cable_delay_gain(params_, cable_length);
       output.trolley_action = k_del * delayed(in_plane_history_, delay);
       output.slew_action = k_del * delayed(out_of_plane_history_, delay);
       break;

@@ -71,6 +71,14 @@ AntiSwingStageParams read_params(config::YamlSection& s, const common::StackFact
   a.delay_gain = s.number("delay_gain", -1000.0, 1000.0);
   a.normalized_delay = s.number("normalized_delay", 1e-3, 5.0);
   a.slew_enabled = s.flag("slew_enabled");
+  {
+    config::YamlSection g = s.child("short_cable");
+    a.short_cable.enabled = g.flag("enabled");
+    a.short_cable.short_length = g.number("short_length", 1e-3, 100.0);
+    a.short_cable.full_gain_length = g.number("full_gain_length", 1e-3, 100.0);
+    a.short_cable.gain = g.number("delay_gain", -1000.0, 1000.0);
+    g.finish();
+  }
   p.fade_periods = s.number("fade_periods", kMinFadePeriods, kMaxFadePeriods);
   s.finish();
   a.sample_period = facts.sample_period;

@@ -32,6 +32,21 @@ enum class AntiSwingKind {
   delayed_feedback,  // (3.47) V_xs = K_del phi(tau - tau_del)
 };
 
+/// The delayed-feedback gain at short cables (beyond the dissertation, which tuned K_del at L = 1 m).
+/// The law is normalized by the swing period, but the chain's fixed lags are not (the drives, the
+/// estimator's filter, a cycle of latency): they are a larger part of a short pendulum's period.
+/// With K_del = -90 the lab crane's slew and its load limit-cycle at L <= 0.25 m (about 2 deg for
+/// 20 s and more after a slew; tests/closed_loop/test_operate.cpp, ShortCable), and a combined move
+/// with the trolley coming in settles in 3 s; with -75 on both axes they settle in under 2 s, and
+/// from 0.3 m up both gains settle. When enabled, K_del is `gain` at and below `short_length` [m],
+/// delay_gain at and above `full_gain_length` [m], linear in L between, on both axes.
+struct ShortCableGain {
+  bool enabled{false};
+  double short_length{0.25};     // [m] > 0
+  double full_gain_length{0.4};  // [m] > short_length
+  double gain{-75.0};            // [-] K_del at short cables, finite
+};
+
 struct AntiSwingParams {
   AntiSwingKind kind{AntiSwingKind::delayed_feedback};
   double pd_proportional_gain{-30.0};  // [-] K_ps (3.45), sign for our convention (header)
@@ -43,6 +58,7 @@ struct AntiSwingParams {
   double min_cable_length{0.1};        // [m] measured L is clamped to [min, max] for T
   double max_cable_length{5.0};        // [m] sizes the delay line
   bool slew_enabled{true};             // apply the same law on theta for the slew axis
+  ShortCableGain short_cable{};  // delayed_feedback: K_del at short cables
 };
 
 struct AntiSwingOutput {
@@ -55,7 +71,8 @@ struct AntiSwingOutput {
 class AntiSwing {
  public:
   /// Throws common::ConfigError naming the field, value and bound for: unknown kind, non-finite
-  /// gains, normalized_delay <= 0, sample_period <= 0, gravity <= 0, min_cable_length <= 0,
+  /// gains, normalized_delay <= 0, sample_period <= 0, gravity <= 0, min_cable_length <= 0, an enabled
+  /// short_cable with short_length <= 0, full_gain_length <= short_length or a non-finite gain,
   /// max_cable_length <= min_cable_length, or a delay line longer than kMaxDelaySamples.
   explicit AntiSwing(const AntiSwingParams& params);
 

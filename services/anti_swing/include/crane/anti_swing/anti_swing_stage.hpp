@@ -67,6 +67,8 @@ struct AntiSwingStageParams {
 
 /// Reads the `anti_swing:` block: controller (a law name), pd_proportional_gain, pd_derivative_gain,
 /// delay_gain [-] in [-1000, 1000], normalized_delay [swing periods] in [1e-3, 5], slew_enabled,
+/// short_cable {enabled, short_length and full_gain_length [m] in [1e-3, 100], delay_gain [-] in
+/// [-1000, 1000]} (anti_swing.hpp, ShortCableGain),
 /// fade_periods [swing periods] in [0.1, 10]; sample period, gravity and cable range from facts.
 /// Throws common::ConfigError naming the field.
 [[nodiscard]] AntiSwingStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
