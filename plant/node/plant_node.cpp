@@ -267,21 +267,22 @@ int main(int argc, char** argv) {
     builtin_interfaces::msg::dds_::Time_ origin = runtime::now_stamp();
     std::int64_t origin_ns = runtime::to_nanoseconds(origin);
     // The sample's stamp is when its positions were measured: now, or, in realtime, the cycle's
-    // scheduled instant (the simulated state is exactly there, however late this process runs).
-    // The supervisor differentiates positions over the stamps' interval (supervisor.hpp): with
-    // publication stamps, a sample published 8 ms late and the next on time read as a 2.5x faster
-    // crane.
-    const auto publish = [&](std::optional<Clock::time_point> scheduled = std::nullopt) {
+    // scheduled instant (the simulated state is exactly there, however late this process runs), on
+    // the wall clock through one offset taken at the start: `measured_ns`. The supervisor
+    // differentiates positions over the stamps' interval (supervisor.hpp): with publication stamps,
+    // a sample published 8 ms late and the next on time read as a 2.5x faster crane. (The first
+    // version read the wall clock and the monotonic clock one after the other at each sample and
+    // subtracted the lateness: exact unless the process is descheduled between the two reads,
+    // which a VM's stolen time makes possible; one offset leaves nothing to race.)
+    const auto publish = [&](std::optional<std::int64_t> measured_ns = std::nullopt) {
       plant.sample(sample_plain);
       protocol::from_dds(origin, sample_plain.header.origin);
       sample_plain.writer_pid = static_cast<std::uint32_t>(getpid());
       protocol::to_dds(sample_plain, sample);
       auto stamp = runtime::now_stamp();
-      if (scheduled) {
-        const auto late = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - *scheduled).count();
-        const std::int64_t ns = runtime::to_nanoseconds(stamp) - std::max<std::int64_t>(late, 0);
-        stamp.sec(static_cast<std::int32_t>(ns / 1000000000LL));
-        stamp.nanosec(static_cast<std::uint32_t>(ns % 1000000000LL));
+      if (measured_ns) {
+        stamp.sec(static_cast<std::int32_t>(*measured_ns / 1000000000LL));
+        stamp.nanosec(static_cast<std::uint32_t>(*measured_ns % 1000000000LL));
       }
       sample.header().stamp(stamp);
       sensors->write(sample);
@@ -403,6 +404,7 @@ int main(int argc, char** argv) {
       // the deadline is an overrun; the gate keeps the last valid one while it is within
       // actuation.watchdog_timeout (a drive amplifier holds its input), then 0 V and brakes.
       const auto epoch = Clock::now();
+      const std::int64_t wall_at_epoch_ns = runtime::now_nanoseconds();  // the one offset of the stamps
       const auto seconds = [&](Clock::time_point t) { return std::chrono::duration<double>(t - epoch).count(); };
       supervisor::GateInput in;
       auto next_deadline = Clock::now() + period;
@@ -466,7 +468,7 @@ int main(int argc, char** argv) {
         const auto measured_at = next_deadline;
         next_deadline += period;
         new_origin();
-        publish(measured_at);
+        publish(wall_at_epoch_ns + std::chrono::duration_cast<std::chrono::nanoseconds>(measured_at - epoch).count());
         diagnostics.maybe_publish(counters, &latency);
       }
     }

@@ -118,7 +118,12 @@ class SiteLink {
                                                 ? supervisor::SiteVerdict::soft_stop
                                                 : supervisor::SiteVerdict::proceed;
     if (verdict != last_) {
-      spdlog::info("site guard: {} ({})", anti_collision::to_string(c.action), c.reason);
+      // With the motion it judged, so that a stop on a host can be traced afterwards.
+      spdlog::info("site guard: {} ({}): slew {:.4f} rad at {:.4f} rad/s, trolley {:.4f} m at {:.4f} m/s, cable {:.4f} m "
+                   "at {:.4f} m/s, swing {:.4f} {:.4f} rad; holding {} of {} granted waypoints",
+                   anti_collision::to_string(c.action), c.reason, motion.slew, motion.slew_rate, motion.trolley,
+                   motion.trolley_velocity, motion.cable_length, motion.cable_rate, motion.swing_in_plane,
+                   motion.swing_out_of_plane, progressed_, granted_.size());
       last_ = verdict;
     }
     return verdict;
@@ -367,8 +372,9 @@ int main(int argc, char** argv) {
       nonfinite = false;
       cycle.nonfinite_rejected = static_cast<std::uint32_t>(counters.nonfinite_rejected);
       if (site && cycle.sensors != nullptr) {
-        // Positions and swing as measured; the speeds the supervisor differentiates; the rates the
-        // estimator gives (0 before its first estimate).
+        // Positions and swing as measured; the speeds the supervisor differentiates (the hoist's
+        // too: the estimator's filtered rate lags, and the supervisor does not trust the control
+        // processes); the swing rates the estimator gives (0 before its first estimate).
         const bool estimated = watched[static_cast<int>(Stage::state_estimator)].seen;
         anti_collision::CraneMotion motion;
         motion.slew = sensors_plain.slew_angle;
@@ -376,7 +382,7 @@ int main(int argc, char** argv) {
         motion.trolley = sensors_plain.trolley_position;
         motion.trolley_velocity = stage.output().trolley_velocity;
         motion.cable_length = sensors_plain.cable_length;
-        motion.cable_rate = estimated ? last_estimate.cable_length_rate() : 0.0;
+        motion.cable_rate = stage.output().cable_rate;
         motion.swing_in_plane = sensors_plain.swing_in_plane;
         motion.swing_out_of_plane = sensors_plain.swing_out_of_plane;
         motion.swing_in_plane_rate = estimated ? last_estimate.swing_in_plane_rate() : 0.0;

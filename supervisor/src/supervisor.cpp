@@ -243,6 +243,9 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
         load_velocity_ = {(load[0] - previous_load_[0]) / dt, (load[1] - previous_load_[1]) / dt};
       }
       bridge_overspeed_samples_ = std::fabs(bridge_velocity_) > params_.bridge().max_speed ? bridge_overspeed_samples_ + 1 : 0;
+      cable_rate_ = std::isfinite(in.cable_length) && std::isfinite(previous_cable_)
+                        ? (in.cable_length - previous_cable_) / dt
+                        : 0.0;
     } else if (!have_previous_sample_ || in.sensor_seq < previous_sensor_seq_) {
       trolley_velocity_ = 0.0;  // first sample, or the sensor writer restarted
       slew_rate_ = 0.0;
@@ -252,6 +255,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
       slew_overspeed_samples_ = 0;
       bridge_velocity_ = 0.0;
       bridge_overspeed_samples_ = 0;
+      cable_rate_ = 0.0;
       load_velocity_ = {};
     }
     if (load_valid) previous_load_ = {load[0], load[1]};
@@ -261,6 +265,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     previous_trolley_ = in.trolley_position;
     previous_slew_ = in.slew_angle;
     previous_bridge_ = in.bridge_position;
+    previous_cable_ = in.cable_length;  // NaN when not measured: no rate from it
   }
 
   std::uint32_t active = 0;
@@ -448,6 +453,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
   out.slew_rate = slew_rate_;
   out.bridge_voltage_limit = enabled ? bridge_limit : 0.0;
   out.bridge_velocity = bridge_velocity_;
+  out.cable_rate = cable_rate_;
   out.operating_mode = operating_mode_;
   out.zones_enabled = zones_enabled_;
   out.command_refused = refused;

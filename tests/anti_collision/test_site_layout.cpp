@@ -101,44 +101,40 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
   // 0.2-1.1 m, slew +-3.0 rad, cable 0.2-2.0 m under tc1's jib at 2.5 m: hooks 0.5-2.3 m; its soft
   // stops at 0.9929 m/s^2, 2.0796 rad/s^2 and 0.5 m/s^2): a site that holds less than the crane's
   // reach, or models its stop quicker than the planner makes it, is refused.
-  EXPECT_EQ(refusal(edited("trolley_max: 1.30", "trolley_max: 1.05")),
-            "site.yaml: site.cranes[0] (tc1).trolley_max = 1.05 is below the crane's config "
-            "trajectory_planner.trolley_max_position = 1.1 (lab_tower_crane.yaml): the site would not hold all of the "
-            "crane's reach");
-  EXPECT_EQ(refusal(edited("trolley_min: 0.05", "trolley_min: 0.25")),
-            "site.yaml: site.cranes[0] (tc1).trolley_min = 0.25 is above the crane's config "
-            "trajectory_planner.trolley_min_position = 0.2 (lab_tower_crane.yaml): the site would not hold all of the "
-            "crane's reach");
-  EXPECT_EQ(refusal(edited("slew_min: -3.0", "slew_min: -2.9")),
-            "site.yaml: site.cranes[0] (tc1).slew_min = -2.9 is above the crane's config "
-            "trajectory_planner.slew_min_angle = -3 (lab_tower_crane.yaml): the site would not hold all of the crane's "
-            "reach");
-  EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: 2.9")),
-            "site.yaml: site.cranes[0] (tc1).slew_max = 2.9 is below the crane's config "
-            "trajectory_planner.slew_max_angle = 3 (lab_tower_crane.yaml): the site would not hold all of the crane's "
-            "reach");
-  EXPECT_EQ(refusal(edited("hook_height_min: 0.5 ", "hook_height_min: 0.6 ")),
-            "site.yaml: site.cranes[0] (tc1).hook_height_min = 0.6 is above jib_height less the crane's config "
-            "crane.max_cable_length = 2 (lab_tower_crane.yaml): the site would not hold all of the crane's reach");
-  EXPECT_EQ(refusal(edited("hook_height_max: 2.3", "hook_height_max: 2.2")),
-            "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.2 is below jib_height less the crane's config "
-            "crane.min_cable_length = 0.2 (lab_tower_crane.yaml): the site would not hold all of the crane's reach");
-  // A raised jib raises the hook's whole range: its highest is then 2.4 m, above the site's 2.3 m.
-  EXPECT_EQ(refusal(edited("jib_height: 2.5", "jib_height: 2.6")),
-            "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.3 is below jib_height less the crane's config "
-            "crane.min_cable_length = 0.2 (lab_tower_crane.yaml): the site would not hold all of the crane's reach");
-  EXPECT_EQ(refusal(edited("trolley_deceleration: 0.99", "trolley_deceleration: 1.2")),
-            "site.yaml: site.cranes[0] (tc1).stopping.trolley_deceleration = 1.2 is above the crane's config "
-            "trajectory_planner.manual.trolley_acceleration = 0.9929 (lab_tower_crane.yaml): the site would predict the "
-            "crane's soft stop shorter than the planner makes it");
-  EXPECT_EQ(refusal(edited("slew_deceleration: 2.0", "slew_deceleration: 2.5")),
-            "site.yaml: site.cranes[0] (tc1).stopping.slew_deceleration = 2.5 is above the crane's config "
-            "trajectory_planner.manual.slew_acceleration = 2.0796 (lab_tower_crane.yaml): the site would predict the "
-            "crane's soft stop shorter than the planner makes it");
-  EXPECT_EQ(refusal(edited("hoist_deceleration: 0.5", "hoist_deceleration: 0.6")),
-            "site.yaml: site.cranes[0] (tc1).stopping.hoist_deceleration = 0.6 is above the crane's config "
-            "trajectory_planner.manual.hoist_acceleration = 0.5 (lab_tower_crane.yaml): the site would predict the "
-            "crane's soft stop shorter than the planner makes it");
+  const std::string reach = " (lab_tower_crane.yaml): the site would not hold all of the crane's reach";
+  const std::string stop =
+      " (lab_tower_crane.yaml): the site would predict the crane's soft stop shorter than the planner makes it";
+  const struct {
+    const char *pattern, *replacement;
+    std::string message;  // after "site.yaml: site.cranes[0] (tc1)."
+  } short_of_the_config[] = {
+      {"trolley_max: 1.30", "trolley_max: 1.05",
+       "trolley_max = 1.05 is below the crane's config trajectory_planner.trolley_max_position = 1.1" + reach},
+      {"trolley_min: 0.05", "trolley_min: 0.25",
+       "trolley_min = 0.25 is above the crane's config trajectory_planner.trolley_min_position = 0.2" + reach},
+      {"slew_min: -3.0", "slew_min: -2.9",
+       "slew_min = -2.9 is above the crane's config trajectory_planner.slew_min_angle = -3" + reach},
+      {"slew_max: 3.0", "slew_max: 2.9", "slew_max = 2.9 is below the crane's config trajectory_planner.slew_max_angle = 3" + reach},
+      {"hook_height_min: 0.5 ", "hook_height_min: 0.6 ",
+       "hook_height_min = 0.6 is above jib_height less the crane's config crane.max_cable_length = 2" + reach},
+      {"hook_height_max: 2.3", "hook_height_max: 2.2",
+       "hook_height_max = 2.2 is below jib_height less the crane's config crane.min_cable_length = 0.2" + reach},
+      // A raised jib raises the hook's whole range: its highest is then 2.4 m, above the site's 2.3 m.
+      {"jib_height: 2.5", "jib_height: 2.6",
+       "hook_height_max = 2.3 is below jib_height less the crane's config crane.min_cable_length = 0.2" + reach},
+      {"trolley_deceleration: 0.99", "trolley_deceleration: 1.2",
+       "stopping.trolley_deceleration = 1.2 is above the crane's config trajectory_planner.manual.trolley_acceleration "
+       "= 0.9929" + stop},
+      {"slew_deceleration: 2.0", "slew_deceleration: 2.5",
+       "stopping.slew_deceleration = 2.5 is above the crane's config trajectory_planner.manual.slew_acceleration = "
+       "2.0796" + stop},
+      {"hoist_deceleration: 0.5", "hoist_deceleration: 0.6",
+       "stopping.hoist_deceleration = 0.6 is above the crane's config trajectory_planner.manual.hoist_acceleration = "
+       "0.5" + stop},
+  };
+  for (const auto& c : short_of_the_config) {
+    EXPECT_EQ(refusal(edited(c.pattern, c.replacement)), "site.yaml: site.cranes[0] (tc1)." + c.message);
+  }
   // The crane's own config: missing, not a stack config, or a stack config whose planner block the
   // planner's own reader refuses (its message passed on).
   const std::string missing = refusal(edited("config: lab_tower_crane.yaml", "config: no_such_crane.yaml"));

@@ -178,6 +178,29 @@ TEST(SoftStop, AFastMoveStoppedHalfWayRestsWithoutSwingWherePredicted) {
   EXPECT_EQ(s.status().latched_faults, 0U);
 }
 
+// The site's kind of move (a crane of deploy/config/site_three_towers.yaml): the trolley out and in
+// while the jib slews at 0.7 rad/s, as the site link asks, and the trolley out on a short slew.
+struct SiteMove {
+  double trolley_from, trolley_to, slew_from, slew_to;
+};
+constexpr SiteMove kSiteMoves[] = {{0.3, 0.9, -1.2, 1.3}, {1.0, 0.3, -1.2, 1.3}, {0.2, 1.0, 0.5, 0.0}};
+// The move's goal, and `options` with the move's initial pose.
+Request site_move_goal(const SiteMove& m) {
+  Request goal;
+  goal.request_id = 1;
+  goal.profile = Request::PROFILE_TRAPEZOID;
+  goal.axes = Request::AXIS_TROLLEY | Request::AXIS_SLEW;
+  goal.trolley_target = m.trolley_to;
+  goal.slew_target = m.slew_to;
+  goal.slew_max_velocity = 0.7;
+  return goal;
+}
+stack::InProcessOptions at_site_move_start(const SiteMove& m, stack::InProcessOptions options) {
+  options.initial_trolley_position = m.trolley_from;
+  options.initial_slew_angle = m.slew_from;
+  return options;
+}
+
 // A stalled command chain (a starved machine, a stage paused) brakes the drives under way: the
 // plant's actuation gate holds the last command for its watchdog_timeout, then brakes. The
 // supervisor warns (WARNING_DRIVES_BRAKED); the planner pauses the goal where the brakes stopped
@@ -190,28 +213,16 @@ TEST(SoftStop, AFastMoveStoppedHalfWayRestsWithoutSwingWherePredicted) {
 // aborted), the load at rest at the end.
 TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) {
   const auto config = lab();
-  struct Move {
-    double trolley_from, trolley_to, slew_from, slew_to;
-  };
-  const Move moves[] = {{0.3, 0.9, -1.2, 1.3}, {1.0, 0.3, -1.2, 1.3}, {0.2, 1.0, 0.5, 0.0}};
   int runs = 0, paused_moves = 0;
   double peak_trolley = 0.0, peak_slew = 0.0, worst_residual = 0.0, worst_error = 0.0, longest = 0.0, peak_swing = 0.0;
-  for (const Move& m : moves) {
+  for (const SiteMove& m : kSiteMoves) {
     for (const std::uint64_t lost : {4U, 10U, 20U}) {
       for (std::uint64_t from = 320; from < 700; from += 40) {
         stack::InProcessOptions options;
-        options.initial_trolley_position = m.trolley_from;
-        options.initial_slew_angle = m.slew_from;
         options.lost_commands_from = from;
         options.lost_commands = lost;
-        stack::InProcessStack s(config, options);
-        Request goal;
-        goal.request_id = 1;
-        goal.profile = Request::PROFILE_TRAPEZOID;
-        goal.axes = Request::AXIS_TROLLEY | Request::AXIS_SLEW;
-        goal.trolley_target = m.trolley_to;
-        goal.slew_target = m.slew_to;
-        goal.slew_max_velocity = 0.7;
+        stack::InProcessStack s(config, at_site_move_start(m, options));
+        const Request goal = site_move_goal(m);
         bool aborted = false, warned = false;
         std::optional<std::uint64_t> arrived;
         double residual = 0.0;
@@ -231,7 +242,7 @@ TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) 
         ++runs;
         paused_moves += warned ? 1 : 0;
         worst_residual = std::max(worst_residual, residual);
-        const auto where = "move " + std::to_string(&m - moves) + ", " + std::to_string(lost) + " commands lost from cycle " +
+        const auto where = "move " + std::to_string(&m - kSiteMoves) + ", " + std::to_string(lost) + " commands lost from cycle " +
                            std::to_string(from);
         const auto& p = s.plant().simulator().state();
         const double error = std::max(std::abs(p.trolley_position - m.trolley_to), std::abs(p.slew_angle - m.slew_to));
@@ -262,28 +273,16 @@ TEST(Stall, DrivesBrakedByAStalledChainPauseTheMoveWhichGoesOnWithoutOverspeed) 
 // targets and the load at rest.
 TEST(Stall, CommandsLostHereAndThereDoNotDriveTheCraneFasterThanItsLimits) {
   const auto config = lab();
-  struct Move {
-    double trolley_from, trolley_to, slew_from, slew_to;
-  };
-  const Move moves[] = {{0.3, 0.9, -1.2, 1.3}, {1.0, 0.3, -1.2, 1.3}, {0.2, 1.0, 0.5, 0.0}};
   int runs = 0;
   double peak_trolley = 0.0, peak_slew = 0.0, worst_residual = 0.0, worst_error = 0.0, peak_swing = 0.0;
-  for (const Move& m : moves) {
+  for (const SiteMove& m : kSiteMoves) {
     for (const double p : {0.05, 0.1, 0.2}) {
       for (std::uint64_t seed = 1; seed <= 5; ++seed) {
         stack::InProcessOptions options;
-        options.initial_trolley_position = m.trolley_from;
-        options.initial_slew_angle = m.slew_from;
         options.lost_command_probability = p;
         options.lost_command_seed = seed;
-        stack::InProcessStack s(config, options);
-        Request goal;
-        goal.request_id = 1;
-        goal.profile = Request::PROFILE_TRAPEZOID;
-        goal.axes = Request::AXIS_TROLLEY | Request::AXIS_SLEW;
-        goal.trolley_target = m.trolley_to;
-        goal.slew_target = m.slew_to;
-        goal.slew_max_velocity = 0.7;
+        stack::InProcessStack s(config, at_site_move_start(m, options));
+        const Request goal = site_move_goal(m);
         double run_trolley = 0.0, run_slew = 0.0, residual = 0.0;
         std::optional<std::uint64_t> arrived;
         for (std::uint64_t k = 0; k < 3000; ++k) {
@@ -298,7 +297,7 @@ TEST(Stall, CommandsLostHereAndThereDoNotDriveTheCraneFasterThanItsLimits) {
           if (k >= 2700) residual = std::max(residual, swing_of(s));
         }
         ++runs;
-        const auto where = "move " + std::to_string(&m - moves) + ", " + std::to_string(p) + " of the commands lost, seed " +
+        const auto where = "move " + std::to_string(&m - kSiteMoves) + ", " + std::to_string(p) + " of the commands lost, seed " +
                            std::to_string(seed);
         const auto& st = s.plant().simulator().state();
         const double error = std::max(std::abs(st.trolley_position - m.trolley_to), std::abs(st.slew_angle - m.slew_to));

@@ -663,9 +663,19 @@ TEST(SupervisorLimits, VelocityIsDifferentiatedFromTheSensorSamples) {
   in.sensor_seq = seq + 2;
   in.trolley_position = 0.6 + 3 * 0.01 * (-0.2);
   in.slew_angle = 0.03;  // from 0 over 3 cycles: 1 rad/s
+  const double cable = in.cable_length;
+  in.cable_length = cable + 0.006;  // the hoist lowering at 0.2 m/s over the same 3 cycles
   const auto later = step(supervisor, in);
   EXPECT_NEAR(later.trolley_velocity, -0.2, 1e-9);
   EXPECT_NEAR(later.slew_rate, 1.0, 1e-9);
+  EXPECT_NEAR(later.cable_rate, 0.2, 1e-9) << "the hoist's rate, for the site guard, from the samples too";
+  // A cable length not measured (NaN) gives no rate, and no rate from it on the next sample.
+  in.sensor_seq += 1;
+  in.cable_length = std::nan("");
+  EXPECT_EQ(step(supervisor, in).cable_rate, 0.0);
+  in.sensor_seq += 1;
+  in.cable_length = cable;
+  EXPECT_EQ(step(supervisor, in).cable_rate, 0.0);
 }
 
 TEST(SupervisorLimits, ApproachMarginLowersTheVoltageLimitOnlyWhenTooFastTowardTheLimit) {

@@ -447,9 +447,12 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     paused_seq_ = seq;  // still held by the brakes (at rest: moving() is false)
   } else if (paused_ && seq > paused_seq_ + kResumeTimeoutCycles) {
     abort_active(Feedback::REASON_BRAKED);  // the swing did not settle: a client sends the goal again
-  } else if (paused_ && swing_amplitude(current, params.gravity) < kResumeSwing) {
-    // The brakes are open again and the swing they caused has settled (the reference holds
-    // meanwhile, the anti-swing law damps it): the rest of the goal, from where the crane stopped.
+  } else if (paused_ && swing_amplitude(current, params.gravity) < kResumeSwing &&
+             std::abs(current.trolley_velocity) < kResumeSpeed && std::abs(current.slew_rate) < kResumeSpeed &&
+             std::abs(current.cable_length_rate) < kResumeSpeed) {
+    // The brakes are open again, the swing they caused has settled (the reference holds meanwhile,
+    // the anti-swing law damps it) and the crane is at rest (the hoist, which the brakes do not
+    // hold, ramps down on its own): the rest of the goal, planned from rest where the crane stopped.
     const MoveGoal rest = *paused_;
     paused_.reset();
     if (planner_.start_move(rest, current) != GoalStatus::accepted) {

@@ -316,6 +316,8 @@ struct SupervisorOutput {
   double slew_rate{0.0};              // [rad/s]
   double bridge_voltage_limit{0.0};   // [V] overhead crane (0 elsewhere)
   double bridge_velocity{0.0};        // [m/s]
+  double cable_rate{0.0};             // [m/s] differentiated from the sensor samples (0 while the cable
+                                      // length is not finite); the site guard's hoist (docs/site.md)
   std::uint8_t operating_mode{StatusCodes::OPERATION_FULLAUTOMATIC};  // an OPERATION_* code
   std::uint32_t zones_enabled{0};     // bit i: site.zones[i] enforced
   int zone{-1};                       // the zone of fault zone or warning zone_approach (-1: none)
@@ -427,6 +429,8 @@ class Supervisor {
   double previous_bridge_{0.0};
   double bridge_velocity_{0.0};
   int bridge_overspeed_samples_{0};
+  double previous_cable_{std::numeric_limits<double>::quiet_NaN()};  // [m] NaN: no finite cable length yet
+  double cable_rate_{0.0};
   double previous_bridge_voltage_{0.0};
   // Voltage rate from successive actuator commands.
   bool have_previous_command_{false};

@@ -34,8 +34,8 @@
 //    position, so a reset resumes nothing;
 //  - when it warns that the drives were braked under way (WARNING_DRIVES_BRAKED: a stalled command
 //    chain, no fault), the goal pauses: the reference holds the measured position, where the
-//    brakes stopped the crane, and when they are open and the swing they caused has settled below
-//    kResumeSwing, the rest of the goal (the waypoints not yet passed, the targets) starts again
+//    brakes stopped the crane, and when they are open, the swing they caused has settled below
+//    kResumeSwing and every axis is slower than kResumeSpeed, the rest of the goal (the waypoints not yet passed, the targets) starts again
 //    from there with the goal's id and profile (a minimum-time goal: time-optimal); not settled
 //    kResumeTimeoutCycles after they opened, the goal ends there (REASON_BRAKED). So the tracking
 //    law never chases a reference that ran on during the stall. Under operator speeds (or a soft
@@ -121,6 +121,11 @@ class TrajectoryPlannerStage {
   /// this: the brakes' jolt swings it, and a move started into that swing (the anti-swing law's
   /// correction on top of the profile) overspeeds the drives.
   static constexpr double kResumeSwing = 0.017;
+  /// [m/s], [rad/s] ... and every axis slower than this (trolley, slew, hoist): the rest of the goal is
+  /// planned from rest. The brakes hold the trolley and the slew; the hoist ramps down to the held
+  /// reference at its own rate (up to 36 mm from 0.2 m/s on the lab crane), and a plan started while it
+  /// still moved left it coasting past a work point's box: the site guard's stop on hosts (docs/site.md).
+  static constexpr double kResumeSpeed = 0.01;
   /// [cycles] a paused goal whose swing has not settled this long after the brakes opened ends
   /// there (REASON_BRAKED): a client sends it again.
   static constexpr std::uint64_t kResumeTimeoutCycles = 1000;
