@@ -103,7 +103,10 @@ class SiteCrane {
         warnings_seen_ |= s.warnings();
       }
       tp::msgs::SensorSample_ sample;
-      while (sensors_reader_->take_next(sample)) trolley_ = sample.trolley_position();
+      while (sensors_reader_->take_next(sample)) {
+        trolley_ = sample.trolley_position();
+        sensed_ = true;
+      }
       tp::msgs::MoveStatus_ m;
       while (move_status_reader_->take_next(m)) {
         crane::protocol::from_dds(m, moves_.emplace_back());
@@ -119,8 +122,10 @@ class SiteCrane {
     }
     return false;
   }
+  // Ready, and this process has a sensor sample (under load the first one can come after the
+  // status: the start position was then read as 0, and a 0.081 m braking figure as 0.331 m).
   bool ready() const {
-    return status_ && status_->stages_alive == Status::STAGES_ALL &&
+    return sensed_ && status_ && status_->stages_alive == Status::STAGES_ALL &&
            (status_->mode == Status::MODE_READY || status_->mode == Status::MODE_OPERATING) && status_->brakes_released;
   }
   // The site service's grant to tc1: from (slew 0, `from` m) to (0, `to` m), cable 1 m, through
@@ -200,6 +205,7 @@ class SiteCrane {
   std::vector<ac::Pose> granted_;
   std::optional<Status> status_;
   double trolley_{0.0};
+  bool sensed_{false};  // a sensor sample was taken
   std::vector<crane::protocol::MoveStatus> moves_;
   std::uint32_t warnings_seen_{0};
   Clock::time_point next_beat_{};

@@ -36,9 +36,9 @@ enum class AntiSwingKind {
 /// The law is normalized by the swing period, but the chain's fixed lags are not (the drives, the
 /// estimator's filter, a cycle of latency): they are a larger part of a short pendulum's period.
 /// With K_del = -90 the lab crane's slew and its load limit-cycle at L <= 0.25 m (about 2 deg for
-/// 20 s and more after a slew; tests/closed_loop/test_operate.cpp, ShortCable), and a combined move
-/// with the trolley coming in settles in 3 s; with -75 on both axes they settle in under 2 s, and
-/// from 0.3 m up both gains settle. When enabled, K_del is `gain` at and below `short_length` [m],
+/// 20 s and more after a slew; tests/closed_loop/test_operate.cpp, ShortCable). With -75 on the slew
+/// alone a slew with the trolley coming in still took 3 s to settle at 0.2 m; with -75 on both axes
+/// every such move settles in under 2.3 s, and from 0.3 m up both gains settle. When enabled, K_del is `gain` at and below `short_length` [m],
 /// delay_gain at and above `full_gain_length` [m], linear in L between, on both axes.
 struct ShortCableGain {
   bool enabled{false};
