@@ -106,6 +106,12 @@ class SiteCrane {
       while (sensors_reader_->take_next(sample)) {
         trolley_ = sample.trolley_position();
         sensed_ = true;
+        const double t = static_cast<double>(sample.header().stamp().sec()) + 1e-9 * sample.header().stamp().nanosec();
+        if (!first_fast_ && last_sample_ && sample.header().seq() == last_sample_->seq + 1 && t > last_sample_->time &&
+            (trolley_ - last_sample_->trolley) / (t - last_sample_->time) >= kGuardSpeed) {
+          first_fast_ = trolley_;
+        }
+        last_sample_ = Sample{sample.header().seq(), t, trolley_};
       }
       tp::msgs::MoveStatus_ m;
       while (move_status_reader_->take_next(m)) {
@@ -182,6 +188,11 @@ class SiteCrane {
   bool heartbeat{false};
   const std::optional<Status>& status() const { return status_; }
   double trolley() const { return trolley_; }  // [m] the latest sensor sample's
+  /// [m/s] the speed at which the guard's emergency stop would carry the trolley past its 2 cm
+  /// containment tolerance: 0.27 x 0.03 + 0.27^2 / (2 x 2.97) = 0.02 m ("moving with no grant").
+  static constexpr double kGuardSpeed = 0.27;
+  /// [m] where the trolley first went kGuardSpeed or faster (two consecutive samples), if it has.
+  const std::optional<double>& first_fast() const { return first_fast_; }
   const std::vector<crane::protocol::MoveStatus>& moves() const { return moves_; }
   std::uint32_t warnings_seen() const { return warnings_seen_; }
   void forget_warnings() { warnings_seen_ = 0; }
@@ -206,6 +217,13 @@ class SiteCrane {
   std::optional<Status> status_;
   double trolley_{0.0};
   bool sensed_{false};  // a sensor sample was taken
+  struct Sample {
+    std::uint64_t seq;
+    double time;     // [s] its stamp: when its position was measured
+    double trolley;  // [m]
+  };
+  std::optional<Sample> last_sample_;
+  std::optional<double> first_fast_;  // [m] where the trolley first went kGuardSpeed or faster
   std::vector<crane::protocol::MoveStatus> moves_;
   std::uint32_t warnings_seen_{0};
   Clock::time_point next_beat_{};
@@ -225,12 +243,19 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
       << "a move with no grant was not braked; see " << crane.dir();
   EXPECT_FALSE(crane.status()->brakes_released);
   const double braked_at = crane.trolley();
-  // "Moving": its emergency stop would travel more than kContainmentTolerance (2 cm): at 0.27 m/s
-  // (0.27 x 0.03 + 0.27^2 / (2 x 2.97) = 0.02 m), 0.073 m into the planner's 0.5 m/s^2 ramp; then
-  // those 2 cm of braking, and a cycle at 0.27 m/s (3 mm) for the sample the supervisor acts on.
-  std::printf("[ figure   ] with no grant the trolley was braked %.3f m from where it started\n", braked_at - start);
-  EXPECT_LT(std::fabs(braked_at - start), 0.073 + 0.02 + 0.003 + 0.004)
-      << "braked after the ramp to 0.27 m/s and its 2 cm stop (4 mm for the model's decelerations)";
+  // "Moving": its emergency stop would travel more than kContainmentTolerance (2 cm): from 0.27 m/s
+  // (kGuardSpeed), 0.073 m into the planner's 0.5 m/s^2 ramp. Braked from where the trolley first
+  // went that fast: those 2 cm of braking, a cycle at 0.27 m/s (3 mm) for the sample the supervisor
+  // acts on and one for this process's own differentiation, 4 mm for the model's decelerations.
+  // (Measured from the start, as first written, the bound failed on a starved machine: stalls brake
+  // the drives, the planner pauses the goal and starts it again from rest, and the trolley crept
+  // 0.17 m before it first went that fast.)
+  ASSERT_TRUE(crane.first_fast().has_value()) << "braked before it went 0.27 m/s; see " << crane.dir();
+  std::printf("[ figure   ] with no grant the trolley was braked %.3f m from where it started, %.3f m from where it "
+              "first went %.2f m/s\n",
+              braked_at - start, braked_at - *crane.first_fast(), SiteCrane::kGuardSpeed);
+  EXPECT_LT(std::fabs(braked_at - *crane.first_fast()), 0.02 + 0.003 + 0.003 + 0.004)
+      << "braked within its 2 cm stop of going 0.27 m/s (a cycle for the supervisor's sample, one for this process's)";
 
   // 2. Granted from where it stands to 0.6 m, the heartbeat on: the move ends, no site fault.
   crane.heartbeat = true;
