@@ -54,10 +54,9 @@ void require_within_site(const std::string& prefix, const SiteCrane& crane,
                          const trajectory_planner::TrajectoryPlannerParams& planner, const std::string& config_name) {
   const auto fail = [&](const char* field, double site_value, const char* relation, const std::string& config_field,
                         double config_value, const char* why) {
-    char text[512];
-    std::snprintf(text, sizeof text, " = %.6g %s the crane's config %s = %.6g (%s): %s", site_value, relation,
-                  config_field.c_str(), config_value, config_name.c_str(), why);
-    throw ConfigError(prefix + "." + field + text);
+    throw ConfigError(prefix + "." + field + " = " + common::format_value(site_value) + " " + relation +
+                      " the crane's config " + config_field + " = " + common::format_value(config_value) + " (" +
+                      config_name + "): " + why);
   };
   constexpr const char* kReach = "the site would not hold all of the crane's reach";
   if (crane.trolley_min > planner.trolley_min_position) {
