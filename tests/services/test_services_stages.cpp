@@ -231,6 +231,11 @@ TEST(PlannerStage, AMinimumTimeGoalWithoutAPlanRunsTheTimeOptimalProfile) {
   (void)unheard.step(at_rest(1), std::span(&other, 1), reference);
   EXPECT_FALSE(unheard.plan_request().has_value());
   EXPECT_EQ(reference.phase, protocol::Reference::PHASE_MOVING);
+  EXPECT_FALSE(reference.feedback_law);
+  EXPECT_EQ(unheard.unsolved_plans(), 1U);  // counted: the node warns (a trapezoid goal is not counted)
+  const Request trapezoid = trolley_goal(7, 0.3);
+  (void)unheard.step(at_rest(2), std::span(&trapezoid, 1), reference);
+  EXPECT_EQ(unheard.unsolved_plans(), 1U);
 }
 
 TEST(PlannerStage, AMinimumTimeGoalWaitingForItsCycleIsPlannedAheadAndStartsOnTime) {

@@ -2,8 +2,8 @@
 // (OperatorSpeed), rt/crane/safety/status (the operating mode, zones, faults) and rt/crane/state/estimate ->
 // TrajectoryPlannerStage (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the
 // time-optimal swing-free profile) -> rt/crane/planner/reference, once per cycle, same seq and
-// origin. Goals are taken only with a new cycle (the stage's rules: trajectory_planner_stage.hpp);
-// their feedback (waiting, rejected with the bound, moving, arrived, aborted) goes to
+// origin. Goals are taken only with a new cycle, once the supervisor has been heard (the stage's
+// rules: trajectory_planner_stage.hpp); their feedback (waiting, rejected with the bound, moving, arrived, aborted) goes to
 // rt/crane/planner/move_status. A goal with the minimum-time profile is planned here (Planning
 // below: the bound solved by IPOPT and its follower's law, optimal_control/planned_move.hpp) and
 // handed to the stage, whose reference then carries the law of each cycle.
@@ -141,11 +141,18 @@ int main(int argc, char** argv) {
               case runtime::CycleKind::stale: continue;
               case runtime::CycleKind::repeat: break;  // answered again from *out; goals wait for a new cycle
               case runtime::CycleKind::new_cycle: {
-                // Goals are taken only with a new cycle, so a cycle's reference is computed once. The
-                // stage refuses (and counts) a goal with a NaN/Inf field itself, with its request id.
+                // The latest supervisor status: the operating mode, the zones, a fault or a zone approach.
+                protocol::SupervisorStatus latest;
+                while (runtime::take_plain(*safety, latest, ctx.counters)) *status = latest;
+                // Goals are taken only with a new cycle, so a cycle's reference is computed once, and
+                // only once the supervisor has been heard: before, the operating mode and the sway
+                // limit a minimum-time plan needs are unknown, and a goal waits in the reader (its
+                // history: 8). Over DDS the two can match hundreds of cycles apart (a Cyclone planner
+                // and a Fast DDS supervisor in lockstep); a minimum-time goal then started unplanned
+                // (CI of stop 42). The stage refuses (and counts) a goal with a NaN/Inf field itself.
                 arrived->clear();
                 tp::msgs::MoveRequest_ request;
-                while (goals->take_next(request)) {
+                while (status->has_value() && goals->take_next(request)) {
                   protocol::from_dds(request, arrived->emplace_back());
                 }
                 operator_speeds->clear();
@@ -153,14 +160,16 @@ int main(int argc, char** argv) {
                 while (speeds->take_next(speed) && operator_speeds->size() < operator_speeds->capacity()) {
                   protocol::from_dds(speed, operator_speeds->emplace_back());
                 }
-                // The latest supervisor status: the operating mode, the zones, a fault or a zone approach.
-                protocol::SupervisorStatus latest;
-                while (runtime::take_plain(*safety, latest, ctx.counters)) *status = latest;
                 const auto refused_before = stage->nonfinite_goals() + stage->rejected_speeds();
                 const trajectory_planner::PlannerCycle cycle{&state, *arrived, *operator_speeds,
                                                              status->has_value() ? &**status : nullptr};
+                const auto unsolved_before = stage->unsolved_plans();
                 const auto step_status = stage->step(cycle, *out);
                 planning->poll(*stage);
+                if (stage->unsolved_plans() != unsolved_before) {
+                  spdlog::warn("a minimum-time goal started without its plan ({} so far): the time-optimal profile runs",
+                               stage->unsolved_plans());
+                }
                 for (const auto& outcome : stage->goal_outcomes()) log_outcome(outcome);
                 for (const auto& move_status : stage->move_statuses()) runtime::write_plain(*feedback, move_status);
                 ctx.counters.nonfinite_rejected += stage->nonfinite_goals() + stage->rejected_speeds() - refused_before;

@@ -606,6 +606,9 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       plan_answered_ = false;
       plan_answer_.reset();
       report(r.request_id, Feedback::RESULT_WAITING);
+    } else if (r.profile == Request::PROFILE_MINIMUM_TIME && !was_moving && goal.waypoint_count == 0 &&
+               (zones_enabled_ == 0 || params.site.zones.empty())) {
+      ++unsolved_plans_;  // the supervisor's sway limit not heard: the time-optimal profile runs
     }
     return status;
   };

@@ -165,7 +165,8 @@ class TrajectoryPlannerStage {
   /// (unsolved_plans() counts it). Ignored for a request that is no longer asked (replaced, stopped,
   /// cancelled by a fault or a mode change meanwhile). Allocates nothing (the path is shared).
   void provide_plan(std::uint64_t sequence, std::shared_ptr<const PlannedPath> path) noexcept;
-  /// Minimum-time goals that ran the time-optimal profile for want of a plan.
+  /// Minimum-time goals from rest (no waypoint, no zone) that ran the time-optimal profile for want of
+  /// a plan: not solved, or started before the supervisor's sway limit was heard.
   [[nodiscard]] std::uint64_t unsolved_plans() const noexcept { return unsolved_plans_; }
   /// The operating mode the stage applies (an OPERATION_* code).
   [[nodiscard]] std::uint8_t operating_mode() const noexcept { return operating_mode_; }
