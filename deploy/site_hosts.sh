@@ -29,8 +29,9 @@
 #                     partition:HOST:START:DURATION   the host's link to the bridge down
 #                     loss:HOST:PERCENT:START:DURATION  that share of the packets to and from the host
 #                                                     dropped (tc netem, else nftables)
-#                     delay:HOST:MS:START:DURATION    packets to and from the host delayed (tc netem;
-#                                                     refused where the kernel has no sch_netem)
+#                     delay:HOST:MS:START:DURATION    packets to and from the host delayed MS ms each
+#                                                     way (tc netem, else an iptables NFQUEUE rule on
+#                                                     the bridge and crane_packet_delay holding them)
 #                     kill-service:START:DURATION     the site service killed with -9, started again
 #                                                     DURATION s later (a new epoch)
 #                     stop-host:CRANE:START           the crane's host stopped for good: every process
@@ -69,7 +70,7 @@ if [ "${CRANE_SITE_NETNS:-}" != 1 ]; then
     --until-done "$UNTIL" ${SECURITY:+--security "$SECURITY"} ${FAULTS[@]+$(printf -- '--fault %s ' "${FAULTS[@]}")}
 fi
 
-declare -A HOLDER ADDRESS PIDS
+declare -A HOLDER ADDRESS PIDS DELAYERS  # DELAYERS: crane_packet_delay of a delay fault
 NAMES=()
 MONITOR=
 cleanup() {
@@ -77,6 +78,7 @@ cleanup() {
   local pid
   for pid in "${PIDS[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
+  for pid in "${DELAYERS[@]}"; do kill -TERM "$pid" 2>/dev/null; wait "$pid" 2>/dev/null || true; done
   for pid in "${HOLDER[@]}"; do kill "$pid" 2>/dev/null || true; done
 }
 trap cleanup EXIT
@@ -187,12 +189,29 @@ apply_fault() {  # index, spec, phase (on|off)
           nft add rule inet crane_fault_$i drop_in oifname "v-$host" numgen random mod 100 "<" "$value" drop
           FAULT_STATE[$i]=nft
         else
-          echo "site_hosts.sh: fault $2: this kernel has no sch_netem (tc netem): delay cannot be emulated here" >&2
-          exit 2
+          # The bridge hands its IPv4 packets to the forward hook (bridge-nf-call-iptables); queue
+          # 100+i holds those to and from the host (--queue-bypass: they pass if the holder is gone).
+          command -v iptables >/dev/null || { echo "site_hosts.sh: fault $2: no tc netem and no iptables here" >&2; exit 2; }
+          sysctl -q net.bridge.bridge-nf-call-iptables=1
+          "$BIN/crane_packet_delay" --queue $((100 + i)) --delay-ms "$value" >> "$OUT/packet_delay_$i.log" 2>&1 &
+          DELAYERS[$i]=$!
+          sleep 0.2
+          kill -0 "${DELAYERS[$i]}" 2>/dev/null || { echo "site_hosts.sh: fault $2: crane_packet_delay failed (see $OUT/packet_delay_$i.log)" >&2; exit 1; }
+          for dir in in out; do
+            iptables -I FORWARD -m physdev --physdev-$dir "v-$host" -j NFQUEUE --queue-num $((100 + i)) --queue-bypass
+          done
+          FAULT_STATE[$i]=nfqueue
         fi
       elif [ "${FAULT_STATE[$i]:-}" = netem ]; then
         tc qdisc del dev "v-$host" root 2>/dev/null || true
         on "$host" tc qdisc del dev eth0 root 2>/dev/null || true
+      elif [ "${FAULT_STATE[$i]:-}" = nfqueue ]; then
+        for dir in in out; do
+          iptables -D FORWARD -m physdev --physdev-$dir "v-$host" -j NFQUEUE --queue-num $((100 + i)) --queue-bypass || true
+        done
+        kill -TERM "${DELAYERS[$i]}" 2>/dev/null || true
+        wait "${DELAYERS[$i]}" 2>/dev/null || true
+        unset "DELAYERS[$i]"
       else
         nft delete table inet crane_fault_$i 2>/dev/null || true
       fi ;;
