@@ -46,15 +46,16 @@ using Clock = std::chrono::steady_clock;
 // the guard's.
 class SiteLink {
  public:
-  SiteLink(const std::string& site_path, const std::string& crane_name, runtime::NodeOptions options)
+  SiteLink(const std::string& site_path, const std::string& crane_name, const runtime::NodeOptions& options,
+           bool site_lan)
       : layout_(anti_collision::load_site_layout(site_path)),
         crane_(anti_collision::find_crane(layout_, crane_name)),
         guard_(layout_, crane_ < 0 ? 0 : static_cast<std::size_t>(crane_)) {
     if (crane_ < 0) {
       throw std::runtime_error("--site-crane " + crane_name + ": no crane of that name in " + site_path);
     }
-    options.domain_id = static_cast<std::uint32_t>(layout_.domain_id);
-    participant_ = runtime::make_participant(options, "supervisor");
+    participant_ = runtime::make_participant(
+        runtime::site_domain_options(options, static_cast<std::uint32_t>(layout_.domain_id), site_lan), "supervisor");
     instructions_ = participant_->make_recording_reader<transport::topics::SiteInstruction>(nullptr, 64);
     status_ = participant_->make_reader<transport::topics::SiteStatus>(nullptr);
     reports_ = participant_->make_recording_reader<transport::topics::SiteReport>(nullptr, 64);
@@ -260,6 +261,8 @@ int main(int argc, char** argv) {
                           ->check(CLI::ExistingFile);
   app.add_option("--site-crane", site_crane, "this crane's name in the site file")->needs(site_option);
   site_option->needs(app.get_option("--site-crane"));
+  bool site_lan = false;
+  runtime::add_site_network_option(app, site_lan);
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "supervisor");
@@ -275,7 +278,7 @@ int main(int argc, char** argv) {
     }
     supervisor::SupervisorStage stage(params);
     std::optional<SiteLink> site;
-    if (!site_path.empty()) site.emplace(site_path, site_crane, options);
+    if (!site_path.empty()) site.emplace(site_path, site_crane, options, site_lan);
     const auto started = Clock::now();
 
     auto participant = runtime::make_participant(options, "supervisor");

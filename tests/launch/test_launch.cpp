@@ -13,6 +13,7 @@
 #include <fstream>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -23,6 +24,7 @@
 #include "crane/stack/maneuver_metrics.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
+#include "crane/runtime/node_runtime.hpp"
 
 namespace la = crane::launch;
 using namespace std::chrono_literals;
@@ -353,4 +355,34 @@ TEST(DdsMix, RefusesBadEntriesNamingThem) {
   EXPECT_NE(message("plant=opensplice").find("vendor 'opensplice' must be fast or cyclone"), std::string::npos)
       << message("plant=opensplice");
   EXPECT_NE(message("plant=fast,plant=cyclone").find("twice"), std::string::npos) << message("plant=fast,plant=cyclone");
+}
+
+// --site-lan: a crane on a host of its own puts only the site's domain on the network: the
+// supervisor (its guard) and the site link get --site-lan, no process gets --lan, and the site's
+// participant (runtime::site_domain_options) leaves loopback while the crane's own stays on it.
+TEST(SiteLan, OnlyTheSiteDomainLeavesTheHost) {
+  crane::launch::StackOptions o;
+  o.config_path = "c.yaml";
+  o.binary_directory = "/bin";
+  o.site_file = "site.yaml";
+  o.site_crane = "tc1";
+  o.site_jobs = "tc1.csv";
+  o.site_lan = true;
+  std::set<std::string> with_site_lan;
+  for (const auto& spec : crane::launch::stack_processes(o)) {
+    const auto& a = spec.arguments;
+    EXPECT_EQ(std::find(a.begin(), a.end(), "--lan"), a.end()) << spec.name;
+    if (std::find(a.begin(), a.end(), "--site-lan") != a.end()) with_site_lan.insert(spec.name);
+  }
+  EXPECT_EQ(with_site_lan, (std::set<std::string>{"site_link", "supervisor"}));
+
+  crane::runtime::NodeOptions crane_side;
+  crane_side.domain_id = 11;
+  const auto site_side = crane::runtime::site_domain_options(crane_side, 10, true);
+  EXPECT_EQ(site_side.domain_id, 10U);
+  EXPECT_FALSE(site_side.loopback_only);
+  EXPECT_TRUE(crane_side.loopback_only);
+  EXPECT_TRUE(crane::runtime::site_domain_options(crane_side, 10, false).loopback_only);
+  // Leaving loopback is the network rule's business: refused without security or --insecure-lan.
+  EXPECT_THROW(crane::runtime::check_network_security(site_side.loopback_only, "", "", false), std::invalid_argument);
 }

@@ -80,6 +80,10 @@ int main(int argc, char** argv) {
       ->needs(site_option)
       ->check(CLI::ExistingFile);
   app.add_option("--site-summary", stack.site_summary, "the site link's figures as JSON (site_link --summary)");
+  app.add_flag("--site-lan", stack.site_lan,
+               "the site's domain (the supervisor's guard, the site link) on every interface, the crane's own on "
+               "loopback unless --lan: a crane on a host of its own")
+      ->needs(site_option);
   app.add_option("--site-slew-speed", stack.site_slew_speed,
                  "[rad/s] the site link's moves slew at most this fast (0: the crane's rated slew rate)")
       ->check(CLI::Range(0.0, 10.0));

@@ -87,6 +87,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     // The site link reads the crane's config from the site file; it works at normal priority.
     if (name != "site_link") spec.arguments.insert(spec.arguments.begin(), {"--config", o.config_path});
     if (o.lan) spec.arguments.push_back("--lan");
+    if (o.site_lan && (name == "supervisor" || name == "site_link")) spec.arguments.push_back("--site-lan");
     if (o.realtime_priority > 0 && name != "site_link") {
       const int offset = name == "plant" || name == "hardware_bridge" ? 10 : name == "supervisor" ? 5 : 0;
       spec.arguments.insert(spec.arguments.end(),

@@ -79,6 +79,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.01, 10.0));
   app.add_option("--slew-speed", params.slew_speed, "[rad/s] of every move (0: the crane's rated slew rate)")
       ->check(CLI::Range(0.0, 10.0));
+  bool site_lan = false;
+  runtime::add_site_network_option(app, site_lan);
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "site_link");
@@ -103,9 +105,8 @@ int main(int argc, char** argv) {
     auto statuses = crane_side->make_reader<tp::SafetyStatus>(nullptr);
     auto move_statuses = crane_side->make_recording_reader<tp::MoveStatus>(nullptr, 64);
     auto goals = crane_side->make_writer<tp::Goal>();
-    runtime::NodeOptions site_options = options;
-    site_options.domain_id = static_cast<std::uint32_t>(layout.domain_id);
-    auto site_side = runtime::make_participant(site_options, "site_link");
+    auto site_side = runtime::make_participant(
+        runtime::site_domain_options(options, static_cast<std::uint32_t>(layout.domain_id), site_lan), "site_link");
     auto reports = site_side->make_writer<tp::SiteReport>();
     auto instructions = site_side->make_recording_reader<tp::SiteInstruction>(nullptr, 64);
     auto site_status = site_side->make_reader<tp::SiteStatus>(nullptr);

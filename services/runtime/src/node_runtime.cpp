@@ -57,6 +57,18 @@ void add_security_options(CLI::App& app, NodeOptions& options) {
                "the crane");
 }
 
+void add_site_network_option(CLI::App& app, bool& site_lan) {
+  app.add_flag("--site-lan", site_lan,
+               "the site's domain on every interface (the crane's own stays on loopback unless --lan): a crane on a "
+               "host of its own");
+}
+
+NodeOptions site_domain_options(NodeOptions options, std::uint32_t site_domain, bool site_lan) {
+  options.domain_id = site_domain;
+  if (site_lan) options.loopback_only = false;
+  return options;
+}
+
 void check_network_security(bool loopback_only, const std::string& dds_profile, const std::string& security_directory,
                             bool insecure_lan) {
   if ((loopback_only && dds_profile.empty()) || !security_directory.empty() || insecure_lan) return;

@@ -49,6 +49,8 @@ struct StackOptions {
                                       // empty: no site link
   std::string site_summary;           // site_link --summary: its figures as JSON (optional)
   double site_slew_speed{0.0};        // site_link --slew-speed [rad/s]: 0, the crane's rated slew rate
+  bool site_lan{false};               // supervisor and site_link --site-lan: the site's domain on every interface,
+                                      // the crane's own as `lan` says (a crane on a host of its own)
   bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
                                       // commands (deploy/crane estop, ...) over a local socket to a participant
                                       // already matched with the supervisor; off: they make a participant each

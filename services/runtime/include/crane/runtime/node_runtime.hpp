@@ -62,6 +62,18 @@ void add_node_options(CLI::App& app, NodeOptions& options);
 /// Adds --security DIR, --identity NAME and --insecure-lan to `app` (every node and tool).
 void add_security_options(CLI::App& app, NodeOptions& options);
 
+/// A crane's process on a site (the supervisor's guard, the site link): adds --site-lan to `app`,
+/// bound to `site_lan`: the site's domain on every interface while the crane's own domain keeps
+/// what --lan says (loopback by default). A crane on a host of its own talks to the site over the
+/// network, and its stack's 100 Hz traffic stays on its host (docs/site.md, "The site on its own
+/// hosts").
+void add_site_network_option(CLI::App& app, bool& site_lan);
+
+/// The options of the participant on the site's domain `site_domain`: the crane's `options` on that
+/// domain, on every interface when `site_lan` (else as the crane's own). The network rule
+/// (check_network_security) applies to it when the participant is made.
+[[nodiscard]] NodeOptions site_domain_options(NodeOptions options, std::uint32_t site_domain, bool site_lan);
+
 /// The rule for the network: a participant that leaves the loopback interface (--lan or a
 /// --dds-profile) needs --security, or --insecure-lan said explicitly. Throws std::invalid_argument
 /// saying why otherwise; nothing on loopback. `security_directory` as resolved ($CRANE_SECURITY).
