@@ -3,10 +3,11 @@
 // TrajectoryPlannerStage (step, the trapezoid of (3.43), input-shaped ZV/ZVD/EI, or the
 // time-optimal swing-free profile) -> rt/crane/planner/reference, once per cycle, same seq and
 // origin. Goals are taken only with a new cycle, once the supervisor has been heard (the stage's
-// rules: trajectory_planner_stage.hpp); their feedback (waiting, rejected with the bound, moving, arrived, aborted) goes to
-// rt/crane/planner/move_status. A goal with the minimum-time profile is planned here (Planning
-// below: the bound solved by IPOPT and its follower's law, optimal_control/planned_move.hpp) and
-// handed to the stage, whose reference then carries the law of each cycle.
+// rules: trajectory_planner_stage.hpp); their feedback (waiting, rejected with the bound, moving,
+// arrived, aborted) goes to rt/crane/planner/move_status. A goal with the minimum-time profile is
+// planned here (Planning below: the bound solved by IPOPT and its follower's law,
+// optimal_control/planned_move.hpp) and handed to the stage, whose reference then carries the law
+// of each cycle.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
