@@ -673,8 +673,9 @@ TEST(Operate, MoveArrivesSettledAndAGoalOutOfRangeIsRefusedNamingTheBound) {
 // A device unplugged mid-jog stops the load softly (issue 14, manual mode), over DDS with real
 // processes: a realtime stack (the planner's dead man counts its cycles, 10 ms of the wall clock
 // each), MANUAL from crane_safety, `crane_jog --script` (50 Hz) pushing the trolley out at 30 %,
-// killed with SIGKILL 3 s into the motion, at the shaped speed's steady value (a stream that stalled
-// past the dead man's time released the axes before: 1 run in 6 here, killed mid-ramp). The planner hears
+// killed with SIGKILL 3 s into the motion, at the shaped speed's steady value (1 run in 6 here was
+// killed mid-ramp, at 0.112 m/s, when the kill came 3 s after the first speed whatever it was; the
+// cause was not reproduced: a stall of the jog's stream is one candidate). The planner hears
 // nothing for manual.dead_man_timeout (200 ms) and releases the axes: its reference starts to
 // decelerate (the shaped ramp) between 200 ms less the jog's 20 ms period and 200 ms plus three
 // cycles (the dead man's "longer than": the 21st cycle; the wait for the planner's next cycle;
@@ -784,7 +785,8 @@ TEST(Operate, AJogKilledMidMoveStopsTheLoadSoftlyWithinTheDeadManTime) {
     if (at_rest && swing_samples > 0 && crane::runtime::now_nanoseconds() > *at_rest + 6'500'000'000LL) break;
   }
   ASSERT_TRUE(moving.has_value()) << "the jog never moved the trolley; see " << dir;
-  ASSERT_TRUE(killed.has_value());
+  // The kill waits for the steady shaped speed (0.3 of the rated 0.4982 m/s): that it came is the check.
+  ASSERT_TRUE(killed.has_value()) << "the reference never held the stick's 0.149 m/s 3 s into the motion; see " << dir;
   const auto jog_exit = jog.poll();
   ASSERT_TRUE(jog_exit.has_value());
   EXPECT_TRUE(WIFSIGNALED(jog_exit->status) && WTERMSIG(jog_exit->status) == SIGKILL) << jog_exit->describe();
@@ -797,7 +799,6 @@ TEST(Operate, AJogKilledMidMoveStopsTheLoadSoftlyWithinTheDeadManTime) {
               "after rest (%llu samples), supervisor faults %u; releases before the kill (the jog's stream stalled) %d\n",
               position_at_kill, speed_at_kill, release_ms, rest_s, rest_position, residual * 180.0 / M_PI,
               static_cast<unsigned long long>(swing_samples), faults, early_releases);
-  EXPECT_NEAR(speed_at_kill, 0.3 * 0.4982, 1e-6) << "the shaped speed steady at the kill";
   EXPECT_GE(release_ms, 200.0 - 20.0) << "released before the dead man's time: by something else";
   EXPECT_LE(release_ms, 200.0 + 3 * 10.0);
   EXPECT_GT(swing_samples, 300U);
