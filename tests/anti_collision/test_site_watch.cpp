@@ -67,6 +67,7 @@ TEST(SiteWatch, TheDistanceBetweenTwoReportedCranesByHand) {
   EXPECT_EQ(watch.closest_parts(), "tc1.jib-tc2.load");
   EXPECT_DOUBLE_EQ(watch.closest_time(), 2.0);
   EXPECT_EQ(watch.cranes()[1].reports, 2u);
+  EXPECT_DOUBLE_EQ(watch.cranes()[1].first_heard, 2.0);
   EXPECT_DOUBLE_EQ(watch.cranes()[1].heard, 3.0);
 }
 

@@ -188,7 +188,7 @@ site)
   start_stack site --security "$MATERIAL" --dds "$CRANE_DDS" --site "$SITE" --site-crane tc1 \
     --site-jobs "$W/jobs/tc1.csv" --site-summary "$W/tc1.json"
   # The monitor (crane_site_status's default identity) and an outsider listen side by side.
-  "$BIN/crane_site_status" --site "$SITE" --security "$MATERIAL" --wait 8 --json "$W/monitor.json" > "$W/monitor.txt" 2>&1 \
+  "$BIN/crane_site_status" --site "$SITE" --security "$MATERIAL" --wait 12 --json "$W/monitor.json" > "$W/monitor.txt" 2>&1 \
     & monitor=$!
   "$BIN/crane_site_status" --site "$SITE" --wait 8 --json "$W/outsider.json" > "$W/outsider.txt" 2>&1 && outsider_rc=0 \
     || outsider_rc=$?
@@ -199,13 +199,21 @@ site)
   wait "$SERVICE" || true
   wait "$WRITER" || true
   SERVICE= WRITER=
-  reports=$(/usr/bin/python3 -c 'import json,sys
+  # tc1 reports once its crane is ready (site_link_node.cpp), which under load may be seconds
+  # after the monitor starts: the rate is checked over the span the monitor heard it.
+  read -r reports first last rate < <(/usr/bin/python3 -c 'import json,sys
 try: s = json.load(open(sys.argv[1]))
 except (OSError, ValueError): s = {"cranes": []}
-print(sum(c["reports"] for c in s["cranes"] if c["name"] == "tc1"))' "$W/monitor.json")
-  echo "monitor: exit $monitor_rc, $reports reports of tc1 heard in 8 s; $(grep -m1 "^tc1 " "$W/monitor.txt" || true)"
+c = next((c for c in s["cranes"] if c["name"] == "tc1" and c["reports"] > 1), None)
+if c is None: print(0, "-", "-", 0)
+else: print(c["reports"], "%.2f" % c["first_report_s"], "%.2f" % c["last_report_s"],
+            "%.1f" % ((c["reports"] - 1) / max(c["last_report_s"] - c["first_report_s"], 1e-3)))' "$W/monitor.json")
+  echo "monitor: exit $monitor_rc, $reports reports of tc1 heard from $first s to $last s ($rate Hz) of 12 s;" \
+    "$(grep -m1 "^tc1 " "$W/monitor.txt" || true)"
   check "the monitor hears the site service's status" test "$monitor_rc" -eq 0
-  check "the monitor hears tc1's reports (> 40 in 8 s, at 10 Hz)" test "$reports" -gt 40
+  check "the monitor hears tc1's reports for >= 2 s" test "$reports" -ge 20
+  check "the monitor hears tc1's reports at their 10 Hz (>= 8 Hz over the span heard)" \
+    /usr/bin/python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) >= 8.0 else 1)' "$rate"
   check "the site service hears tc1" grep -q "crane tc1: reporting" "$W/site_service.log"
   check "tc1's supervisor hears the service's instructions (a grant)" grep -q "site grant" "$W/logs_site/supervisor.log"
   n_outsider=$(/usr/bin/python3 -c 'import json,sys

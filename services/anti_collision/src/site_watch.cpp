@@ -24,7 +24,7 @@ bool SiteWatch::report(const protocol::SiteReport& message, double time) {
   Crane& c = cranes_[message.crane];
   c.report = message;
   c.read = std::move(read);
-  ++c.reports;
+  if (c.reports++ == 0) c.first_heard = time;
   c.heard = time;
   for (std::size_t j = 0; j < cranes_.size(); ++j) {
     if (j == message.crane || !cranes_[j].report) continue;

@@ -124,8 +124,13 @@ int main(int argc, char** argv) {
       }
       std::printf("%-8s %-12s %-8s %-10s %-9s %s\n", layout.cranes[i].name.c_str(), holding.c_str(),
                   last->pending[i] ? "waiting" : "-", waits_for(layout, last->waits_for[i]).c_str(), state.c_str(), pose);
-      out["cranes"].push_back({{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
-                               {"state", state}});
+      nlohmann::json row{{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
+                         {"state", state}};
+      if (cranes[i].reports > 0) {  // [s] since the tool started: the rate is reports over the span
+        row["first_report_s"] = cranes[i].first_heard;
+        row["last_report_s"] = cranes[i].heard;
+      }
+      out["cranes"].push_back(std::move(row));
     }
     std::printf("yields %llu, unresolved waits %llu, reports refused %llu\n",
                 static_cast<unsigned long long>(last->yields), static_cast<unsigned long long>(last->unresolved),

@@ -35,6 +35,7 @@ class SiteWatch {
     std::optional<protocol::SiteReport> report;  // its last report
     std::optional<CraneReport> read;             // that report as the service reads it
     std::uint64_t reports{0};                    // reports heard
+    double first_heard{std::numeric_limits<double>::infinity()};  // [s] its first report
     double heard{-std::numeric_limits<double>::infinity()};  // [s] its last report
     std::optional<SiteOrder> order;              // the last instruction to it
     std::uint32_t order_epoch{0};                // of the service that sent it
