@@ -14,6 +14,7 @@
 #include "crane/common/validation.hpp"
 #include "crane/config/config_document.hpp"
 #include "crane/stack/stack_config.hpp"
+#include "crane/state_estimator/state_estimator_stage.hpp"
 
 namespace cfg = crane::stack;
 
@@ -572,6 +573,44 @@ TEST_F(LabConfigText, AdaptationFieldsAreValidatedByName) {
   EXPECT_TRUE(contains(message, "must contain crane.load_mass = 2 kg")) << message;
   message = error_of(edit_line(text_, "adaptation:", "enabled:", "enabled: maybe").text);
   EXPECT_TRUE(contains(message, "state_estimator.adaptation.enabled")) << message;
+}
+
+// The follower's estimator (state_estimator.follower_cutoff_frequency, for_follower): read and
+// range-checked like the rest, and it changes the Butterworth's cutoff and nothing else. The lag of
+// a ramp, the filter's group delay at DC sqrt2 / (2 pi fc) for a second-order Butterworth, halves
+// from 45 ms at the dissertation's 5 Hz to 22.5 ms at 10 Hz.
+TEST_F(LabConfigText, TheFollowersFilterCutoffIsReadAndChangesOnlyTheCutoff) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_DOUBLE_EQ(c.state_estimator.estimator.cutoff_frequency, 5.0);  // section 4.3: 0.05 fs
+  EXPECT_DOUBLE_EQ(c.state_estimator.follower_cutoff_frequency, 10.0);
+  const auto follower = crane::state_estimator::for_follower(c.state_estimator);
+  EXPECT_DOUBLE_EQ(follower.estimator.cutoff_frequency, 10.0);
+  EXPECT_EQ(follower.estimator.differentiator, c.state_estimator.estimator.differentiator);
+  EXPECT_DOUBLE_EQ(follower.estimator.sample_rate, c.state_estimator.estimator.sample_rate);
+  EXPECT_EQ(follower.adaptation.enabled, c.state_estimator.adaptation.enabled);
+
+  const auto ramp_lag = [](const crane::state_estimator::StateEstimatorParams& params) {
+    crane::state_estimator::StateEstimator estimator(params);
+    crane::common::CraneStateEstimate e;
+    const double v = 0.4, fs = params.sample_rate;
+    double t = 0.0;
+    for (int k = 0; k < 300; ++k) {
+      t = k / fs;
+      EXPECT_EQ(estimator.step(crane::common::CraneMeasurement{v * t, 0.0, 0.0, 0.0, 1.0}, e),
+                crane::common::StepStatus::ok);
+    }
+    return (v * t - e.trolley_position) / v;  // [s]
+  };
+  const double sqrt2_over_2pi = std::numbers::sqrt2 / (2.0 * std::numbers::pi);
+  EXPECT_NEAR(ramp_lag(c.state_estimator.estimator), sqrt2_over_2pi / 5.0, 1e-3);
+  EXPECT_NEAR(ramp_lag(follower.estimator), sqrt2_over_2pi / 10.0, 1e-3);
+
+  auto message = error_of(edit_line(text_, "state_estimator:", "follower_cutoff_frequency:",
+                                    "follower_cutoff_frequency: 60").text);
+  EXPECT_TRUE(contains(message, "state_estimator.follower_cutoff_frequency = 60")) << message;
+  EXPECT_TRUE(contains(message, "49.9")) << message;  // the bound, 0.499 fs
+  message = error_of(edit_line(text_, "state_estimator:", "follower_cutoff_frequency:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field state_estimator.follower_cutoff_frequency")) << message;
 }
 
 TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {

@@ -223,6 +223,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   const auto choice = stack::choose_controller(options.controller, m, options.acceleration_feedforward);
   stack.anti_swing_controller = std::string(anti_swing::law_name(choice.anti_swing));
   stack.tracking_controller = std::string(tracking::law_name(choice.tracking));
+  stack.estimator_follower_filter = choice.follower_filter();
   stack.tracking_acceleration_feedforward = choice.acceleration_feedforward;
   stack.fault_log_path = (log_dir / "faults.jsonl").string();
   // The demo is its own operator (op), in a private network namespace no shell reaches: no relay.

@@ -137,6 +137,7 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     if (name == "anti_swing" && !o.anti_swing_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.anti_swing_controller});
     }
+    if (name == "state_estimator" && o.estimator_follower_filter) spec.arguments.push_back("--follower-filter");
     if (name == "tracking" && !o.tracking_controller.empty()) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.tracking_controller});
     }

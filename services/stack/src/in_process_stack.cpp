@@ -27,6 +27,9 @@ anti_swing::AntiSwingStageParams anti_swing_params(const StackConfig& cfg, const
   p.law = o.controller.anti_swing;
   return p;
 }
+state_estimator::StateEstimatorStageParams estimator_params(const StackConfig& cfg, const InProcessOptions& o) {
+  return o.controller.follower_filter() ? state_estimator::for_follower(cfg.state_estimator) : cfg.state_estimator;
+}
 tracking::TrackingStageParams tracking_params(const StackConfig& cfg, const InProcessOptions& o) {
   auto p = cfg.tracking;
   p.law = o.controller.tracking;
@@ -67,7 +70,7 @@ struct InProcessStack::Stages {
         lost_probability(checked_probability(o.lost_command_probability)),
         lost_random(o.lost_command_seed),
         plant(plant_stage_params(cfg, o)),
-        estimator(cfg.state_estimator),
+        estimator(estimator_params(cfg, o)),
         planner(cfg.trajectory_planner, dt),
         anti_swing(anti_swing_params(cfg, o)),
         tracking(tracking_params(cfg, o)),

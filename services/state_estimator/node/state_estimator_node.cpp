@@ -6,12 +6,18 @@
 int main(int argc, char** argv) {
   using namespace crane;
   namespace tp = transport::topics;
+  auto follower = std::make_shared<bool>(false);
   return runtime::run_stage(
       argc, argv, runtime::ProcessId::state_estimator,
-      "state_estimator: Butterworth filter and Al-Alaoui differentiator (section 4.3) on the sensor stream", {},
-      [](runtime::StageContext& ctx) -> std::function<void()> {
+      "state_estimator: Butterworth filter and Al-Alaoui differentiator (section 4.3) on the sensor stream",
+      [follower](CLI::App& app) {
+        app.add_flag("--follower-filter", *follower,
+                     "the tracking law is the follower: filter at state_estimator.follower_cutoff_frequency");
+      },
+      [follower](runtime::StageContext& ctx) -> std::function<void()> {
+        auto params = ctx.config.read("state_estimator", state_estimator::read_params);
         auto stage = std::make_shared<state_estimator::StateEstimatorStage>(
-            ctx.config.read("state_estimator", state_estimator::read_params));
+            *follower ? state_estimator::for_follower(params) : params);
         auto sensors = std::shared_ptr(ctx.participant.make_reader<tp::Sensors>(&ctx.wakeup));
         auto writer = std::shared_ptr(ctx.participant.make_writer<tp::StateEstimate>());
         auto watch = std::make_shared<runtime::SequenceWatch>();

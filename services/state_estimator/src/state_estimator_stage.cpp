@@ -47,6 +47,7 @@ StateEstimatorStageParams read_params(config::YamlSection& s, const common::Stac
   StateEstimatorParams& p = stage.estimator;
   p.sample_rate = 1.0 / facts.sample_period;
   p.cutoff_frequency = s.number("cutoff_frequency", 1e-3, 0.499 * p.sample_rate);
+  stage.follower_cutoff_frequency = s.number("follower_cutoff_frequency", 1e-3, 0.499 * p.sample_rate);
   const auto kind = s.text("differentiator", {"backward", "al_alaoui_first_order", "al_alaoui_second_order"});
   p.differentiator = kind == "backward"                ? DifferentiatorKind::backward
                      : kind == "al_alaoui_first_order" ? DifferentiatorKind::al_alaoui_first_order
@@ -56,6 +57,11 @@ StateEstimatorStageParams read_params(config::YamlSection& s, const common::Stac
   s.finish();
   StateEstimator{p};  // its own invariants, same message format
   return stage;
+}
+
+StateEstimatorStageParams for_follower(StateEstimatorStageParams params) {
+  params.estimator.cutoff_frequency = params.follower_cutoff_frequency;
+  return params;
 }
 
 StateEstimatorStage::StateEstimatorStage(const StateEstimatorStageParams& params)

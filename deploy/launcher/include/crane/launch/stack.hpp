@@ -39,6 +39,7 @@ struct StackOptions {
   std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
                                       // empty: its default
   bool tracking_acceleration_feedforward{false};  // tracking --acceleration-feedforward
+  bool estimator_follower_filter{false};  // state_estimator --follower-filter (stack::ControllerChoice::follower_filter)
   std::string hardware;               // empty: simulated plant on DDS; shm:NAME or comedi:/dev/comediN: the
                                       // hardware bridge on that board (see the file comment)
   std::string fault_log_path;         // supervisor --fault-log (optional)

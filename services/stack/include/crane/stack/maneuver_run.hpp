@@ -29,6 +29,9 @@ struct ControllerChoice {
   tracking::TrackingLaw tracking{tracking::TrackingLaw::tracking};
   bool acceleration_feedforward{false};
   std::string label;  // "delay1", "gain_scheduling_full", "none+feedforward", ...
+  /// The state estimator filters at state_estimator.follower_cutoff_frequency
+  /// (state_estimator::for_follower): the tracking law is the follower.
+  [[nodiscard]] bool follower_filter() const noexcept { return tracking == tracking::TrackingLaw::follower; }
 };
 
 /// The demo's controller names: none | pd | delay1 | delay2 | fuzzy (anti-swing with PD tracking),

@@ -23,9 +23,21 @@ struct StateEstimatorStageParams {
   adaptation::OnlineAdaptationParams adaptation{};  // the crane and sample period are the stack's facts
   bool bridge{false};  // an overhead crane (facts.crane_kind): the bridge position is filtered and
                        // differentiated like the trolley's, into bridge_velocity(_raw)
+  /// [Hz] the Butterworth's cutoff while the minimum-time follower controls the crane (tracking law
+  /// `follower`; for_follower()): its time-varying LQR feeds back every filtered position and rate,
+  /// and its loop near 3-4 Hz does not survive the 66 deg lag of the dissertation's 5 Hz filter
+  /// there with a shorter cable or less friction than assumed (docs/optimal_control.md, "The
+  /// estimator's lag"). The dissertation's laws keep estimator.cutoff_frequency (section 4.3).
+  double follower_cutoff_frequency{5.0};
 };
 
-/// Reads the `state_estimator:` block: cutoff_frequency [Hz] in [1e-3, 0.499 fs], differentiator
+/// `params` with follower_cutoff_frequency as the Butterworth's cutoff: the estimator of a stack
+/// whose tracking law is the follower. The in-process stack and the state_estimator process
+/// (--follower-filter, which the launcher passes with `--controller follower`) both call it.
+[[nodiscard]] StateEstimatorStageParams for_follower(StateEstimatorStageParams params);
+
+/// Reads the `state_estimator:` block: cutoff_frequency [Hz] and follower_cutoff_frequency [Hz],
+/// each in [1e-3, 0.499 fs], differentiator
 /// (backward (4.8) | al_alaoui_first_order (4.9) | al_alaoui_second_order (4.10)); fs is
 /// 1 / facts.sample_period; and its `adaptation:` block (every field of OnlineAdaptationParams,
 /// limit_cycle: included; ranges in read_adaptation's body and OnlineAdaptation's validate). Throws
