@@ -33,7 +33,7 @@ struct StateEstimatorStageParams {
 
 /// `params` with follower_cutoff_frequency as the Butterworth's cutoff: the estimator of a stack
 /// whose tracking law is the follower. The in-process stack and the state_estimator process
-/// (--follower-filter, which the launcher passes with `--controller follower`) both call it.
+/// (--follower-filter, which crane_demo passes with `--controller follower`) both call it.
 [[nodiscard]] StateEstimatorStageParams for_follower(StateEstimatorStageParams params);
 
 /// Reads the `state_estimator:` block: cutoff_frequency [Hz] and follower_cutoff_frequency [Hz],
