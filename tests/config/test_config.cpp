@@ -13,6 +13,7 @@
 
 #include "crane/common/validation.hpp"
 #include "crane/config/config_document.hpp"
+#include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
 #include "crane/state_estimator/state_estimator_stage.hpp"
 
@@ -588,6 +589,11 @@ TEST_F(LabConfigText, TheFollowersFilterCutoffIsReadAndChangesOnlyTheCutoff) {
   EXPECT_EQ(follower.estimator.differentiator, c.state_estimator.estimator.differentiator);
   EXPECT_DOUBLE_EQ(follower.estimator.sample_rate, c.state_estimator.estimator.sample_rate);
   EXPECT_EQ(follower.adaptation.enabled, c.state_estimator.adaptation.enabled);
+  // Which stacks filter so (the in-process stack and crane_demo ask ControllerChoice): the follower's.
+  EXPECT_TRUE(cfg::choose_controller("follower", c.maneuvers[0], false).follower_filter());
+  for (const char* other : {"delay1", "delay2", "pd", "none", "gain_scheduling_full"}) {
+    EXPECT_FALSE(cfg::choose_controller(other, c.maneuvers[0], false).follower_filter()) << other;
+  }
 
   const auto ramp_lag = [](const crane::state_estimator::StateEstimatorParams& params) {
     crane::state_estimator::StateEstimator estimator(params);

@@ -339,6 +339,25 @@ TEST(DdsMix, ParsesAndOverridesPerProcess) {
   EXPECT_TRUE(crane::launch::parse_dds_mix("", known).empty());
 }
 
+// The follower's filter (state_estimator::for_follower): the state_estimator process, and it alone,
+// gets --follower-filter when the options ask for it (crane_demo: ControllerChoice::follower_filter).
+TEST(FollowerFilter, OnlyTheStateEstimatorGetsTheFlagAndOnlyWhenAsked) {
+  crane::launch::StackOptions o;
+  o.config_path = "c.yaml";
+  o.binary_directory = "/bin";
+  const auto with_flag = [&] {
+    std::set<std::string> names;
+    for (const auto& spec : crane::launch::stack_processes(o)) {
+      const auto& a = spec.arguments;
+      if (std::find(a.begin(), a.end(), "--follower-filter") != a.end()) names.insert(spec.name);
+    }
+    return names;
+  };
+  EXPECT_TRUE(with_flag().empty());
+  o.estimator_follower_filter = true;
+  EXPECT_EQ(with_flag(), (std::set<std::string>{"state_estimator"}));
+}
+
 TEST(DdsMix, RefusesBadEntriesNamingThem) {
   const std::vector<std::string> known{"plant", "tracking"};
   const auto message = [&](const std::string& text) {
