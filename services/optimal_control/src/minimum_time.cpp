@@ -152,12 +152,15 @@ class NodeDynamics {
 // The nonlinear program of the header for IPOPT.
 class MinimumTimeProgram final : public Ipopt::TNLP {
  public:
-  MinimumTimeProgram(const MinimumTimeProblem& problem, const Layout& layout, std::vector<double> initial_guess)
+  // fixed_duration > 0: the second, least-effort solve at that duration (header: least_effort).
+  MinimumTimeProgram(const MinimumTimeProblem& problem, const Layout& layout, std::vector<double> initial_guess,
+                     double fixed_duration = 0.0)
       : problem_(problem),
         layout_(layout),
         dynamics_(problem, layout),
         initial_(std::move(initial_guess)),
-        input_scale_{problem.trolley.max_acceleration, problem.second.max_acceleration, problem.hoist.max_acceleration} {}
+        input_scale_{problem.trolley.max_acceleration, problem.second.max_acceleration, problem.hoist.max_acceleration},
+        fixed_duration_(fixed_duration) {}
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g, Ipopt::Index& nnz_h_lag,
                     IndexStyleEnum& index_style) override {
@@ -222,8 +225,8 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
         lo[layout_.input(2)] = hi[layout_.input(2)] = 0.0;
       }
     }
-    x_l[layout_.duration_index()] = 1e-2;
-    x_u[layout_.duration_index()] = 1e3;
+    x_l[layout_.duration_index()] = fixed_duration_ > 0.0 ? fixed_duration_ : 1e-2;
+    x_u[layout_.duration_index()] = fixed_duration_ > 0.0 ? fixed_duration_ : 1e3;
     std::fill(g_l, g_l + layout_.defect_rows(), 0.0);
     std::fill(g_u, g_u + layout_.defect_rows(), 0.0);
     std::fill(g_l + layout_.defect_rows(), g_l + m, -problem_.voltage_limit);
@@ -238,7 +241,9 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
     return true;
   }
 
-  // T + w sum_k sum_j ((u_j,k+1 - u_j,k) / a_j,max)^2 (header: the input smoothing).
+  // T + w sum_k sum_j ((u_j,k+1 - u_j,k) / a_j,max)^2 (header: the input smoothing); at a fixed
+  // duration also (1 / (N + 1)) sum_k (sum_j (u_j,k / a_j,max)^2 + sum_i (q_i,k / max_swing)^2), i
+  // the swings (header: least_effort).
   bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& obj_value) override {
     obj_value = x[layout_.duration_index()];
     for (int k = 0; k + 1 < layout_.nodes; ++k) {
@@ -246,6 +251,19 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
         const double d = (x[(k + 1) * layout_.stride + layout_.input(j)] - x[k * layout_.stride + layout_.input(j)]) /
                          input_scale_[j];
         obj_value += problem_.input_smoothing * d * d;
+      }
+    }
+    if (fixed_duration_ > 0.0) {
+      for (int k = 0; k < layout_.nodes; ++k) {
+        for (int j = 0; j < kInputs; ++j) {
+          const double u = x[k * layout_.stride + layout_.input(j)] / input_scale_[j];
+          obj_value += u * u / layout_.nodes;
+        }
+        for (int i = 0; i < layout_.n; ++i) {
+          if (i == kTrolleyIndex || i == kSlewIndex) continue;
+          const double swing = x[k * layout_.stride + layout_.position(i)] / problem_.max_swing;
+          obj_value += swing * swing / layout_.nodes;
+        }
       }
     }
     return true;
@@ -261,6 +279,19 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
         const double d = 2.0 * problem_.input_smoothing * (x[b] - x[a]) / (input_scale_[j] * input_scale_[j]);
         grad_f[b] += d;
         grad_f[a] -= d;
+      }
+    }
+    if (fixed_duration_ > 0.0) {
+      for (int k = 0; k < layout_.nodes; ++k) {
+        for (int j = 0; j < kInputs; ++j) {
+          const int a = k * layout_.stride + layout_.input(j);
+          grad_f[a] += 2.0 * x[a] / (input_scale_[j] * input_scale_[j] * layout_.nodes);
+        }
+        for (int i = 0; i < layout_.n; ++i) {
+          if (i == kTrolleyIndex || i == kSlewIndex) continue;
+          const int a = k * layout_.stride + layout_.position(i);
+          grad_f[a] += 2.0 * x[a] / (problem_.max_swing * problem_.max_swing * layout_.nodes);
+        }
       }
     }
     return true;
@@ -365,6 +396,7 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
   NodeDynamics dynamics_;
   std::vector<double> initial_;
   double input_scale_[kInputs];
+  double fixed_duration_;
   std::vector<double> solution_;
   Ipopt::SolverReturn solver_return_{Ipopt::INTERNAL_ERROR};
 };
@@ -401,7 +433,8 @@ void validate_axis(const std::string& name, const AxisRange& axis) {
 
 // The initial guess of the header: each axis on its linear profile, the passive coordinates by RK4
 // along it, stretched to the longest axis.
-std::vector<double> initial_guess(const MinimumTimeProblem& problem, const Layout& layout, double& duration) {
+std::vector<double> initial_guess(const MinimumTimeProblem& problem, const Layout& layout, double& duration,
+                                  double min_duration = 0.0) {
   namespace tp = trajectory_planner;
   const double gravity = problem.model->parameters().gravity;
   const bool second_driven = layout.voltages > 1;
@@ -416,7 +449,7 @@ std::vector<double> initial_guess(const MinimumTimeProblem& problem, const Layou
                       {problem.second.max_speed, problem.second.max_acceleration}, frequency);
   }
   hoist.plan(problem.hoist.start, problem.hoist.target, {problem.hoist.max_speed, problem.hoist.max_acceleration});
-  duration = std::max({trolley.duration(), second.duration(), hoist.duration(), 0.1});
+  duration = std::max({trolley.duration(), second.duration(), hoist.duration(), 0.1, min_duration});
 
   std::vector<double> x(static_cast<std::size_t>(layout.variable_count()), 0.0);
   const int N = layout.nodes - 1;
@@ -501,6 +534,8 @@ void validate(const MinimumTimeProblem& problem) {
   common::require_in_range("minimum_time.input_smoothing", problem.input_smoothing, 0.0, 1.0);
   common::require_in_range("minimum_time.tolerance", problem.tolerance, 1e-14, 1e-2);
   common::require_in_range("minimum_time.max_iterations", problem.max_iterations, 1, 1e6);
+  common::require_in_range("minimum_time.least_effort_margin", problem.least_effort_margin, 0.0, 0.5);
+  common::require_in_range("minimum_time.least_effort_tolerance", problem.least_effort_tolerance, 1e-14, 1e-2);
   common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
   common::validate(problem.second_friction, "minimum_time.second_friction");
 }
@@ -536,26 +571,47 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   }
   const auto start = std::chrono::steady_clock::now();
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(program);
-  result.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.status = solver_return_name(program->solver_return());
   result.solved = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
   if (IsValid(app->Statistics())) result.iterations = app->Statistics()->IterationCount();
-  const std::vector<double>& x = program->solution();
-  if (x.size() != static_cast<std::size_t>(layout.variable_count())) {
+  const std::vector<double>* solution = &program->solution();
+  if (solution->size() != static_cast<std::size_t>(layout.variable_count())) {
     result.solved = false;
     return result;
   }
+  // The least-effort solve at (1 + least_effort_margin) T* (header: least_effort), from the initial
+  // guess at that duration, and where IPOPT does not solve it at twice and four times the margin;
+  // its solution replaces the first only where IPOPT solved it.
+  result.duration = (*solution)[static_cast<std::size_t>(layout.duration_index())];
+  Ipopt::SmartPtr<MinimumTimeProgram> effort;
+  app->Options()->SetNumericValue("tol", problem.least_effort_tolerance);
+  for (int attempt = 0; result.solved && problem.least_effort && !result.least_effort && attempt < 3; ++attempt) {
+    const double duration = result.duration * (1.0 + problem.least_effort_margin * (1 << attempt));
+    double guess_duration = 0.0;
+    std::vector<double> guess_at = initial_guess(problem, layout, guess_duration, duration);
+    effort = new MinimumTimeProgram(problem, layout, std::move(guess_at), duration);
+    const Ipopt::ApplicationReturnStatus effort_status = app->OptimizeTNLP(effort);
+    result.effort_status = solver_return_name(effort->solver_return());
+    if (IsValid(app->Statistics())) result.effort_iterations += app->Statistics()->IterationCount();
+    if ((effort_status == Ipopt::Solve_Succeeded || effort_status == Ipopt::Solved_To_Acceptable_Level) &&
+        effort->solution().size() == solution->size()) {
+      solution = &effort->solution();
+      result.least_effort = true;
+    }
+  }
+  result.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<double>& x = *solution;
 
   std::vector<double> g(static_cast<std::size_t>(layout.constraint_count()));
   program->evaluate_constraints(x.data(), g.data());
   for (int r = 0; r < layout.defect_rows(); ++r) result.max_defect = std::max(result.max_defect, std::abs(g[r]));
 
-  result.duration = x[static_cast<std::size_t>(layout.duration_index())];
+  result.trajectory_duration = x[static_cast<std::size_t>(layout.duration_index())];
   result.nodes.resize(static_cast<std::size_t>(layout.nodes));
   for (int k = 0; k < layout.nodes; ++k) {
     const double* z = x.data() + k * layout.stride;
     TrajectoryNode& node = result.nodes[static_cast<std::size_t>(k)];
-    node.time = result.duration * k / problem.intervals;
+    node.time = result.trajectory_duration * k / problem.intervals;
     for (int i = 0; i < layout.n; ++i) {
       node.state.position[i] = z[layout.position(i)];
       node.state.velocity[i] = z[layout.velocity(i)];
@@ -575,8 +631,8 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
 TrajectoryNode sample(const MinimumTimeResult& result, double time) {
   if (result.nodes.empty()) return {};
   if (result.nodes.size() == 1 || !(time > 0.0)) return result.nodes.front();
-  if (time >= result.duration) return result.nodes.back();
-  const double position = time / result.duration * static_cast<double>(result.nodes.size() - 1);
+  if (time >= result.trajectory_duration) return result.nodes.back();
+  const double position = time / result.trajectory_duration * static_cast<double>(result.nodes.size() - 1);
   const std::size_t k = std::min(static_cast<std::size_t>(position), result.nodes.size() - 2);
   const double w = position - static_cast<double>(k);
   const TrajectoryNode& a = result.nodes[k];

@@ -25,7 +25,7 @@ constexpr int kMaxRiccatiIterations = 200000;  // the stationary solution (a few
 
 plant::HoistMotion hoist_at(const MinimumTimeResult& trajectory, double t) {
   const TrajectoryNode n = sample(trajectory, t);
-  return {n.cable_length, n.cable_length_rate, t >= trajectory.duration ? 0.0 : n.hoist_acceleration};
+  return {n.cable_length, n.cable_length_rate, t >= trajectory.trajectory_duration ? 0.0 : n.hoist_acceleration};
 }
 
 // The model's state after one sample T_s from `start` at time t0 with the drive forces `force`
@@ -83,7 +83,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_in_range("follower.hold.sliding_friction_scale", params.hold.sliding_friction_scale, 0.0, 1.0);
   common::require_in_range("follower.trajectory_sliding_friction_scale", params.trajectory_sliding_friction_scale, 0.0,
                            1.0);
-  if (!trajectory.solved || trajectory.nodes.size() < 2 || !(trajectory.duration > 0.0)) {
+  if (!trajectory.solved || trajectory.nodes.size() < 2 || !(trajectory.trajectory_duration > 0.0)) {
     throw common::ConfigError("follower.trajectory: not solved (" + trajectory.status + ")");
   }
 
@@ -98,7 +98,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
 
   // The reference at the samples, and the feedforward (the bound's voltage less its friction).
   const double period = params.sample_period;
-  const auto count = static_cast<std::size_t>(std::ceil(trajectory.duration / period - 1e-9));
+  const auto count = static_cast<std::size_t>(std::ceil(trajectory.trajectory_duration / period - 1e-9));
   const auto model_state = [](const TrajectoryNode& node) {
     plant::ModelState s;
     s.position = node.state.position.head<plant::kNumCoordinates>();
@@ -107,7 +107,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   };
   // The model's friction [V] at the trajectory's speeds of time t.
   const auto friction = [&](double t) {
-    if (t >= trajectory.duration) return Eigen::Vector2d::Zero().eval();
+    if (t >= trajectory.trajectory_duration) return Eigen::Vector2d::Zero().eval();
     const TrajectoryNode node = sample(trajectory, t);
     Eigen::Vector2d f;
     f[0] = drive_voltage(0.0, fpv_trolley, node.state.velocity[kTrolleyIndex], problem.trolley_friction,
@@ -118,7 +118,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     return f;
   };
   const auto feedforward = [&](double t) {
-    if (t >= trajectory.duration) return Eigen::Vector2d::Zero().eval();
+    if (t >= trajectory.trajectory_duration) return Eigen::Vector2d::Zero().eval();
     const TrajectoryNode node = sample(trajectory, t);
     return (Eigen::Vector2d(node.trolley_voltage, second_drive_ ? node.second_voltage : 0.0) - friction(t)).eval();
   };
@@ -198,7 +198,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   gains_.resize(count + 1);
   Eigen::MatrixXd A, B, K;
   const Eigen::VectorXd u_rest = Eigen::VectorXd::Zero(m);
-  linearize(samples_[count].state, u_rest, trajectory.duration + period, A, B);
+  linearize(samples_[count].state, u_rest, trajectory.trajectory_duration + period, A, B);
   Eigen::MatrixXd P = Q;
   int iteration = 0;
   for (; iteration < kMaxRiccatiIterations; ++iteration) {

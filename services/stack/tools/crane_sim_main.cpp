@@ -471,12 +471,16 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
   std::ofstream summary;
   if (!out_dir.empty()) {
     summary.open(fs::path(out_dir) / "bound.csv");
-    summary << "maneuver,T_star,T_star_refined,linear_profile,intervals,iterations,solve_seconds,max_voltage,max_swing_deg\n";
+    summary << "maneuver,T_star,T_star_refined,linear_profile,intervals,iterations,least_effort_iterations,"
+               "solve_seconds,max_voltage,max_swing_deg\n";
   }
   std::printf("minimum time on the nonlinear model (%s crane; IPOPT, trapezoidal collocation)\n",
               common::to_string(cfg.facts.crane_kind));
-  std::printf("%-14s %9s %11s %9s %9s %6s %8s %8s %10s\n", "maneuver", "T* [s]", "T*(2N) [s]", "change", "linear [s]",
-              "iter", "solve s", "max |V|", "max swing");
+  std::printf("(the trajectory: the least input and swing at (1 + %.2f) T*, or twice or four times the margin where "
+              "IPOPT does not solve that; max |V| and max swing are its)\n",
+              optimal_control::MinimumTimeProblem{}.least_effort_margin);
+  std::printf("%-14s %9s %11s %9s %9s %6s %6s %8s %8s %10s\n", "maneuver", "T* [s]", "T*(2N) [s]", "change",
+              "linear [s]", "iter", "effort", "solve s", "max |V|", "max swing");
   int failures = 0;
   for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
     const auto coarse = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, intervals));
@@ -494,13 +498,15 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
       continue;
     }
     const double change = (fine.duration - coarse.duration) / coarse.duration;
-    std::printf("%-14s %9.4f %11.4f %8.2f%% %9.4f %6d %8.2f %8.2f %8.2f deg\n", m.name.c_str(), coarse.duration,
-                fine.duration, 100.0 * change, coarse.initial_guess_duration, fine.iterations, fine.solve_seconds,
-                max_voltage, max_swing * 180.0 / std::numbers::pi);
+    const std::string effort = fine.least_effort ? std::to_string(fine.effort_iterations) : "-";
+    std::printf("%-14s %9.4f %11.4f %8.2f%% %9.4f %6d %6s %8.2f %8.2f %8.2f deg\n", m.name.c_str(), coarse.duration,
+                fine.duration, 100.0 * change, coarse.initial_guess_duration, fine.iterations, effort.c_str(),
+                fine.solve_seconds, max_voltage, max_swing * 180.0 / std::numbers::pi);
     if (!out_dir.empty()) {
       summary << m.name << ',' << coarse.duration << ',' << fine.duration << ',' << coarse.initial_guess_duration << ','
-              << 2 * intervals << ',' << fine.iterations << ',' << fine.solve_seconds << ',' << max_voltage << ','
-              << max_swing * 180.0 / std::numbers::pi << '\n';
+              << 2 * intervals << ',' << fine.iterations << ','
+              << (fine.least_effort ? fine.effort_iterations : -1) << ',' << fine.solve_seconds << ',' << max_voltage
+              << ',' << max_swing * 180.0 / std::numbers::pi << '\n';
       write_bound_trajectory(fs::path(out_dir) / (m.name + "_bound.csv"), fine);
     }
   }
@@ -532,9 +538,10 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
   std::printf("the minimum-time trajectory followed in closed loop (%s crane; feedforward + time-varying LQR, "
               "friction compensation on)\n",
               common::to_string(cfg.facts.crane_kind));
-  std::printf("%-14s %-16s %8s %8s %7s %10s %13s %13s %15s %6s %7s\n", "maneuver", "plant", "T* [s]", "settle_s",
-              "ratio", "pos_err_mm", bridge ? "bridge_err_mm" : "slew_err_mrad", "max_swing_deg", "resid_swing_deg",
-              "max_V", "faults");
+  std::printf("(traj: the trajectory's duration, the least-effort solve's at 1.01-1.04 T*, or T* where none solved)\n");
+  std::printf("%-14s %-16s %8s %8s %8s %7s %10s %13s %13s %15s %6s %7s\n", "maneuver", "plant", "T* [s]",
+              "traj [s]", "settle_s", "ratio", "pos_err_mm", bridge ? "bridge_err_mm" : "slew_err_mrad",
+              "max_swing_deg", "resid_swing_deg", "max_V", "faults");
   int failures = 0;
   for (const auto& m : maneuvers) {
     for (const auto& corner : runs) {
@@ -546,8 +553,9 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
       const auto r = stack::run_follower(cfg, run);
       const auto& x = r.metrics;
       constexpr double deg = 180.0 / std::numbers::pi;
-      std::printf("%-14s %-16s %8.4f %8s %7s %10.2f %13.2f %13.2f %15.3f %6.2f %7u\n", m.name.c_str(),
-                  corner.label.c_str(), r.bound.duration, stack::format_number(x.settle_time, 2).c_str(),
+      std::printf("%-14s %-16s %8.4f %8.4f %8s %7s %10.2f %13.2f %13.2f %15.3f %6.2f %7u\n", m.name.c_str(),
+                  corner.label.c_str(), r.bound.duration, r.bound.trajectory_duration,
+                  stack::format_number(x.settle_time, 2).c_str(),
                   stack::format_number(x.settle_time / r.bound.duration, 2).c_str(), 1e3 * x.final_position_error,
                   bridge ? 1e3 * x.final_bridge_error : 1e3 * x.final_slew_error, deg * x.max_swing,
                   deg * x.residual_swing, x.max_voltage, r.latched_faults);
@@ -585,6 +593,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   struct MoveResult {
     std::vector<stack::MoveComparison> runs;  // one per plant
     double solve_seconds{0.0};
+    bool least_effort{false};  // the trajectory is the least-effort solve's (MinimumTimeResult::least_effort)
     std::string error;
   };
   std::vector<MoveResult> results(maneuvers.size());
@@ -595,6 +604,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
       try {
         const auto bound = stack::comparison_bound(cfg, maneuvers[i], intervals);
         results[i].solve_seconds = bound.solve_seconds;
+        results[i].least_effort = bound.least_effort;
         for (const auto& plant : plants) {
           results[i].runs.push_back(stack::compare_move(cfg, maneuvers[i], bound, controllers, plant, intervals));
         }
@@ -619,6 +629,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   int errors = 0;
   std::vector<stack::MoveComparison> demo_nominal, random_nominal, at_corners;
   std::vector<double> solve_times;
+  std::size_t least_effort = 0;
   for (std::size_t i = 0; i < maneuvers.size(); ++i) {
     const MoveResult& r = results[i];
     if (!r.error.empty()) {
@@ -627,6 +638,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
       continue;
     }
     solve_times.push_back(r.solve_seconds);
+    if (r.least_effort) ++least_effort;
     for (const auto& run : r.runs) {
       const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
       (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
@@ -658,10 +670,11 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   print_summary("every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3): settle / T*", at_corners);
   std::sort(solve_times.begin(), solve_times.end());
   if (!solve_times.empty()) {
-    std::printf("\nbound solve (IPOPT, %d intervals): median %.2f s, max %.2f s over %zu moves; %.1f s wall on %u "
-                "thread(s)\n",
+    std::printf("\nbound solve (IPOPT, %d intervals, both solves): median %.2f s, max %.2f s over %zu moves; %.1f s "
+                "wall on %u thread(s); the least-effort trajectory on %zu of them (the others the minimum-time "
+                "solve's)\n",
                 intervals, stack::nearest_rank_quantile(solve_times, 0.5), solve_times.back(), solve_times.size(), wall,
-                std::max(1U, jobs));
+                std::max(1U, jobs), least_effort);
   }
   if (!out_dir.empty()) {
     fs::create_directories(out_dir);

@@ -29,9 +29,14 @@
 // The initial guess: each drive axis and the hoist on the linear time-optimal swing-free profile
 // (trajectory_planner/time_optimal_profile.hpp), the swings at 0.
 //
+// The trajectory returned is by default (MinimumTimeProblem::least_effort) not the minimum-time
+// solution but a second solve at 1.01 T* (1.02 or 1.04 T* where IPOPT does not solve that) for
+// the least input and swing; MinimumTimeResult::duration is T*, trajectory_duration the nodes'.
+//
 // Errors: solve_minimum_time throws common::ConfigError naming the field, the value and the bound
 // for a problem that is malformed (a non-finite or non-positive limit, a start or target outside
-// its axis's range, intervals outside [4, 2000]); a problem IPOPT does not solve is returned with
+// its axis's range, intervals outside [4, 2000], least_effort_margin outside [0, 0.5],
+// least_effort_tolerance outside [1e-14, 1e-2]); a problem IPOPT does not solve is returned with
 // `solved == false` and IPOPT's status in `status` (never an exception).
 //
 // Threads: solve_minimum_time may be called from several threads; the solves run one at a time
@@ -75,6 +80,27 @@ struct MinimumTimeProblem {
                                       // inputs where an axis has slack (without it IPOPT wanders on the overhead
                                       // crane's long moves); 1e-5 changes T* by < 1e-4 s on the demo maneuvers
                                       // (docs/optimal_control.md)
+  /// After T* is found, solve again at the fixed duration (1 + least_effort_margin) T* for the
+  /// least input and swing: the objective (1 / (N + 1)) sum over the nodes of sum_j (a_j /
+  /// max_acceleration_j)^2 + sum_i (swing_i / max_swing)^2, plus the smoothing term above, started
+  /// from the header's initial guess (the linear profiles) held to that duration: a lexicographic
+  /// objective, the time first, then the effort. Where IPOPT does not solve it (it stops at a
+  /// point it calls locally infeasible on some long moves), again at twice and at four times the
+  /// margin. T* is the first solve's; the trajectory is the second's where IPOPT solves one of the
+  /// three (else the first's, at T*).
+  /// Why: at T* itself an axis with slack is not free. On the overhead crane's long bridge moves
+  /// the first solve gains a fraction of a percent over the bridge's swing-free profile by swinging
+  /// the load across the girder near the bound's swing limit (0.17 rad), the trolley drive at its
+  /// 10 V for the whole move, so the follower had no drive left for feedback and tripped the
+  /// overspeed on a mismatched crane; a second solve at T* exactly found the same trajectory, at
+  /// 1.01 T* the trolley's swing is 0.007 rad at 1.4 V (tests/optimal_control/test_minimum_time.cpp;
+  /// docs/optimal_control.md, "The least-effort trajectory").
+  bool least_effort{true};
+  double least_effort_margin{0.01};   // [-] in [0, 0.5]: the second solve's duration over T*, minus 1
+  double least_effort_tolerance{1e-5};  // IPOPT's tol of the second solve, in [1e-14, 1e-2]: its optimum is a
+                                      // preference, not a bound (the constraints keep constr_viol_tol 1e-9);
+                                      // 1e-8 took 187 iterations on the test's overhead move, 1e-5 56, the
+                                      // same trajectory to 1e-4 rad of swing
   double tolerance{1e-8};             // IPOPT's tol
   int max_iterations{3000};
 };
@@ -95,12 +121,17 @@ struct TrajectoryNode {
 struct MinimumTimeResult {
   bool solved{false};
   std::string status;                     // IPOPT's return status, e.g. "Solve_Succeeded"
-  double duration{0.0};                   // [s] T*
+  double duration{0.0};                   // [s] T*, the minimum time
+  double trajectory_duration{0.0};        // [s] T of the nodes: (1 + k least_effort_margin) T*, k = 1, 2 or 4,
+                                          // when least_effort (below) is true, else T*
   std::vector<TrajectoryNode> nodes;      // intervals + 1 nodes, t = k T / N
   int iterations{0};
-  double solve_seconds{0.0};              // [s] wall time of IPOPT
+  double solve_seconds{0.0};              // [s] wall time of IPOPT, both solves
   double max_defect{0.0};                 // largest collocation defect at the solution [SI]
   double initial_guess_duration{0.0};     // [s] the linear profiles' duration the solve started from
+  bool least_effort{false};               // the nodes are the least-effort solve's (MinimumTimeProblem::least_effort)
+  std::string effort_status;              // IPOPT's return status of the last least-effort solve ("" if none ran)
+  int effort_iterations{0};               // of every least-effort solve
 };
 
 /// Validates `problem` (see the header's Errors) and solves it.
@@ -110,7 +141,8 @@ struct MinimumTimeResult {
 void validate(const MinimumTimeProblem& problem);
 
 /// The trajectory between nodes: states and inputs linear in time (the trapezoidal rule's own
-/// interpolation of the inputs; the states to the same order). `time` [s] is clamped to [0, T].
+/// interpolation of the inputs; the states to the same order). `time` [s] is clamped to [0, T],
+/// T = result.trajectory_duration.
 [[nodiscard]] TrajectoryNode sample(const MinimumTimeResult& result, double time);
 
 /// Drive voltage [V] of one axis at speed `velocity` for a drive force `force` [N or N m]:
