@@ -136,7 +136,7 @@ optimal_control::MinimumTimeResult comparison_bound(const StackConfig& cfg, cons
 MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
                             const optimal_control::MinimumTimeResult& bound,
                             const std::vector<ComparedController>& controllers, const plant::PlantMismatch& mismatch,
-                            int intervals) {
+                            int intervals, const optimal_control::FollowerParams& follower) {
   MoveComparison out;
   out.maneuver = m;
   out.mismatch = mismatch;
@@ -152,6 +152,7 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         run.mismatch = mismatch;
         run.intervals = intervals;
         run.bound = bound;
+        run.follower = follower;
         const FollowerResult r = run_follower(cfg, run);
         o.metrics = r.metrics;
         o.latched_faults = r.latched_faults;

@@ -573,7 +573,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
 // seeded random moves, each controller's settle time as a ratio to T*, on the nominal plant and,
 // with `corners`, at the eight mismatch corners; one move (its bound and its runs) per thread.
 int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, const std::string& controllers_text,
-            int intervals, unsigned jobs, const std::string& out_dir) {
+            int intervals, unsigned jobs, const optimal_control::FollowerParams& follower, const std::string& out_dir) {
   const auto cfg = load_config(s);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
@@ -606,7 +606,8 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
         results[i].solve_seconds = bound.solve_seconds;
         results[i].least_effort = bound.least_effort;
         for (const auto& plant : plants) {
-          results[i].runs.push_back(stack::compare_move(cfg, maneuvers[i], bound, controllers, plant, intervals));
+          results[i].runs.push_back(
+              stack::compare_move(cfg, maneuvers[i], bound, controllers, plant, intervals, follower));
         }
       } catch (const std::exception& error) {
         results[i].error = error.what();
@@ -806,6 +807,33 @@ int gantry_gains(double full_forward_gain) {
   return 0;
 }
 
+// The follower's weights and friction scales (optimal_control::FollowerParams), for follow and compare.
+void add_follower_options(CLI::App* cmd, optimal_control::FollowerParams& params) {
+  // Bryson's acceptable deviations, along the trajectory ("--NAME-weight") and at the target ("--hold-NAME-weight").
+  const auto add_weights = [cmd](const std::string& prefix, const std::string& where,
+                                 optimal_control::FollowerWeights& w) {
+    const std::pair<const char*, double*> fields[] = {{"position", &w.position}, {"swing", &w.swing},
+                                                      {"speed", &w.speed}, {"swing-rate", &w.swing_rate},
+                                                      {"voltage", &w.voltage}};
+    const char* units[] = {"[m or rad]", "[rad]", "[m/s or rad/s]", "[rad/s]", "[V]"};
+    for (std::size_t i = 0; i < std::size(fields); ++i) {
+      cmd->add_option("--" + prefix + fields[i].first + "-weight", *fields[i].second,
+                      where + "acceptable " + std::string(fields[i].first) + " deviation " + units[i])
+          ->check(CLI::PositiveNumber);
+    }
+  };
+  add_weights("", "the LQR's ", params.weights);
+  add_weights("hold-", "at the target: ", params.hold.weights);
+  cmd->add_option("--trajectory-sliding-friction-scale", params.trajectory_sliding_friction_scale,
+                  "along the trajectory: the fraction of the sliding friction compensated on the measured speed; "
+                  "the rest fed forward at the reference speed [-]")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--hold-sliding-friction-scale", params.hold.sliding_friction_scale,
+                  "at the target: the fraction of the plant's sliding friction compensated, the plant's estimated "
+                  "along the move [-]")
+      ->check(CLI::Range(0.0, 1.0));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -896,27 +924,7 @@ int main(int argc, char** argv) {
   follow_cmd->add_option("--mismatch", mismatch, "one plant instead of the nominal: cable length, load mass and friction factors")
       ->expected(3)->check(CLI::Range(0.1, 10.0));
   optimal_control::FollowerParams follower_params;
-  optimal_control::FollowerWeights& weights = follower_params.weights;
-  follow_cmd->add_option("--position-weight", weights.position, "the LQR's acceptable position deviation [m or rad]")
-      ->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--swing-weight", weights.swing, "acceptable swing [rad]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--speed-weight", weights.speed, "acceptable speed deviation [m/s or rad/s]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--swing-rate-weight", weights.swing_rate, "acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--voltage-weight", weights.voltage, "acceptable input [V]")->check(CLI::PositiveNumber);
-  optimal_control::FollowerWeights& hold = follower_params.hold.weights;
-  follow_cmd->add_option("--hold-position-weight", hold.position, "at the target: acceptable position deviation [m or rad]")
-      ->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--hold-swing-weight", hold.swing, "at the target: acceptable swing [rad]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--hold-speed-weight", hold.speed, "at the target: acceptable speed [m/s or rad/s]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--hold-swing-rate-weight", hold.swing_rate, "at the target: acceptable swing rate [rad/s]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--hold-voltage-weight", hold.voltage, "at the target: acceptable input [V]")->check(CLI::PositiveNumber);
-  follow_cmd->add_option("--trajectory-sliding-friction-scale", follower_params.trajectory_sliding_friction_scale,
-                         "along the trajectory: the fraction of the sliding friction compensated on the measured speed; "
-                         "the rest fed forward at the reference speed [-]")
-      ->check(CLI::Range(0.0, 1.0));
-  follow_cmd->add_option("--hold-sliding-friction-scale", follower_params.hold.sliding_friction_scale,
-                         "at the target: the fraction of the sliding friction compensation applied [-]")
-      ->check(CLI::Range(0.0, 1.0));
+  add_follower_options(follow_cmd, follower_params);
 
   auto* compare_cmd = app.add_subcommand("compare", "every controller's settle time against T*: demo and seeded random moves");
   common_options(compare_cmd);
@@ -934,6 +942,8 @@ int main(int argc, char** argv) {
   compare_cmd->add_option("--intervals", compare_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
   compare_cmd->add_option("--jobs", compare_jobs, "threads (default: every core)")->check(CLI::Range(1, 256));
   compare_cmd->add_option("--out", out_dir, "write compare.csv here");
+  optimal_control::FollowerParams compare_follower;
+  add_follower_options(compare_cmd, compare_follower);
 
   auto* gantry_cmd = app.add_subcommand("gantry-gains", "section 3.2.2 on the gantry: Figures 3.5-3.6 gains, 3.7-3.8 rows");
   double full_forward_gain = 3.0;
@@ -956,7 +966,7 @@ int main(int argc, char** argv) {
     if (*bound_cmd) return bound(s, intervals, out_dir);
     if (*compare_cmd) {
       return compare(s, compare_moves, compare_seed, compare_corners, compare_controllers, compare_intervals, compare_jobs,
-                     out_dir);
+                     compare_follower, out_dir);
     }
     if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed);
   } catch (const std::exception& error) {

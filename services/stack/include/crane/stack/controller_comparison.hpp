@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "crane/optimal_control/minimum_time.hpp"
+#include "crane/optimal_control/trajectory_follower.hpp"
 #include "crane/plant/plant_stage.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
@@ -86,12 +87,13 @@ struct MoveComparison {
                                                                   const ManeuverConfig& maneuver, int intervals = 200);
 
 /// Runs each of `controllers` on `maneuver` against a plant with `mismatch`, the ratio taken to
-/// `bound` (comparison_bound of the same maneuver and intervals). A run that throws is kept with
-/// its error and NaN figures.
+/// `bound` (comparison_bound of the same maneuver and intervals); the follower with `follower`'s
+/// weights (FollowerRun::follower). A run that throws is kept with its error and NaN figures.
 [[nodiscard]] MoveComparison compare_move(const StackConfig& config, const ManeuverConfig& maneuver,
                                           const optimal_control::MinimumTimeResult& bound,
                                           const std::vector<ComparedController>& controllers,
-                                          const plant::PlantMismatch& mismatch = {}, int intervals = 200);
+                                          const plant::PlantMismatch& mismatch = {}, int intervals = 200,
+                                          const optimal_control::FollowerParams& follower = {});
 
 /// The eight corners of cable length and load mass x0.8/x1.2 and friction x0.7/x1.3 (issue 32).
 [[nodiscard]] std::vector<plant::PlantMismatch> mismatch_corners();
