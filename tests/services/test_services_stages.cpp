@@ -631,6 +631,59 @@ TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarrie
   EXPECT_EQ(command.sliding_friction_reduction, 0.0);
 }
 
+// Along a move the follower's stage estimates the plant's friction over the model's from its own
+// feedback (friction_factor_estimate.hpp), and at the target scales the sliding part the friction
+// compensation keeps by it: here the feedback is made (by the trolley's position error against a
+// gain of 40 V/m) 0.3 F(v_ref) + 0.05 a_ref, a plant with 30 % more friction.
+TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlongTheMove) {
+  common::StackFacts facts;
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
+  config::YamlSection block(yaml, "tracking");
+  tracking::TrackingStageParams params = tracking::read_params(block, facts);
+  params.law = tracking::TrackingLaw::follower;
+  tracking::TrackingStage stage{params};
+  const common::AxisFriction& friction = facts.crane.trolley_friction;
+  protocol::Reference reference;
+  reference.cable_length = 1.0;
+  reference.request_id = 4;
+  common::TrajectoryFeedback law;
+  law.gain[0] = 40.0;  // [V/m]
+  law.sliding_friction_reduction = 0.5;  // along the trajectory
+  protocol::LinearCommand command;
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.01 * k;
+    law.position[0] = 0.3 + 0.2 * (1.0 - std::cos(std::numbers::pi * t / 2.0));
+    law.velocity[0] = 0.1 * std::numbers::pi * std::sin(std::numbers::pi * t / 2.0);
+    const double acceleration = 0.05 * std::numbers::pi * std::numbers::pi * std::cos(std::numbers::pi * t / 2.0);
+    common::set_trajectory_feedback(law, false, reference);
+    reference.trolley_acceleration = acceleration;
+    const double feedback = 0.3 * tracking::FrictionFactorEstimate::sliding_friction(friction, law.velocity[0]) +
+                            0.05 * acceleration;
+    auto state = at_rest(static_cast<std::uint64_t>(k + 1), law.position[0] - feedback / 40.0);
+    state.trolley_velocity = law.velocity[0];
+    ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+    EXPECT_NEAR(command.trolley_voltage, feedback, 1e-9);
+    EXPECT_EQ(command.sliding_friction_reduction, 0.5) << "along the move, as the law says";
+  }
+  // At the target (the reference at rest), the hold's kept 0.7 scaled by f = 1.3; also once the
+  // planner holds (request 0).
+  law.velocity = {};
+  law.sliding_friction_reduction = 0.3;
+  common::set_trajectory_feedback(law, false, reference);
+  reference.trolley_acceleration = 0.0;
+  for (const std::uint32_t request : {4U, 0U}) {
+    reference.request_id = request;
+    ASSERT_EQ(stage.step(at_rest(300, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
+              common::StepStatus::ok);
+    EXPECT_NEAR(command.sliding_friction_reduction, 1.0 - 0.7 * 1.3, 1e-6) << request;
+  }
+  // A new move starts with the model's friction (factor 1) until it has rows of its own.
+  reference.request_id = 5;
+  ASSERT_EQ(stage.step(at_rest(301, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
+            common::StepStatus::ok);
+  EXPECT_NEAR(command.sliding_friction_reduction, 0.3, 1e-12);
+}
+
 TEST(TrackingStage, TheFollowerLawDrivesTheBridgeOfAnOverheadCrane) {
   common::StackFacts overhead;
   overhead.crane_kind = common::CraneKind::overhead;

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <string>
 
 #include "crane/common/validation.hpp"
+#include "crane/tracking/friction_factor_estimate.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
 namespace tr = crane::tracking;
@@ -203,4 +205,72 @@ TEST(TrackingController, AccelerationFeedforwardAddsTheReferenceAcceleration) {
   EXPECT_NEAR(b.command.slew_voltage - a.command.slew_voltage, inertia * -2.0796 / params.slew_drive_gain, 1e-12);
   // Off by default: the dissertation's law.
   EXPECT_FALSE(tr::TrackingParams{}.acceleration_feedforward);
+}
+
+// The friction factor (friction_factor_estimate.hpp) from rows made by hand: the LQR's part of the
+// voltage is (f - 1) F(v_ref) + c_j a_ref plus seeded noise, on both drive axes at once; f is
+// recovered, an axis without rows (a gantry's second axis) leaves it solvable, too few rows give 1.
+TEST(FrictionFactorEstimate, RecoversTheFrictionFactorFromTheFeedbackRows) {
+  const crane::common::CraneParameters crane;
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.05);  // [V]
+  for (const double f : {0.7, 1.0, 1.3}) {
+    for (const bool second_axis : {true, false}) {
+      tr::FrictionFactorEstimate estimate(crane.trolley_friction, crane.slew_friction);
+      for (int k = 0; k < 250; ++k) {
+        const double t = 0.01 * k;
+        const double v = 0.4 * std::sin(std::numbers::pi * t / 2.5);      // [m/s] one direction, rest to rest
+        const double a = 0.4 * std::numbers::pi / 2.5 * std::cos(std::numbers::pi * t / 2.5);
+        const double u = (f - 1.0) * tr::FrictionFactorEstimate::sliding_friction(crane.trolley_friction, v) +
+                         0.08 * a + noise(random);
+        estimate.add(0, u, v, a);
+        if (second_axis) {
+          const double w = -0.9 * std::sin(std::numbers::pi * t / 2.5);  // [rad/s] the slew the other way
+          const double b = -0.9 * std::numbers::pi / 2.5 * std::cos(std::numbers::pi * t / 2.5);
+          estimate.add(1, (f - 1.0) * tr::FrictionFactorEstimate::sliding_friction(crane.slew_friction, w) - 0.3 * b +
+                              noise(random), w, b);
+        }
+      }
+      EXPECT_GT(estimate.rows(), 200);
+      EXPECT_NEAR(estimate.factor(), f, 0.01) << "f " << f << " second axis " << second_axis;
+    }
+  }
+  // By hand: Coulomb and viscous, direction dependent (3.1): 0.9 + 1.5 v, -1.2 + 6.0 v.
+  EXPECT_DOUBLE_EQ(tr::FrictionFactorEstimate::sliding_friction(crane.trolley_friction, 0.2), 0.9 + 1.5 * 0.2);
+  EXPECT_DOUBLE_EQ(tr::FrictionFactorEstimate::sliding_friction(crane.trolley_friction, -0.2), -1.2 - 6.0 * 0.2);
+  EXPECT_EQ(tr::FrictionFactorEstimate::sliding_friction(crane.trolley_friction, 0.0), 0.0);
+
+  // Rows only where the reference slides, and finite; fewer than min_rows: the model's friction.
+  tr::FrictionFactorEstimate sparse(crane.trolley_friction, crane.slew_friction);
+  for (int k = 0; k < 100; ++k) sparse.add(0, 1.0, 0.01, 0.0);  // below min_reference_speed
+  sparse.add(0, std::nan(""), 0.3, 0.0);
+  sparse.add(1, 1.0, std::numeric_limits<double>::infinity(), 0.0);
+  sparse.add(2, 1.0, 0.3, 0.0);  // no such axis
+  EXPECT_EQ(sparse.rows(), 0);
+  for (int k = 0; k < 19; ++k) sparse.add(0, 5.0, 0.3, 0.0);
+  EXPECT_EQ(sparse.factor(), 1.0);
+  sparse.add(0, 5.0, 0.3, 0.0);  // the 20th row: f = 1 + 5 / 1.35, clamped to max_factor
+  EXPECT_EQ(sparse.factor(), tr::FrictionFactorParams{}.max_factor);
+  sparse.reset();
+  EXPECT_EQ(sparse.rows(), 0);
+  EXPECT_EQ(sparse.factor(), 1.0);
+
+  // Bad params name the field.
+  const auto message = [&](const tr::FrictionFactorParams& p) {
+    try {
+      tr::FrictionFactorEstimate bad(crane.trolley_friction, crane.slew_friction, p);
+    } catch (const crane::common::ConfigError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  tr::FrictionFactorParams p;
+  p.min_rows = 2;
+  EXPECT_NE(message(p).find("friction_factor.min_rows"), std::string::npos) << message(p);
+  p = {};
+  p.max_factor = 0.4;
+  EXPECT_NE(message(p).find("friction_factor.max_factor"), std::string::npos) << message(p);
+  p = {};
+  p.min_reference_speed = 0.0;
+  EXPECT_NE(message(p).find("friction_factor.min_reference_speed"), std::string::npos) << message(p);
 }

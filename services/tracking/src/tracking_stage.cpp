@@ -1,5 +1,6 @@
 #include "crane/tracking/tracking_stage.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -48,6 +49,8 @@ TrackingStageParams params_for(const common::CraneParameters& crane, const Track
   p.gain_scheduling.min_cable_length = crane.min_cable_length;
   p.trolley_drive_mass = crane.trolley_drive_mass;
   p.jib_inertia = crane.jib_inertia;
+  p.trolley_friction = crane.trolley_friction;
+  p.second_friction = facts.crane_kind == common::CraneKind::overhead ? facts.bridge.friction : crane.slew_friction;
   return p;
 }
 
@@ -76,7 +79,8 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
       tracking_(params.tracking),
       voltage_limit_(params.tracking.voltage_limit),
       trolley_drive_mass_(params.trolley_drive_mass),
-      jib_inertia_(params.jib_inertia) {
+      jib_inertia_(params.jib_inertia),
+      friction_factor_(params.trolley_friction, params.second_friction) {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
   common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
   if (law_ == TrackingLaw::gain_scheduling_partial || law_ == TrackingLaw::gain_scheduling_full) {
@@ -146,7 +150,7 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
 }
 
 common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
-                                         protocol::LinearCommand& command) const noexcept {
+                                         protocol::LinearCommand& command) noexcept {
   const bool bridge = bridge_ != nullptr;
   const std::array<double, 4> position{estimate.trolley_position, estimate.swing_in_plane,
                                        bridge ? estimate.bridge_position : estimate.slew_angle,
@@ -154,15 +158,34 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   const std::array<double, 4> velocity{estimate.trolley_velocity, estimate.swing_in_plane_rate,
                                        bridge ? estimate.bridge_velocity : estimate.slew_rate,
                                        estimate.swing_out_of_plane_rate};
-  const std::array<double, 2> u =
-      trajectory_feedback_voltages(common::to_trajectory_feedback(reference, bridge), position, velocity, voltage_limit_);
+  const common::TrajectoryFeedback law = common::to_trajectory_feedback(reference, bridge);
+  const std::array<double, 2> u = trajectory_feedback_voltages(law, position, velocity, voltage_limit_);
   command = protocol::LinearCommand{};
   common::same_cycle(estimate.header, command.header);
-  const double reduction = reference.sliding_friction_reduction;
+  double reduction = reference.sliding_friction_reduction;
   if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(reference.cable_length_rate) ||
       !(reduction >= 0.0 && reduction <= 1.0)) {
     return common::StepStatus::rejected_nonfinite;  // 0 V, the safe output
   }
+  // The friction factor (friction_factor_estimate.hpp): rows along the move, from the LQR's part of
+  // each drive's voltage where it is not clamped; at the target, the kept sliding part scaled by it.
+  if (reference.request_id != 0 && reference.request_id != friction_request_) {  // a new move (0: holding)
+    friction_factor_.reset();
+    friction_request_ = reference.request_id;
+  }
+  const std::array<double, 2> reference_speed{reference.trolley_velocity,
+                                              bridge ? reference.bridge_velocity : reference.slew_rate};
+  const std::array<double, 2> reference_acceleration{
+      reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
+  for (int axis = 0; axis < 2; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    if (std::abs(u[a]) < voltage_limit_) {
+      friction_factor_.add(axis, u[a] - law.feedforward[a], reference_speed[a], reference_acceleration[a]);
+    }
+  }
+  const bool at_target = reference_speed[0] == 0.0 && reference_speed[1] == 0.0 && reference_acceleration[0] == 0.0 &&
+                         reference_acceleration[1] == 0.0;
+  if (at_target) reduction = 1.0 - std::min(1.0, (1.0 - reduction) * friction_factor_.factor());
   command.trolley_voltage = u[0];
   (bridge ? command.bridge_voltage : command.slew_voltage) = u[1];
   command.hoist_speed = reference.cable_length_rate;

@@ -71,12 +71,16 @@ struct FollowerHold {
   /// 0.2 deg drives the trolley unstable on a random tower move with a 20 % shorter cable and 30 %
   /// less friction: docs/optimal_control.md, "The swing weights").
   FollowerWeights weights{0.005, 0.004, 0.05, 0.05, 0.2};
-  /// [-] in [0, 1]: the fraction of the friction compensation's sliding part (Coulomb and viscous,
-  /// (3.1), (3.3)) to apply while a drive slides after the trajectory; the stiction part (3.2) stays
-  /// whole. Compensation of a friction 30 % above the plant's pushes the drive along its motion and
-  /// sustains a 1.5-2.5 Hz hunting around the target; at 0.5 the sliding drive is braked by the
-  /// remaining friction. 1 keeps the compensation as configured.
-  double sliding_friction_scale{0.5};
+  /// [-] in [0, 1]: the fraction of the plant's sliding friction (Coulomb and viscous, (3.1),
+  /// (3.3)) the compensation applies while a drive slides after the trajectory; the stiction part
+  /// (3.2) stays whole. The law carries it as a fraction of the model's friction; the tracking
+  /// stage multiplies it by the plant's friction over the model's, estimated along the move
+  /// (tracking/friction_factor_estimate.hpp), before it reaches the compensation. Compensation of
+  /// a friction 30 % above the plant's pushes the drive along its motion and sustains a 1.5-2.5 Hz
+  /// hunting around the target; 30 % too little leaves the drive stuck with the swing undamped.
+  /// 0.7 with the estimate (0.5 of the model's before it: docs/optimal_control.md, "The friction
+  /// the hold compensates"). 1 keeps the compensation as configured.
+  double sliding_friction_scale{0.7};
 };
 
 struct FollowerParams {

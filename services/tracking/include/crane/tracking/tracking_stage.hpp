@@ -12,7 +12,10 @@
 //                            minimum-time follower's feedforward and time-varying LQR gains,
 //                            trajectory_feedback.hpp; docs/optimal_control.md), the hoist at the
 //                            reference's cable rate and the reference's sliding friction reduction
-//                            passed on to the friction compensation; a reference without a law
+//                            passed on to the friction compensation; at the target (the law's
+//                            reference at rest) the sliding part kept is scaled by the plant's
+//                            friction over the model's, estimated along the move from the law's
+//                            feedback (friction_factor_estimate.hpp); a reference without a law
 //                            (holding, a stop, manual motion) is tracked by `tracking`
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
@@ -28,6 +31,7 @@
 #include "crane/common/stack_facts.hpp"
 #include "crane/gain_scheduling/gain_scheduling_controller.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/tracking/friction_factor_estimate.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
 namespace crane::config {
@@ -48,6 +52,10 @@ struct TrackingStageParams {
   gain_scheduling::GainSchedulingParams gain_scheduling{};  // the gain-scheduling laws (kind follows law)
   double trolley_drive_mass{22.222};  // [kg] M, > 0: m_t = payload_mass / M when the estimate is confident
   double jib_inertia{7.143};          // [kg m^2] J_o, > 0: m_r = payload_mass / J_o
+  // The follower's drives' friction model (the crane's, the second axis the slew's or the bridge's),
+  // for the friction factor it estimates along a move.
+  common::AxisFriction trolley_friction{};
+  common::AxisFriction second_friction{};
   // An overhead crane (facts.crane_kind): the bridge's stage, the same law on the bridge's gantry view
   // (common::bridge_view) with the bridge's drive (common::bridge_as_trolley); null elsewhere.
   std::shared_ptr<const TrackingStageParams> bridge;
@@ -76,7 +84,7 @@ class TrackingStage {
  private:
   /// The follower law on a reference that carries one.
   [[nodiscard]] common::StepStatus follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
-                                          protocol::LinearCommand& command) const noexcept;
+                                          protocol::LinearCommand& command) noexcept;
 
   TrackingLaw law_;
   TrackingController tracking_;
@@ -85,6 +93,8 @@ class TrackingStage {
   double trolley_drive_mass_;  // [kg]
   double jib_inertia_;         // [kg m^2]
   std::unique_ptr<TrackingStage> bridge_;  // the overhead crane's bridge (its trolley is the bridge)
+  FrictionFactorEstimate friction_factor_;  // the follower's, over the move of friction_request_
+  std::uint32_t friction_request_{0};
 };
 
 }  // namespace crane::tracking

@@ -1,0 +1,64 @@
+#pragma once
+// The plant's sliding friction as a multiple of the model's, estimated along a followed trajectory
+// from the follower's own feedback (docs/optimal_control.md, "The friction the hold compensates").
+//
+// Along a minimum-time trajectory the follower's feedforward carries the model's drive voltage, part
+// of the model's friction at the reference speed, and the friction compensation adds the rest on the
+// measured speed; a plant whose friction is f times the model's needs (f - 1) F(v) more, and the
+// time-varying LQR supplies it as feedback. Per cycle and drive axis j that slides on the reference
+// (|v_ref,j| >= min_reference_speed), one row of the linear regression
+//   u_fb,j = theta_0 F_j(v_ref,j) + theta_(1+j) a_ref,j + e,     f = 1 + theta_0
+// where u_fb = u - feedforward [V] is the LQR's part of the drive voltage, F_j the model's sliding
+// friction (3.1) in volt-equivalents (Coulomb and viscous, direction dependent) and a_ref the
+// reference acceleration, whose coefficient takes the inertia the model gets wrong (the load mass,
+// the axis's own). Least squares over every row of the move, solved when asked:
+//   (Phi^T Phi + ridge I) theta = Phi^T u_fb,
+// the ridge (1e-9 of the information's trace) only so an axis with no rows (a gantry's second axis)
+// leaves its coefficient at 0. factor() is f clamped to [min_factor, max_factor], and 1 while fewer
+// than min_rows rows were taken (no information: the model's friction).
+//
+// Real-time: add() and factor() are noexcept and allocate nothing. reset() starts a new move.
+// Errors: the constructor throws common::ConfigError naming the field, the value and the bound.
+
+#include <cstdint>
+
+#include "crane/common/crane_parameters.hpp"
+
+namespace crane::tracking {
+
+struct FrictionFactorParams {
+  double min_reference_speed{0.05};  // [m/s or rad/s] > 0: rows only where the reference slides
+  int min_rows{20};                  // [-] >= 3: fewer rows give factor() = 1
+  double min_factor{0.5};            // [-] > 0
+  double max_factor{2.0};            // [-] >= min_factor
+};
+
+class FrictionFactorEstimate {
+ public:
+  /// `friction[j]`: the model's friction of drive axis j (0: trolley, 1: the slew or the bridge).
+  FrictionFactorEstimate(const common::AxisFriction& trolley, const common::AxisFriction& second,
+                         const FrictionFactorParams& params = {});
+
+  /// Forgets every row (a new move).
+  void reset() noexcept;
+
+  /// One cycle of axis `axis` (0 or 1): the LQR's part of the voltage [V], the reference speed [m/s
+  /// or rad/s] and acceleration. Ignored where the reference does not slide or an input is not finite.
+  void add(int axis, double feedback_voltage, double reference_speed, double reference_acceleration) noexcept;
+
+  /// f, the plant's sliding friction over the model's (see the header); 1 without enough rows.
+  [[nodiscard]] double factor() const noexcept;
+  [[nodiscard]] int rows() const noexcept { return rows_; }
+
+  /// The model's sliding friction [V] of `friction` at speed `speed` (Coulomb and viscous, (3.1)).
+  [[nodiscard]] static double sliding_friction(const common::AxisFriction& friction, double speed) noexcept;
+
+ private:
+  common::AxisFriction friction_[2];
+  FrictionFactorParams params_;
+  double information_[3][3]{};  // Phi^T Phi
+  double moment_[3]{};          // Phi^T u_fb
+  int rows_{0};
+};
+
+}  // namespace crane::tracking

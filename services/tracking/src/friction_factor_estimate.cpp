@@ -1,0 +1,68 @@
+#include "crane/tracking/friction_factor_estimate.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "crane/common/validation.hpp"
+
+namespace crane::tracking {
+
+FrictionFactorEstimate::FrictionFactorEstimate(const common::AxisFriction& trolley, const common::AxisFriction& second,
+                                               const FrictionFactorParams& params)
+    : friction_{trolley, second}, params_(params) {
+  common::validate(trolley, "friction_factor.trolley");
+  common::validate(second, "friction_factor.second");
+  common::require_greater("friction_factor.min_reference_speed", params.min_reference_speed, 0.0);
+  common::require_finite("friction_factor.min_reference_speed", params.min_reference_speed);
+  common::require_in_range("friction_factor.min_rows", params.min_rows, 3, 1000000);
+  common::require_greater("friction_factor.min_factor", params.min_factor, 0.0);
+  common::require_in_range("friction_factor.max_factor", params.max_factor, params.min_factor, 100.0);
+}
+
+void FrictionFactorEstimate::reset() noexcept {
+  for (auto& row : information_) std::fill(std::begin(row), std::end(row), 0.0);
+  std::fill(std::begin(moment_), std::end(moment_), 0.0);
+  rows_ = 0;
+}
+
+double FrictionFactorEstimate::sliding_friction(const common::AxisFriction& f, double speed) noexcept {
+  if (speed > 0.0) return f.coulomb_positive + f.viscous_positive * speed;
+  if (speed < 0.0) return -f.coulomb_negative + f.viscous_negative * speed;
+  return 0.0;
+}
+
+void FrictionFactorEstimate::add(int axis, double feedback_voltage, double reference_speed,
+                                 double reference_acceleration) noexcept {
+  if (axis < 0 || axis > 1) return;
+  if (!std::isfinite(feedback_voltage) || !std::isfinite(reference_speed) || !std::isfinite(reference_acceleration)) {
+    return;
+  }
+  if (std::abs(reference_speed) < params_.min_reference_speed) return;
+  double phi[3] = {sliding_friction(friction_[axis], reference_speed), 0.0, 0.0};
+  phi[1 + axis] = reference_acceleration;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];
+    moment_[r] += phi[r] * feedback_voltage;
+  }
+  ++rows_;
+}
+
+double FrictionFactorEstimate::factor() const noexcept {
+  if (rows_ < params_.min_rows) return 1.0;
+  Eigen::Matrix3d a;
+  Eigen::Vector3d b;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) a(r, c) = information_[r][c];
+    b[r] = moment_[r];
+  }
+  const double ridge = 1e-9 * std::max(a.trace(), 1e-12);
+  a.diagonal().array() += ridge;
+  const Eigen::Vector3d theta = a.ldlt().solve(b);
+  const double f = 1.0 + theta[0];
+  if (!std::isfinite(f)) return 1.0;
+  return std::clamp(f, params_.min_factor, params_.max_factor);
+}
+
+}  // namespace crane::tracking
