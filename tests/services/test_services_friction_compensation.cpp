@@ -87,6 +87,35 @@ TEST(FrictionCompensation, TheSlidingReductionScalesTheSlidingPartAndKeepsSticti
   }
 }
 
+// The follower's friction factor at the target (LinearCommand.friction_factor, the plant's friction
+// over the model's as the tracking stage estimates it): the stiction part (3.2) at rest multiplied by
+// it, the sliding part kept by min(1, (1 - r) f); 0 leaves the compensation as configured; negative,
+// NaN or above 100 refused with the safe output.
+TEST(FrictionCompensation, TheFrictionFactorScalesStictionAndTheSlidingPartKept) {
+  fc::FrictionCompensation comp(fc::FrictionCompensationParams{});
+  fc::FrictionCompensationOutput out;
+  auto in = input(0.2, 0.5, 0.0, 3.0);  // trolley sliding, slew at rest
+  in.sliding_friction_reduction = 0.3;
+  in.friction_factor = 1.3;
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_friction, 0.7 * 1.3 * 1.2, 1e-12);  // (4.12): 0.9 + 1.5 x 0.2
+  EXPECT_NEAR(out.slew_friction, 1.3 * 0.7, 1e-9);            // stiction (4.15) x 1.3
+  in.friction_factor = 2.0;                                   // the sliding part at most whole
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_friction, 1.2, 1e-12);
+  EXPECT_NEAR(out.slew_friction, 2.0 * 0.7, 1e-9);
+  in.friction_factor = 0.0;  // unset: only the reduction
+  ASSERT_EQ(comp.step(in, out), StepStatus::ok);
+  EXPECT_NEAR(out.trolley_friction, 0.7 * 1.2, 1e-12);
+  EXPECT_NEAR(out.slew_friction, 0.7, 1e-9);
+  for (const double bad : {-0.1, 100.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    in.friction_factor = bad;
+    ASSERT_EQ(comp.step(in, out), StepStatus::rejected_nonfinite) << bad;
+    EXPECT_EQ(out.command.trolley_voltage, 0.0);
+    EXPECT_EQ(out.command.slew_voltage, 0.0);
+  }
+}
+
 TEST(FrictionCompensation, SlewUsesFilteredRateByDefault) {
   // Slew rate 0.5 rad/s (filtered): c+ + b+ w = 0.7 + 1.5*0.5 = 1.45 V (4.16); -0.5: -(0.6+0.025).
   fc::FrictionCompensation comp(fc::FrictionCompensationParams{});

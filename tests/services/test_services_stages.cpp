@@ -632,9 +632,10 @@ TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarrie
 }
 
 // Along a move the follower's stage estimates the plant's friction over the model's from its own
-// feedback (friction_factor_estimate.hpp), and at the target scales the sliding part the friction
-// compensation keeps by it: here the feedback is made (by the trolley's position error against a
-// gain of 40 V/m) 0.3 F(v_ref) + 0.05 a_ref, a plant with 30 % more friction.
+// feedback (friction_factor_estimate.hpp), and at the target hands it to the friction compensation
+// (LinearCommand_.friction_factor), which scales its stiction and the sliding part it keeps by it:
+// here the feedback is made (by the trolley's position error against a gain of 40 V/m)
+// 0.3 F(v_ref) + 0.05 a_ref, a plant with 30 % more friction.
 TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlongTheMove) {
   common::StackFacts facts;
   const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
@@ -664,9 +665,10 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
     ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
     EXPECT_NEAR(command.trolley_voltage, feedback, 1e-9);
     EXPECT_EQ(command.sliding_friction_reduction, 0.5) << "along the move, as the law says";
+    EXPECT_EQ(command.friction_factor, 0.0) << "unset along the move";
   }
-  // At the target (the reference at rest), the hold's kept 0.7 scaled by f = 1.3; also once the
-  // planner holds (request 0).
+  // At the target (the reference at rest): f = 1.3 with the hold's reduction, also once the planner
+  // holds (request 0); the compensation then keeps min(1, 0.7 x 1.3) of its sliding part.
   law.velocity = {};
   law.sliding_friction_reduction = 0.3;
   common::set_trajectory_feedback(law, false, reference);
@@ -675,13 +677,14 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
     reference.request_id = request;
     ASSERT_EQ(stage.step(at_rest(300, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
               common::StepStatus::ok);
-    EXPECT_NEAR(command.sliding_friction_reduction, 1.0 - 0.7 * 1.3, 1e-6) << request;
+    EXPECT_EQ(command.sliding_friction_reduction, 0.3) << request;
+    EXPECT_NEAR(command.friction_factor, 1.3, 1e-6) << request;
   }
   // A new move starts with the model's friction (factor 1) until it has rows of its own.
   reference.request_id = 5;
   ASSERT_EQ(stage.step(at_rest(301, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
             common::StepStatus::ok);
-  EXPECT_NEAR(command.sliding_friction_reduction, 0.3, 1e-12);
+  EXPECT_EQ(command.friction_factor, 1.0);
 }
 
 TEST(TrackingStage, TheFollowerLawDrivesTheBridgeOfAnOverheadCrane) {

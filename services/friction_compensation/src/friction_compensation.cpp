@@ -20,6 +20,8 @@ void validate_axis(const AxisCompensationParams& axis, const std::string& prefix
   }
 }
 
+constexpr double kMaxFrictionFactor = 100.0;  // a larger factor is refused (the safe output)
+
 FrictionCompensationParams validated(const FrictionCompensationParams& params) {
   validate_axis(params.trolley, "friction_compensation.trolley");
   validate_axis(params.slew, "friction_compensation.slew");
@@ -79,7 +81,8 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
   if (!std::isfinite(trolley_velocity) || !std::isfinite(slew_velocity) ||
       !std::isfinite(input.command.trolley_voltage) || !std::isfinite(input.command.slew_voltage) ||
       !std::isfinite(input.command.hoist_speed) ||
-      !(input.sliding_friction_reduction >= 0.0 && input.sliding_friction_reduction <= 1.0)) {
+      !(input.sliding_friction_reduction >= 0.0 && input.sliding_friction_reduction <= 1.0) ||
+      !(input.friction_factor >= 0.0 && input.friction_factor <= kMaxFrictionFactor)) {
     output = FrictionCompensationOutput{};
     return common::StepStatus::rejected_nonfinite;
   }
@@ -101,10 +104,12 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
         friction_voltage(in_use(params_.trolley, input.trolley_friction), trolley_velocity, input.command.trolley_voltage);
     output.slew_friction =
         friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
-    if (input.sliding_friction_reduction != 0.0) {
-      const double kept = 1.0 - input.sliding_friction_reduction;
-      if (friction_direction(trolley_velocity, params_.trolley.zero_velocity_band) != 0) output.trolley_friction *= kept;
-      if (friction_direction(slew_velocity, params_.slew.zero_velocity_band) != 0) output.slew_friction *= kept;
+    const double factor = input.friction_factor > 0.0 ? input.friction_factor : 1.0;
+    if (input.sliding_friction_reduction != 0.0 || factor != 1.0) {
+      const double kept = std::min(1.0, (1.0 - input.sliding_friction_reduction) * factor);
+      output.trolley_friction *=
+          friction_direction(trolley_velocity, params_.trolley.zero_velocity_band) != 0 ? kept : factor;
+      output.slew_friction *= friction_direction(slew_velocity, params_.slew.zero_velocity_band) != 0 ? kept : factor;
     }
     // Finite inputs can still overflow (a coefficient of 1e284 times a rate of 1e202): the clamp
     // below would pass Inf as the limit and NaN as is, so such a step gives the safe output.

@@ -54,6 +54,7 @@ common::StepStatus FrictionCompensationStage::step(const protocol::CraneState& e
   in.command.slew_voltage = linear.slew_voltage;
   in.command.hoist_speed = linear.hoist_speed;
   in.sliding_friction_reduction = linear.sliding_friction_reduction;
+  in.friction_factor = linear.friction_factor;
   // The friction re-estimated online, where the estimator released it (crane::adaptation).
   if ((estimate.adaptation & protocol::CraneState::ADAPTATION_TROLLEY_FRICTION_ADAPTED) != 0) {
     in.trolley_friction = common::trolley_friction_in_use(estimate);
@@ -73,6 +74,7 @@ common::StepStatus FrictionCompensationStage::step(const protocol::CraneState& e
     b.estimate = common::to_estimate(common::bridge_view(estimate));
     b.command.trolley_voltage = linear.bridge_voltage;
     b.sliding_friction_reduction = linear.sliding_friction_reduction;
+    b.friction_factor = linear.friction_factor;
     FrictionCompensationOutput bridge;
     const auto bridge_status = bridge_->step(b, bridge);
     command.bridge_voltage = bridge.command.trolley_voltage;

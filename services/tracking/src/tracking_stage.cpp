@@ -1,6 +1,5 @@
 #include "crane/tracking/tracking_stage.hpp"
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -162,13 +161,13 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   const std::array<double, 2> u = trajectory_feedback_voltages(law, position, velocity, voltage_limit_);
   command = protocol::LinearCommand{};
   common::same_cycle(estimate.header, command.header);
-  double reduction = reference.sliding_friction_reduction;
+  const double reduction = reference.sliding_friction_reduction;
   if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(reference.cable_length_rate) ||
       !(reduction >= 0.0 && reduction <= 1.0)) {
     return common::StepStatus::rejected_nonfinite;  // 0 V, the safe output
   }
   // The friction factor (friction_factor_estimate.hpp): rows along the move, from the LQR's part of
-  // each drive's voltage where it is not clamped; at the target, the kept sliding part scaled by it.
+  // each drive's voltage where it is not clamped; at the target, handed to the compensation.
   if (reference.request_id != 0 && reference.request_id != friction_request_) {  // a new move (0: holding)
     friction_factor_.reset();
     friction_request_ = reference.request_id;
@@ -185,11 +184,11 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   }
   const bool at_target = reference_speed[0] == 0.0 && reference_speed[1] == 0.0 && reference_acceleration[0] == 0.0 &&
                          reference_acceleration[1] == 0.0;
-  if (at_target) reduction = 1.0 - std::min(1.0, (1.0 - reduction) * friction_factor_.factor());
   command.trolley_voltage = u[0];
   (bridge ? command.bridge_voltage : command.slew_voltage) = u[1];
   command.hoist_speed = reference.cable_length_rate;
   command.sliding_friction_reduction = reduction;
+  command.friction_factor = at_target ? friction_factor_.factor() : 0.0;
   return common::StepStatus::ok;
 }
 

@@ -58,6 +58,11 @@ struct FrictionCompensationInput {
   // the minimum-time follower, whose feedforward carries the rest; optimal_control/
   // trajectory_follower.hpp). 0 keeps the compensation as configured.
   double sliding_friction_reduction{0.0};
+  // [-] >= 0: the plant's friction over the model's (LinearCommand's friction_factor, the minimum-time
+  // follower's estimate at the target; tracking/friction_factor_estimate.hpp): the stiction part (3.2)
+  // at rest is multiplied by it and the sliding part kept by min(1, (1 - sliding_friction_reduction)
+  // x it). 0 (unset) or 1: the model's friction.
+  double friction_factor{0.0};
 };
 
 struct FrictionCompensationOutput {

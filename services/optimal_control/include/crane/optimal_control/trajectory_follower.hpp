@@ -73,9 +73,10 @@ struct FollowerHold {
   FollowerWeights weights{0.005, 0.004, 0.05, 0.05, 0.2};
   /// [-] in [0, 1]: the fraction of the plant's sliding friction (Coulomb and viscous, (3.1),
   /// (3.3)) the compensation applies while a drive slides after the trajectory; the stiction part
-  /// (3.2) stays whole. The law carries it as a fraction of the model's friction; the tracking
-  /// stage multiplies it by the plant's friction over the model's, estimated along the move
-  /// (tracking/friction_factor_estimate.hpp), before it reaches the compensation. Compensation of
+  /// (3.2) is scaled as the plant's. The law carries it as a fraction of the model's friction; the
+  /// tracking stage estimates the plant's friction over the model's along the move
+  /// (tracking/friction_factor_estimate.hpp) and the compensation multiplies both parts by it
+  /// (LinearCommand_.friction_factor). Compensation of
   /// a friction 30 % above the plant's pushes the drive along its motion and sustains a 1.5-2.5 Hz
   /// hunting around the target; 30 % too little leaves the drive stuck with the swing undamped.
   /// 0.7 with the estimate (0.5 of the model's before it: docs/optimal_control.md, "The friction

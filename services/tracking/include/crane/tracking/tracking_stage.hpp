@@ -13,9 +13,10 @@
 //                            trajectory_feedback.hpp; docs/optimal_control.md), the hoist at the
 //                            reference's cable rate and the reference's sliding friction reduction
 //                            passed on to the friction compensation; at the target (the law's
-//                            reference at rest) the sliding part kept is scaled by the plant's
-//                            friction over the model's, estimated along the move from the law's
-//                            feedback (friction_factor_estimate.hpp); a reference without a law
+//                            reference at rest) also the plant's friction over the model's,
+//                            estimated along the move from the law's feedback
+//                            (friction_factor_estimate.hpp, LinearCommand_.friction_factor; 0
+//                            elsewhere, unset); a reference without a law
 //                            (holding, a stop, manual motion) is tracked by `tracking`
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
