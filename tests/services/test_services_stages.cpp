@@ -658,8 +658,8 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
     const double acceleration = 0.05 * std::numbers::pi * std::numbers::pi * std::cos(std::numbers::pi * t / 2.0);
     common::set_trajectory_feedback(law, false, reference);
     reference.trolley_acceleration = acceleration;
-    const double feedback = 0.3 * tracking::FrictionFactorEstimate::sliding_friction(friction, law.velocity[0]) +
-                            0.05 * acceleration;
+    const double sliding = friction.coulomb_positive + friction.viscous_positive * law.velocity[0];  // (3.1), v > 0
+    const double feedback = 0.3 * sliding + 0.05 * acceleration;
     auto state = at_rest(static_cast<std::uint64_t>(k + 1), law.position[0] - feedback / 40.0);
     state.trolley_velocity = law.velocity[0];
     ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "crane/common/validation.hpp"
+#include "crane/friction_compensation/friction_compensation.hpp"
 
 namespace crane::tracking {
 
@@ -27,12 +28,6 @@ void FrictionFactorEstimate::reset() noexcept {
   rows_ = 0;
 }
 
-double FrictionFactorEstimate::sliding_friction(const common::AxisFriction& f, double speed) noexcept {
-  if (speed > 0.0) return f.coulomb_positive + f.viscous_positive * speed;
-  if (speed < 0.0) return -f.coulomb_negative + f.viscous_negative * speed;
-  return 0.0;
-}
-
 void FrictionFactorEstimate::add(int axis, double feedback_voltage, double reference_speed,
                                  double reference_acceleration) noexcept {
   if (axis < 0 || axis > 1) return;
@@ -40,7 +35,12 @@ void FrictionFactorEstimate::add(int axis, double feedback_voltage, double refer
     return;
   }
   if (std::abs(reference_speed) < params_.min_reference_speed) return;
-  double phi[3] = {sliding_friction(friction_[axis], reference_speed), 0.0, 0.0};
+  // F(v_ref) (3.1): the compensation's regressor and coefficients, the one place they are written.
+  const auto regressor = friction_compensation::friction_regressor(reference_speed, reference_speed > 0.0 ? 1 : -1);
+  const auto coefficients = friction_compensation::sliding_coefficients(friction_[axis]);
+  double sliding = 0.0;
+  for (std::size_t i = 0; i < regressor.size(); ++i) sliding += coefficients[i] * regressor[i];
+  double phi[3] = {sliding, 0.0, 0.0};
   phi[1 + axis] = reference_acceleration;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];

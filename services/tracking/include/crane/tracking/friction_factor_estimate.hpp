@@ -9,7 +9,8 @@
 // (|v_ref,j| >= min_reference_speed), one row of the linear regression
 //   u_fb,j = theta_0 F_j(v_ref,j) + theta_(1+j) a_ref,j + e,     f = 1 + theta_0
 // where u_fb = u - feedforward [V] is the LQR's part of the drive voltage, F_j the model's sliding
-// friction (3.1) in volt-equivalents (Coulomb and viscous, direction dependent) and a_ref the
+// friction (3.1) in volt-equivalents (Coulomb and viscous, direction dependent; the compensation's
+// own regressor, friction_compensation::friction_regressor . sliding_coefficients) and a_ref the
 // reference acceleration, whose coefficient takes the inertia the model gets wrong (the load mass,
 // the axis's own). Least squares over every row of the move, solved when asked:
 //   (Phi^T Phi + ridge I) theta = Phi^T u_fb,
@@ -19,8 +20,6 @@
 //
 // Real-time: add() and factor() are noexcept and allocate nothing. reset() starts a new move.
 // Errors: the constructor throws common::ConfigError naming the field, the value and the bound.
-
-#include <cstdint>
 
 #include "crane/common/crane_parameters.hpp"
 
@@ -49,9 +48,6 @@ class FrictionFactorEstimate {
   /// f, the plant's sliding friction over the model's (see the header); 1 without enough rows.
   [[nodiscard]] double factor() const noexcept;
   [[nodiscard]] int rows() const noexcept { return rows_; }
-
-  /// The model's sliding friction [V] of `friction` at speed `speed` (Coulomb and viscous, (3.1)).
-  [[nodiscard]] static double sliding_friction(const common::AxisFriction& friction, double speed) noexcept;
 
  private:
   common::AxisFriction friction_[2];
