@@ -687,6 +687,47 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
   EXPECT_EQ(command.friction_factor, 1.0);
 }
 
+// At the target, the follower's hold adds the breakaway ramp (breakaway_ramp.hpp) to a drive the
+// friction holds at rest off it: 7 mm past on the trolley, 40 V/m of gain; after 0.1 s at rest,
+// 0.02 V more toward the target each cycle. The slew, on its target, gets none; a reference that
+// moves forgets the ramp.
+TEST(TrackingStage, TheFollowersHoldRampsADriveStuckOffTheTargetTowardIt) {
+  common::StackFacts facts;
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
+  config::YamlSection block(yaml, "tracking");
+  tracking::TrackingStageParams params = tracking::read_params(block, facts);
+  params.law = tracking::TrackingLaw::follower;
+  tracking::TrackingStage stage{params};
+  common::TrajectoryFeedback law;
+  law.position = {0.5, 0.0, 0.3, 0.0};
+  law.gain[0] = 40.0;      // [V/m]
+  law.gain[8 + 2] = 30.0;  // [V/rad]
+  protocol::Reference reference;
+  reference.cable_length = 1.0;
+  reference.request_id = 7;
+  common::set_trajectory_feedback(law, false, reference);
+  protocol::LinearCommand command;
+  auto state = at_rest(1, 0.507);
+  state.slew_angle = 0.3;
+  for (int k = 1; k <= 20; ++k) {
+    state.header.seq = static_cast<std::uint64_t>(k);
+    ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+    const double ramp = k < 10 ? 0.0 : -0.02 * (k - 9);
+    EXPECT_NEAR(command.trolley_voltage, -40.0 * 0.007 + ramp, 1e-9) << k;
+    EXPECT_EQ(command.slew_voltage, 0.0) << k;
+  }
+  // The reference moves again (a new leg of the same request): the law's voltage alone, and back at
+  // the target the ramp starts from nothing.
+  law.velocity[0] = 0.1;
+  common::set_trajectory_feedback(law, false, reference);
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+  EXPECT_NEAR(command.trolley_voltage, -40.0 * 0.007, 1e-9);
+  law.velocity[0] = 0.0;
+  common::set_trajectory_feedback(law, false, reference);
+  ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+  EXPECT_NEAR(command.trolley_voltage, -40.0 * 0.007, 1e-9);
+}
+
 TEST(TrackingStage, TheFollowerLawDrivesTheBridgeOfAnOverheadCrane) {
   common::StackFacts overhead;
   overhead.crane_kind = common::CraneKind::overhead;

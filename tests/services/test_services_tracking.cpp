@@ -8,6 +8,7 @@
 #include <string>
 
 #include "crane/common/validation.hpp"
+#include "crane/tracking/breakaway_ramp.hpp"
 #include "crane/tracking/friction_factor_estimate.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
@@ -273,4 +274,59 @@ TEST(FrictionFactorEstimate, RecoversTheFrictionFactorFromTheFeedbackRows) {
   p = {};
   p.min_reference_speed = 0.0;
   EXPECT_NE(message(p).find("friction_factor.min_reference_speed"), std::string::npos) << message(p);
+}
+
+// The breakaway ramp by hand (breakaway_ramp.hpp): 100 Hz, deadband 3 mm, at rest below 5 mm/s for
+// 0.1 s (10 cycles), then 2 V/s (0.02 V a cycle) toward the target, at most 1 V.
+TEST(BreakawayRamp, RampsADriveStuckOffTheTargetTowardItAndForgetsItInsideTheBand) {
+  tr::BreakawayRamp ramp{tr::BreakawayRampParams{}, 0.01};
+  // Stuck 7 mm past the target: nothing for 9 cycles, then -0.02 V more each cycle.
+  for (int k = 1; k <= 9; ++k) EXPECT_EQ(ramp.step(0, 0.007, 0.001), 0.0) << k;
+  EXPECT_NEAR(ramp.step(0, 0.007, -0.001), -0.02, 1e-15);
+  EXPECT_NEAR(ramp.step(0, 0.007, 0.0), -0.04, 1e-15);
+  // The other axis is its own: short of the target on the slew, the ramp is positive.
+  for (int k = 1; k <= 9; ++k) EXPECT_EQ(ramp.step(1, -0.004, 0.0), 0.0) << k;
+  EXPECT_NEAR(ramp.step(1, -0.004, 0.0), 0.02, 1e-15);
+  // Moving (>= 5 mm/s): held, and the rest count starts again.
+  EXPECT_NEAR(ramp.step(0, 0.006, -0.02), -0.04, 1e-15);
+  for (int k = 1; k <= 9; ++k) EXPECT_NEAR(ramp.step(0, 0.006, 0.0), -0.04, 1e-15) << k;
+  EXPECT_NEAR(ramp.step(0, 0.006, 0.0), -0.06, 1e-15);
+  // Clamped at 1 V.
+  double r = 0.0;
+  for (int k = 0; k < 100; ++k) r = ramp.step(0, 0.006, 0.0);
+  EXPECT_EQ(r, -1.0);
+  // Inside the band: 0, forgotten; outside again, 10 cycles at rest before it ramps.
+  EXPECT_EQ(ramp.step(0, 0.0029, 0.0), 0.0);
+  for (int k = 1; k <= 9; ++k) EXPECT_EQ(ramp.step(0, 0.006, 0.0), 0.0) << k;
+  EXPECT_NEAR(ramp.step(0, 0.006, 0.0), -0.02, 1e-15);
+  // A non-finite input resets the axis and gives 0 V; reset() forgets both axes.
+  EXPECT_EQ(ramp.step(0, std::numeric_limits<double>::quiet_NaN(), 0.0), 0.0);
+  EXPECT_EQ(ramp.step(0, 0.006, 0.0), 0.0);
+  EXPECT_EQ(ramp.step(1, 0.006, std::numeric_limits<double>::infinity()), 0.0);
+  ramp.reset();
+  EXPECT_EQ(ramp.step(1, -0.004, 0.0), 0.0);
+  EXPECT_EQ(ramp.step(2, 0.1, 0.0), 0.0) << "no third axis";
+
+  // Bad params name the field.
+  const auto message = [](const tr::BreakawayRampParams& p, double period) {
+    try {
+      tr::BreakawayRamp bad(p, period);
+    } catch (const crane::common::ConfigError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  tr::BreakawayRampParams p;
+  p.deadband = 0.0;
+  EXPECT_NE(message(p, 0.01).find("breakaway.deadband"), std::string::npos) << message(p, 0.01);
+  p = {};
+  p.rate = -1.0;
+  EXPECT_NE(message(p, 0.01).find("breakaway.rate"), std::string::npos) << message(p, 0.01);
+  p = {};
+  p.limit = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(p, 0.01).find("breakaway.limit"), std::string::npos) << message(p, 0.01);
+  p = {};
+  p.rest_time = -0.1;
+  EXPECT_NE(message(p, 0.01).find("breakaway.rest_time"), std::string::npos) << message(p, 0.01);
+  EXPECT_NE(message({}, 0.0).find("breakaway.sample_period"), std::string::npos) << message({}, 0.0);
 }

@@ -70,13 +70,17 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_greater("follower.voltage_limit", params.voltage_limit, 0.0);
   const FollowerWeights& w = params.weights;
   common::require_greater("follower.weights.position", w.position, 0.0);
+  common::require_greater("follower.weights.second_position", w.second_position, 0.0);
   common::require_greater("follower.weights.swing", w.swing, 0.0);
+  common::require_greater("follower.weights.out_of_plane_swing", w.out_of_plane_swing, 0.0);
   common::require_greater("follower.weights.speed", w.speed, 0.0);
   common::require_greater("follower.weights.swing_rate", w.swing_rate, 0.0);
   common::require_greater("follower.weights.voltage", w.voltage, 0.0);
   const FollowerWeights& h = params.hold.weights;
   common::require_greater("follower.hold.weights.position", h.position, 0.0);
+  common::require_greater("follower.hold.weights.second_position", h.second_position, 0.0);
   common::require_greater("follower.hold.weights.swing", h.swing, 0.0);
+  common::require_greater("follower.hold.weights.out_of_plane_swing", h.out_of_plane_swing, 0.0);
   common::require_greater("follower.hold.weights.speed", h.speed, 0.0);
   common::require_greater("follower.hold.weights.swing_rate", h.swing_rate, 0.0);
   common::require_greater("follower.hold.weights.voltage", h.voltage, 0.0);
@@ -178,8 +182,13 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   const auto bryson = [&](const FollowerWeights& bw, Eigen::MatrixXd& Qw, Eigen::MatrixXd& Rw) {
     Eigen::VectorXd q(n);
     for (int i = 0; i < c; ++i) {
-      const bool swing = slots_[i] == kInPlaneSwingIndex || slots_[i] == kOutOfPlaneSwingIndex;
-      q[i] = 1.0 / std::pow(swing ? bw.swing : bw.position, 2);
+      const int slot = slots_[i];
+      const bool swing = slot == kInPlaneSwingIndex || slot == kOutOfPlaneSwingIndex;
+      const double acceptable = slot == kTrolleyIndex      ? bw.position
+                                : slot == kSlewIndex         ? bw.second_position
+                                : slot == kInPlaneSwingIndex ? bw.swing
+                                                             : bw.out_of_plane_swing;
+      q[i] = 1.0 / (acceptable * acceptable);
       q[c + i] = 1.0 / std::pow(swing ? bw.swing_rate : bw.speed, 2);
     }
     Qw = q.asDiagonal();

@@ -812,10 +812,12 @@ void add_follower_options(CLI::App* cmd, optimal_control::FollowerParams& params
   // Bryson's acceptable deviations, along the trajectory ("--NAME-weight") and at the target ("--hold-NAME-weight").
   const auto add_weights = [cmd](const std::string& prefix, const std::string& where,
                                  optimal_control::FollowerWeights& w) {
-    const std::pair<const char*, double*> fields[] = {{"position", &w.position}, {"swing", &w.swing},
-                                                      {"speed", &w.speed}, {"swing-rate", &w.swing_rate},
-                                                      {"voltage", &w.voltage}};
-    const char* units[] = {"[m or rad]", "[rad]", "[m/s or rad/s]", "[rad/s]", "[V]"};
+    const std::pair<const char*, double*> fields[] = {
+        {"position", &w.position},   {"second-position", &w.second_position}, {"swing", &w.swing},
+        {"out-of-plane-swing", &w.out_of_plane_swing}, {"speed", &w.speed}, {"swing-rate", &w.swing_rate},
+        {"voltage", &w.voltage}};
+    const char* units[] = {"(trolley) [m]", "(slew [rad] or bridge [m])", "(in plane) [rad]", "[rad]",
+                           "[m/s or rad/s]", "[rad/s]", "[V]"};
     for (std::size_t i = 0; i < std::size(fields); ++i) {
       cmd->add_option("--" + prefix + fields[i].first + "-weight", *fields[i].second,
                       where + "acceptable " + std::string(fields[i].first) + " deviation " + units[i])

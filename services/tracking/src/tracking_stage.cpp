@@ -1,5 +1,6 @@
 #include "crane/tracking/tracking_stage.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -49,6 +50,7 @@ TrackingStageParams params_for(const common::CraneParameters& crane, const Track
   p.trolley_drive_mass = crane.trolley_drive_mass;
   p.jib_inertia = crane.jib_inertia;
   p.trolley_friction = crane.trolley_friction;
+  p.sample_period = facts.sample_period;
   p.second_friction = facts.crane_kind == common::CraneKind::overhead ? facts.bridge.friction : crane.slew_friction;
   return p;
 }
@@ -79,7 +81,8 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
       voltage_limit_(params.tracking.voltage_limit),
       trolley_drive_mass_(params.trolley_drive_mass),
       jib_inertia_(params.jib_inertia),
-      friction_factor_(params.trolley_friction, params.second_friction) {
+      friction_factor_(params.trolley_friction, params.second_friction),
+      breakaway_(params.breakaway, params.sample_period) {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
   common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
   if (law_ == TrackingLaw::gain_scheduling_partial || law_ == TrackingLaw::gain_scheduling_full) {
@@ -170,6 +173,7 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   // each drive's voltage where it is not clamped; at the target, handed to the compensation.
   if (reference.request_id != 0 && reference.request_id != friction_request_) {  // a new move (0: holding)
     friction_factor_.reset();
+    breakaway_.reset();
     friction_request_ = reference.request_id;
   }
   const std::array<double, 2> reference_speed{reference.trolley_velocity,
@@ -184,8 +188,19 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   }
   const bool at_target = reference_speed[0] == 0.0 && reference_speed[1] == 0.0 && reference_acceleration[0] == 0.0 &&
                          reference_acceleration[1] == 0.0;
-  command.trolley_voltage = u[0];
-  (bridge ? command.bridge_voltage : command.slew_voltage) = u[1];
+  // At the target, a drive the friction holds at rest off it is ramped toward it.
+  std::array<double, 2> voltage = u;
+  if (at_target) {
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      const std::size_t slot = axis == 0 ? 0 : 2;  // the trolley, the slew or the bridge
+      const double ramp = breakaway_.step(static_cast<int>(axis), position[slot] - law.position[slot], velocity[slot]);
+      voltage[axis] = std::clamp(u[axis] + ramp, -voltage_limit_, voltage_limit_);
+    }
+  } else {
+    breakaway_.reset();
+  }
+  command.trolley_voltage = voltage[0];
+  (bridge ? command.bridge_voltage : command.slew_voltage) = voltage[1];
   command.hoist_speed = reference.cable_length_rate;
   command.sliding_friction_reduction = reduction;
   command.friction_factor = at_target ? friction_factor_.factor() : 0.0;

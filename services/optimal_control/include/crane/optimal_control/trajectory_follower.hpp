@@ -54,11 +54,13 @@ namespace crane::optimal_control {
 
 /// Acceptable deviations (Bryson's rule), each > 0.
 struct FollowerWeights {
-  double position{0.005};      // [m] trolley and bridge; [rad] the slew (the settle band of the demo table)
-  double swing{0.006};         // [rad] both swing angles (0.34 deg; docs/optimal_control.md, "The
+  double position{0.005};      // [m] the trolley (the settle band of the demo table)
+  double second_position{0.005};  // [rad] the slew, [m] the bridge
+  double swing{0.006};         // [rad] the in-plane swing phi (0.34 deg; docs/optimal_control.md, "The
                                // swing weights": at 0.5 deg fewer mismatch corners settle within 2 T*)
+  double out_of_plane_swing{0.006};  // [rad] theta
   double speed{0.05};          // [m/s or rad/s] drive axes
-  double swing_rate{0.05};     // [rad/s]
+  double swing_rate{0.05};     // [rad/s] both swing angles
   double voltage{0.2};         // [V] the input (measured on the demo maneuvers, docs/optimal_control.md)
 };
 
@@ -66,11 +68,23 @@ struct FollowerWeights {
 /// in closed loop": measured at the +-20 % length and mass, +-30 % friction corners).
 struct FollowerHold {
   /// Bryson's weights of the stationary regulator (and so of the time-varying gains near the
-  /// trajectory's end): the swing tighter than along the trajectory, so that a small swing still
+  /// trajectory's end). The swing tighter than along the trajectory, so that a small swing still
   /// commands the breakaway of a trolley whose stiction is under-compensated by 30 % (0.23 deg;
   /// 0.2 deg drives the trolley unstable on a random tower move with a 20 % shorter cable and 30 %
-  /// less friction: docs/optimal_control.md, "The swing weights").
-  FollowerWeights weights{0.005, 0.004, 0.05, 0.05, 0.2};
+  /// less friction: docs/optimal_control.md, "The swing weights"). The second axis looser and the
+  /// out-of-plane swing tighter (0.01 rad or m, 0.003 rad = 0.17 deg): a slew held as tightly as
+  /// the trolley damps the out-of-plane swing a 20 % longer cable leaves only through its slower
+  /// period; the tracking stage's breakaway ramp (tracking/breakaway_ramp.hpp) brings back a drive
+  /// that friction holds off the target (docs/optimal_control.md, "Breaking the drive loose at the
+  /// target"). The trolley stays at 0.005 m: at 0.0075 or 0.01 m the gantry's trolley overshot into
+  /// its travel limiter's stop margin.
+  FollowerWeights weights{.position = 0.005,
+                          .second_position = 0.01,
+                          .swing = 0.004,
+                          .out_of_plane_swing = 0.003,
+                          .speed = 0.05,
+                          .swing_rate = 0.05,
+                          .voltage = 0.2};
   /// [-] in [0, 1]: the fraction of the plant's sliding friction (Coulomb and viscous, (3.1),
   /// (3.3)) the compensation applies while a drive slides after the trajectory; the stiction part
   /// (3.2) is scaled as the plant's. The law carries it as a fraction of the model's friction; the

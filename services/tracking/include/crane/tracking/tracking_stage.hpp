@@ -16,8 +16,10 @@
 //                            reference at rest) also the plant's friction over the model's,
 //                            estimated along the move from the law's feedback
 //                            (friction_factor_estimate.hpp, LinearCommand_.friction_factor; 0
-//                            elsewhere, unset); a reference without a law
-//                            (holding, a stop, manual motion) is tracked by `tracking`
+//                            elsewhere, unset), and a drive the friction holds at rest off the
+//                            target gets the breakaway ramp (breakaway_ramp.hpp); a reference
+//                            without a law (holding, a stop, manual motion) is tracked by
+//                            `tracking`
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
 // Every law takes the load (m_t, m_r of (3.37)-(3.38) and the gain schedule) from the estimate's
@@ -32,6 +34,7 @@
 #include "crane/common/stack_facts.hpp"
 #include "crane/gain_scheduling/gain_scheduling_controller.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/tracking/breakaway_ramp.hpp"
 #include "crane/tracking/friction_factor_estimate.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
@@ -57,6 +60,9 @@ struct TrackingStageParams {
   // for the friction factor it estimates along a move.
   common::AxisFriction trolley_friction{};
   common::AxisFriction second_friction{};
+  // The follower's hold at the target: integral action against a drive stuck off it.
+  BreakawayRampParams breakaway{};
+  double sample_period{0.01};  // [s] > 0, the cycle (facts.sample_period)
   // An overhead crane (facts.crane_kind): the bridge's stage, the same law on the bridge's gantry view
   // (common::bridge_view) with the bridge's drive (common::bridge_as_trolley); null elsewhere.
   std::shared_ptr<const TrackingStageParams> bridge;
@@ -96,6 +102,7 @@ class TrackingStage {
   std::unique_ptr<TrackingStage> bridge_;  // the overhead crane's bridge (its trolley is the bridge)
   FrictionFactorEstimate friction_factor_;  // the follower's, over the move of friction_request_
   std::uint32_t friction_request_{0};
+  BreakawayRamp breakaway_;  // the follower's hold, reset when the reference moves or a move starts
 };
 
 }  // namespace crane::tracking
