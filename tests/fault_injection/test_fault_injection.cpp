@@ -758,6 +758,23 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
   std::vector<double> relayed, direct;
   constexpr int kStops = 5;
   int protective_stops = 0;  // moves the supervisor stopped itself before the command was typed
+  // After a protective stop, `deploy/crane reset`: the supervisor refuses it (exit 3) while a fault
+  // is still active, as an overspeed is while the braked trolley slows down (seen in a local CI run,
+  // 2026-11-27: a reset typed as the fault latched was refused). Asked again each 0.5 s, 5 s at most;
+  // any other exit code fails.
+  const auto reset_when_the_faults_cleared = [&]() {
+    for (int ask = 0; ask < 10; ++ask) {
+      stack.run_for(0.5);
+      const int rc = WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str()));
+      if (rc == 0) return true;
+      if (rc != 3) {
+        ADD_FAILURE() << "deploy/crane reset exited " << rc;
+        return false;
+      }
+      std::printf("[ note     ] deploy/crane reset refused (a fault still active); asked again\n");
+    }
+    return false;
+  };
   for (int i = 0; i < 2 * kStops; ++i) {
     const bool via_relay = i % 2 == 0;
     // To 0.3 or 1.0 m, whichever is farther from where the last stop left the trolley: 10 cm inside
@@ -779,7 +796,8 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
         ++protective_stops;
         std::printf("[ note     ] stop %d: the crane was faulted before its move (faults 0x%x latched); reset\n", i,
                     stack.status()->latched_faults());
-        ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
+        ASSERT_TRUE(reset_when_the_faults_cleared()) << "before stop " << i << "\n"
+                                                     << recent_history(stack, hb::monotonic_time_ns());
         ASSERT_TRUE(stack.wait_ready(10.0)) << "after the protective stop before stop " << i;
         continue;
       }
@@ -792,7 +810,8 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
       ++protective_stops;
       std::printf("[ note     ] stop %d: the supervisor stopped the move itself (faults 0x%x latched); reset, move again\n",
                   i, stack.status()->latched_faults());
-      ASSERT_EQ(WEXITSTATUS(std::system((script + " reset" + domain + " > /dev/null").c_str())), 0);
+      ASSERT_TRUE(reset_when_the_faults_cleared()) << "before stop " << i << "\n"
+                                                   << recent_history(stack, hb::monotonic_time_ns());
       ASSERT_TRUE(stack.wait_ready(10.0)) << "after the protective stop before stop " << i;
     }
     // --direct: a fresh participant; secured, its handshakes take seconds on a loaded machine before
