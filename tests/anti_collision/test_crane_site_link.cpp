@@ -351,6 +351,10 @@ TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halted);
   ASSERT_EQ(link_->reactions().size(), 1u);
   EXPECT_NEAR(link_->reactions()[0], t_ - 0.01 - last_heard, 0.011);
+  ASSERT_TRUE(link_->longest_reaction().has_value());
+  EXPECT_EQ(link_->longest_reaction()->seconds, link_->reactions()[0]);
+  EXPECT_NEAR(link_->longest_reaction()->lost_at, last_heard, 0.011);
+  EXPECT_EQ(link_->longest_reaction()->end, CraneSiteLink::ReactionEnd::soft_stop);
   // Heard again: it reports where it rests and asks again for the leg.
   (void)step();
   ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
@@ -363,6 +367,18 @@ TEST_F(Link, ALostLinkEndsTheMoveAtItsWaypointWhenASoftStopWouldLeaveTheGrant) {
   EXPECT_FALSE(silent(100, false).has_value()) << "no soft stop, no next move";
   EXPECT_EQ(link_->halts_at_waypoint(), 1);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
+  EXPECT_FALSE(link_->longest_reaction().has_value()) << "not safe yet";
+  // At rest at the waypoint: safe, and the reaction says how.
+  reference_.phase = Reference::PHASE_ARRIVED;
+  at({0.0, 0.9, 0.2});
+  (void)link_->step(t_, estimate_, reference_, false);
+  t_ += 0.01;
+  ASSERT_EQ(link_->reactions().size(), 1u);
+  ASSERT_TRUE(link_->longest_reaction().has_value());
+  EXPECT_EQ(link_->longest_reaction()->end, CraneSiteLink::ReactionEnd::at_waypoint);
+  EXPECT_EQ(link_->longest_reaction()->seconds, link_->reactions()[0]);
+  EXPECT_STREQ(to_string(CraneSiteLink::ReactionEnd::at_waypoint),
+               "at rest at its move's waypoint (a soft stop would have left the grant)");
 }
 
 TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {
@@ -386,6 +402,7 @@ TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::moving);
   EXPECT_EQ(link_->halts(), 0);
   ASSERT_EQ(link_->reactions().size(), 1u) << "safe at once: its path is its own";
+  EXPECT_EQ(link_->longest_reaction()->end, CraneSiteLink::ReactionEnd::outside_shared);
 }
 
 TEST_F(Link, ABrakedCraneStopsReportingForGood) {

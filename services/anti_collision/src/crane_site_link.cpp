@@ -48,6 +48,23 @@ void check_point(const SiteCrane& c, const WorkPoint& w, std::size_t job, const 
 
 }  // namespace
 
+const char* to_string(CraneSiteLink::ReactionEnd end) noexcept {
+  using E = CraneSiteLink::ReactionEnd;
+  switch (end) {
+    case E::outside_shared: return "still on a path outside shared airspace";
+    case E::at_rest_already: return "at rest already";
+    case E::soft_stop: return "at rest after its soft stop";
+    case E::at_waypoint: return "at rest at its move's waypoint (a soft stop would have left the grant)";
+  }
+  return "?";
+}
+
+void CraneSiteLink::record_reaction(double lost_at, double time, ReactionEnd end) {
+  const double seconds = time - lost_at;
+  reactions_.push_back(seconds);
+  if (!longest_reaction_ || seconds > longest_reaction_->seconds) longest_reaction_ = Reaction{lost_at, seconds, end};
+}
+
 const char* to_string(CraneSiteLink::Phase phase) noexcept {
   using P = CraneSiteLink::Phase;
   switch (phase) {
@@ -261,7 +278,8 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         arrived_at_.reset();
         ended_short_at_.reset();
         ++halts_;
-        if (start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate))) {
+        halt_at_waypoint_ = !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate)));
+        if (!halt_at_waypoint_) {
           Request stop{};
           stop.request_id = ++goal_id_;
           stop.command = Request::COMMAND_STOP;
@@ -276,10 +294,10 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         changed_ = true;
         return goal;
       }
-      reactions_.push_back(time - lost_from_);  // it keeps to its own airspace
+      record_reaction(lost_from_, time, ReactionEnd::outside_shared);  // it keeps to its own airspace
     } else if (phase_ != Phase::done && phase_ != Phase::halting && phase_ != Phase::aborted) {
       if (phase_ == Phase::asking || phase_ == Phase::resting) phase_ = Phase::halted;
-      reactions_.push_back(time - lost_from_);  // at rest already
+      record_reaction(lost_from_, time, ReactionEnd::at_rest_already);
       changed_ = true;
     }
   }
@@ -315,7 +333,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
     // A soft stop's reference moves until it arrives; a crane settling at a waypoint holds at once.
     if (reference.phase != protocol::Reference::PHASE_MOVING && at_rest(estimate)) {
       yielding_ = false;
-      reactions_.push_back(time - halt_from_);
+      record_reaction(halt_from_, time, halt_at_waypoint_ ? ReactionEnd::at_waypoint : ReactionEnd::soft_stop);
       phase_ = link_lost_ ? Phase::halted : gave_up_ ? Phase::aborted : Phase::resting;
       changed_ = true;
     }

@@ -221,10 +221,17 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
               "emergency stops\n", slow, stops, emergency);
   std::vector<double> reactions;
   int halts = 0, at_waypoint = 0;
-  for (const SetResult& r : results) {
+  std::string longest_reaction;
+  double longest_reaction_seconds = 0.0;
+  for (std::size_t s = 0; s < results.size(); ++s) {
+    const SetResult& r = results[s];
     reactions.insert(reactions.end(), r.coordinated.reactions.begin(), r.coordinated.reactions.end());
     halts += r.coordinated.halts;
     at_waypoint += r.coordinated.halts_at_waypoint;
+    if (r.coordinated.longest_reaction_seconds > longest_reaction_seconds) {
+      longest_reaction_seconds = r.coordinated.longest_reaction_seconds;
+      longest_reaction = "set seed " + std::to_string(seed + s) + ", " + r.coordinated.longest_reaction;
+    }
   }
   if (faults > 0) {
     std::printf("  link faults: %d per coordinated set (a crane's link lost 0.5-30 s, or the site service killed and "
@@ -235,6 +242,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 "p90 %.0f  p99 %.0f  max %.0f\n",
                 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.0), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.5), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.9),
                 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.99), 1e3 * crane::stack::nearest_rank_quantile(reactions, 1.0));
+    if (!longest_reaction.empty()) std::printf("  the longest: %s\n", longest_reaction.c_str());
   }
   int guard_emergency = 0, guard_soft = 0;
   std::string guard_first;

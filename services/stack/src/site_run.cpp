@@ -1,6 +1,7 @@
 #include "crane/stack/site_run.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -240,6 +241,12 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     c.outcome.latched_faults = c.stack->status().latched_faults;
     out.total_time = std::max(out.total_time, c.outcome.finish_time);
     out.reactions.insert(out.reactions.end(), link.reactions().begin(), link.reactions().end());
+    if (const auto& longest = link.longest_reaction(); longest && longest->seconds > out.longest_reaction_seconds) {
+      out.longest_reaction_seconds = longest->seconds;
+      char text[96];
+      std::snprintf(text, sizeof text, ": link lost at %.2f s, safe %.2f s later, ", longest->lost_at, longest->seconds);
+      out.longest_reaction = c.outcome.name + text + ac::to_string(longest->end);
+    }
     out.halts += link.halts();
     out.halts_at_waypoint += link.halts_at_waypoint();
     out.cranes.push_back(c.outcome);

@@ -151,6 +151,20 @@ class CraneSiteLink {
   /// [s] from each link loss that lasted link_deadline to the crane safe: at rest after its stop,
   /// or still on a path outside shared airspace, or at rest already.
   [[nodiscard]] const std::vector<double>& reactions() const noexcept { return reactions_; }
+  /// How the crane was safe after a link loss.
+  enum class ReactionEnd : std::uint8_t {
+    outside_shared,   // still on a path outside shared airspace
+    at_rest_already,  // it was not moving
+    soft_stop,        // at rest after its soft stop
+    at_waypoint,      // at rest at the waypoint its move went on to (a soft stop would have left the grant)
+  };
+  struct Reaction {
+    double lost_at{0.0};  // [s] the link's last message (the loss counted link_deadline later)
+    double seconds{0.0};  // [s] from then to the crane safe
+    ReactionEnd end{ReactionEnd::at_rest_already};
+  };
+  /// The longest of reactions() and how it ended (none: no loss yet).
+  [[nodiscard]] const std::optional<Reaction>& longest_reaction() const noexcept { return longest_reaction_; }
   [[nodiscard]] const GrantGuard& guard() const noexcept { return guard_; }
   /// The path it moves on (its first waypoint where it started) and the waypoint it moves to.
   [[nodiscard]] const std::vector<Pose>& path() const noexcept { return path_; }
@@ -213,11 +227,17 @@ class CraneSiteLink {
   int halts_at_waypoint_{0};
   int aborted_moves_{0};
   std::vector<double> reactions_;
+  std::optional<Reaction> longest_reaction_;
   double halt_from_{0.0};
+  bool halt_at_waypoint_{false};  // the halt under way ends the move at its waypoint
+
+  void record_reaction(double lost_at, double time, ReactionEnd end);
 };
 
 /// [-] "resting", "asking", ...
 [[nodiscard]] const char* to_string(CraneSiteLink::Phase phase) noexcept;
+/// [-] "still on a path outside shared airspace", ...
+[[nodiscard]] const char* to_string(CraneSiteLink::ReactionEnd end) noexcept;
 
 /// The estimator's state as the site's geometry takes it.
 [[nodiscard]] CraneMotion motion_of(const protocol::CraneState& estimate) noexcept;

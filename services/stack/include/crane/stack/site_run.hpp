@@ -112,6 +112,10 @@ struct SiteOutcome {
   // at rest (trolley, slew and hoist under 0.01 m/s, rad/s) after its soft stop (its path was in
   // shared airspace), or still on a path outside it.
   std::vector<double> reactions;
+  // The longest of them: "tc2: link lost at 41.23 s, safe 6.49 s later, at rest at its move's
+  // waypoint (...)" (empty: no loss), and its length [s].
+  std::string longest_reaction;
+  double longest_reaction_seconds{0.0};
   int halts{0};  // stops for a lost link: a soft stop, or the move under way ended at its waypoint
   int halts_at_waypoint{0};  // of them, those whose soft stop would have run out of the grant
   // Each crane's guard on its grant (grant_guard.hpp): the cranes it braked (leaving their grant:
