@@ -565,6 +565,15 @@ TEST(TrackingStage, AConfidentPayloadEstimateReplacesTheConfiguredMass) {
   EXPECT_TRUE(std::isfinite(absurd.trolley_voltage) && std::isfinite(absurd.slew_voltage));
 }
 
+// The tracking stage's params from its YAML block on `facts`, with the follower law.
+tracking::TrackingStageParams follower_stage_params(const common::StackFacts& facts) {
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
+  config::YamlSection block(yaml, "tracking");
+  tracking::TrackingStageParams params = tracking::read_params(block, facts);
+  params.law = tracking::TrackingLaw::follower;
+  return params;
+}
+
 // The tracking law `follower` applies the feedback law the reference carries (Reference.feedback_law,
 // the minimum-time follower's; trajectory_feedback.hpp): u = feedforward - K (z - z_ref), by hand
 // here for a gain with one entry in each block, on the slew (tower) and on the bridge (overhead).
@@ -637,12 +646,8 @@ TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarrie
 // here the feedback is made (by the trolley's position error against a gain of 40 V/m)
 // 0.3 F(v_ref) + 0.05 a_ref, a plant with 30 % more friction.
 TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlongTheMove) {
-  common::StackFacts facts;
-  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
-  config::YamlSection block(yaml, "tracking");
-  tracking::TrackingStageParams params = tracking::read_params(block, facts);
-  params.law = tracking::TrackingLaw::follower;
-  tracking::TrackingStage stage{params};
+  const common::StackFacts facts;
+  tracking::TrackingStage stage{follower_stage_params(facts)};
   const common::AxisFriction& friction = facts.crane.trolley_friction;
   protocol::Reference reference;
   reference.cable_length = 1.0;
@@ -692,12 +697,7 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
 // 0.02 V more toward the target each cycle. The slew, on its target, gets none; a reference that
 // moves forgets the ramp.
 TEST(TrackingStage, TheFollowersHoldRampsADriveStuckOffTheTargetTowardIt) {
-  common::StackFacts facts;
-  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
-  config::YamlSection block(yaml, "tracking");
-  tracking::TrackingStageParams params = tracking::read_params(block, facts);
-  params.law = tracking::TrackingLaw::follower;
-  tracking::TrackingStage stage{params};
+  tracking::TrackingStage stage{follower_stage_params(common::StackFacts{})};
   common::TrajectoryFeedback law;
   law.position = {0.5, 0.0, 0.3, 0.0};
   law.gain[0] = 40.0;      // [V/m]
