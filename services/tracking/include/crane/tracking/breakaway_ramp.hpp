@@ -14,8 +14,9 @@
 // started only once the drive has been at rest off the target for rest_time (a drive passing
 // through zero speed while it damps a swing is not stuck: the ramp would bias it), and forgotten
 // inside the band, so it cannot wind up against a drive that moves or hold a bias at the target.
-// (K. J. Astrom, T. Hagglund, "Advanced PID Control", 2006, section 3.5: integral action against
-// static friction, with a deadband to stop hunting.)
+// (B. Armstrong-Helouvry, P. Dupont, C. Canudas de Wit, "A survey of models, analysis tools and
+// compensation methods for the control of machines with friction", Automatica 30(7), 1994:
+// integral action against static friction, and the hunting it causes without a deadband.)
 //
 // Real-time: step() and reset() are noexcept and allocate nothing; a non-finite input resets the
 // axis and gives 0 V. Errors: the constructor throws common::ConfigError naming the field, the value
