@@ -52,14 +52,18 @@ std::array<double, 4> sliding_coefficients(const common::AxisFriction& f) noexce
   return {f.viscous_positive, f.viscous_negative, f.coulomb_positive, f.coulomb_negative};
 }
 
+double sliding_friction_voltage(const common::AxisFriction& friction, double velocity, int direction) noexcept {
+  const auto r = friction_regressor(velocity, direction);
+  const auto c = sliding_coefficients(friction);
+  return c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3];
+}
+
 double friction_voltage(const AxisCompensationParams& axis, double velocity,
                         double commanded_voltage) noexcept {
   const auto& f = axis.friction;
   const int direction = friction_direction(velocity, axis.zero_velocity_band);
   if (direction != 0) {  // eta = 1: c+ + b+ v with the motion; xi = 1: -(c- + b- |v|)   (3.1), (3.3)
-    const auto r = friction_regressor(velocity, direction);
-    const auto c = sliding_coefficients(f);
-    return c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3];
+    return sliding_friction_voltage(f, velocity, direction);
   }
   // Stiction (3.2): F_fs = f_sh + f_s tanh(A V), -> +fs+ (V >> 0), -> -fs- (V << 0).
   const double f_s = 0.5 * (f.static_positive + f.static_negative);

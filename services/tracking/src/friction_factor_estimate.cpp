@@ -35,12 +35,10 @@ void FrictionFactorEstimate::add(int axis, double feedback_voltage, double refer
     return;
   }
   if (std::abs(reference_speed) < params_.min_reference_speed) return;
-  // F(v_ref) (3.1): the compensation's regressor and coefficients, the one place they are written.
-  const auto regressor = friction_compensation::friction_regressor(reference_speed, reference_speed > 0.0 ? 1 : -1);
-  const auto coefficients = friction_compensation::sliding_coefficients(friction_[axis]);
-  double sliding = 0.0;
-  for (std::size_t i = 0; i < regressor.size(); ++i) sliding += coefficients[i] * regressor[i];
-  double phi[3] = {sliding, 0.0, 0.0};
+  // F(v_ref) (3.1), as the compensation computes it (the one place it is written).
+  double phi[3] = {friction_compensation::sliding_friction_voltage(friction_[axis], reference_speed,
+                                                                   reference_speed > 0.0 ? 1 : -1),
+                   0.0, 0.0};
   phi[1 + axis] = reference_acceleration;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];

@@ -87,6 +87,12 @@ struct FrictionCompensationOutput {
 /// (b+, b-, c+, c-) of `friction`, in the order of friction_regressor [V s/m, V s/m, V, V].
 [[nodiscard]] std::array<double, 4> sliding_coefficients(const common::AxisFriction& friction) noexcept;
 
+/// The sliding friction (3.1) F_f/K_m [V] of `friction` at `velocity` [m/s or rad/s] in `direction`
+/// (friction_direction, or the sign of a reference speed): sliding_coefficients . friction_regressor;
+/// 0 for direction 0.
+[[nodiscard]] double sliding_friction_voltage(const common::AxisFriction& friction, double velocity,
+                                              int direction) noexcept;
+
 /// F_f/K_m [V] for one axis at `velocity` [m/s or rad/s] and commanded voltage [V].
 /// Preconditions: finite inputs, validated params.
 [[nodiscard]] double friction_voltage(const AxisCompensationParams& axis, double velocity,
