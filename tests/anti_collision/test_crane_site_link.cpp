@@ -107,6 +107,11 @@ class Link : public ::testing::Test {
     answer(g->request_id);
     reference_.request_id = g->request_id;
     reference_.phase = Reference::PHASE_MOVING;
+    // The reference where the crane is, the trolley's moving at the same speed.
+    reference_.slew_angle = here.slew;
+    reference_.trolley_position = here.trolley;
+    reference_.trolley_velocity = velocity;
+    reference_.cable_length = here.cable_length;
     at(here);
     estimate_.trolley_velocity = velocity;
   }
@@ -379,6 +384,20 @@ TEST_F(Link, ALostLinkEndsTheMoveAtItsWaypointWhenASoftStopWouldLeaveTheGrant) {
   EXPECT_EQ(link_->longest_reaction()->seconds, link_->reactions()[0]);
   EXPECT_STREQ(to_string(CraneSiteLink::ReactionEnd::at_waypoint),
                "at rest at its move's waypoint (a soft stop would have left the grant)");
+}
+
+TEST_F(Link, ALostLinkStopsSoftlyWhenTheReferenceRestsWhateverTheMeasuredSpeed) {
+  // The same measured motion, but the reference has arrived at the goal (0.9 m) and rests: the
+  // crane overshooting it still moves at 0.5 m/s. A soft stop keeps the reference there, so it is
+  // the stop (GrantGuard::soft_stop_stays_in_grant with reference_rest_of).
+  moving_at({0.0, 0.89, 0.2}, 0.5);
+  reference_.trolley_position = 0.9;
+  reference_.trolley_velocity = 0.0;
+  const auto stop = silent(100, true);
+  ASSERT_TRUE(stop.has_value());
+  EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
+  EXPECT_EQ(link_->halts(), 1);
+  EXPECT_EQ(link_->halts_at_waypoint(), 0);
 }
 
 TEST_F(Link, ALostLinkOutsideSharedAirspaceLetsTheCraneFinishItsPath) {

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
 #include "crane/anti_collision/site_service.hpp"
@@ -389,6 +390,67 @@ CraneReport at_rest(std::size_t crane, Pose pose, std::uint32_t request_id = 0, 
   r.request_id = request_id;
   r.request = std::move(request);
   return r;
+}
+
+// The traced case of the simulated site (docs/site.md, seed 88): crane A lowers its hook at a work
+// point towards B (slew 0, trolley 0.6 m, cable 0.2 -> 1.0 m) while its load settles, the measured
+// slew 0.007 rad past its goal and still turning at 0.09 rad/s; the link is lost. From the measured
+// speed, a ZVD-shaped soft stop on 0.5 m of cable (T = 2 pi sqrt(0.5 / 9.80665) = 1.41878 s) runs
+// the slew 0.09 x 0.1 + 0.09^2 / (2 x 0.5) + 0.09 x 1.41878 / 2 = 0.08095 rad, to 0.128 rad with
+// the tolerance's margin: far outside the path's zero-width slew interval (0 +- 0.02), so the
+// move would go on to its waypoint (the rest of the descent). But the slew's reference rests at 0:
+// the planner's stop keeps it there and the tracking brings the slew back, so the soft stop ends
+// at 0 on the slew; the hoist, whose reference moves, stops from its speed: 0.2 x 0.1 + 0.2^2 /
+// (2 x 0.5) = 0.06 m, to 0.6 m with the margin, inside 0.2-1.0 m.
+TEST(GrantGuard, AnAxisWhoseReferenceRestsEndsItsSoftStopThere) {
+  const SiteLayout site = two_towers();
+  GrantGuard guard(site, 0);
+  guard.grant(path_airspace(std::vector<Pose>{{0.0, 0.6, 0.2}, {0.0, 0.6, 1.0}}, site.paths), 10.0);
+  ASSERT_TRUE(in_shared_airspace(site, 0, guard.granted()));
+  CraneMotion m;
+  m.slew = 0.007;
+  m.slew_rate = 0.09;
+  m.trolley = 0.6;
+  m.cable_length = 0.5;
+  m.cable_rate = 0.2;
+  const double lost = 10.0 + 1.1 * site.link_deadline;
+  EXPECT_NEAR(stopping_travel(site.cranes[0], m, StopKind::soft).slew,
+              0.009 + 0.0081 + 0.09 * 2.0 * kPi * std::sqrt(0.5 / kStandardGravity) / 2.0, 1e-12);
+  EXPECT_NEAR(stopping_travel(site.cranes[0], m, StopKind::soft).cable, 0.06, 1e-12);
+  // The guard alone (the supervisor's, which does not read the reference): the move goes on.
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m));
+  EXPECT_EQ(guard.check(m, lost).action, GrantAction::finish_path);
+
+  crane::protocol::Reference r{};
+  r.slew_angle = 0.0;
+  r.trolley_position = 0.6;
+  r.cable_length = 0.5;
+  r.cable_length_rate = 0.2;
+  const ReferenceRest rest = reference_rest_of(r);
+  ASSERT_TRUE(rest.slew.has_value() && rest.trolley.has_value());
+  EXPECT_EQ(*rest.slew, 0.0);
+  EXPECT_FALSE(rest.cable_length.has_value());
+  EXPECT_TRUE(guard.soft_stop_stays_in_grant(m, rest));
+  // A reference that rests outside the slew interval by more than the tolerance does not count as
+  // inside; one still turning, or still accelerating from rest, stops from the measured speed.
+  r.slew_angle = 0.03;
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, reference_rest_of(r)));
+  r.slew_angle = 0.0;
+  r.slew_rate = 1e-3;
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, reference_rest_of(r)));
+  r.slew_rate = 0.0;
+  r.slew_acceleration = 0.1;
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, reference_rest_of(r)));
+  r.slew_acceleration = 0.0;
+  // The hoist's own stop must still end inside: lowering at 0.2 m/s from 0.95 m ends at 1.05 m with
+  // the margin, past 1.0 m and the tolerance.
+  m.cable_length = 0.95;
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, reference_rest_of(r)));
+  // Non-finite references are not at rest; a non-finite resting position is not inside.
+  m.cable_length = 0.5;
+  r.slew_rate = std::nan("");
+  EXPECT_FALSE(reference_rest_of(r).slew.has_value());
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, ReferenceRest{std::nan(""), 0.6, std::nullopt}));
 }
 
 TEST(SiteService, AGrantIsHeldUntilCarriedOutThenFollowsTheCranesProgress) {

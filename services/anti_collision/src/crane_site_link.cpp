@@ -96,6 +96,16 @@ CraneMotion motion_of(const protocol::CraneState& e) noexcept {
   return m;
 }
 
+ReferenceRest reference_rest_of(const protocol::Reference& r) noexcept {
+  const auto rest = [](double position, double speed, double acceleration) -> std::optional<double> {
+    if (std::abs(speed) <= kReferenceAtRest && std::abs(acceleration) <= kReferenceAtRest) return position;
+    return std::nullopt;  // moving, or not finite
+  };
+  return {rest(r.slew_angle, r.slew_rate, r.slew_acceleration),
+          rest(r.trolley_position, r.trolley_velocity, r.trolley_acceleration),
+          rest(r.cable_length, r.cable_length_rate, r.cable_length_acceleration)};
+}
+
 Pose site_start_pose(const SiteLayout& layout, std::size_t crane, double planner_slew_min, double planner_slew_max,
                      double trolley) {
   const SiteCrane& c = layout.cranes.at(crane);
@@ -278,7 +288,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         arrived_at_.reset();
         ended_short_at_.reset();
         ++halts_;
-        halt_at_waypoint_ = !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate)));
+        halt_at_waypoint_ = !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate), reference_rest_of(reference)));
         if (!halt_at_waypoint_) {
           Request stop{};
           stop.request_id = ++goal_id_;

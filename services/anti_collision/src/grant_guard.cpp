@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -72,20 +73,22 @@ bool GrantGuard::must_leave_shared_airspace(double time) const noexcept {
   return has_grant_ && granted_shared_ && link_lost(time);
 }
 
-bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m) const noexcept {
+bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m, const ReferenceRest& reference) const noexcept {
   if (!has_grant_ || !is_finite(m)) return false;
   const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
   // The predicted end inside the box by kContainmentTolerance on each axis the stop carries further
   // than that (carried 2 x kContainmentTolerance further, then contained with the tolerance): the
   // tolerance is the drives' tracking, not the stopping model's error. An axis at rest (its
-  // measured speed's noise) is contained as it stands.
-  const auto beyond = [](double travel) {
-    return travel > kContainmentTolerance ? 2.0 * kContainmentTolerance
-           : travel < -kContainmentTolerance ? -2.0 * kContainmentTolerance
-                                             : 0.0;
+  // measured speed's noise) is contained as it stands; one whose reference rests ends there.
+  const auto end = [](const std::optional<double>& rest, double position, double travel) {
+    if (rest) return std::isfinite(*rest) ? *rest : std::numeric_limits<double>::quiet_NaN();
+    return position + travel +
+           (travel > kContainmentTolerance    ? 2.0 * kContainmentTolerance
+            : travel < -kContainmentTolerance ? -2.0 * kContainmentTolerance
+                                              : 0.0);
   };
-  return contains(granted_, {m.slew + stop.slew + beyond(stop.slew), m.trolley + stop.trolley + beyond(stop.trolley),
-                             m.cable_length + stop.cable + beyond(stop.cable)});
+  return contains(granted_, {end(reference.slew, m.slew, stop.slew), end(reference.trolley, m.trolley, stop.trolley),
+                             end(reference.cable_length, m.cable_length, stop.cable)});
 }
 
 GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {

@@ -39,7 +39,8 @@
 // link_deadline, the service holds this crane's whole reach; on its own, the crane then
 //   - moving on a path in shared airspace (the guard's rule 4): stops. A soft stop (the planner's
 //     COMMAND_STOP), or, when a soft stop decided now would run out of the grant (a fast slew near
-//     its goal, GrantGuard::soft_stop_stays_in_grant), the move under way ends at its waypoint and
+//     its goal, GrantGuard::soft_stop_stays_in_grant, which takes an axis whose reference rests as
+//     ending there: reference_rest_of), the move under way ends at its waypoint and
 //     no further one starts; then it waits at rest;
 //   - moving on a path outside shared airspace: finishes it, then waits at rest;
 //   - at rest: waits.
@@ -241,6 +242,10 @@ class CraneSiteLink {
 
 /// The estimator's state as the site's geometry takes it.
 [[nodiscard]] CraneMotion motion_of(const protocol::CraneState& estimate) noexcept;
+/// Where the planner's reference rests on each axis (GrantGuard::soft_stop_stays_in_grant):
+/// the reference's slew, trolley and cable length, each set when its speed and acceleration are
+/// within kReferenceAtRest of zero.
+[[nodiscard]] ReferenceRest reference_rest_of(const protocol::Reference& reference) noexcept;
 
 /// Where crane `crane` of `layout` waits when a site starts: its jib turned away from the site's
 /// centre (the mean of the bases; slew 0 for a site of one crane) within its slew range and

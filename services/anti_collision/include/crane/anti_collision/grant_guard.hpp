@@ -22,7 +22,10 @@
 //                      own; a grant outside shared airspace is finished;
 //      finish_path     the same, when a soft stop decided now would end outside the grant
 //                      (soft_stop_stays_in_grant: a fast move near its goal, the shaped stop running
-//                      past it): the move under way ends at its waypoint, inside the grant, sooner;
+//                      past it): the move under way ends at its waypoint, inside the grant, sooner.
+//                      check() judges the measured motion alone (the supervisor trusts no control
+//                      process); the crane's site link, which sends the stop, also tells
+//                      soft_stop_stays_in_grant where the planner's reference rests;
 //   5. soft_stop       the load swings wider than the grant's allowance where the crane is (the
 //                      largest swing radius of the boxes that contain the pose);
 //   6. proceed.
@@ -41,6 +44,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "crane/anti_collision/airspace.hpp"
 #include "crane/anti_collision/crane_geometry.hpp"
@@ -53,6 +57,17 @@ inline constexpr double kContainmentTolerance = 0.02;
 
 /// True when `pose` lies within `tolerance` of at least one box of `airspace` on every axis.
 [[nodiscard]] bool contains(const Airspace& airspace, const Pose& pose, double tolerance = kContainmentTolerance) noexcept;
+
+/// Where the planner's reference rests on each axis a grant bounds: set for an axis whose reference
+/// speed and acceleration are both within kReferenceAtRest of zero, std::nullopt for one that moves
+/// (or when the reference is not known).
+struct ReferenceRest {
+  std::optional<double> slew;          // [rad]
+  std::optional<double> trolley;       // [m]
+  std::optional<double> cable_length;  // [m]
+};
+/// [m/s, rad/s, m/s^2, rad/s^2]: a reference axis's speed and acceleration this close to zero is at rest.
+inline constexpr double kReferenceAtRest = 1e-9;
 
 enum class GrantAction : std::uint8_t { proceed, soft_stop, finish_path, emergency_stop };
 /// "proceed", "soft_stop", "finish_path", "emergency_stop".
@@ -93,10 +108,15 @@ class GrantGuard {
   /// on each axis the stop carries further than that (the tolerance is for the drives' tracking;
   /// a stop decided while the drive still accelerates runs further than the model, which takes
   /// the speed as constant: 0.26 rad against 0.237 predicted from 0.41 rad/s, a seeded lost-link
-  /// case of the simulated site). When it would not
+  /// case of the simulated site). An axis whose planner reference rests (`reference`, when the
+  /// caller knows it) ends where its reference rests, whatever its measured speed: the planner's
+  /// soft stop brings the reference's speed to zero from where it is, so a reference at rest stays,
+  /// and the drive's tracking brings the crane to it, as the move's own end would (a load settling
+  /// at its goal, the measured slew still swinging past it). When the stop would not stay inside
   /// (a fast slew near its goal: the shaped stop runs past it), the crane's move to its next
   /// waypoint is the shorter way to rest inside what it holds.
-  [[nodiscard]] bool soft_stop_stays_in_grant(const CraneMotion& motion) const noexcept;
+  [[nodiscard]] bool soft_stop_stays_in_grant(const CraneMotion& motion,
+                                              const ReferenceRest& reference = {}) const noexcept;
 
  private:
   SiteLayout layout_;
