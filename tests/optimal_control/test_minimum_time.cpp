@@ -10,6 +10,7 @@
 
 #include "crane/common/validation.hpp"
 #include "crane/optimal_control/minimum_time.hpp"
+#include "crane/optimal_control/planned_move.hpp"
 #include "crane/stack/controller_comparison.hpp"
 #include "crane/stack/maneuver_bound.hpp"
 #include "crane/trajectory_planner/time_optimal_profile.hpp"
@@ -182,6 +183,51 @@ TEST(MinimumTime, TheLeastEffortTrajectoryLeavesTheSlackAxisQuiet) {
   EXPECT_EQ(end.state.velocity.head(plant::kNumCoordinates).norm(), 0.0);
   EXPECT_LE(quiet.max_defect, std::max(1e-6, 10.0 * fastest.max_defect));
   EXPECT_LE(quiet_voltage, problem.voltage_limit * (1.0 + 1e-6));
+}
+
+// A calibrated equivalent pendulum a L + c (trajectory_planner.manual.swing_length_scale and
+// _offset; deploy/crane calibrate swing) is the pendulum the plan swings: the problem's cable
+// lengths are a L + c, its hoist limits a times the request's, and the planned path maps the cable
+// back to the hoist's lengths. Uncalibrated (1, 0), the problem is the request's to the bit. The
+// demo's trolley move while lowering 1.0 -> 1.5 m, with a = 1.1 and c = 0.05 m: 1.15 -> 1.7 m.
+TEST(MinimumTime, PlansTheCalibratedEquivalentPendulumAndMapsTheCableBack) {
+  auto cfg = config("lab_tower_crane.yaml");
+  const auto m = stack::find_maneuver(cfg, "trolley_hoist");
+  const auto request = stack::plan_request_of(cfg, m);
+  const auto plain = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50);
+  EXPECT_EQ(plain.hoist.start, request.cable_from);
+  EXPECT_EQ(plain.hoist.target, request.cable_target);
+  EXPECT_EQ(plain.hoist.max_speed, request.cable_limits.max_velocity);
+  ASSERT_NE(request.cable_from, request.cable_target);
+
+  cfg.trajectory_planner.manual.swing_length_scale = 1.1;
+  cfg.trajectory_planner.manual.swing_length_offset = 0.05;
+  const auto p = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50);
+  EXPECT_NEAR(p.hoist.start, 1.1 * 1.0 + 0.05, 1e-12);
+  EXPECT_NEAR(p.hoist.target, 1.1 * 1.5 + 0.05, 1e-12);
+  EXPECT_NEAR(p.hoist.min_position, 1.1 * cfg.trajectory_planner.cable_min_length + 0.05, 1e-12);
+  EXPECT_NEAR(p.hoist.max_position, 1.1 * cfg.trajectory_planner.cable_max_length + 0.05, 1e-12);
+  EXPECT_NEAR(p.hoist.max_speed, 1.1 * request.cable_limits.max_velocity, 1e-12);
+  EXPECT_NEAR(p.hoist.max_acceleration, 1.1 * request.cable_limits.max_acceleration, 1e-12);
+
+  optimal_control::MovePlanning planning;
+  planning.intervals = 50;
+  optimal_control::MinimumTimeResult bound;
+  const auto path = optimal_control::plan_minimum_time_move(request, cfg.facts, cfg.trajectory_planner, planning, &bound);
+  ASSERT_TRUE(path != nullptr) << bound.status;
+  EXPECT_NEAR(bound.nodes.front().cable_length, 1.15, 1e-9);
+  EXPECT_NEAR(bound.nodes.back().cable_length, 1.7, 1e-9);
+  // The hoist's reference: its own lengths, rates 1 / a of the equivalent pendulum's.
+  EXPECT_NEAR(path->cable.front().position, 1.0, 1e-9);
+  EXPECT_NEAR(path->cable.back().position, 1.5, 1e-9);
+  double peak_rate = 0.0;
+  for (const auto& c : path->cable) peak_rate = std::max(peak_rate, std::abs(c.velocity));
+  EXPECT_LE(peak_rate, request.cable_limits.max_velocity * (1.0 + 1e-6));
+  EXPECT_GT(peak_rate, 0.5 * request.cable_limits.max_velocity);
+  // An equivalent length that is not positive anywhere in the cable range is refused.
+  cfg.trajectory_planner.manual.swing_length_offset = -cfg.trajectory_planner.cable_min_length * 1.1 - 0.01;
+  EXPECT_THROW((void)optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50),
+               common::ConfigError);
 }
 
 TEST(MinimumTime, AMalformedProblemIsRefusedNamingTheField) {

@@ -32,12 +32,17 @@ MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r
                       r.slew_limits.max_acceleration};
     problem.second_friction = facts.crane.slew_friction;
   }
-  problem.hoist = {r.cable_from,
-                   r.cable_target,
-                   planner.cable_min_length,
-                   planner.cable_max_length,
-                   r.cable_limits.max_velocity,
-                   r.cable_limits.max_acceleration};
+  // The pendulum the plan swings is the calibrated equivalent one (see the header): its length
+  // a L + c, its rates a times the hoist's (the controllers' model is the rigid single pendulum,
+  // no hook: a hook's rigging is what the calibration's offset takes in).
+  const trajectory_planner::ManualParams& swing = planner.manual;
+  const double scale = swing.swing_length_scale;
+  problem.hoist = {trajectory_planner::equivalent_swing_length(swing, r.cable_from),
+                   trajectory_planner::equivalent_swing_length(swing, r.cable_target),
+                   trajectory_planner::equivalent_swing_length(swing, planner.cable_min_length),
+                   trajectory_planner::equivalent_swing_length(swing, planner.cable_max_length),
+                   scale * r.cable_limits.max_velocity,
+                   scale * r.cable_limits.max_acceleration};
   problem.voltage_limit = facts.voltage_limit;
   problem.max_swing = kBoundSwingFraction * r.max_swing;
   problem.intervals = intervals;
@@ -47,7 +52,8 @@ MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r
 
 std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const TrajectoryFollower& follower,
                                                                    double sample_period, bool bridge,
-                                                                   double minimum_time) {
+                                                                   double minimum_time,
+                                                                   const trajectory_planner::ManualParams& swing) {
   auto path = std::make_shared<trajectory_planner::PlannedPath>();
   path->sample_period = sample_period;
   path->minimum_time = minimum_time;
@@ -63,7 +69,10 @@ std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const Trajec
     path->trolley[k] = {law.position[0], law.velocity[0], moving ? node.trolley_acceleration : 0.0};
     const common::AxisReference second{law.position[2], law.velocity[2], moving ? node.second_acceleration : 0.0};
     (bridge ? path->bridge[k] : path->slew[k]) = second;
-    path->cable[k] = {node.cable_length, node.cable_length_rate, moving ? node.hoist_acceleration : 0.0};
+    // Back from the equivalent pendulum's length to the hoist's (1 L + 0: the same numbers).
+    const double scale = swing.swing_length_scale;
+    path->cable[k] = {(node.cable_length - swing.swing_length_offset) / scale, node.cable_length_rate / scale,
+                      moving ? node.hoist_acceleration / scale : 0.0};
   }
   return path;
 }
@@ -79,7 +88,8 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan_minimum_time_move(
   params.sample_period = facts.sample_period;
   params.voltage_limit = facts.voltage_limit;
   const TrajectoryFollower follower(problem, result, params);
-  return planned_path(follower, facts.sample_period, facts.crane_kind == common::CraneKind::overhead, result.duration);
+  return planned_path(follower, facts.sample_period, facts.crane_kind == common::CraneKind::overhead, result.duration,
+                      planner.manual);
 }
 
 }  // namespace crane::optimal_control

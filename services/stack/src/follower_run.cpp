@@ -33,7 +33,7 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   const auto setup_start = std::chrono::steady_clock::now();
   const optimal_control::TrajectoryFollower follower(problem, result.bound, follower_params);
   const auto path = optimal_control::planned_path(follower, dt, cfg.facts.crane_kind == common::CraneKind::overhead,
-                                                  result.bound.duration);
+                                                  result.bound.duration, cfg.trajectory_planner.manual);
   result.follower_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
 
   // The stack, the planner handed this path for the maneuver's request.

@@ -166,7 +166,7 @@ std::array<InputShaper, 3> SpeedReference::shapers(SpeedShaping shaping, const M
   std::array<InputShaper, 3> s{};  // identity shapers
   if (shaping == SpeedShaping::none) return s;
   // The equivalent pendulum length (1 * L + 0 = L exactly for the uncalibrated single pendulum).
-  const double cable = params.swing_length_scale * axes_[2].position() + params.swing_length_offset;
+  const double cable = equivalent_swing_length(params, axes_[2].position());
   if (!(cable > 0.0) || !(bounds.gravity > 0.0)) return s;
   ShaperParams p;
   p.kind = shaper_kind(shaping);

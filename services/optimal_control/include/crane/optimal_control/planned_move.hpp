@@ -10,13 +10,18 @@
 //   model          the controllers' model of the configured crane (facts: crane, kind, bridge), rigid
 //   drive axes     from/target of the request, the planner's travel range, the request's rated
 //                  speed and acceleration (the goal's: the move request's or the planner's rated ones)
-//   hoist          the cable from/target, the planner's cable range, the request's hoist limits
+//   hoist          the cable from/target, the planner's cable range, the request's hoist limits, each
+//                  as the equivalent pendulum's length a L + c (the planner's manual.swing_length_scale
+//                  a and swing_length_offset c, trajectory_planner::equivalent_swing_length; the
+//                  rates times a): the swing the plan and its follower's gains are made for is the
+//                  calibrated one. 1 and 0 (uncalibrated): the cable length itself, to the bit.
 //   voltage        facts.voltage_limit, with the crane's friction (3.1)
 //   swing          kBoundSwingFraction x the supervisor's sway limit (request.max_swing): a margin
 //                  for the follower's tracking error and a mismatched plant
 //
 // Errors: minimum_time_problem throws common::ConfigError (optimal_control::validate: a request
-// outside the ranges names the field and the bound); plan_minimum_time_move returns null when the
+// outside the ranges names the field and the bound: an equivalent length a L + c <= 0 is refused
+// as minimum_time.hoist.min_position); plan_minimum_time_move returns null when the
 // bound is not solved, and throws what the problem and the follower throw.
 
 #include <memory>
@@ -55,9 +60,11 @@ struct MovePlanning {
     MinimumTimeResult* bound = nullptr);
 
 /// The path of `follower`, one sample per cycle (see the header), of a bound of duration
-/// `minimum_time` [s]; `bridge`: the second axis is an overhead crane's bridge (else the slew).
-[[nodiscard]] std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const TrajectoryFollower& follower,
-                                                                                double sample_period, bool bridge,
-                                                                                double minimum_time);
+/// `minimum_time` [s]; `bridge`: the second axis is an overhead crane's bridge (else the slew). The
+/// cable's reference is mapped back from the equivalent pendulum's length of `swing` (the planner's
+/// manual block, as minimum_time_problem mapped it) to the hoist's.
+[[nodiscard]] std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(
+    const TrajectoryFollower& follower, double sample_period, bool bridge, double minimum_time,
+    const trajectory_planner::ManualParams& swing);
 
 }  // namespace crane::optimal_control

@@ -113,11 +113,19 @@ struct ManualParams {
   SpeedShaping shaping{SpeedShaping::zv};  // sway control in MANUAL and SEMIAUTOMATIC
   // The swing the shaper is designed for: w = sqrt(g / (swing_length_scale L + swing_length_offset)),
   // damping swing_damping_ratio. 1, 0, 0 is the single pendulum sqrt(g/L); a calibration
-  // (deploy/crane calibrate swing) fits them from a recording (a hook, rigging, a stiff rope).
+  // (deploy/crane calibrate swing) fits them from a recording (a hook, rigging, a stiff rope). The
+  // minimum-time plans use the same equivalent length (equivalent_swing_length; optimal_control's
+  // minimum_time_problem), so one calibration serves manual and automatic moves.
   double swing_length_scale{1.0};   // [-] in [0.1, 10]
   double swing_length_offset{0.0};  // [m] in [-1, 10]; an equivalent length <= 0 gets no shaping
   double swing_damping_ratio{0.0};  // [-] in [0, 0.3]
 };
+/// [m] The equivalent pendulum length of `params` at cable length `cable_length` [m]:
+/// swing_length_scale L + swing_length_offset (1 L + 0 = L exactly, uncalibrated). Not checked > 0.
+[[nodiscard]] inline double equivalent_swing_length(const ManualParams& params, double cable_length) noexcept {
+  return params.swing_length_scale * cable_length + params.swing_length_offset;
+}
+
 /// Throws common::ConfigError naming the field ("trajectory_planner.manual.<name>") unless every
 /// speed and acceleration is finite and > 0, both fractions in (0, 1], the timeout in [0.02, 5] s,
 /// the swing model's fields in their ranges above.
