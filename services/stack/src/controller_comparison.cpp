@@ -133,14 +133,28 @@ optimal_control::MinimumTimeResult comparison_bound(const StackConfig& cfg, cons
   return bound;
 }
 
+namespace {
+
+// A run that could not be made: its error, NaN figures.
+ControllerOutcome failed_outcome(const std::string& controller, const std::string& error) {
+  ControllerOutcome o;
+  o.controller = controller;
+  o.error = error;
+  o.metrics = ManeuverMetrics{kNaN, kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
+  o.ratio = kNaN;
+  return o;
+}
+
+}  // namespace
+
 MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
                             const optimal_control::MinimumTimeResult& bound,
                             const std::vector<ComparedController>& controllers, const plant::PlantMismatch& mismatch,
-                            int intervals, const optimal_control::FollowerParams& follower) {
+                            int intervals, const optimal_control::FollowerParams& follower, double reference_bound) {
   MoveComparison out;
   out.maneuver = m;
   out.mismatch = mismatch;
-  out.bound = bound.duration;
+  out.bound = reference_bound > 0.0 ? reference_bound : bound.duration;
   out.swing_period = swing_period(m, cfg.facts);
   for (const ComparedController& c : controllers) {
     ControllerOutcome o;
@@ -168,14 +182,23 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         o.latched_faults = r.latched_faults;
         o.braked_cycles = r.braked_cycles;
       }
-      o.ratio = o.metrics.settle_time / bound.duration;
+      o.ratio = o.metrics.settle_time / out.bound;
     } catch (const std::exception& error) {
-      o.error = error.what();
-      o.metrics = ManeuverMetrics{kNaN, kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
-      o.ratio = kNaN;
+      o = failed_outcome(c.name, error.what());
     }
     out.outcomes.push_back(std::move(o));
   }
+  return out;
+}
+
+MoveComparison failed_comparison(const ManeuverConfig& maneuver, const plant::PlantMismatch& mismatch,
+                                 const std::vector<ComparedController>& controllers, double bound,
+                                 const std::string& error) {
+  MoveComparison out;
+  out.maneuver = maneuver;
+  out.mismatch = mismatch;
+  out.bound = bound;
+  for (const ComparedController& c : controllers) out.outcomes.push_back(failed_outcome(c.name, error));
   return out;
 }
 

@@ -58,6 +58,7 @@
 #include <fstream>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -68,6 +69,7 @@
 #include "crane/stack/in_process_stack.hpp"
 #include "crane/stack/follower_run.hpp"
 #include "crane/stack/maneuver_bound.hpp"
+#include "crane/stack/swing_calibration_run.hpp"
 
 namespace {
 
@@ -571,9 +573,12 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
 
 // The comparison of issue 32, item 3 (controller_comparison.hpp): the demo maneuvers and `moves`
 // seeded random moves, each controller's settle time as a ratio to T*, on the nominal plant and,
-// with `corners`, at the eight mismatch corners; one move (its bound and its runs) per thread.
-int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, const std::string& controllers_text,
-            int intervals, unsigned jobs, const optimal_control::FollowerParams& follower, const std::string& out_dir) {
+// with `corners`, at the eight mismatch corners; one move (its bound and its runs) per thread. With
+// `calibrate`, each corner's controllers first calibrated on its plant (swing_calibration_run.hpp):
+// its runs follow a bound on the calibrated model, their ratio taken to the nominal T*.
+int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, bool calibrate,
+            const std::string& controllers_text, int intervals, unsigned jobs,
+            const optimal_control::FollowerParams& follower, const std::string& out_dir) {
   const auto cfg = load_config(s);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
@@ -590,6 +595,28 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
     const auto c = stack::mismatch_corners();
     plants.insert(plants.end(), c.begin(), c.end());
   }
+  // One config per plant: the config itself, or calibrated on that corner's plant.
+  std::vector<std::optional<stack::CalibratedStack>> calibrated(plants.size());
+  if (calibrate) {
+    std::atomic<std::size_t> next_plant{1};
+    std::string calibration_error;
+    std::mutex error_lock;
+    const auto calibrate_plants = [&] {
+      for (std::size_t p = next_plant++; p < plants.size(); p = next_plant++) {
+        try {
+          calibrated[p] = stack::calibrate_swing_on(cfg, plants[p], follower, intervals);
+        } catch (const std::exception& error) {
+          const std::lock_guard lock(error_lock);
+          calibration_error = stack::mismatch_label(plants[p]) + ": " + error.what();
+        }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < std::max(1U, jobs); ++t) pool.emplace_back(calibrate_plants);
+    calibrate_plants();
+    for (auto& t : pool) t.join();
+    if (!calibration_error.empty()) throw std::runtime_error("calibration on " + calibration_error);
+  }
   struct MoveResult {
     std::vector<stack::MoveComparison> runs;  // one per plant
     double solve_seconds{0.0};
@@ -605,9 +632,22 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
         const auto bound = stack::comparison_bound(cfg, maneuvers[i], intervals);
         results[i].solve_seconds = bound.solve_seconds;
         results[i].least_effort = bound.least_effort;
-        for (const auto& plant : plants) {
-          results[i].runs.push_back(
-              stack::compare_move(cfg, maneuvers[i], bound, controllers, plant, intervals, follower));
+        for (std::size_t p = 0; p < plants.size(); ++p) {
+          if (!calibrated[p]) {
+            results[i].runs.push_back(
+                stack::compare_move(cfg, maneuvers[i], bound, controllers, plants[p], intervals, follower));
+            continue;
+          }
+          const stack::StackConfig& own = calibrated[p]->config;
+          try {
+            const auto own_bound = stack::comparison_bound(own, maneuvers[i], intervals);
+            results[i].runs.push_back(stack::compare_move(own, maneuvers[i], own_bound, controllers, plants[p],
+                                                          intervals, follower, bound.duration));
+          } catch (const std::exception& error) {  // that corner's bound alone: its runs are errors
+            results[i].runs.push_back(stack::failed_comparison(maneuvers[i], plants[p], controllers, bound.duration,
+                                                               std::string("calibrated: ") + error.what()));
+          }
+          results[i].runs.back().calibrated = true;
         }
       } catch (const std::exception& error) {
         results[i].error = error.what();
@@ -623,6 +663,18 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   std::printf("controllers against the minimum-time bound T* (%s crane, %zu demo maneuvers and %d random moves, seed "
               "%llu; friction compensation on; settle: 5 mm, 0.005 rad, 0.5 deg)\n",
               common::to_string(cfg.facts.crane_kind), demo_count, moves, static_cast<unsigned long long>(seed));
+  if (calibrate) {
+    std::printf("each corner's controllers calibrated on its plant ('+cal'; the nominal T* kept): the fitted "
+                "equivalent pendulum a L + c against the plant's\n");
+    for (std::size_t p = 1; p < plants.size(); ++p) {
+      const auto& f = calibrated[p]->fit;
+      const double configured = cfg.facts.crane.cable_length;
+      std::printf("  %-16s on %-10s a %.4f  c %+.4f m  -> %.4f m at L %.3f m (the plant's %.4f m), rms %.2e rad\n",
+                  stack::mismatch_label(plants[p]).c_str(), calibrated[p]->maneuver.c_str(), f.length_scale,
+                  f.length_offset, f.length_scale * configured + f.length_offset, configured,
+                  plants[p].cable_length_factor * configured, f.rms_residual);
+    }
+  }
   std::printf("settle time / T* per controller ('-': not settled within the record, '!': a supervisor fault or "
               "the brakes)\n%-12s %-16s %8s", "move", "plant", "T* [s]");
   for (const auto& c : controllers) std::printf(" %12s", c.name.c_str());
@@ -643,7 +695,8 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
     for (const auto& run : r.runs) {
       const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
       (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
-      std::printf("%-13s %-16s %8.4f", maneuvers[i].name.c_str(), stack::mismatch_label(run.mismatch).c_str(), run.bound);
+      const std::string label = stack::mismatch_label(run.mismatch) + (run.calibrated ? "+cal" : "");
+      std::printf("%-13s %-16s %8.4f", maneuvers[i].name.c_str(), label.c_str(), run.bound);
       for (const auto& o : run.outcomes) {
         if (!o.error.empty()) ++errors;
         const bool faulted = o.latched_faults != 0 || o.braked_cycles != 0;
@@ -668,7 +721,10 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
   };
   print_summary("demo maneuvers, nominal plant: settle / T*", demo_nominal);
   print_summary("random moves, nominal plant: settle / T*", random_nominal);
-  print_summary("every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3): settle / T*", at_corners);
+  print_summary(calibrate ? "every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3), each calibrated on its "
+                            "plant: settle / nominal T*"
+                          : "every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3): settle / T*",
+                at_corners);
   std::sort(solve_times.begin(), solve_times.end());
   if (!solve_times.empty()) {
     std::printf("\nbound solve (IPOPT, %d intervals, both solves): median %.2f s, max %.2f s over %zu moves; %.1f s "
@@ -687,7 +743,8 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, con
       for (const auto& run : r.runs) {
         for (const auto& o : run.outcomes) {
           const auto& x = o.metrics;
-          csv << run.maneuver.name << ',' << stack::mismatch_label(run.mismatch) << ',' << run.bound << ','
+          csv << run.maneuver.name << ',' << stack::mismatch_label(run.mismatch) << (run.calibrated ? "+cal" : "")
+              << ',' << run.bound << ','
               << o.controller << ',' << x.settle_time << ',' << o.ratio << ',' << 1e3 * x.final_position_error << ','
               << 1e3 * x.final_slew_error << ',' << 1e3 * x.final_bridge_error << ',' << deg * x.max_swing << ','
               << deg * x.residual_swing << ',' << x.max_voltage << ',' << o.latched_faults << ',' << o.braked_cycles
@@ -933,12 +990,17 @@ int main(int argc, char** argv) {
   int compare_moves = 20;
   std::uint64_t compare_seed = 1;
   bool compare_corners = false;
+  bool compare_calibrate = false;
   std::string compare_controllers;
   int compare_intervals = 200;
   unsigned compare_jobs = default_jobs();
   compare_cmd->add_option("--moves", compare_moves, "seeded random moves besides the demo maneuvers")->check(CLI::Range(0, 1000));
   compare_cmd->add_option("--seed", compare_seed, "the random moves' seed");
   compare_cmd->add_flag("--corners", compare_corners, "also at the eight +-20 % length and mass, +-30 % friction corners");
+  compare_cmd->add_flag("--calibrate", compare_calibrate,
+                        "with --corners: each corner's controllers calibrated on its plant first (a recorded demo "
+                        "maneuver, the swing fitted; tower and gantry cranes)")
+      ->needs("--corners");
   compare_cmd->add_option("--controllers", compare_controllers,
                           "comma-separated: follower,delay1,delay2,time_optimal,zv,zvd (default: all)");
   compare_cmd->add_option("--intervals", compare_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
@@ -967,8 +1029,8 @@ int main(int argc, char** argv) {
     if (*integrators_cmd) return integrators(s);
     if (*bound_cmd) return bound(s, intervals, out_dir);
     if (*compare_cmd) {
-      return compare(s, compare_moves, compare_seed, compare_corners, compare_controllers, compare_intervals, compare_jobs,
-                     compare_follower, out_dir);
+      return compare(s, compare_moves, compare_seed, compare_corners, compare_calibrate, compare_controllers,
+                     compare_intervals, compare_jobs, compare_follower, out_dir);
     }
     if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed);
   } catch (const std::exception& error) {

@@ -75,7 +75,8 @@ struct ControllerOutcome {
 struct MoveComparison {
   ManeuverConfig maneuver;
   plant::PlantMismatch mismatch;     // the plant's, against the controllers' model
-  double bound{0.0};                 // [s] T*
+  double bound{0.0};                 // [s] T* (the nominal model's when calibrated)
+  bool calibrated{false};            // the controllers' config was calibrated on this plant (compare_move's caller)
   double bound_solve_seconds{0.0};   // [s] IPOPT's wall time (0 when the bound was given)
   double swing_period{0.0};          // [s] at the target cable length
   std::vector<ControllerOutcome> outcomes;  // one per controller, in their order
@@ -89,11 +90,21 @@ struct MoveComparison {
 /// Runs each of `controllers` on `maneuver` against a plant with `mismatch`, the ratio taken to
 /// `bound` (comparison_bound of the same maneuver and intervals); the follower with `follower`'s
 /// weights (FollowerRun::follower). A run that throws is kept with its error and NaN figures.
+/// `reference_bound` [s] > 0: the ratio (and MoveComparison::bound) taken to this T* instead, the
+/// nominal model's, for a config calibrated on the plant (swing_calibration_run.hpp) whose own
+/// bound `bound` is on the calibrated model.
 [[nodiscard]] MoveComparison compare_move(const StackConfig& config, const ManeuverConfig& maneuver,
                                           const optimal_control::MinimumTimeResult& bound,
                                           const std::vector<ComparedController>& controllers,
                                           const plant::PlantMismatch& mismatch = {}, int intervals = 200,
-                                          const optimal_control::FollowerParams& follower = {});
+                                          const optimal_control::FollowerParams& follower = {},
+                                          double reference_bound = 0.0);
+
+/// A comparison none of whose runs could be made (`error`: why, e.g. its bound not solved): each of
+/// `controllers` with that error and NaN figures, the ratio to `bound` [s].
+[[nodiscard]] MoveComparison failed_comparison(const ManeuverConfig& maneuver, const plant::PlantMismatch& mismatch,
+                                               const std::vector<ComparedController>& controllers, double bound,
+                                               const std::string& error);
 
 /// The eight corners of cable length and load mass x0.8/x1.2 and friction x0.7/x1.3 (issue 32).
 [[nodiscard]] std::vector<plant::PlantMismatch> mismatch_corners();
