@@ -669,6 +669,11 @@ TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
       "test.yaml");
   EXPECT_EQ(calibrated.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::two_hump_ei);
   EXPECT_EQ(calibrated.trajectory_planner.manual.swing_length_offset, 0.25);
+  // An equivalent pendulum that is no pendulum at the shortest cable (the minimum-time plans swing
+  // it, optimal_control::minimum_time_problem): refused with the length it would have.
+  message = error_of(edit_line(text_, "manual:", "swing_length_offset:", "swing_length_offset: -0.99").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.manual.swing_length_offset = -0.99")) << message;
+  EXPECT_TRUE(contains(message, "leaves no pendulum at the shortest cable")) << message;
 }
 
 TEST_F(LabConfigText, PlantRopeIsOffAndValidatedLikeTheRest) {

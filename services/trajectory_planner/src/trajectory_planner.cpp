@@ -58,6 +58,15 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   common::require_in_range("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance,
                            0.0, 0.2);
   validate(params.manual);
+  // The calibrated equivalent pendulum must be one over the whole cable range (a > 0: its shortest
+  // is at the shortest cable), or the minimum-time plans have no pendulum to swing.
+  const double shortest = equivalent_swing_length(params.manual, params.cable_min_length);
+  if (!(shortest > 0.0)) {
+    throw common::ConfigError("trajectory_planner.manual.swing_length_offset = " +
+                              std::to_string(params.manual.swing_length_offset) +
+                              " leaves no pendulum at the shortest cable: swing_length_scale x cable_min_length + "
+                              "swing_length_offset = " + std::to_string(shortest) + " m, must be > 0");
+  }
   common::validate(params.site, "site");
 }
 
