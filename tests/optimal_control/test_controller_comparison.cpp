@@ -123,6 +123,23 @@ TEST(ControllerComparison, SummaryCountsNeverSettledAsInfiniteAndFaultsApart) {
   EXPECT_TRUE(std::isinf(s[0].worst_ratio));
   EXPECT_DOUBLE_EQ(s[0].peak_voltage, 1.3);
   EXPECT_DOUBLE_EQ(s[0].worst_position_error, 0.0013);
+
+  // A comparison none of whose runs could be made (a calibrated corner's bound not solved): one
+  // error per controller, NaN figures, the given T*; the summary counts each as failed, not settled.
+  const auto controllers = stack::compared_controllers({"follower", "delay1"});
+  const auto failed = stack::failed_comparison(stack::random_moves(config("lab_tower_crane.yaml"), 1, 1)[0], {},
+                                               controllers, 2.5, "the bound was not solved");
+  ASSERT_EQ(failed.outcomes.size(), 2u);
+  EXPECT_EQ(failed.bound, 2.5);
+  for (const auto& o : failed.outcomes) {
+    EXPECT_EQ(o.error, "the bound was not solved");
+    EXPECT_TRUE(std::isnan(o.ratio));
+    EXPECT_TRUE(std::isnan(o.metrics.settle_time));
+  }
+  const auto f = stack::summarize({failed});
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_EQ(f[0].failed, 1);
+  EXPECT_EQ(f[0].settled, 0);
 }
 
 // Three seeded random tower moves (trolley and slew together, some hoisting): T* is no faster than
