@@ -288,7 +288,8 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         arrived_at_.reset();
         ended_short_at_.reset();
         ++halts_;
-        halt_at_waypoint_ = !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate), reference_rest_of(reference)));
+        halt_at_waypoint_ =
+            !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate), reference_rest_of(reference)));
         if (!halt_at_waypoint_) {
           Request stop{};
           stop.request_id = ++goal_id_;
