@@ -95,7 +95,8 @@ std::string estimate_json(const Estimate* e) {
           ", \"estimate\": {\"payload_mass_kg\": %g, \"payload_mass_bound_kg\": %g, \"payload_confident\": %s, "
           "\"adaptation\": [%s], \"trolley_friction_V\": [%g, %g, %g, %g, %g, %g], "
           "\"slew_friction_V\": [%g, %g, %g, %g, %g, %g], \"trolley_voltage_sign_changes\": %u, "
-          "\"slew_voltage_sign_changes\": %u, \"seq\": %llu}",
+          "\"slew_voltage_sign_changes\": %u, \"swing_length_scale\": %g, \"swing_length_offset_m\": %g, "
+          "\"swing_length_bound_m\": %g, \"swing_length_confident\": %s, \"seq\": %llu}",
           e->payload_mass, e->payload_mass_bound, e->payload_confident ? "true" : "false",
           adaptation_list(e->adaptation, ", ", "\"").c_str(), e->trolley_friction_viscous_positive,
           e->trolley_friction_viscous_negative, e->trolley_friction_coulomb_positive,
@@ -103,7 +104,8 @@ std::string estimate_json(const Estimate* e) {
           e->trolley_friction_static_negative, e->slew_friction_viscous_positive, e->slew_friction_viscous_negative,
           e->slew_friction_coulomb_positive, e->slew_friction_coulomb_negative, e->slew_friction_static_positive,
           e->slew_friction_static_negative, e->trolley_voltage_sign_changes, e->slew_voltage_sign_changes,
-          static_cast<unsigned long long>(e->header.seq));
+          e->swing_length_scale, e->swing_length_offset, e->swing_length_bound,
+          e->swing_length_confident ? "true" : "false", static_cast<unsigned long long>(e->header.seq));
   return text;
 }
 
@@ -142,6 +144,12 @@ void append_estimate(std::string& text, const Estimate* e) {
   if (enabled) {
     appendf(text, "sign changes    drive voltage at rest: trolley %u, slew %u\n", e->trolley_voltage_sign_changes,
             e->slew_voltage_sign_changes);
+  }
+  if (e->swing_length_confident) {
+    appendf(text, "pendulum        %.4f L %+.4f m, +- %.4f m where learnt (online estimate, 2 sigma; the plans swing it)\n",
+            e->swing_length_scale, e->swing_length_offset, e->swing_length_bound);
+  } else {
+    text += "pendulum        the planner's configured a L + c (trajectory_planner.manual; no online estimate)\n";
   }
 }
 

@@ -576,6 +576,24 @@ TEST_F(LabConfigText, AdaptationFieldsAreValidatedByName) {
   EXPECT_TRUE(contains(message, "state_estimator.adaptation.enabled")) << message;
 }
 
+// The equivalent pendulum's block (state_estimator.swing_length): every field required and
+// range-checked by name; off in the shipped configs; the stage's facts (kind, crane) filled in.
+TEST_F(LabConfigText, SwingLengthFieldsAreValidatedByName) {
+  const auto shipped = crane::stack::parse_stack_config(text_, "test.yaml");
+  EXPECT_FALSE(shipped.state_estimator.swing_length.enabled);
+  EXPECT_EQ(shipped.state_estimator.swing_length.crane_kind, shipped.facts.crane_kind);
+  EXPECT_EQ(shipped.state_estimator.swing_length.crane.gravity, shipped.facts.crane.gravity);
+  EXPECT_EQ(shipped.state_estimator.swing_length.length_bound, 0.02);
+  auto message = error_of(edit_line(text_, "swing_length:", "length_bound:", "length_bound: 0").text);
+  EXPECT_TRUE(contains(message, "state_estimator.swing_length.length_bound = 0")) << message;
+  message = error_of(edit_line(text_, "swing_length:", "forgetting_factor:", "forgetting_factor: 1.5").text);
+  EXPECT_TRUE(contains(message, "state_estimator.swing_length.forgetting_factor = 1.5")) << message;
+  message = error_of(edit_line(text_, "swing_length:", "min_swing:", std::nullopt).text);
+  EXPECT_TRUE(contains(message, "missing field state_estimator.swing_length.min_swing")) << message;
+  message = error_of(edit_line(text_, "swing_length:", "enabled:", "enabled: sometimes").text);
+  EXPECT_TRUE(contains(message, "state_estimator.swing_length.enabled")) << message;
+}
+
 // The follower's estimator (state_estimator.follower_cutoff_frequency, for_follower): read and
 // range-checked like the rest, and it changes the Butterworth's cutoff and nothing else. The lag of
 // a ramp, the filter's group delay at DC sqrt2 / (2 pi fc) for a second-order Butterworth, halves

@@ -185,23 +185,25 @@ TEST(MinimumTime, TheLeastEffortTrajectoryLeavesTheSlackAxisQuiet) {
   EXPECT_LE(quiet_voltage, problem.voltage_limit * (1.0 + 1e-6));
 }
 
-// A calibrated equivalent pendulum a L + c (trajectory_planner.manual.swing_length_scale and
-// _offset; deploy/crane calibrate swing) is the pendulum the plan swings: the problem's cable
+// The request's equivalent pendulum a L + c (the calibrated trajectory_planner.manual.swing_length_scale
+// and _offset, deploy/crane calibrate swing; or the state estimator's online estimate) is the
+// pendulum the plan swings: the problem's cable
 // lengths are a L + c, its hoist limits a times the request's, and the planned path maps the cable
 // back to the hoist's lengths. Uncalibrated (1, 0), the problem is the request's to the bit. The
 // demo's trolley move while lowering 1.0 -> 1.5 m, with a = 1.1 and c = 0.05 m: 1.15 -> 1.7 m.
 TEST(MinimumTime, PlansTheCalibratedEquivalentPendulumAndMapsTheCableBack) {
   auto cfg = config("lab_tower_crane.yaml");
   const auto m = stack::find_maneuver(cfg, "trolley_hoist");
-  const auto request = stack::plan_request_of(cfg, m);
+  auto request = stack::plan_request_of(cfg, m);
   const auto plain = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50);
   EXPECT_EQ(plain.hoist.start, request.cable_from);
   EXPECT_EQ(plain.hoist.target, request.cable_target);
   EXPECT_EQ(plain.hoist.max_speed, request.cable_limits.max_velocity);
   ASSERT_NE(request.cable_from, request.cable_target);
 
-  cfg.trajectory_planner.manual.swing_length_scale = 1.1;
-  cfg.trajectory_planner.manual.swing_length_offset = 0.05;
+  EXPECT_EQ(request.swing.scale, cfg.trajectory_planner.manual.swing_length_scale);  // the configured
+  EXPECT_EQ(request.swing.offset, cfg.trajectory_planner.manual.swing_length_offset);
+  request.swing = {1.1, 0.05};
   const auto p = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50);
   EXPECT_NEAR(p.hoist.start, 1.1 * 1.0 + 0.05, 1e-12);
   EXPECT_NEAR(p.hoist.target, 1.1 * 1.5 + 0.05, 1e-12);
@@ -224,8 +226,14 @@ TEST(MinimumTime, PlansTheCalibratedEquivalentPendulumAndMapsTheCableBack) {
   for (const auto& c : path->cable) peak_rate = std::max(peak_rate, std::abs(c.velocity));
   EXPECT_LE(peak_rate, request.cable_limits.max_velocity * (1.0 + 1e-6));
   EXPECT_GT(peak_rate, 0.5 * request.cable_limits.max_velocity);
-  // An equivalent length that is not positive anywhere in the cable range is refused.
-  cfg.trajectory_planner.manual.swing_length_offset = -cfg.trajectory_planner.cable_min_length * 1.1 - 0.01;
+  // A pendulum that is none at the planner's shortest cable (a learnt one: what the crane swung at
+  // says little of much shorter cables) is planned over the move's own span, from its shorter cable.
+  request.swing = {1.0, -cfg.trajectory_planner.cable_min_length * 1.1 - 0.01};
+  const auto span = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50);
+  EXPECT_NEAR(span.hoist.min_position, 1.0 + request.swing.offset, 1e-12);
+  EXPECT_NEAR(span.hoist.max_position, cfg.trajectory_planner.cable_max_length + request.swing.offset, 1e-12);
+  // One that is none at the move's own cable is refused.
+  request.swing.offset = -1.0;
   EXPECT_THROW((void)optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 50),
                common::ConfigError);
 }

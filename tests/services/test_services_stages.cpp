@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <string>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <vector>
@@ -152,6 +153,59 @@ struct HeardPlanner {
     EXPECT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, goals, {}, &status}, reference), common::StepStatus::ok);
   }
 };
+
+// The pendulum a plan swings (PlanRequest::swing): the state estimator's learnt one while it is
+// confident and swings over the move's cable span (a L + c > 0 at its shorter cable, here 1.0 m: the
+// goal does not hoist; a and c in the manual block's ranges), the configured trajectory_planner.manual
+// one otherwise. The planner's shortest cable, 0.3 m, does not bound a learnt pendulum.
+TEST(PlannerStage, AMinimumTimePlanSwingsTheLearntPendulumWhenItSwingsOverTheMove) {
+  trajectory_planner::TrajectoryPlannerParams params;
+  params.cable_min_length = 0.3;
+  params.manual.swing_length_scale = 0.995;  // a calibration: the lab crane's hook
+  params.manual.swing_length_offset = 0.257;
+  struct Case {
+    bool confident;
+    double scale, offset;
+    double expected_scale, expected_offset;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const Case c : {Case{true, 1.0, 0.2, 1.0, 0.2},          // learnt: planned
+                       Case{false, 1.0, 0.2, 0.995, 0.257},      // not confident: the configured
+                       Case{true, 1.0, -1.0, 0.995, 0.257},      // a L + c = 0 at the move's 1.0 m
+                       Case{true, 1.0, -0.99, 1.0, -0.99},       // 1 cm of pendulum there (none at 0.3 m)
+                       Case{true, 0.5, -0.2, 0.5, -0.2},         // 0.3 m at 1.0 m, none at 0.3 m
+                       Case{true, 12.0, 0.0, 0.995, 0.257},      // a out of [0.1, 10]
+                       Case{true, 1.0, 10.5, 0.995, 0.257},      // c out of [-1, 10]
+                       Case{true, nan, 0.2, 0.995, 0.257}}) {    // NaN: the estimate is refused first
+    trajectory_planner::TrajectoryPlannerStage stage(params, 0.01);
+    protocol::Reference reference;
+    const protocol::SupervisorStatus status = with_sway_limit(0);
+    const Request goal = minimum_time_goal(3, 0.35);
+    for (std::uint64_t k = 0; k <= 1; ++k) {
+      auto state = at_rest(k);
+      state.swing_length_confident = c.confident;
+      state.swing_length_scale = c.scale;
+      state.swing_length_offset = c.offset;
+      const auto step = stage.step(trajectory_planner::PlannerCycle{&state, k == 1 ? std::span(&goal, 1)
+                                                                                  : std::span<const Request>(),
+                                                                    {}, &status},
+                                   reference);
+      if (std::isnan(c.scale)) {
+        EXPECT_EQ(step, common::StepStatus::rejected_nonfinite);
+        state.swing_length_scale = 1.0;  // the next estimate is whole again, not confident
+        state.swing_length_confident = false;
+        ASSERT_EQ(stage.step(trajectory_planner::PlannerCycle{&state, k == 1 ? std::span(&goal, 1)
+                                                                             : std::span<const Request>(),
+                                                              {}, &status},
+                             reference),
+                  common::StepStatus::ok);
+      }
+    }
+    ASSERT_TRUE(stage.plan_request().has_value()) << c.scale << " " << c.offset;
+    EXPECT_EQ(stage.plan_request()->swing.scale, c.expected_scale) << c.scale << " " << c.offset;
+    EXPECT_EQ(stage.plan_request()->swing.offset, c.expected_offset) << c.scale << " " << c.offset;
+  }
+}
 
 TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
   HeardPlanner p;

@@ -153,6 +153,19 @@ TEST(OperatorExchange, StatusWaitsHalfASecondForTheEstimateThenPrintsWithoutIt) 
   EXPECT_NE(with_estimate.outcome().out.find("payload         3.012 kg +- 0.041 kg (online estimate, 2 sigma; in use)"),
             std::string::npos)
       << with_estimate.outcome().out;
+  EXPECT_NE(with_estimate.outcome().out.find("pendulum        the planner's configured a L + c"), std::string::npos)
+      << with_estimate.outcome().out;
+
+  OperatorExchange learnt(request("status"), 1, 0, t0);
+  learnt.on_status(s, t0);
+  e.swing_length_scale = 1.0;
+  e.swing_length_offset = 0.2031;
+  e.swing_length_bound = 0.0042;
+  e.swing_length_confident = true;
+  learnt.on_estimate(e);
+  ASSERT_TRUE(learnt.done(t0 + milliseconds(1)));
+  EXPECT_NE(learnt.outcome().out.find("pendulum        1.0000 L +0.2031 m, +- 0.0042 m where learnt"), std::string::npos)
+      << learnt.outcome().out;
 
   OperatorExchange nothing(request("status", {}, 0.2), 1, 4, t0);
   ASSERT_TRUE(nothing.done(t0 + milliseconds(200)));

@@ -19,6 +19,7 @@
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
 
 int main(int argc, char** argv) {
@@ -64,10 +65,19 @@ int main(int argc, char** argv) {
   app.add_option("--initial-slew", initial_slew, "[rad] initial slew angle (default: the same)");
   app.add_option("--initial-bridge", initial_bridge, "[m] initial bridge position (overhead crane; default: the same)");
   app.add_flag("--no-friction-compensation", no_compensation, "friction_compensation passes V through");
+  std::string controller;
+  app.add_option("--controller", controller,
+                 "the stack's controllers, as crane_demo names them: follower (minimum-time goals followed in "
+                 "closed loop: send them with `deploy/crane move --profile minimum_time`), delay1, delay2, pd, "
+                 "none, fuzzy, gain_scheduling_partial, gain_scheduling_full (default: each stage's own)");
   app.add_option("--plant-load-mass-factor", stack.plant_load_mass_factor,
                  "--sim: the simulated load mass is this times the configured one (the controllers assume the "
                  "configuration; the online estimate, state_estimator.adaptation, finds it)")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--plant-cable-length-factor", stack.plant_cable_length_factor,
+                 "--sim: the simulated pendulum is this times the cable the hoist reports (the controllers assume "
+                 "the configured pendulum; the online estimate, state_estimator.swing_length, finds it)")
+      ->check(CLI::Range(0.1, 10.0));
   auto* site_option = app.add_option("--site", stack.site_file,
                                      "the crane is on this site (docs/site.md): its supervisor enforces its grant")
                           ->check(CLI::ExistingFile);
@@ -113,6 +123,13 @@ int main(int argc, char** argv) {
       stack.initial_trolley_position = first.initial_trolley_position;
       stack.initial_slew_angle = first.initial_slew_angle;
       stack.initial_bridge_position = first.initial_bridge_position;
+    }
+    if (!controller.empty()) {  // the demo's names (crane::stack::choose_controller: one place)
+      const auto choice = crane::stack::choose_controller(
+          controller, config.maneuvers.empty() ? crane::stack::ManeuverConfig{} : config.maneuvers.front(), false);
+      stack.anti_swing_controller = std::string(anti_swing::law_name(choice.anti_swing));
+      stack.tracking_controller = std::string(tracking::law_name(choice.tracking));
+      stack.estimator_follower_filter = choice.follower_filter();
     }
     stack.initial_trolley_position = initial_trolley.value_or(stack.initial_trolley_position);
     stack.initial_slew_angle = initial_slew.value_or(stack.initial_slew_angle);

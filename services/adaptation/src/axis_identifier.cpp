@@ -64,10 +64,7 @@ AxisIdentifier::AxisIdentifier(const AxisIdentifierParams& params, const char* p
 }
 
 void AxisIdentifier::reset() noexcept {
-  information_.setZero();
-  weighted_output_.setZero();
-  weighted_output_energy_ = 0.0;
-  weight_sum_ = 0.0;
+  statistics_ = WeightedLeastSquares<kParameterCount>{};
   state_ = AxisIdentification{};
   state_.estimate = params_.initial;
   state_.standard_deviation.setZero();
@@ -75,11 +72,7 @@ void AxisIdentifier::reset() noexcept {
 
 bool AxisIdentifier::update(double y, const ParameterVector& phi) noexcept {
   if (!std::isfinite(y) || !phi.allFinite()) return false;
-  const double lambda = params_.forgetting_factor;
-  information_ = lambda * information_ + phi * phi.transpose();
-  weighted_output_ = lambda * weighted_output_ + phi * y;
-  weighted_output_energy_ = lambda * weighted_output_energy_ + y * y;
-  weight_sum_ = lambda * weight_sum_ + 1.0;
+  statistics_.add(params_.forgetting_factor, y, phi);
   ++state_.accepted_samples;
   return true;
 }
@@ -87,7 +80,8 @@ bool AxisIdentifier::update(double y, const ParameterVector& phi) noexcept {
 bool AxisIdentifier::solve() noexcept {
   // Scaled information S = D R D: each parameter at its typical size.
   const ParameterVector& d = params_.scale;
-  const InformationMatrix scaled = d.asDiagonal() * information_ * d.asDiagonal();
+  const InformationMatrix& information = statistics_.information;
+  const InformationMatrix scaled = d.asDiagonal() * information * d.asDiagonal();
 
   // Candidates: the load when its information alone passes, and every friction group with any data
   // (a group without data is exactly decoupled). The candidates together must pass both bounds (so
@@ -128,14 +122,14 @@ bool AxisIdentifier::solve() noexcept {
     rhs.resize(n);
     for (int a = 0; a < n; ++a) {
       const int i = index[static_cast<std::size_t>(a)];
-      rhs(a) = weighted_output_(i);
+      rhs(a) = statistics_.weighted_output(i);
       for (int j = 0; j < kParameterCount; ++j) {
-        if (!active[static_cast<std::size_t>(j)]) rhs(a) -= information_(i, j) * theta(j);  // held
+        if (!active[static_cast<std::size_t>(j)]) rhs(a) -= information(i, j) * theta(j);  // held
       }
       for (int b = 0; b < n; ++b) {
         const int j = index[static_cast<std::size_t>(b)];
         s_aa(a, b) = scaled(i, j);
-        r_aa(a, b) = information_(i, j);
+        r_aa(a, b) = information(i, j);
       }
     }
     const Conditioning joint = conditioning_of(s_aa);
@@ -163,9 +157,8 @@ bool AxisIdentifier::solve() noexcept {
   for (int a = 0; a < n; ++a) next(index[static_cast<std::size_t>(a)]) = d(index[static_cast<std::size_t>(a)]) * z(a);
 
   // Weighted residual sum of squares from the sufficient statistics: E - 2 theta^T r + theta^T R theta.
-  const double rss = std::max(0.0, weighted_output_energy_ - 2.0 * next.dot(weighted_output_) +
-                                       next.dot(information_ * next));
-  const double dof = std::max(1.0, weight_sum_ - static_cast<double>(n));
+  const double rss = statistics_.residual_sum_of_squares(next);
+  const double dof = std::max(1.0, statistics_.weight_sum - static_cast<double>(n));
   const double variance = params_.noise_correlation * rss / dof;
   // Covariance of the excited parameters: s^2 R_aa^-1 = s^2 D_a S_aa^-1 D_a.
   const SmallMatrix s_inverse = ldlt.solve(SmallMatrix::Identity(n, n));
@@ -178,7 +171,7 @@ bool AxisIdentifier::solve() noexcept {
   state_.load_excited = load_excited;
   state_.positive_excited = group_excited[0];
   state_.negative_excited = group_excited[1];
-  state_.residual_rms = std::sqrt(rss / std::max(1.0, weight_sum_));
+  state_.residual_rms = std::sqrt(rss / std::max(1.0, statistics_.weight_sum));
   ++state_.solves;
   return true;
 }

@@ -51,12 +51,15 @@ AxisIdentifierParams identifier_params(const OnlineAdaptationParams& p, double l
   return a;
 }
 
-// The filter's impulse response h: its memory (last sample with |h| >= 1 % of the peak) and the
-// equivalent number of correlated samples (sum h)^2 / sum h^2.
-struct ImpulseFigures {
-  int memory{0};
-  double correlation{1.0};
-};
+// (3.3) over the stencil [k-2, k]: both backward differences beyond d_s with the same sign.
+int sliding_direction(const double (&q)[3], double sample_period, double band) {
+  const int newer = friction_compensation::friction_direction((q[0] - q[1]) / sample_period, band);
+  const int older = friction_compensation::friction_direction((q[1] - q[2]) / sample_period, band);
+  return newer == older ? newer : 0;
+}
+
+}  // namespace
+
 ImpulseFigures impulse_figures(const state_estimator::DiscreteTransferFunction& tf) {
   // A stable filter's response decays geometrically: it is followed until it has stayed below
   // 1e-17 of its peak for kQuietSamples samples (about 250 samples for the 4 Hz Butterworth at
@@ -87,15 +90,6 @@ ImpulseFigures impulse_figures(const state_estimator::DiscreteTransferFunction& 
   f.correlation = std::max(1.0, sum * sum / sum_squares);
   return f;
 }
-
-// (3.3) over the stencil [k-2, k]: both backward differences beyond d_s with the same sign.
-int sliding_direction(const double (&q)[3], double sample_period, double band) {
-  const int newer = friction_compensation::friction_direction((q[0] - q[1]) / sample_period, band);
-  const int older = friction_compensation::friction_direction((q[1] - q[2]) / sample_period, band);
-  return newer == older ? newer : 0;
-}
-
-}  // namespace
 
 void validate(const OnlineAdaptationParams& p) {
   const std::string f = kPrefix;

@@ -1,5 +1,7 @@
 #include "crane/optimal_control/planned_move.hpp"
 
+#include <algorithm>
+
 #include "crane/plant/crane_simulator.hpp"
 
 namespace crane::optimal_control {
@@ -32,14 +34,19 @@ MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r
                       r.slew_limits.max_acceleration};
     problem.second_friction = facts.crane.slew_friction;
   }
-  // The pendulum the plan swings is the calibrated equivalent one (see the header): its length
+  // The pendulum the plan swings is the request's equivalent one (see the header): its length
   // a L + c, its rates a times the hoist's (the controllers' model is the rigid single pendulum,
-  // no hook: a hook's rigging is what the calibration's offset takes in).
-  const trajectory_planner::ManualParams& swing = planner.manual;
-  const double scale = swing.swing_length_scale;
+  // no hook: a hook's rigging is what the offset takes in).
+  // The hoist's range is the planner's where the pendulum is one down to its shortest cable, else
+  // the move's own span (a learnt pendulum, trajectory_planner::swings_down_to).
+  const trajectory_planner::EquivalentPendulum& swing = r.swing;
+  const double scale = swing.scale;
+  const double shortest = trajectory_planner::swings_down_to(swing, planner.cable_min_length)
+                              ? planner.cable_min_length
+                              : std::max(planner.cable_min_length, std::min(r.cable_from, r.cable_target));
   problem.hoist = {trajectory_planner::equivalent_swing_length(swing, r.cable_from),
                    trajectory_planner::equivalent_swing_length(swing, r.cable_target),
-                   trajectory_planner::equivalent_swing_length(swing, planner.cable_min_length),
+                   trajectory_planner::equivalent_swing_length(swing, shortest),
                    trajectory_planner::equivalent_swing_length(swing, planner.cable_max_length),
                    scale * r.cable_limits.max_velocity,
                    scale * r.cable_limits.max_acceleration};
@@ -53,7 +60,7 @@ MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r
 std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const TrajectoryFollower& follower,
                                                                    double sample_period, bool bridge,
                                                                    double minimum_time,
-                                                                   const trajectory_planner::ManualParams& swing) {
+                                                                   const trajectory_planner::EquivalentPendulum& swing) {
   auto path = std::make_shared<trajectory_planner::PlannedPath>();
   path->sample_period = sample_period;
   path->minimum_time = minimum_time;
@@ -70,8 +77,8 @@ std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(const Trajec
     const common::AxisReference second{law.position[2], law.velocity[2], moving ? node.second_acceleration : 0.0};
     (bridge ? path->bridge[k] : path->slew[k]) = second;
     // Back from the equivalent pendulum's length to the hoist's (1 L + 0: the same numbers).
-    const double scale = swing.swing_length_scale;
-    path->cable[k] = {(node.cable_length - swing.swing_length_offset) / scale, node.cable_length_rate / scale,
+    const double scale = swing.scale;
+    path->cable[k] = {(node.cable_length - swing.offset) / scale, node.cable_length_rate / scale,
                       moving ? node.hoist_acceleration / scale : 0.0};
   }
   return path;
@@ -89,7 +96,7 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan_minimum_time_move(
   params.voltage_limit = facts.voltage_limit;
   const TrajectoryFollower follower(problem, result, params);
   return planned_path(follower, facts.sample_period, facts.crane_kind == common::CraneKind::overhead, result.duration,
-                      planner.manual);
+                      request.swing);
 }
 
 }  // namespace crane::optimal_control

@@ -150,8 +150,10 @@ ControllerOutcome failed_outcome(const std::string& controller, const std::strin
 MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
                             const optimal_control::MinimumTimeResult& bound,
                             const std::vector<ComparedController>& controllers, const plant::PlantMismatch& mismatch,
-                            int intervals, const optimal_control::FollowerParams& follower, double reference_bound) {
+                            int intervals, const optimal_control::FollowerParams& follower, double reference_bound,
+                            const std::optional<ManeuverConfig>& first_move) {
   MoveComparison out;
+  out.learnt = first_move.has_value();
   out.maneuver = m;
   out.mismatch = mismatch;
   out.bound = reference_bound > 0.0 ? reference_bound : bound.duration;
@@ -167,7 +169,9 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         run.intervals = intervals;
         run.bound = bound;
         run.follower = follower;
+        run.first_move = first_move;
         const FollowerResult r = run_follower(cfg, run);
+        o.planned_swing = r.planned_swing;
         o.metrics = r.metrics;
         o.latched_faults = r.latched_faults;
         o.braked_cycles = r.braked_cycles;
@@ -177,6 +181,7 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         run.controller = choose_controller(c.controller, m, c.acceleration_feedforward);
         run.profile = c.profile;
         run.mismatch = mismatch;
+        run.first_move = first_move;
         const InProcessResult r = run_in_process(cfg, run);
         o.metrics = r.metrics;
         o.latched_faults = r.latched_faults;

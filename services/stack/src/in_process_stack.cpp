@@ -106,17 +106,18 @@ struct InProcessStack::Stages {
   std::uint64_t plant_step_failures{0};
 };
 
-namespace {
-MovePlanner planner_node_way(const StackConfig& cfg) {
-  return [facts = cfg.facts, params = cfg.trajectory_planner](const trajectory_planner::PlanRequest& request)
+MovePlanner planner_node_way(const StackConfig& cfg, const optimal_control::MovePlanning& planning) {
+  return [facts = cfg.facts, params = cfg.trajectory_planner, planning](const trajectory_planner::PlanRequest& request)
              -> std::shared_ptr<const trajectory_planner::PlannedPath> {
     try {
-      return optimal_control::plan_minimum_time_move(request, facts, params, optimal_control::MovePlanning{});
+      return optimal_control::plan_minimum_time_move(request, facts, params, planning);
     } catch (const common::ConfigError&) {
       return nullptr;  // a request the bound cannot take: the time-optimal profile runs
     }
   };
 }
+
+namespace {
 InProcessOptions with_planner(const StackConfig& cfg, InProcessOptions o) {
   if (!o.plan_move) o.plan_move = planner_node_way(cfg);
   return o;
@@ -213,11 +214,10 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
         f.bridge_target != m.initial_bridge_position) {
       throw std::invalid_argument("run_in_process: the first move " + f.name + " does not end where " + m.name + " starts");
     }
-    if (m.cable_length_target != cfg.facts.crane.cable_length || f.cable_length_target != cfg.facts.crane.cable_length) {
-      throw std::invalid_argument("run_in_process: a first move with hoisting (" + f.name + ", " + m.name + ")");
+    if (f.cable_length_target != cfg.facts.crane.cable_length) {
+      throw std::invalid_argument("run_in_process: a first move with hoisting (" + f.name + ")");
     }
-    const protocol::MoveRequest first =
-        move_request(f, cfg.facts, run.request_id, protocol::MoveRequest::PROFILE_TRAPEZOID, start_cycle);
+    const protocol::MoveRequest first = move_request(f, cfg.facts, run.request_id, run.first_move_profile, start_cycle);
     const auto first_cycles = static_cast<std::uint64_t>(std::llround(f.duration / dt));
     for (; k <= start_cycle + first_cycles; ++k) {
       stack.step(k == 0 ? std::span(&first, 1) : std::span<const protocol::MoveRequest>());

@@ -575,11 +575,14 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
 // seeded random moves, each controller's settle time as a ratio to T*, on the nominal plant and,
 // with `corners`, at the eight mismatch corners; one move (its bound and its runs) per thread. With
 // `calibrate`, each corner's controllers first calibrated on its plant (swing_calibration_run.hpp):
-// its runs follow a bound on the calibrated model, their ratio taken to the nominal T*.
-int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, bool calibrate,
+// its runs follow a bound on the calibrated model, their ratio taken to the nominal T*. With `learn`,
+// each run is made after a learning move on its plant (stack::learning_move) with the state
+// estimator's swing_length on: the follower's move is planned on the pendulum it learnt.
+int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, bool calibrate, bool learn,
             const std::string& controllers_text, int intervals, unsigned jobs,
             const optimal_control::FollowerParams& follower, const std::string& out_dir) {
-  const auto cfg = load_config(s);
+  auto cfg = load_config(s);
+  if (learn) cfg.state_estimator.swing_length.enabled = true;
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
   const auto controllers = controllers_text.empty() ? stack::compared_controllers()
@@ -634,8 +637,9 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
         results[i].least_effort = bound.least_effort;
         for (std::size_t p = 0; p < plants.size(); ++p) {
           if (!calibrated[p]) {
-            results[i].runs.push_back(
-                stack::compare_move(cfg, maneuvers[i], bound, controllers, plants[p], intervals, follower));
+            results[i].runs.push_back(stack::compare_move(
+                cfg, maneuvers[i], bound, controllers, plants[p], intervals, follower, 0.0,
+                learn ? std::optional(stack::learning_move(cfg, maneuvers[i])) : std::nullopt));
             continue;
           }
           const stack::StackConfig& own = calibrated[p]->config;
@@ -695,7 +699,8 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     for (const auto& run : r.runs) {
       const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
       (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
-      const std::string label = stack::mismatch_label(run.mismatch) + (run.calibrated ? "+cal" : "");
+      const std::string label = stack::mismatch_label(run.mismatch) + (run.calibrated ? "+cal" : "") +
+                                (run.learnt ? "+learn" : "");
       std::printf("%-13s %-16s %8.4f", maneuvers[i].name.c_str(), label.c_str(), run.bound);
       for (const auto& o : run.outcomes) {
         if (!o.error.empty()) ++errors;
@@ -719,6 +724,29 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     }
     if (bridge) std::printf("(* the trolley's or the bridge's, the larger)\n");
   };
+  if (learn) {
+    // What the follower's moves were planned on, per plant: the pendulum learnt in the first move.
+    std::printf("\nthe follower's plans after the learning move: the pendulum a L + c at L %.3f m, per plant "
+                "(min / median / max over its moves; the plant's own: L x its factor)\n",
+                cfg.facts.crane.cable_length);
+    for (const auto& plant : plants) {
+      std::vector<double> lengths;
+      for (const auto& r : results) {
+        for (const auto& run : r.runs) {
+          if (stack::mismatch_label(run.mismatch) != stack::mismatch_label(plant)) continue;
+          for (const auto& o : run.outcomes) {
+            if (o.controller == "follower" && o.error.empty()) {
+              lengths.push_back(trajectory_planner::equivalent_swing_length(o.planned_swing, cfg.facts.crane.cable_length));
+            }
+          }
+        }
+      }
+      if (lengths.empty()) continue;
+      std::printf("  %-16s %.4f / %.4f / %.4f m (the plant's %.4f m)\n", stack::mismatch_label(plant).c_str(),
+                  stack::nearest_rank_quantile(lengths, 0.0), stack::nearest_rank_quantile(lengths, 0.5),
+                  stack::nearest_rank_quantile(lengths, 1.0), plant.cable_length_factor * cfg.facts.crane.cable_length);
+    }
+  }
   print_summary("demo maneuvers, nominal plant: settle / T*", demo_nominal);
   print_summary("random moves, nominal plant: settle / T*", random_nominal);
   print_summary(calibrate ? "every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3), each calibrated on its "
@@ -744,6 +772,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
         for (const auto& o : run.outcomes) {
           const auto& x = o.metrics;
           csv << run.maneuver.name << ',' << stack::mismatch_label(run.mismatch) << (run.calibrated ? "+cal" : "")
+              << (run.learnt ? "+learn" : "")
               << ',' << run.bound << ','
               << o.controller << ',' << x.settle_time << ',' << o.ratio << ',' << 1e3 * x.final_position_error << ','
               << 1e3 * x.final_slew_error << ',' << 1e3 * x.final_bridge_error << ',' << deg * x.max_swing << ','
@@ -1001,6 +1030,11 @@ int main(int argc, char** argv) {
                         "with --corners: each corner's controllers calibrated on its plant first (a recorded demo "
                         "maneuver, the swing fitted; tower and gantry cranes)")
       ->needs("--corners");
+  bool compare_learn = false;
+  compare_cmd->add_flag("--learn", compare_learn,
+                        "each run made after a learning move on its plant (the first demo maneuver backwards to the "
+                        "move's start) with state_estimator.swing_length on: the follower plans the pendulum it learnt")
+      ->excludes("--calibrate");
   compare_cmd->add_option("--controllers", compare_controllers,
                           "comma-separated: follower,delay1,delay2,time_optimal,zv,zvd (default: all)");
   compare_cmd->add_option("--intervals", compare_intervals, "collocation intervals of the bound")->check(CLI::Range(4, 2000));
@@ -1029,7 +1063,7 @@ int main(int argc, char** argv) {
     if (*integrators_cmd) return integrators(s);
     if (*bound_cmd) return bound(s, intervals, out_dir);
     if (*compare_cmd) {
-      return compare(s, compare_moves, compare_seed, compare_corners, compare_calibrate, compare_controllers,
+      return compare(s, compare_moves, compare_seed, compare_corners, compare_calibrate, compare_learn, compare_controllers,
                      compare_intervals, compare_jobs, compare_follower, out_dir);
     }
     if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed);

@@ -40,6 +40,26 @@ adaptation::OnlineAdaptationParams read_adaptation(config::YamlSection s, const 
   return a;
 }
 
+adaptation::SwingLengthParams read_swing_length(config::YamlSection s, const common::StackFacts& facts) {
+  adaptation::SwingLengthParams p;
+  p.sample_period = facts.sample_period;
+  p.crane_kind = facts.crane_kind;
+  p.crane = facts.crane;
+  p.bridge = facts.bridge;
+  p.enabled = s.flag("enabled");
+  p.filter_cutoff = s.number("filter_cutoff", 1e-2, 0.45 / facts.sample_period);
+  p.forgetting_factor = s.number("forgetting_factor", 0.9, 1.0);
+  p.min_swing = s.number("min_swing", 0.0, 1.0);
+  p.min_information = s.number("min_information", 1e-9, 1e9);
+  p.max_condition = s.number("max_condition", 1.0, 1e12);
+  p.solve_period = s.number("solve_period", facts.sample_period, 60.0);
+  p.length_bound = s.number("length_bound", 1e-6, 10.0);
+  p.scale_bound = s.number("scale_bound", 1e-6, 10.0);
+  s.finish();
+  adaptation::validate(p);
+  return p;
+}
+
 }  // namespace
 
 StateEstimatorStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
@@ -53,6 +73,7 @@ StateEstimatorStageParams read_params(config::YamlSection& s, const common::Stac
                      : kind == "al_alaoui_first_order" ? DifferentiatorKind::al_alaoui_first_order
                                                        : DifferentiatorKind::al_alaoui_second_order;
   stage.adaptation = read_adaptation(s.child("adaptation"), facts);
+  stage.swing_length = read_swing_length(s.child("swing_length"), facts);
   stage.bridge = facts.crane_kind == common::CraneKind::overhead;
   s.finish();
   StateEstimator{p};  // its own invariants, same message format
@@ -65,7 +86,7 @@ StateEstimatorStageParams for_follower(StateEstimatorStageParams params) {
 }
 
 StateEstimatorStage::StateEstimatorStage(const StateEstimatorStageParams& params)
-    : estimator_(params.estimator), adaptation_(params.adaptation) {
+    : estimator_(params.estimator), adaptation_(params.adaptation), swing_length_(params.swing_length) {
   if (params.bridge) bridge_estimator_.emplace(params.estimator);
 }
 
@@ -106,6 +127,18 @@ common::StepStatus StateEstimatorStage::step(const protocol::SensorSample& senso
   common::set_friction_in_use(adapted_.trolley_friction, adapted_.slew_friction, estimate);
   estimate.trolley_voltage_sign_changes = adapted_.trolley_voltage_sign_changes;
   estimate.slew_voltage_sign_changes = adapted_.slew_voltage_sign_changes;
+  adaptation::SwingLengthInput swing;
+  swing.trolley_position = sensors.trolley_position;
+  swing.second_axis = bridge_estimator_ ? sensors.bridge_position : sensors.slew_angle;
+  swing.swing_in_plane = sensors.swing_in_plane;
+  swing.swing_out_of_plane = sensors.swing_out_of_plane;
+  swing.cable_length = sensors.cable_length;
+  swing.brakes_engaged = sensors.brakes_engaged;
+  swing_length_.step(swing, pendulum_);
+  estimate.swing_length_scale = pendulum_.scale;
+  estimate.swing_length_offset = pendulum_.offset;
+  estimate.swing_length_bound = pendulum_.length_bound;
+  estimate.swing_length_confident = pendulum_.confident;
   common::same_cycle(sensors.header, estimate.header);
   return status;
 }

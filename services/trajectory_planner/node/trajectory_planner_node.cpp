@@ -57,10 +57,10 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan(const trajectory_pla
     auto path = optimal_control::plan_minimum_time_move(request, facts, params, optimal_control::MovePlanning{}, &bound);
     if (path) {
       spdlog::info("move request {}: minimum-time plan, T* = {:.4f} s, trajectory {:.4f} s ({}), {} + {} IPOPT "
-                   "iterations in {:.2f} s",
+                   "iterations in {:.2f} s; the pendulum {:.4f} L + {:.4f} m",
                    request.request_id, bound.duration, bound.trajectory_duration,
                    bound.least_effort ? "least effort" : "the minimum-time solve's", bound.iterations,
-                   bound.effort_iterations, bound.solve_seconds);
+                   bound.effort_iterations, bound.solve_seconds, request.swing.scale, request.swing.offset);
     } else {
       spdlog::warn("move request {}: the minimum-time bound was not solved ({}): the time-optimal profile runs",
                    request.request_id, bound.status);

@@ -5,6 +5,12 @@
 
 namespace crane::trajectory_planner {
 
+bool swings_down_to(const EquivalentPendulum& pendulum, double shortest_cable) noexcept {
+  return pendulum.scale >= kMinSwingLengthScale && pendulum.scale <= kMaxSwingLengthScale &&
+         pendulum.offset >= kMinSwingLengthOffset && pendulum.offset <= kMaxSwingLengthOffset &&
+         equivalent_swing_length(pendulum, shortest_cable) > 0.0;
+}
+
 std::size_t PlannedPath::index(double time) const noexcept {
   if (trolley.empty()) return 0;
   const double k = std::round(time / sample_period);

@@ -106,8 +106,10 @@ void validate(const ManualParams& p) {
   common::require_greater(prefix + "maintenance_speed_fraction", p.maintenance_speed_fraction, 0.0);
   common::require_in_range(prefix + "maintenance_speed_fraction", p.maintenance_speed_fraction, 0.0, 1.0);
   common::require_in_range(prefix + "dead_man_timeout", p.dead_man_timeout, 0.02, 5.0);
-  common::require_in_range(prefix + "swing_length_scale", p.swing_length_scale, 0.1, 10.0);
-  common::require_in_range(prefix + "swing_length_offset", p.swing_length_offset, -1.0, 10.0);
+  common::require_in_range(prefix + "swing_length_scale", p.swing_length_scale, kMinSwingLengthScale,
+                           kMaxSwingLengthScale);
+  common::require_in_range(prefix + "swing_length_offset", p.swing_length_offset, kMinSwingLengthOffset,
+                           kMaxSwingLengthOffset);
   common::require_in_range(prefix + "swing_damping_ratio", p.swing_damping_ratio, 0.0, 0.3);
 }
 

@@ -60,8 +60,8 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   validate(params.manual);
   // The calibrated equivalent pendulum must be one over the whole cable range (a > 0: its shortest
   // is at the shortest cable), or the minimum-time plans have no pendulum to swing.
-  const double shortest = equivalent_swing_length(params.manual, params.cable_min_length);
-  if (!(shortest > 0.0)) {
+  if (!swings_down_to(params.manual.pendulum(), params.cable_min_length)) {
+    const double shortest = equivalent_swing_length(params.manual, params.cable_min_length);
     throw common::ConfigError("trajectory_planner.manual.swing_length_offset = " +
                               std::to_string(params.manual.swing_length_offset) +
                               " leaves no pendulum at the shortest cable: swing_length_scale x cable_min_length + "

@@ -40,8 +40,8 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.manual.maintenance_speed_fraction = m.number("maintenance_speed_fraction", 0.0, 1.0);
   p.manual.dead_man_timeout = m.number("dead_man_timeout", 0.02, 5.0);
   p.manual.shaping = speed_shaping_from_string(m.text("shaping"), m.field("shaping"));
-  p.manual.swing_length_scale = m.number("swing_length_scale", 0.1, 10.0);
-  p.manual.swing_length_offset = m.number("swing_length_offset", -1.0, 10.0);
+  p.manual.swing_length_scale = m.number("swing_length_scale", kMinSwingLengthScale, kMaxSwingLengthScale);
+  p.manual.swing_length_offset = m.number("swing_length_offset", kMinSwingLengthOffset, kMaxSwingLengthOffset);
   p.manual.swing_damping_ratio = m.number("swing_damping_ratio", 0.0, 0.3);
   m.finish();
   s.finish();
@@ -267,6 +267,11 @@ PlanRequest TrajectoryPlannerStage::plan_of(const protocol::MoveRequest& r, cons
                           r.bridge_max_acceleration > 0.0 ? r.bridge_max_acceleration : params.manual.bridge.acceleration};
   }
   plan.max_swing = max_swing_;
+  plan.swing = params.manual.pendulum();
+  if (cycle_estimate_ != nullptr && cycle_estimate_->swing_length_confident) {
+    const EquivalentPendulum learnt{cycle_estimate_->swing_length_scale, cycle_estimate_->swing_length_offset};
+    if (swings_down_to(learnt, std::min(plan.cable_from, plan.cable_target))) plan.swing = learnt;
+  }
   return plan;
 }
 

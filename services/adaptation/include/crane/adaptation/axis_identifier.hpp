@@ -41,6 +41,29 @@
 
 namespace crane::adaptation {
 
+/// The sufficient statistics of exponentially weighted least squares in information form (the
+/// header's R, r, and the sums the residual needs), shared by AxisIdentifier and
+/// SwingLengthEstimator. Only rows that are taken forget: add() is the one update.
+template <int N>
+struct WeightedLeastSquares {
+  Eigen::Matrix<double, N, N> information{Eigen::Matrix<double, N, N>::Zero()};  // R
+  Eigen::Matrix<double, N, 1> weighted_output{Eigen::Matrix<double, N, 1>::Zero()};  // r
+  double output_energy{0.0};  // sum lambda^j y^2
+  double weight_sum{0.0};     // sum lambda^j
+  /// Takes row (y, phi) with forgetting factor `lambda`. noexcept, no allocation.
+  void add(double lambda, double y, const Eigen::Matrix<double, N, 1>& phi) noexcept {
+    information = lambda * information + phi * phi.transpose();
+    weighted_output = lambda * weighted_output + phi * y;
+    output_energy = lambda * output_energy + y * y;
+    weight_sum = lambda * weight_sum + 1.0;
+  }
+  /// The weighted residual sum of squares of `theta`: E - 2 theta^T r + theta^T R theta, >= 0.
+  [[nodiscard]] double residual_sum_of_squares(const Eigen::Matrix<double, N, 1>& theta) const noexcept {
+    const double rss = output_energy - 2.0 * theta.dot(weighted_output) + theta.dot(information * theta);
+    return rss > 0.0 ? rss : 0.0;
+  }
+};
+
 inline constexpr int kParameterCount = 5;   // load, b+, b-, c+, c-
 inline constexpr int kLoadIndex = 0;
 
@@ -91,15 +114,12 @@ class AxisIdentifier {
 
   [[nodiscard]] const AxisIdentification& identification() const noexcept { return state_; }
   /// The information matrix R (unscaled) of the excitation check.
-  [[nodiscard]] const InformationMatrix& information() const noexcept { return information_; }
+  [[nodiscard]] const InformationMatrix& information() const noexcept { return statistics_.information; }
   [[nodiscard]] const AxisIdentifierParams& params() const noexcept { return params_; }
 
  private:
   AxisIdentifierParams params_;
-  InformationMatrix information_{InformationMatrix::Zero()};
-  ParameterVector weighted_output_{ParameterVector::Zero()};  // r
-  double weighted_output_energy_{0.0};                        // sum lambda^j y^2
-  double weight_sum_{0.0};                                    // sum lambda^j
+  WeightedLeastSquares<kParameterCount> statistics_{};
   AxisIdentification state_{};
 };
 

@@ -80,6 +80,15 @@ struct OnlineAdaptationParams {
 /// the bound.
 void validate(const OnlineAdaptationParams& params);
 
+/// A stable low-pass's impulse response h: its memory [samples] (the last sample with |h| >= 1 % of
+/// the peak) and the equivalent number of correlated samples (sum h)^2 / sum h^2 (>= 1) of rows
+/// filtered by it. Allocates (the response); for constructors.
+struct ImpulseFigures {
+  int memory{0};
+  double correlation{1.0};
+};
+[[nodiscard]] ImpulseFigures impulse_figures(const state_estimator::DiscreteTransferFunction& low_pass);
+
 /// One sensor sample as the estimator sees it (SI; voltages applied during the previous cycle).
 struct AdaptationInput {
   double trolley_position{0.0};        // [m] x(k)

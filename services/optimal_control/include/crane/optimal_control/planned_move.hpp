@@ -11,10 +11,14 @@
 //   drive axes     from/target of the request, the planner's travel range, the request's rated
 //                  speed and acceleration (the goal's: the move request's or the planner's rated ones)
 //   hoist          the cable from/target, the planner's cable range, the request's hoist limits, each
-//                  as the equivalent pendulum's length a L + c (the planner's manual.swing_length_scale
-//                  a and swing_length_offset c, trajectory_planner::equivalent_swing_length; the
-//                  rates times a): the swing the plan and its follower's gains are made for is the
-//                  calibrated one. 1 and 0 (uncalibrated): the cable length itself, to the bit.
+//                  as the equivalent pendulum's length a L + c (the request's `swing`: the planner's
+//                  calibrated manual.swing_length_scale a and swing_length_offset c, or the state
+//                  estimator's online estimate; trajectory_planner::equivalent_swing_length; the
+//                  rates times a): the swing the plan and its follower's gains are made for is that
+//                  pendulum. 1 and 0 (uncalibrated): the cable length itself, to the bit. The range
+//                  is the planner's where the pendulum is one down to its shortest cable, else
+//                  (a learnt pendulum, trajectory_planner::swings_down_to) from the move's shorter
+//                  cable up.
 //   voltage        facts.voltage_limit, with the crane's friction (3.1)
 //   swing          kBoundSwingFraction x the supervisor's sway limit (request.max_swing): a margin
 //                  for the follower's tracking error and a mismatched plant
@@ -61,10 +65,10 @@ struct MovePlanning {
 
 /// The path of `follower`, one sample per cycle (see the header), of a bound of duration
 /// `minimum_time` [s]; `bridge`: the second axis is an overhead crane's bridge (else the slew). The
-/// cable's reference is mapped back from the equivalent pendulum's length of `swing` (the planner's
-/// manual block, as minimum_time_problem mapped it) to the hoist's.
+/// cable's reference is mapped back from the equivalent pendulum's length of `swing` (the request's,
+/// as minimum_time_problem mapped it) to the hoist's.
 [[nodiscard]] std::shared_ptr<const trajectory_planner::PlannedPath> planned_path(
     const TrajectoryFollower& follower, double sample_period, bool bridge, double minimum_time,
-    const trajectory_planner::ManualParams& swing);
+    const trajectory_planner::EquivalentPendulum& swing);
 
 }  // namespace crane::optimal_control

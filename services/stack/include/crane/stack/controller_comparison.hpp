@@ -21,6 +21,7 @@
 // common::ConfigError for an invalid config (the bound's validation names the field).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +66,7 @@ struct ComparedController {
 
 struct ControllerOutcome {
   std::string controller;
+  trajectory_planner::EquivalentPendulum planned_swing{};  // the follower's plan's pendulum (FollowerResult)
   ManeuverMetrics metrics;
   double ratio{0.0};                 // settle_time / T* (NaN: never settled within the record)
   std::uint32_t latched_faults{0};   // the supervisor's FAULT_* bits at the end
@@ -77,6 +79,7 @@ struct MoveComparison {
   plant::PlantMismatch mismatch;     // the plant's, against the controllers' model
   double bound{0.0};                 // [s] T* (the nominal model's when calibrated)
   bool calibrated{false};            // the controllers' config was calibrated on this plant (compare_move's caller)
+  bool learnt{false};                // made after a first move (compare_move's first_move)
   double bound_solve_seconds{0.0};   // [s] IPOPT's wall time (0 when the bound was given)
   double swing_period{0.0};          // [s] at the target cable length
   std::vector<ControllerOutcome> outcomes;  // one per controller, in their order
@@ -92,13 +95,17 @@ struct MoveComparison {
 /// weights (FollowerRun::follower). A run that throws is kept with its error and NaN figures.
 /// `reference_bound` [s] > 0: the ratio (and MoveComparison::bound) taken to this T* instead, the
 /// nominal model's, for a config calibrated on the plant (swing_calibration_run.hpp) whose own
-/// bound `bound` is on the calibrated model.
+/// bound `bound` is on the calibrated model. `first_move`: each run makes it first on the same
+/// plant, unmeasured (FollowerRun::first_move and learning_move: the follower's, minimum-time, and
+/// its maneuver planned in the stack from what the state estimator learnt; the other laws' with
+/// the trapezoid profile, InProcessRun::first_move).
 [[nodiscard]] MoveComparison compare_move(const StackConfig& config, const ManeuverConfig& maneuver,
                                           const optimal_control::MinimumTimeResult& bound,
                                           const std::vector<ComparedController>& controllers,
                                           const plant::PlantMismatch& mismatch = {}, int intervals = 200,
                                           const optimal_control::FollowerParams& follower = {},
-                                          double reference_bound = 0.0);
+                                          double reference_bound = 0.0,
+                                          const std::optional<ManeuverConfig>& first_move = std::nullopt);
 
 /// A comparison none of whose runs could be made (`error`: why, e.g. its bound not solved): each of
 /// `controllers` with that error and NaN figures, the ratio to `bound` [s].

@@ -37,6 +37,11 @@ namespace crane::stack {
 using MovePlanner =
     std::function<std::shared_ptr<const trajectory_planner::PlannedPath>(const trajectory_planner::PlanRequest&)>;
 
+/// The planner node's way (trajectory_planner_node.cpp): optimal_control::plan_minimum_time_move of
+/// the request on `config` with `planning`; null when the bound is not solved or the request is one
+/// it cannot take (common::ConfigError): the goal then runs the time-optimal profile.
+[[nodiscard]] MovePlanner planner_node_way(const StackConfig& config, const optimal_control::MovePlanning& planning = {});
+
 struct InProcessOptions {
   bool friction_compensation{true};
   ControllerChoice controller{};
@@ -108,9 +113,10 @@ struct InProcessRun {
   // A move made first, unmeasured, from its initial positions (where the crane starts) to its
   // targets, which must be the maneuver's start, with its own limits and a trapezoid profile (the
   // maneuver's duration); then the maneuver, measured: a move after one with the same load, what
-  // the online estimate has learnt from (docs/architecture.md, "Online estimation"). Neither may
-  // hoist. std::invalid_argument otherwise.
+  // the online estimate has learnt from (docs/architecture.md, "Online estimation"). The first move
+  // may not hoist (std::invalid_argument); with the minimum-time profile it is planned by plan_move.
   std::optional<ManeuverConfig> first_move;
+  std::uint8_t first_move_profile{protocol::MoveRequest::PROFILE_TRAPEZOID};
   // Keep the plant's drive input and true state of every cycle (InProcessResult::plant_inputs,
   // plant_states): the convergence study's replay (convergence_study.hpp).
   bool record_plant{false};

@@ -33,7 +33,8 @@ namespace crane::stack {
 
 /// The maneuver as the planner stage asks for its minimum-time plan, with the limits above (its rated
 /// motion capped by the supervisor's overspeed, the hoist's by the actuation gate's, the
-/// supervisor's sway limit); from the maneuver's initial positions and the configured cable.
+/// supervisor's sway limit); from the maneuver's initial positions and the configured cable, the
+/// configured equivalent pendulum (trajectory_planner.manual).
 [[nodiscard]] trajectory_planner::PlanRequest plan_request_of(const StackConfig& config, const ManeuverConfig& maneuver);
 
 /// The problem of `maneuver` on `config`'s crane, on `intervals` collocation intervals:

@@ -3,11 +3,14 @@
 // clock or thread. Sensor sample of cycle k -> section 4.3 filter and differentiator -> the
 // estimate of cycle k (same seq and origin), with the online payload mass and friction estimate
 // (crane::adaptation, online_adaptation.hpp) in its payload_* and *_friction_* fields: the
-// configured values while adaptation is off or has not identified them.
+// configured values while adaptation is off or has not identified them; and the load's equivalent
+// pendulum learnt from the swing (adaptation/swing_length_estimator.hpp) in its swing_length_* fields:
+// 1 L + 0, not confident, while that is off or has learnt nothing.
 
 #include <optional>
 
 #include "crane/adaptation/online_adaptation.hpp"
+#include "crane/adaptation/swing_length_estimator.hpp"
 #include "crane/common/stack_facts.hpp"
 #include "crane/protocol/messages.hpp"
 #include "crane/state_estimator/state_estimator.hpp"
@@ -21,6 +24,7 @@ namespace crane::state_estimator {
 struct StateEstimatorStageParams {
   StateEstimatorParams estimator{};
   adaptation::OnlineAdaptationParams adaptation{};  // the crane and sample period are the stack's facts
+  adaptation::SwingLengthParams swing_length{};     // its sample period, crane kind, crane and bridge too
   bool bridge{false};  // an overhead crane (facts.crane_kind): the bridge position is filtered and
                        // differentiated like the trolley's, into bridge_velocity(_raw)
   /// [Hz] the Butterworth's cutoff while the minimum-time follower controls the crane (tracking law
@@ -39,8 +43,10 @@ struct StateEstimatorStageParams {
 /// Reads the `state_estimator:` block: cutoff_frequency [Hz] and follower_cutoff_frequency [Hz],
 /// each in [1e-3, 0.499 fs], differentiator
 /// (backward (4.8) | al_alaoui_first_order (4.9) | al_alaoui_second_order (4.10)); fs is
-/// 1 / facts.sample_period; and its `adaptation:` block (every field of OnlineAdaptationParams,
-/// limit_cycle: included; ranges in read_adaptation's body and OnlineAdaptation's validate). Throws
+/// 1 / facts.sample_period; its `adaptation:` block (every field of OnlineAdaptationParams,
+/// limit_cycle: included; ranges in read_adaptation's body and OnlineAdaptation's validate); and its
+/// `swing_length:` block (SwingLengthParams but the facts': enabled, filter_cutoff, forgetting_factor,
+/// min_swing, min_information, max_condition, solve_period, length_bound, scale_bound). Throws
 /// common::ConfigError naming the field, value and bound.
 [[nodiscard]] StateEstimatorStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
 
@@ -60,6 +66,8 @@ class StateEstimatorStage {
   adaptation::OnlineAdaptation adaptation_;
   common::CraneStateEstimate scratch_{};
   adaptation::AdaptationEstimate adapted_{};
+  adaptation::SwingLengthEstimator swing_length_;
+  adaptation::SwingLengthEstimate pendulum_{};
 };
 
 }  // namespace crane::state_estimator

@@ -18,6 +18,29 @@
 
 namespace crane::trajectory_planner {
 
+/// The pendulum the load swings as: length a L + c at cable length L [m]. The planner's configured
+/// one is trajectory_planner.manual's swing_length_scale a and swing_length_offset c (a calibration,
+/// `deploy/crane calibrate swing`); the state estimator learns one online (CraneState_'s
+/// swing_length_*, adaptation/swing_length_estimator.hpp). 1 L + 0 is the single pendulum.
+struct EquivalentPendulum {
+  double scale{1.0};   // a [-], in [kMinSwingLengthScale, kMaxSwingLengthScale]
+  double offset{0.0};  // c [m], in [kMinSwingLengthOffset, kMaxSwingLengthOffset]
+};
+inline constexpr double kMinSwingLengthScale = 0.1, kMaxSwingLengthScale = 10.0;    // [-]
+inline constexpr double kMinSwingLengthOffset = -1.0, kMaxSwingLengthOffset = 10.0;  // [m]
+
+/// [m] a L + c at `cable_length` L [m] (1 L + 0 = L exactly). Not checked > 0.
+[[nodiscard]] inline double equivalent_swing_length(const EquivalentPendulum& pendulum, double cable_length) noexcept {
+  return pendulum.scale * cable_length + pendulum.offset;
+}
+
+/// Whether `pendulum` is one the planner may plan down to the cable length `shortest_cable` [m]: a
+/// and c finite and in their ranges above, and a pendulum there (a L + c > 0 at it; a > 0, so at
+/// every longer cable too). A configured pendulum must be one over the whole hoist range
+/// (shortest_cable = trajectory_planner.cable_min_length); a learnt one over the move's own cable
+/// span (what the crane swung at says nothing of much shorter cables; planned_move.hpp). noexcept.
+[[nodiscard]] bool swings_down_to(const EquivalentPendulum& pendulum, double shortest_cable) noexcept;
+
 struct PlannedPath {
   double sample_period{0.01};                   // [s] T_s, > 0
   std::vector<common::AxisReference> trolley;   // [m, m/s, m/s^2]
@@ -65,6 +88,9 @@ struct PlanRequest {
   double bridge_from{0.0}, bridge_target{0.0};                  // [m]
   AxisLimits bridge_limits{};
   double max_swing{0.0};  // [rad] the supervisor's sway limit (SupervisorStatus.max_swing)
+  EquivalentPendulum swing{};  // the pendulum to plan: the estimate's when the state estimator has
+                               // learnt one that swings over the move's cable span, else the
+                               // configured (manual's)
 };
 
 }  // namespace crane::trajectory_planner

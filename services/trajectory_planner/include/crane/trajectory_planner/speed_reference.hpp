@@ -27,6 +27,7 @@
 #include "crane/common/crane_signals.hpp"
 #include "crane/common/site.hpp"
 #include "crane/trajectory_planner/input_shaper.hpp"
+#include "crane/trajectory_planner/planned_path.hpp"
 
 namespace crane::trajectory_planner {
 
@@ -116,14 +117,15 @@ struct ManualParams {
   // (deploy/crane calibrate swing) fits them from a recording (a hook, rigging, a stiff rope). The
   // minimum-time plans use the same equivalent length (equivalent_swing_length; optimal_control's
   // minimum_time_problem), so one calibration serves manual and automatic moves.
-  double swing_length_scale{1.0};   // [-] in [0.1, 10]
+  double swing_length_scale{1.0};   // [-] in [0.1, 10] (EquivalentPendulum's ranges, planned_path.hpp)
   double swing_length_offset{0.0};  // [m] in [-1, 10]; an equivalent length <= 0 gets no shaping
   double swing_damping_ratio{0.0};  // [-] in [0, 0.3]
+  [[nodiscard]] EquivalentPendulum pendulum() const noexcept { return {swing_length_scale, swing_length_offset}; }
 };
 /// [m] The equivalent pendulum length of `params` at cable length `cable_length` [m]:
 /// swing_length_scale L + swing_length_offset (1 L + 0 = L exactly, uncalibrated). Not checked > 0.
 [[nodiscard]] inline double equivalent_swing_length(const ManualParams& params, double cable_length) noexcept {
-  return params.swing_length_scale * cable_length + params.swing_length_offset;
+  return equivalent_swing_length(params.pendulum(), cable_length);
 }
 
 /// Throws common::ConfigError naming the field ("trajectory_planner.manual.<name>") unless every

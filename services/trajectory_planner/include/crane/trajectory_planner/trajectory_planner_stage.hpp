@@ -158,6 +158,10 @@ class TrajectoryPlannerStage {
   [[nodiscard]] std::uint64_t speeds_outside_manual() const noexcept { return speeds_outside_manual_; }
   /// A goal with the minimum-time profile (PROFILE_MINIMUM_TIME) waiting for its plan, or empty:
   /// the crane holds where the move starts until provide_plan() hands the plan over (see the header).
+  /// Its `swing` is the pendulum the state estimator has learnt (the estimate's swing_length_scale
+  /// and _offset while swing_length_confident) when it swings over the move's cable span
+  /// (swings_down_to the shorter of cable_from and cable_target), else the configured
+  /// manual.swing_length_scale and _offset.
   [[nodiscard]] const std::optional<PlanRequest>& plan_request() const noexcept { return plan_request_; }
   /// The plan of request `sequence` (PlanRequest::sequence), taken at the next step: its path starts
   /// then (or at the goal's start cycle), and the reference carries the path's law of each cycle;
