@@ -33,7 +33,8 @@
 // Every `solve_period`: (a, c) jointly when the information scaled by diag(1, 1 m) has a smallest
 // eigenvalue >= `min_information` and a condition number <= `max_condition` (the rows span cable
 // lengths: at one length h is proportional to (L, 1) and a is not separable from c); otherwise c
-// alone, a held at the value in use (1 until a joint solve), when R_cc >= `min_information`; otherwise nothing moves.
+// alone, a held at the value in use (1 until a joint solve), when R_cc >= `min_information`;
+// otherwise nothing moves.
 // Standard deviations from the forgetting-weighted a-posteriori residual variance times the filter's
 // equivalent number of correlated samples, times R^-1 (as AxisIdentifier).
 //
@@ -42,8 +43,8 @@
 // are correlated; their sum at the lengths the rows saw is what the swing tells), and 2 sigma of a
 // <= `scale_bound` when a was solved. A confident estimate replaces the one in use; the last one
 // stays in use until a better one replaces it. Before the first: a = 1, c = 0, not confident (the
-// planner then plans its configured trajectory_planner.manual pendulum, and checks an estimate
-// against its cable range before it plans one: trajectory_planner_stage.hpp).
+// planner then plans its configured trajectory_planner.manual pendulum, and plans an estimate only
+// where it is a pendulum over the move's cable span: trajectory_planner::swings_down_to).
 //
 // Errors: the constructor validates (common::ConfigError naming "state_estimator.swing_length.<field>",
 // the value and the bound); step() is noexcept, allocates nothing, and skips samples with a
