@@ -163,6 +163,8 @@ int main(int argc, char** argv) {
   CLI::App app{"plant: simulated tower crane (nonlinear model, friction, drives and sensors) on the DDS bus"};
   runtime::NodeOptions options;
   runtime::add_node_options(app, options);
+  std::string wake = "listener";
+  runtime::add_wake_option(app, wake);
   bool realtime = false;
   double initial_trolley = 0.25;
   double initial_slew = 0.0;
@@ -323,81 +325,101 @@ int main(int argc, char** argv) {
       // machine slows the simulation, never changes it. While it waits, the plant offers cycle k
       // again (after 10 ms, then doubling to 80 ms): a lost best-effort sample is recovered, and
       // every stage and the supervisor answer a repeated cycle from their stored output.
-      while (!runtime::stop_requested()) {
+      // The cycle advances on the DDS listener thread that brings its last input
+      // (runtime::ListenerDispatch: one thread wake-up for the chain's last hop); this thread keeps
+      // the re-offers and the hang report, serialized with it.
+      struct CycleWait {
+        bool got_command{false};
+        bool got_status{false};
+        std::int64_t arrival_ns{0};
+        Clock::time_point start;
+        Clock::duration backoff{std::chrono::milliseconds(10)};
+        Clock::time_point next_reoffer;
+        bool hang_reported{false};
+      };
+      CycleWait wait;
+      const auto begin_wait = [&wait] {
+        wait = CycleWait{};
+        wait.start = Clock::now();
+        wait.next_reoffer = wait.start + wait.backoff;
+      };
+      begin_wait();
+      // Takes what has arrived; steps and publishes cycle k once its inputs are complete.
+      const auto advance = [&] {
         const std::uint64_t seq = plant.cycle();
-        bool got_command = false;
-        bool got_status = false;
-        std::int64_t arrival_ns = 0;
-        const auto wait_start = Clock::now();
-        auto backoff = std::chrono::milliseconds(10);
-        auto next_reoffer = wait_start + backoff;
-        bool hang_reported = false;
-        while (!runtime::stop_requested()) {
-          while (actuators->take_next(incoming)) {
-            if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
-            if (!runtime::all_finite(incoming)) {
-              ++counters.nonfinite_rejected;
-              continue;
-            }
-            if (incoming.header().seq() == seq && !got_command) {
-              protocol::from_dds(incoming, command);
-              got_command = true;
-              arrival_ns = runtime::now_nanoseconds();
-            }
+        while (actuators->take_next(incoming)) {
+          if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
+          if (!runtime::all_finite(incoming)) {
+            ++counters.nonfinite_rejected;
+            continue;
           }
-          while (safety->take_next(incoming_status)) {
-            if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
-            if (!runtime::all_finite(incoming_status)) {
-              ++counters.nonfinite_rejected;
-              continue;
-            }
-            // Kept by cycle: one for a later cycle may arrive before this cycle is done.
-            protocol::from_dds(incoming_status, recent_statuses[incoming_status.header().seq() % recent_statuses.size()].emplace());
+          if (incoming.header().seq() == seq && !wait.got_command) {
+            protocol::from_dds(incoming, command);
+            wait.got_command = true;
+            wait.arrival_ns = runtime::now_nanoseconds();
           }
-          if (!got_status) {
-            const std::uint64_t gate_seq = supervisor::gating_cycle(seq);
-            const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
-            if (gate.has_value() && gate->header.seq == gate_seq) {
-              status = *gate;
-              got_status = true;
-            }
-          }
-          if (got_status && supervisor::lockstep_may_run(got_command, status)) break;
-          const auto now = Clock::now();
-          if (now >= next_reoffer) {
-            if (started) {
-              ++reoffered;
-              // The previous cycle first: the supervisor may still lack it (it gates this cycle).
-              previous_sample.header().stamp(runtime::now_stamp());
-              sensors->write(previous_sample);
-            } else {
-              new_origin();  // start-up: latency counts from when the chain is up
-            }
-            publish();
-            backoff = std::min(backoff * 2, std::chrono::milliseconds(80));
-            next_reoffer = now + backoff;
-          }
-          if (started && !hang_reported && now - wait_start >= hang_timeout) {
-            hang_reported = true;
-            ++hangs;
-            const auto a = actuators->health();
-            const auto h = safety->health();
-            spdlog::error("lockstep: cycle {} has waited {:.1f} s for {}{}{}: the chain is hung (not a crane fault; "
-                          "the cycle keeps waiting). Actuator writers matched {}, supervisor status writers matched {}",
-                          seq, std::chrono::duration<double>(now - wait_start).count(),
-                          got_command ? "" : "the actuator command", !got_command && !got_status ? " and " : "",
-                          got_status ? "" : "the supervisor status", a.matched_writers, h.matched_writers);
-          }
-          wakeup.wait_until(next_reoffer);
         }
-        if (runtime::stop_requested()) break;
+        while (safety->take_next(incoming_status)) {
+          if (runtime::injected_loss()) continue;  // tests only (CRANE_INJECT_LOSS)
+          if (!runtime::all_finite(incoming_status)) {
+            ++counters.nonfinite_rejected;
+            continue;
+          }
+          // Kept by cycle: one for a later cycle may arrive before this cycle is done.
+          protocol::from_dds(incoming_status, recent_statuses[incoming_status.header().seq() % recent_statuses.size()].emplace());
+        }
+        if (!wait.got_status) {
+          const std::uint64_t gate_seq = supervisor::gating_cycle(seq);
+          const auto& gate = recent_statuses[gate_seq % recent_statuses.size()];
+          if (gate.has_value() && gate->header.seq == gate_seq) {
+            status = *gate;
+            wait.got_status = true;
+          }
+        }
+        if (!wait.got_status || !supervisor::lockstep_may_run(wait.got_command, status)) return;
         started = true;
-        if (got_command) record_arrival(arrival_ns);
+        if (wait.got_command) record_arrival(wait.arrival_ns);
         previous_sample = sample;
-        step(supervisor::lockstep_gate_input(seq, dt, got_command ? &command : nullptr, status));
+        step(supervisor::lockstep_gate_input(seq, dt, wait.got_command ? &command : nullptr, status));
         new_origin();
         publish();
+        begin_wait();
+      };
+      // The node's thread: offers the cycle again while it waits, and reports a hang.
+      Clock::time_point next_timer;
+      const auto timers = [&] {
+        const auto now = Clock::now();
+        if (now >= wait.next_reoffer) {
+          if (started) {
+            ++reoffered;
+            // The previous cycle first: the supervisor may still lack it (it gates this cycle).
+            previous_sample.header().stamp(runtime::now_stamp());
+            sensors->write(previous_sample);
+          } else {
+            new_origin();  // start-up: latency counts from when the chain is up
+          }
+          publish();
+          wait.backoff = std::min(wait.backoff * 2, Clock::duration(std::chrono::milliseconds(80)));
+          wait.next_reoffer = now + wait.backoff;
+        }
+        if (started && !wait.hang_reported && now - wait.start >= hang_timeout) {
+          wait.hang_reported = true;
+          ++hangs;
+          const auto a = actuators->health();
+          const auto h = safety->health();
+          spdlog::error("lockstep: cycle {} has waited {:.1f} s for {}{}{}: the chain is hung (not a crane fault; "
+                        "the cycle keeps waiting). Actuator writers matched {}, supervisor status writers matched {}",
+                        plant.cycle(), std::chrono::duration<double>(now - wait.start).count(),
+                        wait.got_command ? "" : "the actuator command", !wait.got_command && !wait.got_status ? " and " : "",
+                        wait.got_status ? "" : "the supervisor status", a.matched_writers, h.matched_writers);
+        }
         diagnostics.maybe_publish(counters, &latency);
+        next_timer = std::min(wait.next_reoffer, Clock::now() + std::chrono::milliseconds(5));
+      };
+      runtime::ListenerDispatch dispatch(wakeup, advance, wake == "listener");
+      while (!runtime::stop_requested()) {
+        dispatch.run(timers);
+        wakeup.wait_until(next_timer);
       }
     } else {
       // Realtime: absolute deadlines every sample period on the monotonic clock. A command missing at

@@ -358,6 +358,31 @@ TEST(FollowerFilter, OnlyTheStateEstimatorGetsTheFlagAndOnlyWhenAsked) {
   EXPECT_EQ(with_flag(), (std::set<std::string>{"state_estimator"}));
 }
 
+// Where a cycle runs (runtime::ListenerDispatch): --wake reaches the chain (the five stages and the
+// plant) and no other process, and only when the options name it (the nodes' default: listener).
+TEST(Wake, TheChainsProcessesAndOnlyTheyGetIt) {
+  crane::launch::StackOptions o;
+  o.config_path = "c.yaml";
+  o.binary_directory = "/bin";
+  const auto with_wake = [&](const std::string& value) {
+    std::set<std::string> names;
+    for (const auto& spec : crane::launch::stack_processes(o)) {
+      const auto& a = spec.arguments;
+      const auto at = std::find(a.begin(), a.end(), "--wake");
+      if (at != a.end() && at + 1 != a.end() && *(at + 1) == value) names.insert(spec.name);
+    }
+    return names;
+  };
+  EXPECT_TRUE(with_wake("thread").empty());
+  EXPECT_TRUE(with_wake("listener").empty());
+  o.wake = "thread";
+  const std::set<std::string> chain{"plant", "state_estimator", "trajectory_planner", "anti_swing", "tracking",
+                                    "friction_compensation"};
+  EXPECT_EQ(with_wake("thread"), chain);
+  o.hardware = "shm:test_board";  // the plant behind the board, and the bridge, which has no such option
+  EXPECT_EQ(with_wake("thread"), chain);
+}
+
 TEST(DdsMix, RefusesBadEntriesNamingThem) {
   const std::vector<std::string> known{"plant", "tracking"};
   const auto message = [&](const std::string& text) {

@@ -328,6 +328,11 @@ int main(int argc, char** argv) {
   latency_cmd->add_flag("--lockstep", lockstep,
                         "plant in lockstep (as the demo): where a cycle's time goes when nothing waits on a clock, "
                         "and the speed in multiples of real time");
+  std::string wake;
+  latency_cmd->add_option("--wake", wake,
+                          "the chain's --wake (stages and plant): listener (their default: one thread wake-up per "
+                          "hop) | thread (two)")
+      ->check(CLI::IsMember({"listener", "thread"}));
   std::string dds = "fast";
   std::string dds_mix;
   latency_cmd->add_option("--dds", dds, "DDS vendor of every process: fast | cyclone")
@@ -417,6 +422,7 @@ int main(int argc, char** argv) {
     stack.log_directory = dir.string();
     stack.domain_id = domain;
     stack.lockstep = lockstep;
+    stack.wake = wake;
     stack.plant_stats_path = (dir / "plant_stats.json").string();
     if (latency_priority > 0) {
       const std::string rt_failure = launch::probe_realtime(latency_priority + 10);
@@ -549,6 +555,7 @@ int main(int argc, char** argv) {
     j["floor_one_way"] = summary(floor);
     j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
     j["clock"] = lockstep ? "lockstep" : "realtime";
+    j["wake"] = wake.empty() ? "listener" : wake;
     if (plant.is_object() && plant.contains("step_us")) j["plant_step"] = plant["step_us"];
     if (lockstep && sensor_stamps.size() > 1) {
       // Cycles stepped per second of wall time while recording.

@@ -1,6 +1,7 @@
 #include "crane/launch/stack.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -16,12 +17,19 @@ std::string number(double value) {
 
 bool is_shm(const std::string& hardware) { return hardware.rfind("shm:", 0) == 0 && hardware.size() > 4; }
 bool is_comedi(const std::string& hardware) { return hardware.rfind("comedi:", 0) == 0 && hardware.size() > 7; }
+
+constexpr std::array<const char*, 5> kStages{"friction_compensation", "tracking", "anti_swing", "trajectory_planner",
+                                             "state_estimator"};  // the run_stage processes, in start order
+
+bool is_stage(const std::string& name) {
+  return std::find(kStages.begin(), kStages.end(), name) != kStages.end();
+}
 }  // namespace
 
 std::vector<std::string> stack_process_names(const StackOptions& o) {
   std::vector<std::string> names{"supervisor"};
   if (o.operator_relay) names.push_back("operator_relay");
-  names.insert(names.end(), {"friction_compensation", "tracking", "anti_swing", "trajectory_planner", "state_estimator"});
+  names.insert(names.end(), kStages.begin(), kStages.end());
   if (o.hardware.empty()) {
     names.push_back("plant");
   } else if (is_shm(o.hardware)) {
@@ -119,6 +127,9 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       if (!o.plant_stats_path.empty()) spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
     }
     if (name == "trajectory_planner" && o.lockstep) spec.arguments.push_back("--lockstep");
+    if (!o.wake.empty() && (is_stage(name) || name == "plant")) {
+      spec.arguments.insert(spec.arguments.end(), {"--wake", o.wake});
+    }
     if (name == "friction_compensation" && !o.friction_compensation) spec.arguments.push_back("--disable");
     if (name == "supervisor") {
       if (o.lockstep) spec.arguments.push_back("--lockstep");

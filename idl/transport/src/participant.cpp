@@ -44,6 +44,11 @@ std::string profile_for_vendor(const std::string& path, Vendor vendor) {
 }
 
 void Wakeup::notify() noexcept {
+  if (dispatching_.load(std::memory_order_acquire)) {
+    dispatch_pending_.store(true, std::memory_order_release);
+    run_pending_dispatch();
+    return;
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = true;
@@ -56,6 +61,38 @@ bool Wakeup::wait_until(std::chrono::steady_clock::time_point deadline) {
   const bool notified = condition_.wait_until(lock, deadline, [this] { return pending_; });
   pending_ = false;
   return notified;
+}
+
+void Wakeup::run_pending_dispatch() noexcept {
+  // Whoever holds the mutex handles every notify() made before it lets go: a notify() that finds
+  // the mutex held leaves its flag for the holder, who looks again after unlocking.
+  while (dispatch_pending_.load(std::memory_order_acquire)) {
+    std::unique_lock<std::mutex> lock(dispatch_mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return;
+    while (dispatch_pending_.exchange(false, std::memory_order_acq_rel)) {
+      if (dispatch_) dispatch_();
+    }
+  }
+}
+
+void Wakeup::dispatch_on_notify(std::function<void()> handler) {
+  std::lock_guard<std::mutex> lock(dispatch_mutex_);
+  dispatch_ = std::move(handler);
+  dispatching_.store(static_cast<bool>(dispatch_), std::memory_order_release);
+}
+
+void Wakeup::run_exclusive(const std::function<void()>& work) {
+  {
+    std::lock_guard<std::mutex> lock(dispatch_mutex_);
+    work();
+  }
+  run_pending_dispatch();
+}
+
+void Wakeup::stop_dispatch() {
+  std::lock_guard<std::mutex> lock(dispatch_mutex_);
+  dispatching_.store(false, std::memory_order_release);
+  dispatch_ = nullptr;
 }
 
 Participant::Participant(const ParticipantOptions& options) : options_(options) {

@@ -200,6 +200,48 @@ void install_stop_handlers(transport::Wakeup* wakeup) {
 
 bool stop_requested() noexcept { return g_stop.load(); }
 
+void add_wake_option(CLI::App& app, std::string& wake) {
+  app.add_option("--wake", wake,
+                 "listener: a cycle runs on the DDS listener thread that delivers its input (one thread wake-up "
+                 "per hop, the default); thread: on the node's own thread, which the listener wakes (two)")
+      ->check(CLI::IsMember({"listener", "thread"}));
+}
+
+ListenerDispatch::ListenerDispatch(transport::Wakeup& wakeup, std::function<void()> poll, bool on_listener)
+    : wakeup_(wakeup), poll_(std::move(poll)) {
+  if (on_listener) wakeup_.dispatch_on_notify([this] { guarded_poll(); });
+}
+
+ListenerDispatch::~ListenerDispatch() { wakeup_.stop_dispatch(); }
+
+void ListenerDispatch::guarded_poll() noexcept {
+  if (failure_) return;
+  try {
+    poll_();
+  } catch (...) {
+    failure_ = std::current_exception();
+  }
+}
+
+void ListenerDispatch::run(const std::function<void()>& timer_work) {
+  std::exception_ptr failure;
+  wakeup_.run_exclusive([&] {
+    guarded_poll();
+    if (!failure_) {
+      try {
+        timer_work();
+      } catch (...) {
+        failure_ = std::current_exception();
+      }
+    }
+    failure = failure_;
+  });
+  if (failure) {
+    wakeup_.stop_dispatch();
+    std::rethrow_exception(failure);
+  }
+}
+
 std::uint32_t fresh_request_id() noexcept {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   const auto tenths = std::chrono::duration_cast<std::chrono::milliseconds>(now).count() / 100 - 17356896000LL;

@@ -32,6 +32,8 @@ int run_stage(int argc, char** argv, ProcessId process, const std::string& descr
   CLI::App app{description};
   NodeOptions options;
   add_node_options(app, options);
+  std::string wake = "listener";
+  add_wake_option(app, wake);
   if (add_options) add_options(app);
   try {
     app.parse(argc, argv);
@@ -51,10 +53,12 @@ int run_stage(int argc, char** argv, ProcessId process, const std::string& descr
     StageContext context{cfg, *participant, wakeup, counters, latency};
     const auto poll = setup(context);
     spdlog::info("running on {} dds, domain {}", transport::vendor_name(participant->vendor()), options.domain_id);
-    while (!stop_requested()) {
-      wakeup.wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(5));
-      poll();
-      diagnostics.maybe_publish(counters, &latency);
+    {
+      ListenerDispatch dispatch(wakeup, poll, wake == "listener");
+      while (!stop_requested()) {
+        wakeup.wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(5));
+        dispatch.run([&] { diagnostics.maybe_publish(counters, &latency); });
+      }
     }
     leave_realtime();
     diagnostics.publish_final(counters, &latency);

@@ -73,25 +73,31 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan(const trajectory_pla
   }
 }
 
-// Solves the stage's plan requests: in lockstep in the cycle the request appears (the chain waits for
-// this stage, as for any, so every run starts the move at the same cycle); in real time on a worker
-// thread at normal priority while the crane holds, handed over at the first cycle after it ends.
+// Solves the stage's plan requests on a worker thread at normal priority (never on the DDS listener
+// thread the stage runs on), handed over before the first cycle after it ends. In real time the
+// crane holds meanwhile. In lockstep the solve holds the next cycle: the stage takes no new cycle
+// until the plan is handed over, so every run starts the move at the same cycle, as when the solve
+// ran in the cycle (the chain waits for this stage, as for any).
 class Planning {
  public:
   Planning(bool lockstep, common::StackFacts facts, trajectory_planner::TrajectoryPlannerParams params)
       : lockstep_(lockstep), facts_(std::move(facts)), params_(std::move(params)) {}
 
-  void poll(trajectory_planner::TrajectoryPlannerStage& stage) {
+  /// In lockstep, while a solve runs: take no new cycle.
+  [[nodiscard]] bool holds_cycle() const {
+    return lockstep_ && worker_.valid() && worker_.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
+  }
+  /// Hands a finished plan to the stage (before its step: that cycle uses it).
+  void collect(trajectory_planner::TrajectoryPlannerStage& stage) {
     if (worker_.valid() && worker_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
       stage.provide_plan(worker_sequence_, worker_.get());  // ignored if the request was dropped meanwhile
     }
+  }
+  /// Starts the solve of a new plan request of the stage (after its step).
+  void start(trajectory_planner::TrajectoryPlannerStage& stage) {
     const auto& request = stage.plan_request();
     if (!request || request->sequence == started_sequence_ || worker_.valid()) return;
     started_sequence_ = request->sequence;
-    if (lockstep_) {
-      stage.provide_plan(started_sequence_, plan(*request, facts_, params_));
-      return;
-    }
     worker_sequence_ = started_sequence_;
     worker_ = std::async(std::launch::async, [request = *request, facts = facts_, params = params_] {
       runtime::leave_realtime_this_thread();
@@ -117,8 +123,8 @@ int main(int argc, char** argv) {
       "time-optimal swing-free, the minimum-time bound with its follower's law)",
       [&lockstep](CLI::App& app) {
         app.add_flag("--lockstep", lockstep,
-                     "solve a minimum-time plan in the cycle its goal arrives (the chain waits); default: on a "
-                     "worker thread while the crane holds");
+                     "a minimum-time plan holds the next cycle until it is solved (the chain waits: every run the "
+                     "same); default: the crane holds while it is solved");
       },
       [&lockstep](runtime::StageContext& ctx) -> std::function<void()> {
         const auto params = ctx.config.read("trajectory_planner", trajectory_planner::read_params);
@@ -139,7 +145,8 @@ int main(int argc, char** argv) {
         arrived->reserve(trajectory_planner::TrajectoryPlannerStage::kMaxGoalsPerCycle);
         return [=, &ctx] {
           protocol::CraneState state;
-          while (runtime::take_plain(*states, state, ctx.counters)) {
+          // While a lockstep solve runs, the next cycle's state waits in its reader.
+          while (!planning->holds_cycle() && runtime::take_plain(*states, state, ctx.counters)) {
             const auto seq = state.header.seq;
             switch (watch->classify(seq, ctx.counters)) {
               case runtime::CycleKind::stale: continue;
@@ -168,8 +175,9 @@ int main(int argc, char** argv) {
                 const trajectory_planner::PlannerCycle cycle{&state, *arrived, *operator_speeds,
                                                              status->has_value() ? &**status : nullptr};
                 const auto unsolved_before = stage->unsolved_plans();
+                planning->collect(*stage);
                 const auto step_status = stage->step(cycle, *out);
-                planning->poll(*stage);
+                planning->start(*stage);
                 if (stage->unsolved_plans() != unsolved_before) {
                   spdlog::warn("a minimum-time goal started without its plan ({} so far): the time-optimal profile runs",
                                stage->unsolved_plans());

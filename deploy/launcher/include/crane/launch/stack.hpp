@@ -55,6 +55,8 @@ struct StackOptions {
   bool operator_relay{true};          // the operator relay (supervisor/node/operator_relay_node.cpp): the operator's
                                       // commands (deploy/crane estop, ...) over a local socket to a participant
                                       // already matched with the supervisor; off: they make a participant each
+  std::string wake;                   // the chain's --wake (the stages and the plant): listener | thread; empty:
+                                      // their default, listener (runtime::ListenerDispatch)
   int realtime_priority{0};           // > 0: every process --realtime-priority: the sensor writer (plant or
                                       // bridge) this + 10, the supervisor + 5, the chain this (as the
                                       // systemd units); 0: normal priority

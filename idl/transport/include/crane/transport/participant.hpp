@@ -9,8 +9,10 @@
 // Network scope: by default a participant binds to the loopback interface only and discovers its
 // peers by unicast on 127.0.0.1 (no multicast leaves the host), as ROS 2's localhost-only mode.
 //
-// Threading: Reader callbacks run on the vendor's listener thread; they only copy status and poke
-// the Wakeup given at creation. take_next() and health() may be called from any single thread.
+// Threading: Reader callbacks run on the vendor's listener thread; they copy status and poke the
+// Wakeup given at creation, which either wakes the node's thread or, with listener dispatch, runs
+// the node's poll right there (Wakeup::dispatch_on_notify). take_next() and health() may be called
+// from any single thread at a time.
 
 #include <atomic>
 #include <chrono>
@@ -87,17 +89,35 @@ struct DiscoveredEndpoint {
 };
 
 /// A wake-up shared by all readers of one process: readers notify it on data and status changes,
-/// the node's loop waits on it. Blocks only in wait_until().
+/// the node's loop waits on it, or its handler runs on the notifying thread (listener dispatch).
+/// Blocks only in wait_until(), run_exclusive() and stop_dispatch().
 class Wakeup {
  public:
   void notify() noexcept;
   /// Waits until notified (returns true) or the deadline passes (false). Consumes the notification.
   bool wait_until(std::chrono::steady_clock::time_point deadline);
 
+  /// Listener dispatch: from now on notify() runs `handler` on the notifying thread (the vendor's
+  /// listener thread), one call at a time, instead of waking the thread in wait_until(): a sample
+  /// is handled with one thread wake-up (the vendor's receive thread) instead of two. A notify()
+  /// that arrives while a call runs makes that call repeat once it returns. `handler` must not
+  /// throw and must not call notify(). wait_until() then wakes only at its deadline.
+  void dispatch_on_notify(std::function<void()> handler);
+  /// Runs `work` on the calling thread, serialized with the handler's calls (the node's timer path:
+  /// its poll and diagnostics), then any handler call a notify() asked for meanwhile.
+  void run_exclusive(const std::function<void()>& work);
+  /// Ends listener dispatch, waiting for a call in progress; notify() wakes wait_until() again.
+  void stop_dispatch();
+
  private:
+  void run_pending_dispatch() noexcept;
   std::mutex mutex_;
   std::condition_variable condition_;
   bool pending_{false};
+  std::mutex dispatch_mutex_;                   // held while the handler runs
+  std::function<void()> dispatch_;              // set and cleared under dispatch_mutex_
+  std::atomic<bool> dispatching_{false};        // dispatch_ is set
+  std::atomic<bool> dispatch_pending_{false};   // a notify() not yet handled
 };
 
 namespace detail {

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -118,6 +120,36 @@ void configure_logging(const std::string& level, const std::string& process);
 /// std::invalid_argument naming the variable on the first call when it is malformed or P is not
 /// in [0, 0.5].
 [[nodiscard]] bool injected_loss();
+
+/// Adds --wake listener|thread to `app`, bound to `wake` ("listener" by default): where the chain's
+/// nodes (the stages and the plant) run a cycle (ListenerDispatch).
+void add_wake_option(CLI::App& app, std::string& wake);
+
+/// A chain node's poll on the DDS listener thread that delivers its input
+/// (transport::Wakeup::dispatch_on_notify): a hop of the 100 Hz chain costs one thread wake-up (the
+/// vendor's receive thread) instead of two (it, then the node's thread; docs/integration.md, "One
+/// wake-up per hop"). The node's own thread keeps its timer work (a poll at least every few
+/// milliseconds, re-offers, diagnostics) through run(), never at the same time as the poll. With
+/// `on_listener` false, or `wake` "thread", the poll runs only through run(), after the node's
+/// thread is woken. The poll must not block (a DDS listener thread held holds the participant's
+/// traffic) and is called with nothing else of the node running; an exception it throws on a
+/// listener thread stops further calls and is rethrown by the next run().
+class ListenerDispatch {
+ public:
+  ListenerDispatch(transport::Wakeup& wakeup, std::function<void()> poll, bool on_listener);
+  ~ListenerDispatch();  // ends the dispatch (waits for a poll in progress)
+  ListenerDispatch(const ListenerDispatch&) = delete;
+  ListenerDispatch& operator=(const ListenerDispatch&) = delete;
+  /// On the node's thread: the poll, then `timer_work`, serialized with the listener's polls.
+  /// Rethrows what a poll threw (on either thread).
+  void run(const std::function<void()>& timer_work);
+
+ private:
+  void guarded_poll() noexcept;
+  transport::Wakeup& wakeup_;
+  std::function<void()> poll_;
+  std::exception_ptr failure_;  // guarded by the wakeup's exclusion
+};
 
 /// SIGINT/SIGTERM set a flag (async-signal-safe) and wake the given Wakeup.
 void install_stop_handlers(transport::Wakeup* wakeup);

@@ -2,6 +2,9 @@
 // The skeleton every data-driven stage process shares: parse options, open the configuration,
 // open the participant, then loop: wait for a wake-up (data or status change, at most 5 ms apart),
 // let the node poll its readers, publish diagnostics once a second; stop cleanly on SIGINT/SIGTERM.
+// The poll runs on the DDS listener thread that brings the input (runtime::ListenerDispatch; --wake
+// thread: only on the node's thread) and, every 5 ms, on the node's own thread; never two at once.
+// It must not block: work that may take long (the planner's solve) goes to a thread of its own.
 //
 // A node only translates: DDS samples to the protocol's plain structs (take_plain), its stage
 // object's step(), the output back to DDS (write_plain). The stage runs when the inputs of cycle k
