@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
   app.add_flag("--insecure-lan", stack.insecure_lan,
                "allow --lan or --dds-profile without --security: anyone on that network can read and command the crane");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
+  app.add_option("--wake", stack.wake,
+                 "the chain's --wake (stages and plant): listener (their default: a cycle runs on the DDS thread "
+                 "that delivers its input) | thread (the node's own thread, woken by it)")
+      ->check(CLI::IsMember({"listener", "thread"}));
   std::optional<double> initial_trolley, initial_slew, initial_bridge;
   app.add_option("--initial-trolley", initial_trolley,
                  "[m] initial trolley position (default: where the configuration's first maneuver starts)");
