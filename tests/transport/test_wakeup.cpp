@@ -1,15 +1,18 @@
 // transport::Wakeup's listener dispatch (the stages' poll on the DDS listener thread, one thread
 // wake-up per hop): no notification is lost, the handler never runs twice at once, the node's own
-// timer path is serialized with it, and a two-participant chain over each vendor's wire answers
-// every cycle in order with the answer written from the handler.
+// timer path is serialized with it, runtime::ListenerDispatch hands a listener's exception to the
+// node's thread, and a two-participant chain over each vendor's wire answers every cycle in order
+// with the answer written from the handler.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
+#include "crane/runtime/node_runtime.hpp"
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 
@@ -116,6 +119,49 @@ TEST(Wakeup, RunExclusiveHandlesANotifyThatArrivedWhileItRan) {
   });
   EXPECT_EQ(calls.load(), 1) << "the notify made during run_exclusive was not handled after it";
   wakeup.stop_dispatch();
+}
+
+// runtime::ListenerDispatch, the stages' and the plant's loop: a poll that throws on a listener
+// thread is not called again, and the node's next run() rethrows its exception (the node then stops
+// with its message, as when the poll threw on its own thread).
+TEST(ListenerDispatch, APollThatThrowsOnAListenerThreadIsRethrownOnTheNodesThread) {
+  Wakeup wakeup;
+  std::atomic<int> polls{0};
+  crane::runtime::ListenerDispatch dispatch(
+      wakeup,
+      [&] {
+        if (polls.fetch_add(1) == 0) throw std::runtime_error("a stage's poll failed");
+      },
+      true);
+  std::thread listener([&] { wakeup.notify(); });  // the poll runs here and throws
+  listener.join();
+  EXPECT_EQ(polls.load(), 1);
+  wakeup.notify();
+  EXPECT_EQ(polls.load(), 1) << "a failed poll ran again";
+  int timer_work = 0;
+  try {
+    dispatch.run([&] { ++timer_work; });
+    ADD_FAILURE() << "run() did not rethrow the listener's exception";
+  } catch (const std::runtime_error& error) {
+    EXPECT_STREQ(error.what(), "a stage's poll failed");
+  }
+  EXPECT_EQ(timer_work, 0);
+  // After the failure, notify() wakes the node's thread again (the dispatch has ended).
+  wakeup.notify();
+  EXPECT_TRUE(wakeup.wait_until(Clock::now() + std::chrono::seconds(5)));
+}
+
+TEST(ListenerDispatch, OnTheNodesThreadOnlyThePollRunsThroughRunAfterAWakeUp) {
+  Wakeup wakeup;
+  int polls = 0;
+  crane::runtime::ListenerDispatch dispatch(wakeup, [&] { ++polls; }, false);
+  wakeup.notify();
+  EXPECT_EQ(polls, 0) << "--wake thread: a notify ran the poll";
+  EXPECT_TRUE(wakeup.wait_until(Clock::now() + std::chrono::seconds(5)));
+  int timer_work = 0;
+  dispatch.run([&] { ++timer_work; });
+  EXPECT_EQ(polls, 1);
+  EXPECT_EQ(timer_work, 1);
 }
 
 // A lockstep chain of two participants of different vendors: the test writes sensor sample k and
