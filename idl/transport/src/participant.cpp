@@ -81,14 +81,6 @@ void Wakeup::dispatch_on_notify(std::function<void()> handler) {
   dispatching_.store(static_cast<bool>(dispatch_), std::memory_order_release);
 }
 
-void Wakeup::run_exclusive(const std::function<void()>& work) {
-  {
-    std::lock_guard<std::mutex> lock(dispatch_mutex_);
-    work();
-  }
-  run_pending_dispatch();
-}
-
 void Wakeup::stop_dispatch() {
   std::lock_guard<std::mutex> lock(dispatch_mutex_);
   dispatching_.store(false, std::memory_order_release);

@@ -223,24 +223,6 @@ void ListenerDispatch::guarded_poll() noexcept {
   }
 }
 
-void ListenerDispatch::run(const std::function<void()>& timer_work) {
-  std::exception_ptr failure;
-  wakeup_.run_exclusive([&] {
-    guarded_poll();
-    if (!failure_) {
-      try {
-        timer_work();
-      } catch (...) {
-        failure_ = std::current_exception();
-      }
-    }
-    failure = failure_;
-  });
-  if (failure) {
-    wakeup_.stop_dispatch();
-    std::rethrow_exception(failure);
-  }
-}
 
 std::uint32_t fresh_request_id() noexcept {
   const auto now = std::chrono::system_clock::now().time_since_epoch();

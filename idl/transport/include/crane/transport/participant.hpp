@@ -104,8 +104,16 @@ class Wakeup {
   /// throw and must not call notify(). wait_until() then wakes only at its deadline.
   void dispatch_on_notify(std::function<void()> handler);
   /// Runs `work` on the calling thread, serialized with the handler's calls (the node's timer path:
-  /// its poll and diagnostics), then any handler call a notify() asked for meanwhile.
-  void run_exclusive(const std::function<void()>& work);
+  /// its poll and diagnostics), then any handler call a notify() asked for meanwhile. A template,
+  /// so that the timer path wraps nothing in a std::function (no allocation).
+  template <class Work>
+  void run_exclusive(Work&& work) {
+    {
+      std::lock_guard<std::mutex> lock(dispatch_mutex_);
+      work();
+    }
+    run_pending_dispatch();
+  }
   /// Ends listener dispatch, waiting for a call in progress; notify() wakes wait_until() again.
   void stop_dispatch();
 

@@ -141,8 +141,26 @@ class ListenerDispatch {
   ListenerDispatch(const ListenerDispatch&) = delete;
   ListenerDispatch& operator=(const ListenerDispatch&) = delete;
   /// On the node's thread: the poll, then `timer_work`, serialized with the listener's polls.
-  /// Rethrows what a poll threw (on either thread).
-  void run(const std::function<void()>& timer_work);
+  /// Rethrows what a poll or `timer_work` threw (on either thread). Allocates nothing.
+  template <class TimerWork>
+  void run(TimerWork&& timer_work) {
+    std::exception_ptr failure;
+    wakeup_.run_exclusive([&] {
+      guarded_poll();
+      if (!failure_) {
+        try {
+          timer_work();
+        } catch (...) {
+          failure_ = std::current_exception();
+        }
+      }
+      failure = failure_;
+    });
+    if (failure) {
+      wakeup_.stop_dispatch();
+      std::rethrow_exception(failure);
+    }
+  }
 
  private:
   void guarded_poll() noexcept;
