@@ -12,6 +12,7 @@
 #include "crane/optimal_control/minimum_time.hpp"
 #include "crane/optimal_control/planned_move.hpp"
 #include "crane/stack/controller_comparison.hpp"
+#include "crane/stack/follower_run.hpp"
 #include "crane/stack/maneuver_bound.hpp"
 #include "crane/trajectory_planner/time_optimal_profile.hpp"
 
@@ -49,6 +50,7 @@ TEST(MinimumTime, TrolleyMoveRespectsTheLinearBangBangTime) {
               linear.duration(), result.iterations, result.solve_seconds);
   EXPECT_GE(result.duration, linear.duration());
   EXPECT_LE(result.duration, 1.01 * linear.duration());
+  EXPECT_EQ(result.restarts, 0) << "solved from the profiles' guess: no restart";
   EXPECT_LT(result.max_defect, 1e-7);
   // Rest at both ends, the limits held at every node.
   EXPECT_DOUBLE_EQ(result.nodes.front().state.position[plant::kTrolleyIndex], m.initial_trolley_position);
@@ -138,6 +140,41 @@ TEST(MinimumTime, TheSlewsBoundUsesTheTrolley) {
               1e3 * excursion, held.duration);
   EXPECT_GT(excursion, 0.01);
   EXPECT_LT(free.duration, 0.9 * held.duration);
+}
+
+// The restart (MinimumTimeProblem::restart_stretch) on the request that the planner made for the
+// learning move before the overhead crane's random move 18 (seed 1; crane_sim compare --learn): the
+// bridge 10 -> 45.48 m, the trolley 12 -> 14.32 m, from where the planner's reference rested (3.6 and
+// 0.35 um off the config's 12 and 10 m). From the linear profiles' guess IPOPT stops there at a point
+// of local infeasibility (measured: Infeasible_Problem_Detected), and the planner fell back to the
+// time-optimal profile with no swing feedback, which pumped the load to 10 deg and the run to a
+// latched fault; from the guess stretched to 1.25 times it solves. T* is checked against the rigid
+// bridge's trapezoid time, which it cannot beat and which a swing-free move of 55 s (14 swing
+// periods) costs nearly nothing over.
+TEST(MinimumTime, AnInfeasibleStopIsRestartedFromAStretchedGuess) {
+  const auto cfg = config("overhead_crane.yaml");
+  const auto move = stack::random_moves(cfg, 20, 1).at(18);
+  auto request = stack::plan_request_of(cfg, stack::learning_move(cfg, move));
+  request.trolley_from = 11.999996436788372;
+  request.bridge_from = 9.9999996486508529;
+  auto problem = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 200);
+  problem.least_effort = false;  // the minimum-time solve is the point
+  const auto result = optimal_control::solve_minimum_time(problem);
+  std::printf("learning move to overhead random_18: %s after %d restart(s), T* %.4f s, %d iterations, %.1f s\n",
+              result.status.c_str(), result.restarts, result.duration, result.iterations, result.solve_seconds);
+  ASSERT_TRUE(result.solved) << result.status;
+  // A restart runs only after a solve that did not solve: the premise, the profiles' guess failing.
+  EXPECT_GE(result.restarts, 1) << "the premise: IPOPT no longer stops on this request from the profiles' guess";
+  const double distance = request.bridge_target - request.bridge_from;
+  const double speed = request.bridge_limits.max_velocity;
+  const double rigid = distance / speed + speed / request.bridge_limits.max_acceleration;
+  EXPECT_GE(result.duration, rigid * (1.0 - 1e-6));
+  EXPECT_LE(result.duration, 1.01 * rigid);
+  EXPECT_LT(result.max_defect, 1e-6);
+  const auto& end = result.nodes.back();
+  EXPECT_DOUBLE_EQ(end.state.position[plant::kTrolleyIndex], request.trolley_target);
+  EXPECT_DOUBLE_EQ(end.state.position[plant::kSlewIndex], request.bridge_target);
+  EXPECT_EQ(end.state.velocity.head(plant::kNumCoordinates).norm(), 0.0);
 }
 
 // The least-effort second solve (MinimumTimeProblem::least_effort) on the overhead crane's first
@@ -264,6 +301,11 @@ TEST(MinimumTime, AMalformedProblemIsRefusedNamingTheField) {
   p = problem;
   p.least_effort_margin = -0.01;
   EXPECT_NE(message(p).find("minimum_time.least_effort_margin"), std::string::npos) << message(p);
+  p = problem;
+  p.restart_stretch = {1.25, 0.5};  // a restart from a guess shorter than the profiles'
+  EXPECT_NE(message(p).find("minimum_time.restart_stretch"), std::string::npos) << message(p);
+  p.restart_stretch = {std::nan("")};
+  EXPECT_NE(message(p).find("minimum_time.restart_stretch"), std::string::npos) << message(p);
   EXPECT_EQ(message(problem), "accepted");
 }
 

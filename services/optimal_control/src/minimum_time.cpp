@@ -536,9 +536,18 @@ void validate(const MinimumTimeProblem& problem) {
   common::require_in_range("minimum_time.max_iterations", problem.max_iterations, 1, 1e6);
   common::require_in_range("minimum_time.least_effort_margin", problem.least_effort_margin, 0.0, 0.5);
   common::require_in_range("minimum_time.least_effort_tolerance", problem.least_effort_tolerance, 1e-14, 1e-2);
+  for (const double stretch : problem.restart_stretch) {
+    common::require_in_range("minimum_time.restart_stretch", stretch, 1.0, 10.0);
+  }
   common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
   common::validate(problem.second_friction, "minimum_time.second_friction");
 }
+
+namespace {
+bool solved_status(Ipopt::ApplicationReturnStatus status) {
+  return status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+}
+}  // namespace
 
 MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   validate(problem);
@@ -570,9 +579,18 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
     return result;
   }
   const auto start = std::chrono::steady_clock::now();
-  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(program);
+  Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(program);
+  // Not solved from the profiles' guess: again from it stretched in time (restart_stretch).
+  for (const double stretch : problem.restart_stretch) {
+    if (solved_status(status)) break;
+    double stretched_duration = 0.0;
+    program = new MinimumTimeProgram(
+        problem, layout, initial_guess(problem, layout, stretched_duration, stretch * result.initial_guess_duration));
+    status = app->OptimizeTNLP(program);
+    ++result.restarts;
+  }
   result.status = solver_return_name(program->solver_return());
-  result.solved = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+  result.solved = solved_status(status);
   if (IsValid(app->Statistics())) result.iterations = app->Statistics()->IterationCount();
   const std::vector<double>* solution = &program->solution();
   if (solution->size() != static_cast<std::size_t>(layout.variable_count())) {
@@ -593,8 +611,7 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
     const Ipopt::ApplicationReturnStatus effort_status = app->OptimizeTNLP(effort);
     result.effort_status = solver_return_name(effort->solver_return());
     if (IsValid(app->Statistics())) result.effort_iterations += app->Statistics()->IterationCount();
-    if ((effort_status == Ipopt::Solve_Succeeded || effort_status == Ipopt::Solved_To_Acceptable_Level) &&
-        effort->solution().size() == solution->size()) {
+    if (solved_status(effort_status) && effort->solution().size() == solution->size()) {
       solution = &effort->solution();
       result.least_effort = true;
     }

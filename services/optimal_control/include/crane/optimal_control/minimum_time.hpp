@@ -103,6 +103,13 @@ struct MinimumTimeProblem {
                                       // same trajectory to 1e-4 rad of swing
   double tolerance{1e-8};             // IPOPT's tol
   int max_iterations{3000};
+  /// Where IPOPT does not solve the minimum-time problem from the linear profiles' guess, it is
+  /// solved again from that guess stretched in time by each of these factors in turn (the profiles,
+  /// then rest) until one solves (MinimumTimeResult::restarts). IPOPT can stop at a point of local
+  /// infeasibility of a feasible problem: a 35 m overhead-crane move whose start was 4 um off one it
+  /// solved did (tests/optimal_control/test_minimum_time.cpp; docs/optimal_control.md, "Learnt while
+  /// working"). Each in [1, 10]; empty: no restart.
+  std::vector<double> restart_stretch{1.25, 1.5};
 };
 
 /// One node of the trajectory.
@@ -125,8 +132,9 @@ struct MinimumTimeResult {
   double trajectory_duration{0.0};        // [s] T of the nodes: (1 + k least_effort_margin) T*, k = 1, 2 or 4,
                                           // when least_effort (below) is true, else T*
   std::vector<TrajectoryNode> nodes;      // intervals + 1 nodes, t = k T / N
-  int iterations{0};
-  double solve_seconds{0.0};              // [s] wall time of IPOPT, both solves
+  int iterations{0};                      // of the minimum-time solve that decided (the last one)
+  int restarts{0};                        // minimum-time solves again from a stretched guess (restart_stretch)
+  double solve_seconds{0.0};              // [s] wall time of IPOPT, every solve
   double max_defect{0.0};                 // largest collocation defect at the solution [SI]
   double initial_guess_duration{0.0};     // [s] the linear profiles' duration the solve started from
   bool least_effort{false};               // the nodes are the least-effort solve's (MinimumTimeProblem::least_effort)
