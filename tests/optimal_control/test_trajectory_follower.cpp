@@ -14,6 +14,8 @@
 #include "crane/optimal_control/trajectory_follower.hpp"
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/stack/follower_run.hpp"
+#include "crane/stack/in_process_stack.hpp"
+#include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/maneuver_bound.hpp"
 #include "crane/stack/controller_comparison.hpp"
 #include "crane/stack/swing_calibration_run.hpp"
@@ -302,6 +304,7 @@ TEST(TrajectoryFollower, LearntWhileWorkingOnALongerCableTheSlowestMoveSettlesAs
                 ratio, nominal_bound);
     EXPECT_EQ(r.latched_faults, 0u);
     EXPECT_EQ(r.braked_cycles, 0u);
+    EXPECT_EQ(r.unsolved_plans, 0u) << "the learning move and the move, each followed on its own plan";
     if (learn) {
       EXPECT_EQ(r.planned_swing.scale, 1.0) << "one cable length: the scale is held";
       EXPECT_NEAR(r.planned_swing.offset, 0.2 * cfg.facts.crane.cable_length, 0.01);
@@ -312,6 +315,31 @@ TEST(TrajectoryFollower, LearntWhileWorkingOnALongerCableTheSlowestMoveSettlesAs
       EXPECT_GT(ratio, 1.5) << "the premise: on the configured length this move is slow";
     }
   }
+}
+
+// A minimum-time goal that the planner does not plan (no plan solved) runs the time-optimal
+// profile, which the run counts (InProcessResult::unsolved_plans, the planner stage's
+// unsolved_plans): a failure of the solve is not silent in a comparison (crane_sim compare prints
+// the runs that had one). The lab crane's trolley move still arrives (the profile is swing-free on
+// the linear model).
+TEST(TrajectoryFollower, AGoalThePlannerDoesNotPlanRunsTheTimeOptimalProfileAndIsCounted) {
+  const auto cfg = config("lab_tower_crane.yaml");
+  stack::InProcessRun run;
+  run.maneuver = stack::find_maneuver(cfg, "trolley");
+  run.controller = stack::choose_controller("follower", run.maneuver, false);
+  run.profile = protocol::MoveRequest::PROFILE_MINIMUM_TIME;
+  run.plan_move = [](const trajectory_planner::PlanRequest&) {
+    return std::shared_ptr<const trajectory_planner::PlannedPath>();
+  };
+  const auto unplanned = stack::run_in_process(cfg, run);
+  run.plan_move = nullptr;  // the planner's own solve (planner_node_way)
+  const auto planned = stack::run_in_process(cfg, run);
+  std::printf("trolley, no plan: settle %.2f s, error %.2f mm; planned: settle %.2f s\n",
+              unplanned.metrics.settle_time, 1e3 * unplanned.metrics.final_position_error, planned.metrics.settle_time);
+  EXPECT_EQ(unplanned.unsolved_plans, 1u);
+  EXPECT_EQ(planned.unsolved_plans, 0u);
+  EXPECT_EQ(unplanned.latched_faults, 0u);
+  EXPECT_LT(unplanned.metrics.final_position_error, 0.005);
 }
 
 }  // namespace

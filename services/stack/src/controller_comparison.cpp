@@ -175,6 +175,7 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         o.metrics = r.metrics;
         o.latched_faults = r.latched_faults;
         o.braked_cycles = r.braked_cycles;
+        o.unsolved_plans = r.unsolved_plans;
       } else {
         InProcessRun run;
         run.maneuver = m;
@@ -186,6 +187,7 @@ MoveComparison compare_move(const StackConfig& cfg, const ManeuverConfig& m,
         o.metrics = r.metrics;
         o.latched_faults = r.latched_faults;
         o.braked_cycles = r.braked_cycles;
+        o.unsolved_plans = r.unsolved_plans;
       }
       o.ratio = o.metrics.settle_time / out.bound;
     } catch (const std::exception& error) {

@@ -78,6 +78,7 @@ FollowerResult run_follower(const StackConfig& cfg, const FollowerRun& run) {
   result.swing_period = stack_result.swing_period;
   result.latched_faults = stack_result.latched_faults;
   result.braked_cycles = stack_result.braked_cycles;
+  result.unsolved_plans = stack_result.unsolved_plans;
   return result;
 }
 

@@ -277,6 +277,7 @@ InProcessResult run_in_process(const StackConfig& cfg, const InProcessRun& run) 
   result.plant_step_failures = stack.plant_step_failures();
   result.friction_events = stack.plant().simulator().friction_event_count();
   result.latched_faults = stack.status().latched_faults;
+  result.unsolved_plans = stack.planner().unsolved_plans();
   result.integrator_work = stack.plant().simulator().integrator_work();
   if (run.record_plant) result.plant_parameters = stack.plant().simulator().parameters();
   result.metrics = evaluate(result.records, m);

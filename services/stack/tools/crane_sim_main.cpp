@@ -29,7 +29,7 @@
 //       docs/optimal_control.md): T* on N and on 2N intervals (their difference: the
 //       discretization's), the linear profile's time, IPOPT's iterations and solve time, the largest
 //       drive voltage and swing; --out writes bound.csv and <maneuver>_bound.csv (the trajectory);
-//   crane_sim follow --config FILE [--maneuver M ... | --moves N --seed S] [--intervals N] [--corners] [--out DIR]
+//   crane_sim follow --config FILE [--maneuver M ...] [--moves N --seed S] [--intervals N] [--corners] [--out DIR]
 //       each demo maneuver followed in closed loop from its minimum-time trajectory (follower_run.hpp:
 //       the bound's feedforward with time-varying LQR, friction compensation on; docs/optimal_control.md):
 //       T*, the settle time and its ratio to T*, the final errors, swing, voltage and the supervisor's
@@ -43,6 +43,8 @@
 //       (follower, delay1, delay2, time_optimal, zv, zvd), then per controller the median and worst
 //       ratio, residual swing, final errors and peak voltage; --corners: also at the eight mismatch
 //       corners; --out: compare.csv, one row per move, plant and controller;
+//   (follow and compare: --maneuver names demo maneuvers or random moves, random_0 .. random_{N-1}
+//   of --moves N, and runs only those; follow with --moves runs the random moves only)
 //   crane_sim gantry-gains [--K K]
 //       section 3.2.2 on the gantry crane (K_mx = 1.34): the gains of Figures 3.5 (over L, m_t = 0)
 //       and 3.6 (over m_t, L = 1 m), and Figures 3.7/3.8 as measured closed-loop rows (overshoot,
@@ -115,6 +117,31 @@ std::vector<stack::ManeuverConfig> selected_maneuvers(const stack::StackConfig& 
   }
   for (const auto& m : cfg.maneuvers) {
     if (names.empty() || std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
+  }
+  return out;
+}
+
+// The moves of follow and compare: the demo maneuvers and `moves` seeded random moves (random_0 ..),
+// or of those the ones named by --maneuver. Throws std::invalid_argument naming a name that is neither.
+std::vector<stack::ManeuverConfig> chosen_moves(const stack::StackConfig& cfg, const std::vector<std::string>& names,
+                                                int moves, std::uint64_t seed, bool demo_maneuvers) {
+  std::vector<stack::ManeuverConfig> pool;
+  if (demo_maneuvers) pool = cfg.maneuvers;
+  if (moves > 0) {
+    const auto random = stack::random_moves(cfg, moves, seed);
+    pool.insert(pool.end(), random.begin(), random.end());
+  }
+  if (names.empty()) return pool;
+  for (const auto& name : names) {
+    if (std::none_of(pool.begin(), pool.end(), [&](const auto& x) { return x.name == name; })) {
+      throw std::invalid_argument("--maneuver '" + name + "' is neither a demo maneuver of the configuration nor one of " +
+                                  std::to_string(std::max(moves, 0)) + " random moves (random_0 .. random_" +
+                                  std::to_string(std::max(moves, 1) - 1) + ", --moves)");
+    }
+  }
+  std::vector<stack::ManeuverConfig> out;  // in the pool's order: the demo maneuvers first
+  for (const auto& m : pool) {
+    if (std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
   }
   return out;
 }
@@ -516,10 +543,12 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
 }
 
 int follow(const Selection& s, int intervals, bool corners, const std::vector<double>& mismatch,
-           const optimal_control::FollowerParams& params, const std::string& out_dir, int moves, std::uint64_t seed) {
-  const auto cfg = load_config(s);
+           const optimal_control::FollowerParams& params, const std::string& out_dir, int moves, std::uint64_t seed,
+           bool learn) {
+  auto cfg = load_config(s);
+  if (learn) cfg.state_estimator.swing_length.enabled = true;
   // The demo maneuvers (those named), or with --moves the seeded random moves of crane_sim compare.
-  const auto maneuvers = moves > 0 ? stack::random_moves(cfg, moves, seed) : selected_maneuvers(cfg, s.maneuvers);
+  const auto maneuvers = chosen_moves(cfg, s.maneuvers, moves, seed, moves <= 0);
   if (!out_dir.empty()) fs::create_directories(out_dir);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   struct Corner {
@@ -552,6 +581,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
       run.mismatch = corner.mismatch;
       run.intervals = intervals;
       run.follower = params;
+      if (learn) run.first_move = stack::learning_move(cfg, m);
       const auto r = stack::run_follower(cfg, run);
       const auto& x = r.metrics;
       constexpr double deg = 180.0 / std::numbers::pi;
@@ -562,6 +592,10 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
                   bridge ? 1e3 * x.final_bridge_error : 1e3 * x.final_slew_error, deg * x.max_swing,
                   deg * x.residual_swing, x.max_voltage, r.latched_faults);
       if (r.latched_faults != 0) ++failures;
+      if (r.unsolved_plans != 0) {
+        std::printf("  (%llu goal(s) of this run not planned: the time-optimal profile ran, no swing feedback)\n",
+                    static_cast<unsigned long long>(r.unsolved_plans));
+      }
       if (!out_dir.empty()) {
         std::ofstream csv(fs::path(out_dir) / (m.name + "_follow_" + corner.label + ".csv"));
         stack::write_csv(csv, r.records, bridge);
@@ -587,12 +621,10 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
   const auto controllers = controllers_text.empty() ? stack::compared_controllers()
                                                     : stack::compared_controllers(split_list(controllers_text));
-  auto maneuvers = selected_maneuvers(cfg, s.maneuvers);
-  const std::size_t demo_count = maneuvers.size();
-  if (moves > 0) {
-    const auto random = stack::random_moves(cfg, moves, seed);
-    maneuvers.insert(maneuvers.end(), random.begin(), random.end());
-  }
+  const auto maneuvers = chosen_moves(cfg, s.maneuvers, moves, seed, true);
+  const auto demo_count = static_cast<std::size_t>(std::count_if(maneuvers.begin(), maneuvers.end(), [&](const auto& m) {
+    return std::any_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& d) { return d.name == m.name; });
+  }));
   std::vector<plant::PlantMismatch> plants{plant::PlantMismatch{}};
   if (corners) {
     const auto c = stack::mismatch_corners();
@@ -753,6 +785,19 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
                             "plant: settle / nominal T*"
                           : "every move at the eight corners (L, m x0.8/1.2, friction x0.7/1.3): settle / T*",
                 at_corners);
+  // Goals the planner could not plan ran the time-optimal profile (no swing feedback under the
+  // follower): where a run had one, it is not the follower's run.
+  std::size_t unplanned_runs = 0, runs_counted = 0;
+  for (const auto& r : results) {
+    for (const auto& run : r.runs) {
+      for (const auto& o : run.outcomes) {
+        ++runs_counted;
+        if (o.unsolved_plans != 0) ++unplanned_runs;
+      }
+    }
+  }
+  std::printf("\nruns with a goal the planner did not solve (the time-optimal profile ran instead): %zu of %zu\n",
+              unplanned_runs, runs_counted);
   std::sort(solve_times.begin(), solve_times.end());
   if (!solve_times.empty()) {
     std::printf("\nbound solve (IPOPT, %d intervals, both solves): median %.2f s, max %.2f s over %zu moves; %.1f s "
@@ -765,7 +810,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     fs::create_directories(out_dir);
     std::ofstream csv(fs::path(out_dir) / "compare.csv");
     csv << "move,plant,T_star_s,controller,settle_s,ratio,pos_err_mm,slew_err_mrad,bridge_err_mm,max_swing_deg,"
-           "resid_swing_deg,max_V,latched_faults,braked_cycles,error\n";
+           "resid_swing_deg,max_V,latched_faults,braked_cycles,unsolved_plans,error\n";
     csv.precision(6);
     for (const auto& r : results) {
       for (const auto& run : r.runs) {
@@ -777,7 +822,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
               << o.controller << ',' << x.settle_time << ',' << o.ratio << ',' << 1e3 * x.final_position_error << ','
               << 1e3 * x.final_slew_error << ',' << 1e3 * x.final_bridge_error << ',' << deg * x.max_swing << ','
               << deg * x.residual_swing << ',' << x.max_voltage << ',' << o.latched_faults << ',' << o.braked_cycles
-              << ",\"" << o.error << "\"\n";
+              << ',' << o.unsolved_plans << ",\"" << o.error << "\"\n";
         }
       }
     }
@@ -1011,6 +1056,9 @@ int main(int argc, char** argv) {
   follow_cmd->add_option("--seed", follow_seed, "the random moves' seed");
   follow_cmd->add_option("--mismatch", mismatch, "one plant instead of the nominal: cable length, load mass and friction factors")
       ->expected(3)->check(CLI::Range(0.1, 10.0));
+  bool follow_learn = false;
+  follow_cmd->add_flag("--learn", follow_learn,
+                       "each run after a learning move on its plant, the state estimator's swing_length on (as compare's)");
   optimal_control::FollowerParams follower_params;
   add_follower_options(follow_cmd, follower_params);
 
@@ -1066,7 +1114,8 @@ int main(int argc, char** argv) {
       return compare(s, compare_moves, compare_seed, compare_corners, compare_calibrate, compare_learn, compare_controllers,
                      compare_intervals, compare_jobs, compare_follower, out_dir);
     }
-    if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed);
+    if (*follow_cmd) return follow(s, follow_intervals, corners, mismatch, follower_params, out_dir, follow_moves, follow_seed,
+                                       follow_learn);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_sim: %s\n", error.what());
     return 1;

@@ -71,6 +71,7 @@ struct ControllerOutcome {
   double ratio{0.0};                 // settle_time / T* (NaN: never settled within the record)
   std::uint32_t latched_faults{0};   // the supervisor's FAULT_* bits at the end
   std::uint64_t braked_cycles{0};    // cycles of the move with the brakes on
+  std::uint64_t unsolved_plans{0};   // InProcessResult::unsolved_plans (the learning move's included)
   std::string error;                 // what a run threw (its figures are then NaN)
 };
 

@@ -54,6 +54,7 @@ struct FollowerResult {
   double swing_period{0.0};                  // [s] at the target cable length
   std::uint32_t latched_faults{0};           // the supervisor's at the end (FAULT_* bits)
   std::uint64_t braked_cycles{0};            // cycles of the move with the brakes on
+  std::uint64_t unsolved_plans{0};           // InProcessResult::unsolved_plans
   double follower_setup_seconds{0.0};        // [s] wall time of the gains (linearization and Riccati)
   trajectory_planner::EquivalentPendulum planned_swing{};  // the pendulum the maneuver's plan swung
 };

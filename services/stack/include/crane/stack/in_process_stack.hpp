@@ -132,6 +132,8 @@ struct InProcessResult {
   std::uint64_t plant_step_failures{0};
   long friction_events{0};
   std::uint32_t latched_faults{0};   // the supervisor's at the end
+  std::uint64_t unsolved_plans{0};   // minimum-time goals the planner ran as the time-optimal profile, no plan
+                                     // solved (TrajectoryPlannerStage::unsolved_plans; a first move's included)
   plant::IntegratorWork integrator_work;  // the plant's integrator over the whole run
   // With InProcessRun::record_plant, from cycle 0 (rest and a first move included): the input the
   // plant held over cycle k (after the actuation gate) and its true state at the end of it, and
