@@ -11,6 +11,7 @@
 #include "crane/common/validation.hpp"
 #include "crane/optimal_control/minimum_time.hpp"
 #include "crane/optimal_control/planned_move.hpp"
+#include "crane/optimal_control/trajectory_follower.hpp"
 #include "crane/stack/controller_comparison.hpp"
 #include "crane/stack/follower_run.hpp"
 #include "crane/stack/maneuver_bound.hpp"
@@ -142,6 +143,16 @@ TEST(MinimumTime, TheSlewsBoundUsesTheTrolley) {
   EXPECT_LT(free.duration, 0.9 * held.duration);
 }
 
+// The request the planner made for the learning move before the overhead crane's random move 18
+// (seed 1), from where its reference rested (see the next test).
+trajectory_planner::PlanRequest learning_request_before_random_18(const stack::StackConfig& cfg) {
+  const auto move = stack::random_moves(cfg, 20, 1).at(18);
+  auto request = stack::plan_request_of(cfg, stack::learning_move(cfg, move));
+  request.trolley_from = 11.999996436788372;
+  request.bridge_from = 9.9999996486508529;
+  return request;
+}
+
 // The restart (MinimumTimeProblem::restart_stretch) on the request that the planner made for the
 // learning move before the overhead crane's random move 18 (seed 1; crane_sim compare --learn): the
 // bridge 10 -> 45.48 m, the trolley 12 -> 14.32 m, from where the planner's reference rested (3.6 and
@@ -153,10 +164,7 @@ TEST(MinimumTime, TheSlewsBoundUsesTheTrolley) {
 // periods) costs nearly nothing over.
 TEST(MinimumTime, AnInfeasibleStopIsRestartedFromAStretchedGuess) {
   const auto cfg = config("overhead_crane.yaml");
-  const auto move = stack::random_moves(cfg, 20, 1).at(18);
-  auto request = stack::plan_request_of(cfg, stack::learning_move(cfg, move));
-  request.trolley_from = 11.999996436788372;
-  request.bridge_from = 9.9999996486508529;
+  const auto request = learning_request_before_random_18(cfg);
   auto problem = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 200);
   problem.least_effort = false;  // the minimum-time solve is the point
   const auto result = optimal_control::solve_minimum_time(problem);
@@ -175,6 +183,36 @@ TEST(MinimumTime, AnInfeasibleStopIsRestartedFromAStretchedGuess) {
   EXPECT_DOUBLE_EQ(end.state.position[plant::kTrolleyIndex], request.trolley_target);
   EXPECT_DOUBLE_EQ(end.state.position[plant::kSlewIndex], request.bridge_target);
   EXPECT_EQ(end.state.velocity.head(plant::kNumCoordinates).norm(), 0.0);
+  EXPECT_FALSE(result.fallback);
+}
+
+// The same request with no restart: no T*, but the fixed-duration fallback
+// (MinimumTimeProblem::fallback_stretch), a plan the follower takes (planned_move.hpp), at rest at
+// the targets within the limits.
+TEST(MinimumTime, WithNoRestartTheFallbackIsATrajectoryAtAFixedDuration) {
+  const auto cfg = config("overhead_crane.yaml");
+  const auto request = learning_request_before_random_18(cfg);
+  auto problem = optimal_control::minimum_time_problem(request, cfg.facts, cfg.trajectory_planner, 200);
+  problem.restart_stretch.clear();
+  const auto fallback = optimal_control::solve_minimum_time(problem);
+  std::printf("with no restart: %s; fallback %d (%s) at %.4f s (%.2f of the profiles' %.4f s), %.1f s\n",
+              fallback.status.c_str(), fallback.fallback, fallback.effort_status.c_str(), fallback.trajectory_duration,
+              fallback.trajectory_duration / fallback.initial_guess_duration, fallback.initial_guess_duration,
+              fallback.solve_seconds);
+  EXPECT_FALSE(fallback.solved);
+  ASSERT_TRUE(fallback.fallback) << fallback.status;
+  EXPECT_EQ(fallback.restarts, 0);
+  EXPECT_NEAR(fallback.trajectory_duration, problem.fallback_stretch.front() * fallback.initial_guess_duration, 1e-9);
+  EXPECT_LT(fallback.max_defect, 1e-6);
+  const auto& rest = fallback.nodes.back();
+  EXPECT_DOUBLE_EQ(rest.state.position[plant::kTrolleyIndex], request.trolley_target);
+  EXPECT_DOUBLE_EQ(rest.state.position[plant::kSlewIndex], request.bridge_target);
+  EXPECT_EQ(rest.state.velocity.head(plant::kNumCoordinates).norm(), 0.0);
+  for (const auto& n : fallback.nodes) {
+    EXPECT_LE(std::abs(n.trolley_voltage), problem.voltage_limit * (1.0 + 1e-6));
+    EXPECT_LE(std::abs(n.second_voltage), problem.voltage_limit * (1.0 + 1e-6));
+  }
+  EXPECT_NO_THROW(optimal_control::TrajectoryFollower(problem, fallback, optimal_control::FollowerParams{}));
 }
 
 // The least-effort second solve (MinimumTimeProblem::least_effort) on the overhead crane's first
@@ -306,6 +344,9 @@ TEST(MinimumTime, AMalformedProblemIsRefusedNamingTheField) {
   EXPECT_NE(message(p).find("minimum_time.restart_stretch"), std::string::npos) << message(p);
   p.restart_stretch = {std::nan("")};
   EXPECT_NE(message(p).find("minimum_time.restart_stretch"), std::string::npos) << message(p);
+  p = problem;
+  p.fallback_stretch = {11.0};
+  EXPECT_NE(message(p).find("minimum_time.fallback_stretch"), std::string::npos) << message(p);
   EXPECT_EQ(message(problem), "accepted");
 }
 

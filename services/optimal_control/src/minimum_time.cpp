@@ -539,6 +539,9 @@ void validate(const MinimumTimeProblem& problem) {
   for (const double stretch : problem.restart_stretch) {
     common::require_in_range("minimum_time.restart_stretch", stretch, 1.0, 10.0);
   }
+  for (const double stretch : problem.fallback_stretch) {
+    common::require_in_range("minimum_time.fallback_stretch", stretch, 1.0, 10.0);
+  }
   common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
   common::validate(problem.second_friction, "minimum_time.second_friction");
 }
@@ -589,12 +592,25 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
     status = app->OptimizeTNLP(program);
     ++result.restarts;
   }
-  result.status = solver_return_name(program->solver_return());
+  result.status = solver_return_name(program->solver_return());  // the minimum-time solve's, the last
   result.solved = solved_status(status);
+  // Still not solved: a trajectory at a fixed, longer duration (fallback_stretch), the least-effort
+  // program, which needs no free duration.
+  app->Options()->SetNumericValue("tol", problem.least_effort_tolerance);
+  for (const double stretch : problem.fallback_stretch) {
+    if (solved_status(status)) break;
+    const double duration = stretch * result.initial_guess_duration;
+    double guess_duration = 0.0;
+    program = new MinimumTimeProgram(problem, layout, initial_guess(problem, layout, guess_duration, duration), duration);
+    status = app->OptimizeTNLP(program);
+    result.fallback = solved_status(status);
+  }
+  if (result.fallback) result.effort_status = solver_return_name(program->solver_return());
   if (IsValid(app->Statistics())) result.iterations = app->Statistics()->IterationCount();
   const std::vector<double>* solution = &program->solution();
   if (solution->size() != static_cast<std::size_t>(layout.variable_count())) {
     result.solved = false;
+    result.fallback = false;
     return result;
   }
   // The least-effort solve at (1 + least_effort_margin) T* (header: least_effort), from the initial

@@ -90,7 +90,7 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan_minimum_time_move(
   const MinimumTimeProblem problem = minimum_time_problem(request, facts, planner, planning.intervals);
   MinimumTimeResult result = solve_minimum_time(problem);
   if (bound != nullptr) *bound = result;
-  if (!result.solved) return nullptr;
+  if (!result.solved && !result.fallback) return nullptr;  // a fallback is followed like T*'s (minimum_time.hpp)
   FollowerParams params = planning.follower;
   params.sample_period = facts.sample_period;
   params.voltage_limit = facts.voltage_limit;

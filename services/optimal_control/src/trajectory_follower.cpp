@@ -87,7 +87,8 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_in_range("follower.hold.sliding_friction_scale", params.hold.sliding_friction_scale, 0.0, 1.0);
   common::require_in_range("follower.trajectory_sliding_friction_scale", params.trajectory_sliding_friction_scale, 0.0,
                            1.0);
-  if (!trajectory.solved || trajectory.nodes.size() < 2 || !(trajectory.trajectory_duration > 0.0)) {
+  if (!(trajectory.solved || trajectory.fallback) || trajectory.nodes.size() < 2 ||
+      !(trajectory.trajectory_duration > 0.0)) {
     throw common::ConfigError("follower.trajectory: not solved (" + trajectory.status + ")");
   }
 

@@ -55,12 +55,17 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan(const trajectory_pla
   optimal_control::MinimumTimeResult bound;
   try {
     auto path = optimal_control::plan_minimum_time_move(request, facts, params, optimal_control::MovePlanning{}, &bound);
-    if (path) {
+    if (path && bound.fallback) {
+      spdlog::warn("move request {}: the minimum-time bound was not solved; its fixed-duration fallback runs, "
+                   "{:.4f} s ({} IPOPT iterations, {} restart(s), {:.2f} s)",
+                   request.request_id, bound.trajectory_duration, bound.iterations, bound.restarts, bound.solve_seconds);
+    } else if (path) {
       spdlog::info("move request {}: minimum-time plan, T* = {:.4f} s, trajectory {:.4f} s ({}), {} + {} IPOPT "
-                   "iterations in {:.2f} s; the pendulum {:.4f} L + {:.4f} m",
+                   "iterations in {:.2f} s ({} restart(s)); the pendulum {:.4f} L + {:.4f} m",
                    request.request_id, bound.duration, bound.trajectory_duration,
                    bound.least_effort ? "least effort" : "the minimum-time solve's", bound.iterations,
-                   bound.effort_iterations, bound.solve_seconds, request.swing.scale, request.swing.offset);
+                   bound.effort_iterations, bound.solve_seconds, bound.restarts, request.swing.scale,
+                   request.swing.offset);
     } else {
       spdlog::warn("move request {}: the minimum-time bound was not solved ({}): the time-optimal profile runs",
                    request.request_id, bound.status);

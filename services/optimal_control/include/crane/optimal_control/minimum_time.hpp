@@ -110,6 +110,12 @@ struct MinimumTimeProblem {
   /// solved did (tests/optimal_control/test_minimum_time.cpp; docs/optimal_control.md, "Learnt while
   /// working"). Each in [1, 10]; empty: no restart.
   std::vector<double> restart_stretch{1.25, 1.5};
+  /// Where no restart solves either: the least-effort program at the fixed duration of each of these
+  /// factors times the profiles' guess in turn (the profiles, then rest), until one solves. Its
+  /// trajectory is a plan to follow, not the minimum time (MinimumTimeResult::fallback; `solved`
+  /// stays false): a crane that follows it keeps its swing feedback, where no plan would leave the
+  /// planner's time-optimal profile without any. Each in [1, 10]; empty: none.
+  std::vector<double> fallback_stretch{1.5, 2.0};
 };
 
 /// One node of the trajectory.
@@ -126,7 +132,10 @@ struct TrajectoryNode {
 };
 
 struct MinimumTimeResult {
-  bool solved{false};
+  bool solved{false};                     // T* found (the minimum-time solve, restarted or not)
+  bool fallback{false};                   // not solved, but the nodes are a trajectory at a fixed duration
+                                          // (MinimumTimeProblem::fallback_stretch): T = trajectory_duration,
+                                          // an upper bound of T*; `duration` is then that too
   std::string status;                     // IPOPT's return status, e.g. "Solve_Succeeded"
   double duration{0.0};                   // [s] T*, the minimum time
   double trajectory_duration{0.0};        // [s] T of the nodes: (1 + k least_effort_margin) T*, k = 1, 2 or 4,
@@ -138,7 +147,8 @@ struct MinimumTimeResult {
   double max_defect{0.0};                 // largest collocation defect at the solution [SI]
   double initial_guess_duration{0.0};     // [s] the linear profiles' duration the solve started from
   bool least_effort{false};               // the nodes are the least-effort solve's (MinimumTimeProblem::least_effort)
-  std::string effort_status;              // IPOPT's return status of the last least-effort solve ("" if none ran)
+  std::string effort_status;              // IPOPT's return status of the last least-effort solve, or of the
+                                          // fallback ("" if none ran)
   int effort_iterations{0};               // of every least-effort solve
 };
 

@@ -25,8 +25,9 @@
 //
 // Errors: minimum_time_problem throws common::ConfigError (optimal_control::validate: a request
 // outside the ranges names the field and the bound: an equivalent length a L + c <= 0 is refused
-// as minimum_time.hoist.min_position); plan_minimum_time_move returns null when the
-// bound is not solved, and throws what the problem and the follower throw.
+// as minimum_time.hoist.min_position); plan_minimum_time_move returns null when IPOPT solves
+// neither the bound nor its fixed-duration fallback (MinimumTimeResult::fallback, followed like the
+// bound), and throws what the problem and the follower throw.
 
 #include <memory>
 
@@ -56,8 +57,9 @@ struct MovePlanning {
                                                       const trajectory_planner::TrajectoryPlannerParams& planner,
                                                       int intervals);
 
-/// The path of `request`: its bound solved and followed (see the header); null when IPOPT does not
-/// solve it. `bound`, when given, receives the solution (T*, the solve time).
+/// The path of `request`: its bound solved and followed (see the header), or its fixed-duration
+/// fallback; null when IPOPT solves neither. `bound`, when given, receives the solution (T*, the
+/// solve time, `fallback`).
 [[nodiscard]] std::shared_ptr<const trajectory_planner::PlannedPath> plan_minimum_time_move(
     const trajectory_planner::PlanRequest& request, const common::StackFacts& facts,
     const trajectory_planner::TrajectoryPlannerParams& planner, const MovePlanning& planning,
