@@ -547,7 +547,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
            bool learn) {
   auto cfg = load_config(s);
   if (learn) cfg.state_estimator.swing_length.enabled = true;
-  // The demo maneuvers (those named), or with --moves the seeded random moves of crane_sim compare.
+  // The demo maneuvers, or with --moves the seeded random moves of crane_sim compare (those named).
   const auto maneuvers = chosen_moves(cfg, s.maneuvers, moves, seed, moves <= 0);
   if (!out_dir.empty()) fs::create_directories(out_dir);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;

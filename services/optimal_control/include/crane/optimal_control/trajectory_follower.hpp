@@ -38,9 +38,9 @@
 //
 // Errors: the constructor throws common::ConfigError naming the field for a model with more than
 // four coordinates (a hook or a rope), a non-positive weight, sample period or voltage limit, a
-// sliding_friction_scale (the hold's or the trajectory's) outside [0, 1], or a
-// trajectory that is neither solved nor a fallback (MinimumTimeResult) or has fewer than two nodes. step() is noexcept and allocates
-// nothing; a non-finite state gives 0 V (the safe output) and rejected_nonfinite.
+// sliding_friction_scale (the hold's or the trajectory's) outside [0, 1], or a trajectory that is
+// neither solved nor a fallback (MinimumTimeResult) or has fewer than two nodes. step() is noexcept
+// and allocates nothing; a non-finite state gives 0 V (the safe output) and rejected_nonfinite.
 
 #include <cstddef>
 #include <vector>
