@@ -223,7 +223,6 @@ void ListenerDispatch::guarded_poll() noexcept {
   }
 }
 
-
 std::uint32_t fresh_request_id() noexcept {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   const auto tenths = std::chrono::duration_cast<std::chrono::milliseconds>(now).count() / 100 - 17356896000LL;

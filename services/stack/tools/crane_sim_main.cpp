@@ -984,7 +984,8 @@ int main(int argc, char** argv) {
                     "step | trapezoid | zv | zvd | ei | time_optimal | minimum_time (as crane_demo)")
         ->check(CLI::IsMember({"step", "trapezoid", "zv", "zvd", "ei", "time_optimal", "minimum_time"}))
         ->each([&](const std::string&) { s.profile_given = true; });
-    cmd->add_option("--maneuver", s.maneuvers, "maneuver names (default: all; sweep: trolley)");
+    cmd->add_option("--maneuver", s.maneuvers,
+                    "maneuver names (default: all; sweep: trolley; follow and compare: also random_0 .. of --moves)");
     cmd->add_flag("--acceleration-feedforward", s.acceleration_feedforward,
                   "tracking adds the reference acceleration (beyond the dissertation)");
     cmd->add_option("--integrator", s.integrator,

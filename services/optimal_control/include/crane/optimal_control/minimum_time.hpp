@@ -141,7 +141,8 @@ struct MinimumTimeResult {
   double trajectory_duration{0.0};        // [s] T of the nodes: (1 + k least_effort_margin) T*, k = 1, 2 or 4,
                                           // when least_effort (below) is true, else T*
   std::vector<TrajectoryNode> nodes;      // intervals + 1 nodes, t = k T / N
-  int iterations{0};                      // of the minimum-time solve that decided (the last one)
+  int iterations{0};                      // of the last solve before the least-effort one: the minimum-time
+                                          // solve that decided, or the fallback's
   int restarts{0};                        // minimum-time solves again from a stretched guess (restart_stretch)
   double solve_seconds{0.0};              // [s] wall time of IPOPT, every solve
   double max_defect{0.0};                 // largest collocation defect at the solution [SI]
