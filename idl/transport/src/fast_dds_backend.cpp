@@ -81,7 +81,7 @@ dds::DataReaderQos reader_qos(QosKind kind, std::int32_t history_depth) {
   // Data sharing off (writers too): a deep reader history would only hold references into the
   // writer's keep-last-1 pool, which the next sample overwrites; and a reader whose remote writer's
   // process has exited crashed here when freeing its cache (Fast DDS 2.9, CacheChangePool
-  // destructor). Samples still travel through the shared-memory transport on one host.
+  // destructor).
   qos.data_sharing().off();
   qos.deadline().period = to_duration(p.reader_deadline);
   return qos;
@@ -278,6 +278,22 @@ void apply_security(const SecurityFiles& files, dds::DomainParticipantQos& qos) 
   set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
 }
 
+// The UDP transport of the loopback and the UDP-only participants. Its sockets may buffer 4 MiB
+// (the kernel caps this at net.core.rmem_max; Debian's default is 208 KiB, this machine's 4 MiB).
+// On the loopback every sample of the stack is a datagram (the loopback participants announce
+// their UDP locator for user data, so the shared-memory transport carries none), and the kernel
+// charges each small datagram its whole buffer, not its payload: a recorder reading six topics
+// whose receive thread was starved for a fraction of a second under load lost samples. Measured (docs/architecture.md, "QoS"):
+// crane_demo's own threads at nice 19 beside four CPU hogs, the default buffer lost 289-708 of
+// 1501 cycles of each recorded move (UDP RcvbufErrors 5720 in one run); 4 MiB lost none.
+constexpr std::uint32_t kUdpReceiveBufferBytes = 4U * 1024U * 1024U;
+
+std::shared_ptr<eprosima::fastdds::rtps::UDPv4TransportDescriptor> udp_transport() {
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->receiveBufferSize = kUdpReceiveBufferBytes;
+  return udp;
+}
+
 class FastParticipant final : public ParticipantBackend {
  public:
   FastParticipant(const ParticipantOptions& options, const SecurityFiles* security) {
@@ -304,7 +320,7 @@ class FastParticipant final : public ParticipantBackend {
       qos.name(options.name);
     } else if (options.loopback_only) {
       qos.transport().use_builtin_transports = false;
-      auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+      auto udp = udp_transport();
       udp->interfaceWhiteList.emplace_back("127.0.0.1");
       udp->maxInitialPeersRange = 32;  // participants probed on 127.0.0.1 by unicast discovery
       qos.transport().user_transports.push_back(udp);
@@ -325,7 +341,7 @@ class FastParticipant final : public ParticipantBackend {
       // writer sends each sample once for all such monitors (Fast DDS picks a multicast locator
       // that several readers share) instead of once per monitor.
       qos.transport().use_builtin_transports = false;
-      qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+      qos.transport().user_transports.push_back(udp_transport());
       eprosima::fastrtps::rtps::Locator_t group;
       eprosima::fastrtps::rtps::IPLocator::setIPv4(group, 239, 255, 0, 1);
       group.kind = LOCATOR_KIND_UDPv4;
