@@ -695,11 +695,12 @@ TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarrie
 }
 
 // Along a move the follower's stage estimates the plant's friction over the model's from its own
-// feedback (friction_factor_estimate.hpp), and at the target hands it to the friction compensation
+// feedback (friction_factor_estimate.hpp) and hands it, every cycle, to the friction compensation
 // (LinearCommand_.friction_factor), which scales its stiction and the sliding part it keeps by it:
-// here the feedback is made (by the trolley's position error against a gain of 40 V/m)
-// 0.3 F(v_ref) + 0.05 a_ref, a plant with 30 % more friction.
-TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlongTheMove) {
+// here the feedback is made (by the trolley's position error against a gain of 40 V/m) what a
+// plant with 30 % more friction leaves to it, 0.3 F(v_ref) + 0.05 a_ref less what the compensation
+// adds with the factor it was handed.
+TEST(TrackingStage, TheFollowerHandsTheCompensationTheFrictionFactorItEstimatesAlongTheMove) {
   const common::StackFacts facts;
   tracking::TrackingStage stage{follower_stage_params(facts)};
   const common::AxisFriction& friction = facts.crane.trolley_friction;
@@ -710,6 +711,8 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
   law.gain[0] = 40.0;  // [V/m]
   law.sliding_friction_reduction = 0.5;  // along the trajectory
   protocol::LinearCommand command;
+  double applied = 1.0;  // the factor the compensation applied to the last command
+  int first_estimate = -1;
   for (int k = 0; k < 200; ++k) {
     const double t = 0.01 * k;
     law.position[0] = 0.3 + 0.2 * (1.0 - std::cos(std::numbers::pi * t / 2.0));
@@ -718,16 +721,28 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
     common::set_trajectory_feedback(law, false, reference);
     reference.trolley_acceleration = acceleration;
     const double sliding = friction.coulomb_positive + friction.viscous_positive * law.velocity[0];  // (3.1), v > 0
-    const double feedback = 0.3 * sliding + 0.05 * acceleration;
+    // The plant has 30 % more friction than the model. Of it, the compensation supplies what the
+    // factor it was handed adds to the half it keeps (min(1, 0.5 f) - 0.5 of F), the feedback the rest.
+    const double compensated = std::min(1.0, 0.5 * applied) - 0.5;
+    const double feedback = (0.3 - compensated) * sliding + 0.05 * acceleration;
     auto state = at_rest(static_cast<std::uint64_t>(k + 1), law.position[0] - feedback / 40.0);
     state.trolley_velocity = law.velocity[0];
     ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
     EXPECT_NEAR(command.trolley_voltage, feedback, 1e-9);
     EXPECT_EQ(command.sliding_friction_reduction, 0.5) << "along the move, as the law says";
-    EXPECT_EQ(command.friction_factor, 0.0) << "unset along the move";
+    // The model's friction (1) until the move has 20 rows (from k = 11, where v_ref >= 0.05 m/s),
+    // then toward the estimate, 1.3, at 1/s (0.01 a cycle), and 1.3 from then on: the rows add back
+    // what the compensation took over, so the estimate does not drift toward 1 as the feedback shrinks.
+    if (first_estimate < 0 && command.friction_factor != 1.0) first_estimate = k;
+    if (first_estimate >= 0) {
+      EXPECT_NEAR(command.friction_factor, std::min(1.3, 1.0 + 0.01 * (k - first_estimate + 1)), 1e-6) << k;
+    }
+    applied = command.friction_factor;
   }
+  EXPECT_EQ(first_estimate, 30);
   // At the target (the reference at rest): f = 1.3 with the hold's reduction, also once the planner
   // holds (request 0); the compensation then keeps min(1, 0.7 x 1.3) of its sliding part.
+  ASSERT_NEAR(applied, 1.3, 1e-6);
   law.velocity = {};
   law.sliding_friction_reduction = 0.3;
   common::set_trajectory_feedback(law, false, reference);
@@ -744,6 +759,17 @@ TEST(TrackingStage, TheFollowerScalesTheHoldsFrictionByTheFactorItEstimatedAlong
   ASSERT_EQ(stage.step(at_rest(301, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
             common::StepStatus::ok);
   EXPECT_EQ(command.friction_factor, 1.0);
+  // A rate that is not a positive number is refused, naming the field.
+  for (const double rate : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    auto bad = follower_stage_params(facts);
+    bad.friction_factor_rate = rate;
+    try {
+      tracking::TrackingStage refused{bad};
+      ADD_FAILURE() << rate << " accepted";
+    } catch (const common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("tracking.friction_factor_rate"), std::string::npos) << error.what();
+    }
+  }
 }
 
 // At the target, the follower's hold adds the breakaway ramp (breakaway_ramp.hpp) to a drive the

@@ -58,6 +58,10 @@ double sliding_friction_voltage(const common::AxisFriction& friction, double vel
   return c[0] * r[0] + c[1] * r[1] + c[2] * r[2] + c[3] * r[3];
 }
 
+double kept_sliding_share(double sliding_friction_reduction, double friction_factor) noexcept {
+  return std::min(1.0, (1.0 - sliding_friction_reduction) * friction_factor);
+}
+
 double friction_voltage(const AxisCompensationParams& axis, double velocity,
                         double commanded_voltage) noexcept {
   const auto& f = axis.friction;
@@ -110,7 +114,7 @@ common::StepStatus FrictionCompensation::step(const FrictionCompensationInput& i
         friction_voltage(in_use(params_.slew, input.slew_friction), slew_velocity, input.command.slew_voltage);
     const double factor = input.friction_factor > 0.0 ? input.friction_factor : 1.0;
     if (input.sliding_friction_reduction != 0.0 || factor != 1.0) {
-      const double kept = std::min(1.0, (1.0 - input.sliding_friction_reduction) * factor);
+      const double kept = kept_sliding_share(input.sliding_friction_reduction, factor);
       output.trolley_friction *=
           friction_direction(trolley_velocity, params_.trolley.zero_velocity_band) != 0 ? kept : factor;
       output.slew_friction *= friction_direction(slew_velocity, params_.slew.zero_velocity_band) != 0 ? kept : factor;

@@ -29,9 +29,10 @@ void FrictionFactorEstimate::reset() noexcept {
 }
 
 void FrictionFactorEstimate::add(int axis, double feedback_voltage, double reference_speed,
-                                 double reference_acceleration) noexcept {
+                                 double reference_acceleration, double compensated_share) noexcept {
   if (axis < 0 || axis > 1) return;
-  if (!std::isfinite(feedback_voltage) || !std::isfinite(reference_speed) || !std::isfinite(reference_acceleration)) {
+  if (!std::isfinite(feedback_voltage) || !std::isfinite(reference_speed) || !std::isfinite(reference_acceleration) ||
+      !std::isfinite(compensated_share)) {
     return;
   }
   if (std::abs(reference_speed) < params_.min_reference_speed) return;
@@ -40,9 +41,10 @@ void FrictionFactorEstimate::add(int axis, double feedback_voltage, double refer
                                                                    reference_speed > 0.0 ? 1 : -1),
                    0.0, 0.0};
   phi[1 + axis] = reference_acceleration;
+  const double y = feedback_voltage + compensated_share * phi[0];
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];
-    moment_[r] += phi[r] * feedback_voltage;
+    moment_[r] += phi[r] * y;
   }
   ++rows_;
 }

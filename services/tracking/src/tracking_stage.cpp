@@ -8,6 +8,7 @@
 #include "crane/common/protocol_signals.hpp"
 #include "crane/common/validation.hpp"
 #include "crane/config/yaml_section.hpp"
+#include "crane/friction_compensation/friction_compensation.hpp"
 #include "crane/tracking/trajectory_feedback.hpp"
 
 namespace crane::tracking {
@@ -82,8 +83,11 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
       trolley_drive_mass_(params.trolley_drive_mass),
       jib_inertia_(params.jib_inertia),
       friction_factor_(params.trolley_friction, params.second_friction),
+      friction_factor_step_(params.friction_factor_rate * params.sample_period),
       breakaway_(params.breakaway, params.sample_period) {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
+  common::require_greater("tracking.friction_factor_rate", params.friction_factor_rate, 0.0);
+  common::require_finite("tracking.friction_factor_rate", params.friction_factor_rate);
   common::require_greater("tracking.jib_inertia", jib_inertia_, 0.0);
   if (law_ == TrackingLaw::gain_scheduling_partial || law_ == TrackingLaw::gain_scheduling_full) {
     auto p = params.gain_scheduling;
@@ -170,20 +174,27 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
     return common::StepStatus::rejected_nonfinite;  // 0 V, the safe output
   }
   // The friction factor (friction_factor_estimate.hpp): rows along the move, from the LQR's part of
-  // each drive's voltage where it is not clamped; at the target, handed to the compensation.
+  // each drive's voltage where it is not clamped. A row adds back the share the compensation took
+  // over from the feedback with the factor handed with the last command. Along the move the handed
+  // factor follows the estimate at friction_factor_rate at most (1 until the move has rows
+  // enough); at the target it is the estimate.
   if (reference.request_id != 0 && reference.request_id != friction_request_) {  // a new move (0: holding)
     friction_factor_.reset();
     breakaway_.reset();
     friction_request_ = reference.request_id;
+    handed_friction_factor_ = 1.0;
   }
   const std::array<double, 2> reference_speed{reference.trolley_velocity,
                                               bridge ? reference.bridge_velocity : reference.slew_rate};
   const std::array<double, 2> reference_acceleration{
       reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
+  const double compensated_share = friction_compensation::kept_sliding_share(reduction, handed_friction_factor_) -
+                                   friction_compensation::kept_sliding_share(reduction, 1.0);
   for (int axis = 0; axis < 2; ++axis) {
     const auto a = static_cast<std::size_t>(axis);
     if (std::abs(u[a]) < voltage_limit_) {
-      friction_factor_.add(axis, u[a] - law.feedforward[a], reference_speed[a], reference_acceleration[a]);
+      friction_factor_.add(axis, u[a] - law.feedforward[a], reference_speed[a], reference_acceleration[a],
+                           compensated_share);
     }
   }
   const bool at_target = reference_speed[0] == 0.0 && reference_speed[1] == 0.0 && reference_acceleration[0] == 0.0 &&
@@ -203,7 +214,12 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   (bridge ? command.bridge_voltage : command.slew_voltage) = voltage[1];
   command.hoist_speed = reference.cable_length_rate;
   command.sliding_friction_reduction = reduction;
-  command.friction_factor = at_target ? friction_factor_.factor() : 0.0;
+  const double estimate_factor = friction_factor_.factor();
+  handed_friction_factor_ =
+      at_target ? estimate_factor
+                : handed_friction_factor_ + std::clamp(estimate_factor - handed_friction_factor_,
+                                                       -friction_factor_step_, friction_factor_step_);
+  command.friction_factor = handed_friction_factor_;
   return common::StepStatus::ok;
 }
 

@@ -93,6 +93,13 @@ struct FrictionCompensationOutput {
 [[nodiscard]] double sliding_friction_voltage(const common::AxisFriction& friction, double velocity,
                                               int direction) noexcept;
 
+/// The share of the sliding friction the compensation applies while an axis slides, given the
+/// share the command's feedforward already carries (`sliding_friction_reduction`, in [0, 1]) and the
+/// plant's friction over the model's the tracking stage estimated (`friction_factor` > 0; 1: the
+/// model's): min(1, (1 - reduction) x factor) (docs/optimal_control.md, "The friction the hold
+/// compensates"). Preconditions: the inputs in their ranges (FrictionCompensation::step checks them).
+[[nodiscard]] double kept_sliding_share(double sliding_friction_reduction, double friction_factor) noexcept;
+
 /// F_f/K_m [V] for one axis at `velocity` [m/s or rad/s] and commanded voltage [V].
 /// Preconditions: finite inputs, validated params.
 [[nodiscard]] double friction_voltage(const AxisCompensationParams& axis, double velocity,

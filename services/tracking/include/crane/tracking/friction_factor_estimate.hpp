@@ -5,9 +5,13 @@
 // Along a minimum-time trajectory the follower's feedforward carries the model's drive voltage, part
 // of the model's friction at the reference speed, and the friction compensation adds the rest on the
 // measured speed; a plant whose friction is f times the model's needs (f - 1) F(v) more, and the
-// time-varying LQR supplies it as feedback. Per cycle and drive axis j that slides on the reference
-// (|v_ref,j| >= min_reference_speed), one row of the linear regression
-//   u_fb,j = theta_0 F_j(v_ref,j) + theta_(1+j) a_ref,j + e,     f = 1 + theta_0
+// time-varying LQR supplies it as feedback. The tracking stage hands the running estimate to the
+// compensation along the move as well, which then adds s F(v) of it itself, s = kept_sliding_share
+// (reduction, f_applied) - kept_sliding_share(reduction, 1) (friction_compensation.hpp), so the
+// feedback no longer has to; each row adds s F back so the estimate does not chase its own
+// correction. Per cycle and drive axis j that slides on the reference (|v_ref,j| >=
+// min_reference_speed), one row of the linear regression
+//   u_fb,j + s F_j(v_ref,j) = theta_0 F_j(v_ref,j) + theta_(1+j) a_ref,j + e,     f = 1 + theta_0
 // where u_fb = u - feedforward [V] is the LQR's part of the drive voltage, F_j the model's sliding
 // friction (3.1) in volt-equivalents (Coulomb and viscous, direction dependent; the compensation's
 // own regressor, friction_compensation::friction_regressor . sliding_coefficients) and a_ref the
@@ -42,8 +46,11 @@ class FrictionFactorEstimate {
   void reset() noexcept;
 
   /// One cycle of axis `axis` (0 or 1): the LQR's part of the voltage [V], the reference speed [m/s
-  /// or rad/s] and acceleration. Ignored where the reference does not slide or an input is not finite.
-  void add(int axis, double feedback_voltage, double reference_speed, double reference_acceleration) noexcept;
+  /// or rad/s] and acceleration, and s [-], the share of the model's sliding friction the
+  /// compensation added beyond its unscaled part because of the factor it applied (see the header;
+  /// 0 with factor 1). Ignored where the reference does not slide or an input is not finite.
+  void add(int axis, double feedback_voltage, double reference_speed, double reference_acceleration,
+           double compensated_share = 0.0) noexcept;
 
   /// f, the plant's sliding friction over the model's (see the header); 1 without enough rows.
   [[nodiscard]] double factor() const noexcept;

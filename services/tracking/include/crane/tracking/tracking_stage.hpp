@@ -12,12 +12,14 @@
 //                            minimum-time follower's feedforward and time-varying LQR gains,
 //                            trajectory_feedback.hpp; docs/optimal_control.md), the hoist at the
 //                            reference's cable rate and the reference's sliding friction reduction
-//                            passed on to the friction compensation; at the target (the law's
-//                            reference at rest) also the plant's friction over the model's,
-//                            estimated along the move from the law's feedback
-//                            (friction_factor_estimate.hpp, LinearCommand_.friction_factor; 0
-//                            elsewhere, unset), and a drive the friction holds at rest off the
-//                            target gets the breakaway ramp (breakaway_ramp.hpp); a reference
+//                            passed on to the friction compensation, with the plant's friction
+//                            over the model's, estimated along the move from the law's feedback
+//                            (friction_factor_estimate.hpp, LinearCommand_.friction_factor:
+//                            along the move following the estimate at friction_factor_rate at
+//                            most, 1 until the move has rows enough; at the target the estimate;
+//                            0 under the other laws: unset); at
+//                            the target (the law's reference at rest) a drive the friction holds
+//                            at rest off the target gets the breakaway ramp (breakaway_ramp.hpp); a reference
 //                            without a law (holding, a stop, manual motion) is tracked by
 //                            `tracking`
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
@@ -60,6 +62,9 @@ struct TrackingStageParams {
   // for the friction factor it estimates along a move.
   common::AxisFriction trolley_friction{};
   common::AxisFriction second_friction{};
+  // [1/s] > 0: how fast the friction factor the follower hands the compensation along a move may
+  // change (its estimate from the move's first rows is noisy; at the target it hands the estimate).
+  double friction_factor_rate{1.0};
   // The follower's hold at the target: integral action against a drive stuck off it.
   BreakawayRampParams breakaway{};
   double sample_period{0.01};  // [s] > 0, the cycle (facts.sample_period)
@@ -102,6 +107,8 @@ class TrackingStage {
   std::unique_ptr<TrackingStage> bridge_;  // the overhead crane's bridge (its trolley is the bridge)
   FrictionFactorEstimate friction_factor_;  // the follower's, over the move of friction_request_
   std::uint32_t friction_request_{0};
+  double friction_factor_step_;     // [-] the most the handed factor changes in a cycle along a move
+  double handed_friction_factor_{1.0};  // handed to the compensation with the last command (this move's)
   BreakawayRamp breakaway_;  // the follower's hold, reset when the reference moves or a move starts
 };
 
