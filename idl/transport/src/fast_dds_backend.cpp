@@ -282,10 +282,11 @@ void apply_security(const SecurityFiles& files, dds::DomainParticipantQos& qos) 
 // (the kernel caps this at net.core.rmem_max; Debian's default is 208 KiB, this machine's 4 MiB).
 // On the loopback every sample of the stack is a datagram (the loopback participants announce
 // their UDP locator for user data, so the shared-memory transport carries none), and the kernel
-// charges each small datagram its whole buffer, not its payload: a recorder reading six topics
-// whose receive thread was starved for a fraction of a second under load lost samples. Measured (docs/architecture.md, "QoS"):
-// crane_demo's own threads at nice 19 beside four CPU hogs, the default buffer lost 289-708 of
-// 1501 cycles of each recorded move (UDP RcvbufErrors 5720 in one run); 4 MiB lost none.
+// charges each small datagram its allocation, far more than its payload: a recorder reading six
+// topics whose receive thread was starved for a fraction of a second under load lost samples.
+// Measured (docs/architecture.md, "QoS"): crane_demo's own threads at nice 19 beside four CPU
+// hogs, the default buffer lost 289-708 of 1501 cycles of each recorded move (UDP RcvbufErrors
+// 5720 in one run); 4 MiB lost none.
 constexpr std::uint32_t kUdpReceiveBufferBytes = 4U * 1024U * 1024U;
 
 std::shared_ptr<eprosima::fastdds::rtps::UDPv4TransportDescriptor> udp_transport() {
