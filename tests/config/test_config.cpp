@@ -661,6 +661,20 @@ TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {
   EXPECT_EQ(on.plant.wind.seed, 1U);
 }
 
+TEST_F(LabConfigText, TheRobustPlanIsOffAndItsRangesAreValidated) {
+  const auto c = cfg::parse_stack_config(text_, "test.yaml");
+  EXPECT_EQ(c.trajectory_planner.robust_length_range, 0.0);  // off: every plan as before
+  EXPECT_EQ(c.trajectory_planner.robust_margin, 0.2);
+  auto message = error_of(edit_line(text_, "trajectory_planner:", "robust_length_range:", "robust_length_range: 0.6").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.robust_length_range = 0.6")) << message;
+  EXPECT_TRUE(contains(message, "[0, 0.5]")) << message;
+  message = error_of(edit_line(text_, "trajectory_planner:", "robust_margin:", "robust_margin: -0.1").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.robust_margin = -0.1")) << message;
+  const auto on = cfg::parse_stack_config(
+      edit_line(text_, "trajectory_planner:", "robust_length_range:", "robust_length_range: 0.2").text, "test.yaml");
+  EXPECT_EQ(on.trajectory_planner.robust_length_range, 0.2);
+}
+
 TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {
   const auto c = cfg::parse_stack_config(text_, "test.yaml");
   EXPECT_EQ(c.trajectory_planner.manual.shaping, crane::trajectory_planner::SpeedShaping::zvd);

@@ -157,10 +157,14 @@ struct HeardPlanner {
 // The pendulum a plan swings (PlanRequest::swing): the state estimator's learnt one while it is
 // confident and swings over the move's cable span (a L + c > 0 at its shorter cable, here 1.0 m: the
 // goal does not hoist; a and c in the manual block's ranges), the configured trajectory_planner.manual
-// one otherwise. The planner's shortest cable, 0.3 m, does not bound a learnt pendulum.
+// one otherwise. The planner's shortest cable, 0.3 m, does not bound a learnt pendulum. A plan on the
+// configured pendulum is robust to its length (robust_length_range, here 0.2, with its margin); one
+// on the learnt pendulum is not.
 TEST(PlannerStage, AMinimumTimePlanSwingsTheLearntPendulumWhenItSwingsOverTheMove) {
   trajectory_planner::TrajectoryPlannerParams params;
   params.cable_min_length = 0.3;
+  params.robust_length_range = 0.2;
+  params.robust_margin = 0.15;
   params.manual.swing_length_scale = 0.995;  // a calibration: the lab crane's hook
   params.manual.swing_length_offset = 0.257;
   struct Case {
@@ -204,6 +208,9 @@ TEST(PlannerStage, AMinimumTimePlanSwingsTheLearntPendulumWhenItSwingsOverTheMov
     ASSERT_TRUE(stage.plan_request().has_value()) << c.scale << " " << c.offset;
     EXPECT_EQ(stage.plan_request()->swing.scale, c.expected_scale) << c.scale << " " << c.offset;
     EXPECT_EQ(stage.plan_request()->swing.offset, c.expected_offset) << c.scale << " " << c.offset;
+    const bool learnt = c.expected_offset != 0.257;
+    EXPECT_EQ(stage.plan_request()->robust_length_range, learnt ? 0.0 : 0.2) << c.scale << " " << c.offset;
+    EXPECT_EQ(stage.plan_request()->robust_margin, 0.15);
   }
 }
 

@@ -28,12 +28,16 @@ using plant::kTrolleyIndex;
 
 constexpr double kInfinity = 1e19;  // IPOPT's default nlp_upper_bound_inf
 constexpr int kInputs = 3;          // a_trolley, a_second, a_hoist
-constexpr int kMaxNodeVariables = 2 * plant::kMaxCoordinates + 2 + kInputs;
+constexpr int kMaxPassive = plant::kMaxCoordinates - 2;  // the coordinates without a drive
+constexpr int kMaxNodeVariables = 2 * plant::kMaxCoordinates + 2 + kMaxDetunedPendulums * 2 * kMaxPassive + kInputs;
 
-// The variables of one node: q (n), q' (n), L, L', then the inputs.
+// The variables of one node: q (n), q' (n), L, L', the detuned pendulums' passive coordinates and
+// rates (copies x 2 p), then the inputs.
 struct Layout {
   int n{4};            // the model's coordinates
-  int states{10};      // 2 n + 2
+  int passive{2};      // p = n - 2, the coordinates without a drive
+  int copies{0};       // detuned pendulums (MinimumTimeProblem::detuned_pendulums), the least-effort solve only
+  int states{10};      // 2 n + 2 + copies 2 p
   int stride{13};      // states + inputs
   int nodes{101};      // N + 1
   int voltages{2};     // drives with a voltage row (1 on a gantry)
@@ -41,6 +45,9 @@ struct Layout {
   [[nodiscard]] int velocity(int i) const { return n + i; }
   [[nodiscard]] int cable_length() const { return 2 * n; }
   [[nodiscard]] int cable_rate() const { return 2 * n + 1; }
+  /// Copy c's r-th passive coordinate (in the order of the model's coordinates) and its rate.
+  [[nodiscard]] int copy_position(int c, int r) const { return 2 * n + 2 + c * 2 * passive + r; }
+  [[nodiscard]] int copy_velocity(int c, int r) const { return 2 * n + 2 + c * 2 * passive + passive + r; }
   [[nodiscard]] int input(int j) const { return states + j; }
   [[nodiscard]] int duration_index() const { return nodes * stride; }
   [[nodiscard]] int variable_count() const { return nodes * stride + 1; }
@@ -50,6 +57,13 @@ struct Layout {
 
 using NodeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxNodeVariables, 1>;
 using NodeJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxNodeVariables, kMaxNodeVariables>;
+
+// [rad/s] The swing frequency of detuned pendulum c at the target, sqrt(g / (factor L_target)): it
+// weighs the rate in the pendulum's residual amplitude (header: detuned_pendulums).
+double detuned_frequency(const MinimumTimeProblem& problem, int c) {
+  return std::sqrt(problem.model->parameters().gravity /
+                   (problem.detuned_pendulums[static_cast<std::size_t>(c)] * problem.hoist.target));
+}
 
 bool second_axis_driven(const plant::CraneDynamics& model) {
   return model.drive_force_per_volt(plant::DriveAxis::second) > 0.0;
@@ -61,6 +75,7 @@ class NodeDynamics {
   NodeDynamics(const MinimumTimeProblem& problem, const Layout& layout)
       : model_(problem.model->clone()),
         layout_(layout),
+        detuned_(problem.detuned_pendulums),
         trolley_friction_(problem.trolley_friction),
         second_friction_(problem.second_friction),
         smoothing_(problem.friction_smoothing_speed),
@@ -80,7 +95,6 @@ class NodeDynamics {
     ExtendedVector bias;
     model_->compute_extended_dynamics(s, hoist, mass, bias);
 
-    // Passive rows: M_PP q''_P = -(b_P + M_PA a_A), Q_P = 0.
     ExtendedVector acceleration = ExtendedVector::Zero();
     acceleration[kTrolleyIndex] = z[layout_.input(0)];
     acceleration[kSlewIndex] = z[layout_.input(1)];
@@ -89,17 +103,41 @@ class NodeDynamics {
     for (int i = 0; i < n; ++i) {
       if (i != kTrolleyIndex && i != kSlewIndex) passive[p++] = i;
     }
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, plant::kMaxCoordinates, plant::kMaxCoordinates> mpp(p, p);
-    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, plant::kMaxCoordinates, 1> rhs(p);
-    for (int r = 0; r < p; ++r) {
-      rhs[r] = -bias[passive[r]] - mass(passive[r], kTrolleyIndex) * acceleration[kTrolleyIndex] -
-               mass(passive[r], kSlewIndex) * acceleration[kSlewIndex];
-      for (int c = 0; c < p; ++c) mpp(r, c) = mass(passive[r], passive[c]);
-    }
-    const auto solution = mpp.partialPivLu().solve(rhs).eval();
-    for (int r = 0; r < p; ++r) acceleration[passive[r]] = solution[r];
+    // Passive rows: M_PP q''_P = -(b_P + M_PA a_A), Q_P = 0.
+    const auto passive_accelerations = [&](const ExtendedMatrix& m, const ExtendedVector& b, ExtendedVector& a) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, plant::kMaxCoordinates, plant::kMaxCoordinates> mpp(p, p);
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, plant::kMaxCoordinates, 1> rhs(p);
+      for (int r = 0; r < p; ++r) {
+        rhs[r] = -b[passive[r]] - m(passive[r], kTrolleyIndex) * a[kTrolleyIndex] - m(passive[r], kSlewIndex) * a[kSlewIndex];
+        for (int c = 0; c < p; ++c) mpp(r, c) = m(passive[r], passive[c]);
+      }
+      const auto solution = mpp.partialPivLu().solve(rhs).eval();
+      for (int r = 0; r < p; ++r) a[passive[r]] = solution[r];
+    };
+    passive_accelerations(mass, bias, acceleration);
 
     derivative.resize(layout_.states);
+    // The detuned pendulums (header: detuned_pendulums): the same drive motion, the hoist's length,
+    // rate and acceleration scaled, their own passive coordinates.
+    for (int c = 0; c < layout_.copies; ++c) {
+      const double factor = detuned_[static_cast<std::size_t>(c)];
+      ExtendedState copy = s;
+      for (int r = 0; r < p; ++r) {
+        copy.position[passive[r]] = z[layout_.copy_position(c, r)];
+        copy.velocity[passive[r]] = z[layout_.copy_velocity(c, r)];
+      }
+      const HoistMotion copy_hoist{factor * hoist.cable_length, factor * hoist.cable_length_rate,
+                                   factor * hoist.cable_length_acceleration};
+      ExtendedMatrix copy_mass;
+      ExtendedVector copy_bias;
+      model_->compute_extended_dynamics(copy, copy_hoist, copy_mass, copy_bias);
+      ExtendedVector copy_acceleration = acceleration;
+      passive_accelerations(copy_mass, copy_bias, copy_acceleration);
+      for (int r = 0; r < p; ++r) {
+        derivative[layout_.copy_position(c, r)] = copy.velocity[passive[r]];
+        derivative[layout_.copy_velocity(c, r)] = copy_acceleration[passive[r]];
+      }
+    }
     for (int i = 0; i < n; ++i) {
       derivative[layout_.position(i)] = s.velocity[i];
       derivative[layout_.velocity(i)] = acceleration[i];
@@ -142,6 +180,7 @@ class NodeDynamics {
  private:
   std::unique_ptr<plant::CraneDynamics> model_;
   Layout layout_;
+  std::vector<double> detuned_;  // the copies' length factors
   common::AxisFriction trolley_friction_;
   common::AxisFriction second_friction_;
   double smoothing_;
@@ -160,7 +199,19 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
         dynamics_(problem, layout),
         initial_(std::move(initial_guess)),
         input_scale_{problem.trolley.max_acceleration, problem.second.max_acceleration, problem.hoist.max_acceleration},
-        fixed_duration_(fixed_duration) {}
+        fixed_duration_(fixed_duration) {
+    // The detuned pendulums' residual swing at the end, weighted as an amplitude: (q / max_swing)^2 +
+    // (q' / (omega max_swing))^2, omega = sqrt(g / (factor L_target)) (header: detuned_pendulums).
+    for (int c = 0; c < layout_.copies; ++c) {
+      const double omega = detuned_frequency(problem, c);
+      for (int r = 0; r < layout_.passive; ++r) {
+        residual_.push_back({layout_.duration_index() - layout_.stride + layout_.copy_position(c, r),
+                             problem.detuned_weight / (problem.max_swing * problem.max_swing)});
+        residual_.push_back({layout_.duration_index() - layout_.stride + layout_.copy_velocity(c, r),
+                             problem.detuned_weight / std::pow(omega * problem.max_swing, 2)});
+      }
+    }
+  }
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g, Ipopt::Index& nnz_h_lag,
                     IndexStyleEnum& index_style) override {
@@ -208,6 +259,14 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
         lo[layout_.position(i)] = end ? 0.0 : -problem_.max_swing;
         hi[layout_.position(i)] = end ? 0.0 : problem_.max_swing;
         if (end) lo[layout_.velocity(i)] = hi[layout_.velocity(i)] = 0.0;
+      }
+      for (int c = 0; c < layout_.copies; ++c) {  // at rest at the start; their end is in the objective
+        for (int r = 0; r < layout_.passive; ++r) {
+          if (k == 0) {
+            lo[layout_.copy_position(c, r)] = hi[layout_.copy_position(c, r)] = 0.0;
+            lo[layout_.copy_velocity(c, r)] = hi[layout_.copy_velocity(c, r)] = 0.0;
+          }
+        }
       }
       if (hoisting) {
         lo[layout_.cable_length()] = problem_.hoist.min_position;
@@ -265,6 +324,7 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
           obj_value += swing * swing / layout_.nodes;
         }
       }
+      for (const auto& [index, weight] : residual_) obj_value += weight * x[index] * x[index];
     }
     return true;
   }
@@ -293,6 +353,7 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
           grad_f[a] += 2.0 * x[a] / (problem_.max_swing * problem_.max_swing * layout_.nodes);
         }
       }
+      for (const auto& [index, weight] : residual_) grad_f[index] += 2.0 * weight * x[index];
     }
     return true;
   }
@@ -397,6 +458,7 @@ class MinimumTimeProgram final : public Ipopt::TNLP {
   std::vector<double> initial_;
   double input_scale_[kInputs];
   double fixed_duration_;
+  std::vector<std::pair<int, double>> residual_;  // the last node's detuned variables and their weights
   std::vector<double> solution_;
   Ipopt::SolverReturn solver_return_{Ipopt::INTERNAL_ERROR};
 };
@@ -542,6 +604,14 @@ void validate(const MinimumTimeProblem& problem) {
   for (const double stretch : problem.fallback_stretch) {
     common::require_in_range("minimum_time.fallback_stretch", stretch, 1.0, 10.0);
   }
+  if (problem.detuned_pendulums.size() > static_cast<std::size_t>(kMaxDetunedPendulums)) {
+    throw common::ConfigError("minimum_time.detuned_pendulums: " + std::to_string(problem.detuned_pendulums.size()) +
+                              " pendulums, at most " + std::to_string(kMaxDetunedPendulums));
+  }
+  for (const double factor : problem.detuned_pendulums) {
+    common::require_in_range("minimum_time.detuned_pendulums", factor, 0.5, 2.0);
+  }
+  common::require_in_range("minimum_time.detuned_weight", problem.detuned_weight, 0.0, 1e12);
   common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
   common::validate(problem.second_friction, "minimum_time.second_friction");
 }
@@ -556,10 +626,16 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   validate(problem);
   Layout layout;
   layout.n = problem.model->coordinate_count();
+  layout.passive = layout.n - 2;
   layout.states = 2 * layout.n + 2;
   layout.stride = layout.states + kInputs;
   layout.nodes = problem.intervals + 1;
   layout.voltages = second_axis_driven(*problem.model) ? 2 : 1;
+  // The least-effort solve's, with the detuned pendulums (the fallback's has none).
+  Layout effort_layout = layout;
+  effort_layout.copies = static_cast<int>(problem.detuned_pendulums.size());
+  effort_layout.states += effort_layout.copies * 2 * effort_layout.passive;
+  effort_layout.stride = effort_layout.states + kInputs;
 
   MinimumTimeResult result;
   std::vector<double> guess = initial_guess(problem, layout, result.initial_guess_duration);
@@ -617,46 +693,60 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   // guess at that duration, and where IPOPT does not solve it at twice and four times the margin;
   // its solution replaces the first only where IPOPT solved it.
   result.duration = (*solution)[static_cast<std::size_t>(layout.duration_index())];
+  const Layout* solution_layout = &layout;
+  const MinimumTimeProgram* solution_program = GetRawPtr(program);
   Ipopt::SmartPtr<MinimumTimeProgram> effort;
   app->Options()->SetNumericValue("tol", problem.least_effort_tolerance);
   for (int attempt = 0; result.solved && problem.least_effort && !result.least_effort && attempt < 3; ++attempt) {
     const double duration = result.duration * (1.0 + problem.least_effort_margin * (1 << attempt));
     double guess_duration = 0.0;
-    std::vector<double> guess_at = initial_guess(problem, layout, guess_duration, duration);
-    effort = new MinimumTimeProgram(problem, layout, std::move(guess_at), duration);
+    std::vector<double> guess_at = initial_guess(problem, effort_layout, guess_duration, duration);
+    effort = new MinimumTimeProgram(problem, effort_layout, std::move(guess_at), duration);
     const Ipopt::ApplicationReturnStatus effort_status = app->OptimizeTNLP(effort);
     result.effort_status = solver_return_name(effort->solver_return());
     if (IsValid(app->Statistics())) result.effort_iterations += app->Statistics()->IterationCount();
-    if (solved_status(effort_status) && effort->solution().size() == solution->size()) {
+    if (solved_status(effort_status) &&
+        effort->solution().size() == static_cast<std::size_t>(effort_layout.variable_count())) {
       solution = &effort->solution();
+      solution_layout = &effort_layout;
+      solution_program = GetRawPtr(effort);
       result.least_effort = true;
     }
   }
   result.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<double>& x = *solution;
+  const Layout& chosen = *solution_layout;
 
-  std::vector<double> g(static_cast<std::size_t>(layout.constraint_count()));
-  program->evaluate_constraints(x.data(), g.data());
-  for (int r = 0; r < layout.defect_rows(); ++r) result.max_defect = std::max(result.max_defect, std::abs(g[r]));
+  std::vector<double> g(static_cast<std::size_t>(chosen.constraint_count()));
+  solution_program->evaluate_constraints(x.data(), g.data());
+  for (int r = 0; r < chosen.defect_rows(); ++r) result.max_defect = std::max(result.max_defect, std::abs(g[r]));
+  const double* last = x.data() + (chosen.nodes - 1) * chosen.stride;
+  for (int c = 0; c < chosen.copies; ++c) {
+    double& residual = result.detuned_residual_swing[static_cast<std::size_t>(c)];
+    const double omega = detuned_frequency(problem, c);
+    for (int r = 0; r < chosen.passive; ++r) {
+      residual = std::max(residual, std::hypot(last[chosen.copy_position(c, r)], last[chosen.copy_velocity(c, r)] / omega));
+    }
+  }
 
-  result.trajectory_duration = x[static_cast<std::size_t>(layout.duration_index())];
-  result.nodes.resize(static_cast<std::size_t>(layout.nodes));
-  for (int k = 0; k < layout.nodes; ++k) {
-    const double* z = x.data() + k * layout.stride;
+  result.trajectory_duration = x[static_cast<std::size_t>(chosen.duration_index())];
+  result.nodes.resize(static_cast<std::size_t>(chosen.nodes));
+  for (int k = 0; k < chosen.nodes; ++k) {
+    const double* z = x.data() + k * chosen.stride;
     TrajectoryNode& node = result.nodes[static_cast<std::size_t>(k)];
     node.time = result.trajectory_duration * k / problem.intervals;
-    for (int i = 0; i < layout.n; ++i) {
-      node.state.position[i] = z[layout.position(i)];
-      node.state.velocity[i] = z[layout.velocity(i)];
+    for (int i = 0; i < chosen.n; ++i) {
+      node.state.position[i] = z[chosen.position(i)];
+      node.state.velocity[i] = z[chosen.velocity(i)];
     }
-    node.cable_length = z[layout.cable_length()];
-    node.cable_length_rate = z[layout.cable_rate()];
-    node.trolley_acceleration = z[layout.input(0)];
-    node.second_acceleration = z[layout.input(1)];
-    node.hoist_acceleration = z[layout.input(2)];
-    const double* v = g.data() + layout.defect_rows() + k * layout.voltages;
+    node.cable_length = z[chosen.cable_length()];
+    node.cable_length_rate = z[chosen.cable_rate()];
+    node.trolley_acceleration = z[chosen.input(0)];
+    node.second_acceleration = z[chosen.input(1)];
+    node.hoist_acceleration = z[chosen.input(2)];
+    const double* v = g.data() + chosen.defect_rows() + k * chosen.voltages;
     node.trolley_voltage = v[0];
-    node.second_voltage = layout.voltages > 1 ? v[1] : 0.0;
+    node.second_voltage = chosen.voltages > 1 ? v[1] : 0.0;
   }
   return result;
 }

@@ -53,6 +53,10 @@ MinimumTimeProblem minimum_time_problem(const trajectory_planner::PlanRequest& r
   problem.voltage_limit = facts.voltage_limit;
   problem.max_swing = kBoundSwingFraction * r.max_swing;
   problem.intervals = intervals;
+  if (r.robust_length_range > 0.0) {  // robust to the configured pendulum's length (planned_path.hpp)
+    problem.detuned_pendulums = {1.0 - r.robust_length_range, 1.0 + r.robust_length_range};
+    problem.least_effort_margin = r.robust_margin;
+  }
   validate(problem);
   return problem;
 }

@@ -27,7 +27,7 @@ trajectory_planner::PlanRequest plan_request_of(const StackConfig& cfg, const Ma
   r.bridge_target = m.bridge_target;
   r.bridge_limits = {std::min(m.bridge_max_velocity, limits.bridge_max_speed), m.bridge_max_acceleration};
   r.max_swing = limits.max_swing;
-  r.swing = cfg.trajectory_planner.manual.pendulum();
+  trajectory_planner::plan_on_pendulum(r, cfg.trajectory_planner.manual.pendulum(), false, cfg.trajectory_planner);
   return r;
 }
 

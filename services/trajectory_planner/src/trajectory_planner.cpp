@@ -58,6 +58,8 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   common::require_in_range("trajectory_planner.ei_vibration_tolerance", params.ei_vibration_tolerance,
                            0.0, 0.2);
   validate(params.manual);
+  common::require_in_range("trajectory_planner.robust_length_range", params.robust_length_range, 0.0, 0.5);
+  common::require_in_range("trajectory_planner.robust_margin", params.robust_margin, 0.0, 0.5);
   // The calibrated equivalent pendulum must be one over the whole cable range (a > 0: its shortest
   // is at the shortest cable), or the minimum-time plans have no pendulum to swing.
   if (!swings_down_to(params.manual.pendulum(), params.cable_min_length)) {

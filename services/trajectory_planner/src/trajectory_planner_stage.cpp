@@ -44,6 +44,8 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   p.manual.swing_length_offset = m.number("swing_length_offset", kMinSwingLengthOffset, kMaxSwingLengthOffset);
   p.manual.swing_damping_ratio = m.number("swing_damping_ratio", 0.0, 0.3);
   m.finish();
+  p.robust_length_range = s.number("robust_length_range", 0.0, 0.5);
+  p.robust_margin = s.number("robust_margin", 0.0, 0.5);
   s.finish();
   p.site = facts.site;
   if (p.bridge_enabled && !p.site.zones.empty()) {
@@ -267,10 +269,10 @@ PlanRequest TrajectoryPlannerStage::plan_of(const protocol::MoveRequest& r, cons
                           r.bridge_max_acceleration > 0.0 ? r.bridge_max_acceleration : params.manual.bridge.acceleration};
   }
   plan.max_swing = max_swing_;
-  plan.swing = params.manual.pendulum();
+  plan_on_pendulum(plan, params.manual.pendulum(), false, params);
   if (cycle_estimate_ != nullptr && cycle_estimate_->swing_length_confident) {
     const EquivalentPendulum learnt{cycle_estimate_->swing_length_scale, cycle_estimate_->swing_length_offset};
-    if (swings_down_to(learnt, std::min(plan.cable_from, plan.cable_target))) plan.swing = learnt;
+    if (swings_down_to(learnt, std::min(plan.cable_from, plan.cable_target))) plan_on_pendulum(plan, learnt, true, params);
   }
   return plan;
 }

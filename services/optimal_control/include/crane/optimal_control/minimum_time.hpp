@@ -31,18 +31,21 @@
 //
 // The trajectory returned is by default (MinimumTimeProblem::least_effort) not the minimum-time
 // solution but a second solve at 1.01 T* (1.02 or 1.04 T* where IPOPT does not solve that) for
-// the least input and swing; MinimumTimeResult::duration is T*, trajectory_duration the nodes'.
+// the least input and swing (with detuned_pendulums, also the least swing left on cables of other
+// lengths); MinimumTimeResult::duration is T*, trajectory_duration the nodes'.
 //
 // Errors: solve_minimum_time throws common::ConfigError naming the field, the value and the bound
 // for a problem that is malformed (a non-finite or non-positive limit, a start or target outside
 // its axis's range, intervals outside [4, 2000], least_effort_margin outside [0, 0.5],
-// least_effort_tolerance outside [1e-14, 1e-2]); a problem IPOPT does not solve is returned with
+// least_effort_tolerance outside [1e-14, 1e-2], more than kMaxDetunedPendulums detuned pendulums
+// or one outside [0.5, 2], detuned_weight outside [0, 1e12]); a problem IPOPT does not solve is returned with
 // `solved == false` and IPOPT's status in `status` (never an exception).
 //
 // Threads: solve_minimum_time may be called from several threads; the solves run one at a time
 // (IPOPT's linear solver, Debian's sequential MUMPS, is not reentrant), so solve_seconds counts
 // only the solve, not the wait.
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,6 +54,9 @@
 #include "crane/plant/crane_dynamics.hpp"
 
 namespace crane::optimal_control {
+
+/// The most detuned pendulums a problem may carry (MinimumTimeProblem::detuned_pendulums).
+inline constexpr int kMaxDetunedPendulums = 2;
 
 /// Range and rated limits of one axis [m, m/s, m/s^2] or [rad, rad/s, rad/s^2].
 struct AxisRange {
@@ -101,6 +107,18 @@ struct MinimumTimeProblem {
                                       // preference, not a bound (the constraints keep constr_viol_tol 1e-9);
                                       // 1e-8 took 187 iterations on the test's overhead move, 1e-5 56, the
                                       // same trajectory to 1e-4 rad of swing
+  /// Robust to the pendulum's length: in the least-effort solve (not the fallback's), copies
+  /// of the passive coordinates (the swings) of a pendulum whose cable is each of these factors
+  /// times the planned one, driven by the same drive and hoist motion (the hoist's length, rate and
+  /// acceleration scaled), start at rest, and their amplitude at the end,
+  /// (q / max_swing)^2 + (q' / (omega max_swing))^2 with omega = sqrt(g / (factor L_target)), is in
+  /// the objective with detuned_weight: the multiple-model form of a robust input shaper (W. Singhose,
+  /// W. Seering, N. Singer, "Residual vibration reduction using vector diagrams to generate shaped
+  /// inputs", J. Mech. Des. 116, 1994: zero vibration at detuned frequencies) on the nonlinear
+  /// model. The minimum-time solve (T*) never carries them. At most kMaxDetunedPendulums, each in
+  /// [0.5, 2]; empty: none (docs/optimal_control.md, "Robust to the pendulum's length").
+  std::vector<double> detuned_pendulums{};
+  double detuned_weight{1e4};       // [-] >= 0, finite: the weight of the detuned pendulums' residual amplitude
   double tolerance{1e-8};             // IPOPT's tol
   int max_iterations{3000};
   /// Where IPOPT does not solve the minimum-time problem from the linear profiles' guess, it is
@@ -151,6 +169,9 @@ struct MinimumTimeResult {
   std::string effort_status;              // IPOPT's return status of the last least-effort solve, or of the
                                           // fallback ("" if none ran)
   int effort_iterations{0};               // of every least-effort solve
+  /// [rad] each detuned pendulum's amplitude at the trajectory's end, sqrt(q^2 + (q' / omega)^2), the
+  /// largest over its passive coordinates (0 where the nodes are not a solve that carried them)
+  std::array<double, kMaxDetunedPendulums> detuned_residual_swing{};
 };
 
 /// Validates `problem` (see the header's Errors) and solves it.

@@ -91,6 +91,9 @@ struct PlanRequest {
   EquivalentPendulum swing{};  // the pendulum to plan: the estimate's when the state estimator has
                                // learnt one that swings over the move's cable span, else the
                                // configured (manual's)
+  double robust_length_range{0.0};  // [-] in [0, 0.5]: TrajectoryPlannerParams::robust_length_range where
+                                    // `swing` is the configured pendulum, else 0 (not robust)
+  double robust_margin{0.0};        // [-] in [0, 0.5]: TrajectoryPlannerParams::robust_margin, with it
 };
 
 }  // namespace crane::trajectory_planner

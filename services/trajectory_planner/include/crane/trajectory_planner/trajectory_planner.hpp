@@ -58,6 +58,14 @@ struct TrajectoryPlannerParams {
   double swing_damping_ratio{0.0};    // [-] swing damping used by the zv/zvd/ei shapers, 0..0.3
   double ei_vibration_tolerance{0.05};  // [-] EI residual-vibration tolerance V, (0, 0.2]
   ManualParams manual{};              // operator speed control and stops (speed_reference.hpp)
+  /// A minimum-time plan made on the configured pendulum (none learnt yet, or the state
+  /// estimator's swing_length off) robust to its length: the plan also brings pendulums
+  /// (1 - robust_length_range) and (1 + robust_length_range) times as long to rest, at a duration of
+  /// (1 + robust_margin) T* (optimal_control::MinimumTimeProblem::detuned_pendulums;
+  /// docs/optimal_control.md, "Robust to the pendulum's length"). Each in [0, 0.5]; a range of 0
+  /// plans every move as before. A plan on a learnt pendulum is never made robust.
+  double robust_length_range{0.0};    // [-]
+  double robust_margin{0.2};          // [-]
   common::Site site{};                // the no-go zones (goals refused inside, paths planned around)
   // An overhead crane's bridge (crane.kind = overhead; false elsewhere): its runway travel (its manual
   // motion is manual.bridge). The planner stage runs it as the trolley of a second planner
@@ -85,6 +93,15 @@ struct TrajectoryPlannerParams {
             gravity};
   }
 };
+
+/// Plans `r` on `pendulum`: robust to its length (params.robust_length_range and robust_margin) where
+/// it is the configured one (`learnt` false), fast on it where the state estimator learnt it.
+inline void plan_on_pendulum(PlanRequest& r, const EquivalentPendulum& pendulum, bool learnt,
+                             const TrajectoryPlannerParams& params) noexcept {
+  r.swing = pendulum;
+  r.robust_length_range = learnt ? 0.0 : params.robust_length_range;
+  r.robust_margin = params.robust_margin;
+}
 
 /// An intermediate point of a move.
 struct Waypoint {
