@@ -105,10 +105,13 @@ class NodeDynamics {
     }
     // Passive rows: M_PP q''_P = -(b_P + M_PA a_A), Q_P = 0.
     const auto passive_accelerations = [&](const ExtendedMatrix& m, const ExtendedVector& b, ExtendedVector& a) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, plant::kMaxCoordinates, plant::kMaxCoordinates> mpp(p, p);
+      using PassiveMatrix =
+          Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, plant::kMaxCoordinates, plant::kMaxCoordinates>;
+      PassiveMatrix mpp(p, p);
       Eigen::Matrix<double, Eigen::Dynamic, 1, 0, plant::kMaxCoordinates, 1> rhs(p);
       for (int r = 0; r < p; ++r) {
-        rhs[r] = -b[passive[r]] - m(passive[r], kTrolleyIndex) * a[kTrolleyIndex] - m(passive[r], kSlewIndex) * a[kSlewIndex];
+        rhs[r] = -b[passive[r]] - m(passive[r], kTrolleyIndex) * a[kTrolleyIndex] -
+                 m(passive[r], kSlewIndex) * a[kSlewIndex];
         for (int c = 0; c < p; ++c) mpp(r, c) = m(passive[r], passive[c]);
       }
       const auto solution = mpp.partialPivLu().solve(rhs).eval();
@@ -725,7 +728,8 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
     double& residual = result.detuned_residual_swing[static_cast<std::size_t>(c)];
     const double omega = detuned_frequency(problem, c);
     for (int r = 0; r < chosen.passive; ++r) {
-      residual = std::max(residual, std::hypot(last[chosen.copy_position(c, r)], last[chosen.copy_velocity(c, r)] / omega));
+      residual =
+          std::max(residual, std::hypot(last[chosen.copy_position(c, r)], last[chosen.copy_velocity(c, r)] / omega));
     }
   }
 

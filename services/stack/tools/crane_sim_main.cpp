@@ -569,7 +569,8 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
   std::printf("the minimum-time trajectory followed in closed loop (%s crane; feedforward + time-varying LQR, "
               "friction compensation on)\n",
               common::to_string(cfg.facts.crane_kind));
-  std::printf("(traj: the trajectory's duration, the least-effort solve's at 1.01-1.04 T* (1 + trajectory_planner.robust_margin with robust_length_range > 0), or T* where none solved)\n");
+  std::printf("(traj: the trajectory's duration, the least-effort solve's at 1.01-1.04 T* (1 + "
+              "trajectory_planner.robust_margin with robust_length_range > 0), or T* where none solved)\n");
   std::printf("%-14s %-16s %8s %8s %8s %7s %10s %13s %13s %15s %6s %7s\n", "maneuver", "plant", "T* [s]",
               "traj [s]", "settle_s", "ratio", "pos_err_mm", bridge ? "bridge_err_mm" : "slew_err_mrad",
               "max_swing_deg", "resid_swing_deg", "max_V", "faults");
