@@ -27,6 +27,7 @@
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/dds.hpp"
+#include "crane/testing/scratch_directory.hpp"
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 
@@ -46,10 +47,7 @@ constexpr std::uint32_t kCraneDomain = 63;
 class SiteCrane {
  public:
   SiteCrane()
-      : dir_(fs::temp_directory_path() / ("crane_site_guard_" + std::to_string(getpid()))),
-        layout_(ac::load_site_layout(kSite)) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+      : dir_(crane::testing::scratch_directory("site_guard")), layout_(ac::load_site_layout(kSite)) {
     crane::launch::StackOptions options;
     options.config_path = kConfig;
     options.binary_directory = kBin;

@@ -26,6 +26,7 @@
 #include "crane/anti_collision/site_messages.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/protocol/dds.hpp"
+#include "crane/testing/scratch_directory.hpp"
 #include "crane/transport/participant.hpp"
 #include "crane/transport/topics.hpp"
 
@@ -47,9 +48,7 @@ const ac::Pose kRest[3] = {{kPi, 0.5, 0.2}, {kPi, 0.5, 0.2}, {kPi, 0.5, 0.2}};
 
 class SiteProcess {
  public:
-  SiteProcess() : dir_(fs::temp_directory_path() / ("crane_site_service_" + std::to_string(getpid()))) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+  SiteProcess() : dir_(crane::testing::scratch_directory("site_service")) {
     crane::transport::ParticipantOptions p;
     p.name = "site_test_cranes";
     p.domain_id = kDomain;

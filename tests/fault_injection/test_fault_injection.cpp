@@ -42,6 +42,7 @@
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
 #include "crane/supervisor/actuation_gate.hpp"
+#include "crane/testing/scratch_directory.hpp"
 #include "crane/supervisor/operator_socket.hpp"
 
 namespace {
@@ -69,12 +70,8 @@ const crane::supervisor::ActuationGateParams& gate_params() {
   return params;
 }
 
-fs::path fresh_directory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("crane_fault_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// crane_fault_<name>_<pid>, removed at the end of a test that passes (scratch_directory.hpp).
+fs::path fresh_directory(const std::string& name) { return crane::testing::scratch_directory("fault_" + name); }
 
 std::string read_file(const fs::path& path) {
   std::ifstream in(path);

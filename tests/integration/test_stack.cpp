@@ -23,6 +23,7 @@
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/messages.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/testing/scratch_directory.hpp"
 
 namespace {
 
@@ -37,12 +38,8 @@ const std::string kConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/lab_
 const std::string kOverheadConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/overhead_crane.yaml";
 const std::string kGantryConfig = std::string(CRANE_SOURCE_DIR) + "/deploy/config/gantry_crane.yaml";
 
-fs::path fresh_directory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("crane_test_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// crane_test_<name>_<pid>, removed at the end of a test that passes (scratch_directory.hpp).
+fs::path fresh_directory(const std::string& name) { return crane::testing::scratch_directory("test_" + name); }
 
 // The main job on one maneuver: every stage its own process, the move sent over DDS, the
 // acceptance figures of the issue read back from summary.json.
