@@ -153,6 +153,8 @@ TEST(MinimumTime, ADetunedPlanLeavesLessSwingOnTheShorterAndTheLongerPendulum) {
   EXPECT_NEAR(robust.trajectory_duration, 1.2 * robust.duration, 1e-9);
   EXPECT_LT(robust.max_defect, 1e-6);
   EXPECT_EQ(plain.detuned_residual_swing[0], 0.0);  // no detuned pendulum in its solve
+  EXPECT_FALSE(plain.robust);
+  EXPECT_TRUE(robust.robust);
   const double g = cfg.facts.crane.gravity;
   const double L = cfg.facts.crane.cable_length;
   double energy_without = 0.0, energy_with = 0.0;  // sum of the squared residual amplitudes
@@ -174,6 +176,36 @@ TEST(MinimumTime, ADetunedPlanLeavesLessSwingOnTheShorterAndTheLongerPendulum) {
   EXPECT_THROW((void)optimal_control::solve_minimum_time(problem), common::ConfigError);
   problem.detuned_pendulums = {2.5};
   EXPECT_THROW((void)optimal_control::solve_minimum_time(problem), common::ConfigError);
+  problem.detuned_pendulums = {0.8, 1.2};
+  problem.detuned_max_iterations = 0;
+  EXPECT_THROW((void)optimal_control::solve_minimum_time(problem), common::ConfigError);
+}
+
+// A robust solve that IPOPT does not finish within detuned_max_iterations gives way to the plain
+// least-effort solve at the same margin: the same trajectory as a problem with no detuned pendulum.
+TEST(MinimumTime, ARobustSolveOverItsIterationsGivesThePlainLeastEffortPlan) {
+  const auto cfg = config("lab_tower_crane.yaml");
+  auto problem = stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), 100);
+  problem.least_effort_margin = 0.2;
+  const auto plain = optimal_control::solve_minimum_time(problem);
+  problem.detuned_pendulums = {0.8, 1.2};
+  problem.detuned_max_iterations = 5;  // the robust solve takes 31 (test above)
+  const auto capped = optimal_control::solve_minimum_time(problem);
+  ASSERT_TRUE(plain.solved && plain.least_effort) << plain.status << ' ' << plain.effort_status;
+  ASSERT_TRUE(capped.solved && capped.least_effort) << capped.status << ' ' << capped.effort_status;
+  EXPECT_FALSE(capped.robust);
+  EXPECT_EQ(capped.detuned_residual_swing[0], 0.0);
+  EXPECT_EQ(capped.detuned_residual_swing[1], 0.0);
+  EXPECT_GT(capped.effort_iterations, plain.effort_iterations);  // the capped attempt's 5 besides
+  EXPECT_EQ(capped.trajectory_duration, plain.trajectory_duration);
+  ASSERT_EQ(capped.nodes.size(), plain.nodes.size());
+  double largest = 0.0;
+  for (std::size_t k = 0; k < plain.nodes.size(); ++k) {
+    for (int i = 0; i < plant::kNumCoordinates; ++i) {
+      largest = std::max(largest, std::abs(capped.nodes[k].state.position[i] - plain.nodes[k].state.position[i]));
+    }
+  }
+  EXPECT_LT(largest, 1e-9);
 }
 
 // The planner's request to the problem (optimal_control::minimum_time_problem): a request robust to

@@ -615,6 +615,7 @@ void validate(const MinimumTimeProblem& problem) {
     common::require_in_range("minimum_time.detuned_pendulums", factor, 0.5, 2.0);
   }
   common::require_in_range("minimum_time.detuned_weight", problem.detuned_weight, 0.0, 1e12);
+  common::require_in_range("minimum_time.detuned_max_iterations", problem.detuned_max_iterations, 1, 1e6);
   common::validate(problem.trolley_friction, "minimum_time.trolley_friction");
   common::validate(problem.second_friction, "minimum_time.second_friction");
 }
@@ -699,22 +700,32 @@ MinimumTimeResult solve_minimum_time(const MinimumTimeProblem& problem) {
   const Layout* solution_layout = &layout;
   const MinimumTimeProgram* solution_program = GetRawPtr(program);
   Ipopt::SmartPtr<MinimumTimeProgram> effort;
+  // With detuned pendulums, the first attempt carries them, within detuned_max_iterations; where
+  // it does not solve, the attempts run again without them (header: detuned_max_iterations).
   app->Options()->SetNumericValue("tol", problem.least_effort_tolerance);
-  for (int attempt = 0; result.solved && problem.least_effort && !result.least_effort && attempt < 3; ++attempt) {
+  bool robust = effort_layout.copies > 0;
+  for (int attempt = 0; result.solved && problem.least_effort && !result.least_effort && attempt < 3;) {
+    const Layout& attempt_layout = robust ? effort_layout : layout;
+    app->Options()->SetIntegerValue("max_iter", robust ? problem.detuned_max_iterations : problem.max_iterations);
     const double duration = result.duration * (1.0 + problem.least_effort_margin * (1 << attempt));
     double guess_duration = 0.0;
-    std::vector<double> guess_at = initial_guess(problem, effort_layout, guess_duration, duration);
-    effort = new MinimumTimeProgram(problem, effort_layout, std::move(guess_at), duration);
+    std::vector<double> guess_at = initial_guess(problem, attempt_layout, guess_duration, duration);
+    effort = new MinimumTimeProgram(problem, attempt_layout, std::move(guess_at), duration);
     const Ipopt::ApplicationReturnStatus effort_status = app->OptimizeTNLP(effort);
     result.effort_status = solver_return_name(effort->solver_return());
     if (IsValid(app->Statistics())) result.effort_iterations += app->Statistics()->IterationCount();
     if (solved_status(effort_status) &&
-        effort->solution().size() == static_cast<std::size_t>(effort_layout.variable_count())) {
+        effort->solution().size() == static_cast<std::size_t>(attempt_layout.variable_count())) {
       solution = &effort->solution();
-      solution_layout = &effort_layout;
+      solution_layout = &attempt_layout;
       solution_program = GetRawPtr(effort);
       result.least_effort = true;
+      result.robust = robust;
+    } else if (robust) {
+      robust = false;  // the same attempt again, without the copies
+      continue;
     }
+    ++attempt;
   }
   result.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<double>& x = *solution;

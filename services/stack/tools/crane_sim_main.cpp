@@ -657,6 +657,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     std::vector<stack::MoveComparison> runs;  // one per plant
     double solve_seconds{0.0};
     bool least_effort{false};  // the trajectory is the least-effort solve's (MinimumTimeResult::least_effort)
+    bool robust{false};        // ... with the detuned pendulums (MinimumTimeResult::robust)
     std::string error;
   };
   std::vector<MoveResult> results(maneuvers.size());
@@ -668,6 +669,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
         const auto bound = stack::comparison_bound(cfg, maneuvers[i], intervals);
         results[i].solve_seconds = bound.solve_seconds;
         results[i].least_effort = bound.least_effort;
+        results[i].robust = bound.robust;
         for (std::size_t p = 0; p < plants.size(); ++p) {
           if (!calibrated[p]) {
             results[i].runs.push_back(stack::compare_move(
@@ -720,6 +722,9 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
   std::vector<stack::MoveComparison> demo_nominal, random_nominal, at_corners;
   std::vector<double> solve_times;
   std::size_t least_effort = 0;
+  std::size_t robust = 0;
+  std::string slowest;  // the move of the longest solve
+  double slowest_seconds = -1.0;
   for (std::size_t i = 0; i < maneuvers.size(); ++i) {
     const MoveResult& r = results[i];
     if (!r.error.empty()) {
@@ -728,7 +733,12 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
       continue;
     }
     solve_times.push_back(r.solve_seconds);
+    if (r.solve_seconds > slowest_seconds) {
+      slowest_seconds = r.solve_seconds;
+      slowest = maneuvers[i].name;
+    }
     if (r.least_effort) ++least_effort;
+    if (r.robust) ++robust;
     for (const auto& run : r.runs) {
       const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
       (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
@@ -801,11 +811,18 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
               unplanned_runs, runs_counted);
   std::sort(solve_times.begin(), solve_times.end());
   if (!solve_times.empty()) {
-    std::printf("\nbound solve (IPOPT, %d intervals, both solves): median %.2f s, max %.2f s over %zu moves; %.1f s "
-                "wall on %u thread(s); the least-effort trajectory on %zu of them (the others the minimum-time "
+    std::printf("\nbound solve (IPOPT, %d intervals, both solves): median %.2f s, max %.2f s (%s) over %zu moves; "
+                "%.1f s wall on %u thread(s); the least-effort trajectory on %zu of them (the others the minimum-time "
                 "solve's)\n",
-                intervals, stack::nearest_rank_quantile(solve_times, 0.5), solve_times.back(), solve_times.size(), wall,
-                std::max(1U, jobs), least_effort);
+                intervals, stack::nearest_rank_quantile(solve_times, 0.5), solve_times.back(), slowest.c_str(),
+                solve_times.size(), wall, std::max(1U, jobs), least_effort);
+    if (cfg.trajectory_planner.robust_length_range > 0.0) {
+      std::printf("robust to the pendulum's length (trajectory_planner.robust_length_range %.2f): %zu of the "
+                  "least-effort trajectories; the others over the robust solve's %d IPOPT iterations, planned as "
+                  "with it off\n",
+                  cfg.trajectory_planner.robust_length_range, robust,
+                  optimal_control::MinimumTimeProblem{}.detuned_max_iterations);
+    }
   }
   if (!out_dir.empty()) {
     fs::create_directories(out_dir);

@@ -63,7 +63,10 @@ std::shared_ptr<const trajectory_planner::PlannedPath> plan(const trajectory_pla
       spdlog::info("move request {}: minimum-time plan, T* = {:.4f} s, trajectory {:.4f} s ({}), {} + {} IPOPT "
                    "iterations in {:.2f} s ({} restart(s)); the pendulum {:.4f} L + {:.4f} m",
                    request.request_id, bound.duration, bound.trajectory_duration,
-                   bound.least_effort ? "least effort" : "the minimum-time solve's", bound.iterations,
+                   bound.robust         ? "least effort, robust to the pendulum's length"
+                   : bound.least_effort ? "least effort"
+                                        : "the minimum-time solve's",
+                   bound.iterations,
                    bound.effort_iterations, bound.solve_seconds, bound.restarts, request.swing.scale,
                    request.swing.offset);
     } else {

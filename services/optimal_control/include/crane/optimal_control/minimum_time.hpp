@@ -38,8 +38,9 @@
 // for a problem that is malformed (a non-finite or non-positive limit, a start or target outside
 // its axis's range, intervals outside [4, 2000], least_effort_margin outside [0, 0.5],
 // least_effort_tolerance outside [1e-14, 1e-2], more than kMaxDetunedPendulums detuned pendulums
-// or one outside [0.5, 2], detuned_weight outside [0, 1e12]); a problem IPOPT does not solve is returned with
-// `solved == false` and IPOPT's status in `status` (never an exception).
+// or one outside [0.5, 2], detuned_weight outside [0, 1e12], detuned_max_iterations outside
+// [1, 1e6]); a problem IPOPT does not solve is returned with `solved == false` and IPOPT's status
+// in `status` (never an exception).
 //
 // Threads: solve_minimum_time may be called from several threads; the solves run one at a time
 // (IPOPT's linear solver, Debian's sequential MUMPS, is not reentrant), so solve_seconds counts
@@ -119,6 +120,14 @@ struct MinimumTimeProblem {
   /// [0.5, 2]; empty: none (docs/optimal_control.md, "Robust to the pendulum's length").
   std::vector<double> detuned_pendulums{};
   double detuned_weight{1e4};       // [-] >= 0, finite: the weight of the detuned pendulums' residual amplitude
+  /// IPOPT iterations the least-effort solve with the detuned pendulums may take, in [1, 1e6]. Where
+  /// it does not solve within them, the least-effort solves run as with none (the least-effort margins,
+  /// no copies; MinimumTimeResult::robust false): a bound on the planning time that, unlike a clock,
+  /// gives the same plan on every machine. Why 500: on the tower's 24 moves of seed 2 (200
+  /// intervals) the robust solve took 31-249 iterations (0.9-11 s with T*'s) on 22 of them, and
+  /// 970 and 2273 (23 and 52 s) on the other two (docs/optimal_control.md, "Robust to the
+  /// pendulum's length").
+  int detuned_max_iterations{500};
   double tolerance{1e-8};             // IPOPT's tol
   int max_iterations{3000};
   /// Where IPOPT does not solve the minimum-time problem from the linear profiles' guess, it is
@@ -172,6 +181,9 @@ struct MinimumTimeResult {
   /// [rad] each detuned pendulum's amplitude at the trajectory's end, sqrt(q^2 + (q' / omega)^2), the
   /// largest over its passive coordinates (0 where the nodes are not a solve that carried them)
   std::array<double, kMaxDetunedPendulums> detuned_residual_swing{};
+  bool robust{false};                     // the nodes are the least-effort solve's with the detuned pendulums;
+                                          // false with none, or where that solve took more than
+                                          // detuned_max_iterations (the plain least-effort solve's then)
 };
 
 /// Validates `problem` (see the header's Errors) and solves it.
