@@ -140,10 +140,16 @@ TEST(MinimumTime, TheBoundsTrolleyAccelerationLeavesThePendulumAtRest) {
 // -> 1.41 deg and 2.62 -> 1.76 deg; at 1.2 T* the drives cannot bring both to rest), the configured
 // cable still at rest; the transcription's own residual of each detuned pendulum agrees with the
 // integration; T* is the same solve's.
+// The tower's trolley move with its least-effort trajectory at 1.2 T*, on `intervals` intervals.
+optimal_control::MinimumTimeProblem trolley_at_a_fifth_more(const stack::StackConfig& cfg, int intervals) {
+  auto problem = stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), intervals);
+  problem.least_effort_margin = 0.2;
+  return problem;
+}
+
 TEST(MinimumTime, ADetunedPlanLeavesLessSwingOnTheShorterAndTheLongerPendulum) {
   const auto cfg = config("lab_tower_crane.yaml");
-  auto problem = stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), 200);
-  problem.least_effort_margin = 0.2;
+  auto problem = trolley_at_a_fifth_more(cfg, 200);
   const auto plain = optimal_control::solve_minimum_time(problem);
   problem.detuned_pendulums = {0.8, 1.2};
   const auto robust = optimal_control::solve_minimum_time(problem);
@@ -185,11 +191,10 @@ TEST(MinimumTime, ADetunedPlanLeavesLessSwingOnTheShorterAndTheLongerPendulum) {
 // least-effort solve at the same margin: the same trajectory as a problem with no detuned pendulum.
 TEST(MinimumTime, ARobustSolveOverItsIterationsGivesThePlainLeastEffortPlan) {
   const auto cfg = config("lab_tower_crane.yaml");
-  auto problem = stack::bound_problem(cfg, stack::find_maneuver(cfg, "trolley"), 100);
-  problem.least_effort_margin = 0.2;
+  auto problem = trolley_at_a_fifth_more(cfg, 100);
   const auto plain = optimal_control::solve_minimum_time(problem);
   problem.detuned_pendulums = {0.8, 1.2};
-  problem.detuned_max_iterations = 5;  // the robust solve takes 31 (test above)
+  problem.detuned_max_iterations = 5;  // far fewer than the robust solve takes
   const auto capped = optimal_control::solve_minimum_time(problem);
   ASSERT_TRUE(plain.solved && plain.least_effort) << plain.status << ' ' << plain.effort_status;
   ASSERT_TRUE(capped.solved && capped.least_effort) << capped.status << ' ' << capped.effort_status;
