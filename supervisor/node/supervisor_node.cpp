@@ -16,6 +16,8 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -82,33 +84,39 @@ class SiteLink {
       seq_ = order.seq;
       guard_.grant(anti_collision::path_airspace(order.waypoints, layout_.paths), time);
       granted_ = order.waypoints;
-      progressed_ = granted_.size();
+      held_count_ = 0;  // the whole grant
       spdlog::info("site grant {} (epoch {}): {} through {} waypoints", order.seq, message.epoch,
                    order.kind == anti_collision::Instruction::Kind::go ? "go" : "yield", order.waypoints.size());
     }
     transport::topics::msgs::SiteStatus_ dds_status;
     while (status_->take_next(dds_status)) guard_.heard(time);
     // The crane's own progress (its site link's reports): moving on this grant, the rest of the
-    // path from the last waypoint it reached. Taken only when it is the tail of the granted
-    // waypoints, shorter than the last taken: the guard's grant only narrows.
+    // path from the last waypoint it reached or from the point of the segment under way it has
+    // passed. Taken only when it narrows what the guard holds (anti_collision::narrows: the rest
+    // of the granted path, from further along it).
     transport::topics::msgs::SiteReport_ dds_report;
     while (reports_->take_next(dds_report)) {
       if (dds_report.crane() != crane_ || dds_report.state() != protocol::SiteReport::STATE_MOVING ||
           dds_report.instruction_epoch() != epoch_ || dds_report.instruction_seq() != seq_) {
         continue;
       }
-      // Read in place from the message (no allocation in the cycle): the tail of granted_ or nothing.
+      // Read from the message into a fixed array (no allocation in the cycle).
       const std::size_t n = dds_report.waypoint_count();
-      if (n == 0 || n >= progressed_ || n > granted_.size() || n > dds_report.waypoint_slew().size()) continue;
-      const std::span<const anti_collision::Pose> rest = std::span<const anti_collision::Pose>(granted_).last(n);
-      bool tail = true;
-      for (std::size_t k = 0; k < n && tail; ++k) {
-        tail = dds_report.waypoint_slew()[k] == rest[k].slew && dds_report.waypoint_trolley()[k] == rest[k].trolley &&
-               dds_report.waypoint_cable_length()[k] == rest[k].cable_length;
+      if (n == 0 || n > reported_.size() || n > dds_report.waypoint_slew().size() ||
+          n > dds_report.waypoint_trolley().size() || n > dds_report.waypoint_cable_length().size()) {
+        continue;
       }
-      if (!tail) continue;
-      guard_.progress(anti_collision::path_airspace(rest, layout_.paths));
-      progressed_ = n;
+      for (std::size_t k = 0; k < n; ++k) {
+        reported_[k] = {dds_report.waypoint_slew()[k], dds_report.waypoint_trolley()[k],
+                        dds_report.waypoint_cable_length()[k]};
+      }
+      const std::span<const anti_collision::Pose> reported(reported_.data(), n);
+      if (!anti_collision::narrows(granted_, std::span<const anti_collision::Pose>(held_.data(), held_count_), reported)) {
+        continue;
+      }
+      guard_.progress(anti_collision::path_airspace(reported, layout_.paths));
+      std::copy(reported.begin(), reported.end(), held_.begin());
+      held_count_ = n;
     }
     const anti_collision::GrantCheck c = guard_.check(motion, time);
     // finish_path: the move under way ends at its waypoint inside the grant, sooner than a soft
@@ -124,7 +132,7 @@ class SiteLink {
                    "at {:.4f} m/s, swing {:.4f} {:.4f} rad; holding {} of {} granted waypoints",
                    anti_collision::to_string(c.action), c.reason, motion.slew, motion.slew_rate, motion.trolley,
                    motion.trolley_velocity, motion.cable_length, motion.cable_rate, motion.swing_in_plane,
-                   motion.swing_out_of_plane, progressed_, granted_.size());
+                   motion.swing_out_of_plane, held_count_ == 0 ? granted_.size() : held_count_, granted_.size());
       last_ = verdict;
     }
     return verdict;
@@ -139,7 +147,11 @@ class SiteLink {
   std::unique_ptr<transport::Reader<transport::topics::SiteStatus>> status_;
   std::unique_ptr<transport::Reader<transport::topics::SiteReport>> reports_;
   std::vector<anti_collision::Pose> granted_;  // the last grant's waypoints
-  std::size_t progressed_{0};                  // waypoints the guard holds of it (granted_.size(): all)
+  // What the guard holds of it: the rest of the path from a waypoint, or from a point of a segment
+  // (held_count_ 0: the whole grant), and the last report read (fixed arrays: no allocation).
+  std::array<anti_collision::Pose, anti_collision::Airspace::kMaxBoxes + 1> held_{};
+  std::size_t held_count_{0};
+  std::array<anti_collision::Pose, anti_collision::Airspace::kMaxBoxes + 1> reported_{};
   std::uint32_t epoch_{0};
   std::uint64_t seq_{0};
   supervisor::SiteVerdict last_{supervisor::SiteVerdict::proceed};

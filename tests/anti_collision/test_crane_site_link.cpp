@@ -191,6 +191,44 @@ TEST_F(Link, AsksForItsLegAndMovesOnlyOnTheGoForIt) {
   EXPECT_EQ(r->waypoints.size(), 4u) << "the whole path ahead until it reaches waypoint 1";
 }
 
+// Within a segment the crane reports, every kProgressStep of its travel, the point it has passed,
+// and its guard holds the same: the segment from there, with the tracking allowance behind it.
+// Backwards, it reports nothing new; within the last step, nothing; at the waypoint, the rest.
+TEST_F(Link, ReportsThePointOfTheSegmentItHasPassed) {
+  moving_at({0.0, 0.3, 0.2}, 0.3);  // the first segment: the trolley 0.3 -> 0.9 m, hook up
+  EXPECT_EQ(link_->report()->waypoints.size(), 4u);
+  at({0.0, 0.37, 0.2});  // 0.07 m on: not a step yet
+  (void)step();
+  expect_pose(link_->report()->waypoints[0], 0.0, 0.3, 0.2);
+  (void)link_->report_changed();
+  at({0.0, 0.55, 0.2});  // 0.25 m on: two steps passed
+  (void)step();
+  EXPECT_TRUE(link_->report_changed()) << "sent at once, not only at the report period";
+  auto r = link_->report();
+  ASSERT_EQ(r->waypoints.size(), 4u);
+  EXPECT_NEAR(r->waypoints[0].trolley, 0.5, 1e-12);
+  expect_pose(r->waypoints[1], 0.0, 0.9, 0.2);
+  const double tracking = layout_.paths.trolley_tracking;
+  const JointBox& box = link_->guard().granted().boxes[0];
+  EXPECT_NEAR(box.trolley_low, 0.5 - tracking, 1e-12) << "the guard holds the same, the allowance behind";
+  EXPECT_EQ(link_->guard().granted().count, 3u);
+  at({0.0, 0.45, 0.2});  // pulled back: nothing new
+  (void)step();
+  EXPECT_NEAR(link_->report()->waypoints[0].trolley, 0.5, 1e-12);
+  at({0.0, 0.89, 0.2});  // within the last step: the report stays a step short of the waypoint
+  (void)step();
+  EXPECT_NEAR(link_->report()->waypoints[0].trolley, 0.8, 1e-12);
+  // Arrived and settled: the next move, and the rest of the path from the waypoint.
+  reference_.phase = Reference::PHASE_ARRIVED;
+  at({0.0, 0.9, 0.2});
+  const auto g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 1.5);
+  r = link_->report();
+  ASSERT_EQ(r->waypoints.size(), 3u);
+  expect_pose(r->waypoints[0], 0.0, 0.9, 0.2);
+}
+
 TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
   (void)step();
   ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));

@@ -453,6 +453,118 @@ TEST(GrantGuard, AnAxisWhoseReferenceRestsEndsItsSoftStopThere) {
   EXPECT_FALSE(guard.soft_stop_stays_in_grant(m, ReferenceRest{std::nan(""), 0.6, std::nullopt}));
 }
 
+// Progress within a segment (grant_guard.hpp), by hand: the point a crane has passed on each axis,
+// in whole steps, and which reports narrow what a crane holds of its grant.
+TEST(GrantGuard, ProgressWithinASegmentByHand) {
+  ASSERT_DOUBLE_EQ(kProgressStep, 0.1);
+  const Pose from{0.0, 0.5, 0.2};
+  const Pose to{1.0, 0.9, 0.2};
+  // The slew 0.57 rad on: 5 steps; the trolley 0.27 m on: 2 steps; the hoist does not move here.
+  Pose p = passed_point(from, to, {0.57, 0.77, 0.2}, from);
+  EXPECT_NEAR(p.slew, 0.5, 1e-12);
+  EXPECT_NEAR(p.trolley, 0.7, 1e-12);
+  EXPECT_DOUBLE_EQ(p.cable_length, 0.2);
+  // Pulled back: nothing passed is given back.
+  p = passed_point(from, to, {0.45, 0.62, 0.2}, p);
+  EXPECT_NEAR(p.slew, 0.5, 1e-12);
+  EXPECT_NEAR(p.trolley, 0.7, 1e-12);
+  // Within each axis's last step: a step short of `to` (the slew 0.9, the trolley 0.8).
+  p = passed_point(from, to, {0.99, 0.9, 0.2}, p);
+  EXPECT_NEAR(p.slew, 0.9, 1e-12);
+  EXPECT_NEAR(p.trolley, 0.8, 1e-12);
+  // 0.6 m of trolley is six steps in doubles too (0.6 / 0.1 = 5.999999999999999): 0.8 at most.
+  EXPECT_NEAR(passed_point({0.0, 0.3, 0.2}, {0.0, 0.9, 0.2}, {0.0, 0.9, 0.2}, {0.0, 0.3, 0.2}).trolley, 0.8, 1e-12);
+  // Backwards along an axis (the slew from 1.0 to 0.0), an axis shorter than two steps, NaN.
+  EXPECT_NEAR(passed_point(to, from, {0.62, 0.9, 0.2}, to).slew, 0.7, 1e-12);
+  EXPECT_DOUBLE_EQ(passed_point(from, {0.15, 0.5, 0.2}, {0.15, 0.5, 0.2}, from).slew, 0.0);
+  EXPECT_DOUBLE_EQ(passed_point(from, to, {std::nan(""), 0.5, 0.2}, from).slew, 0.0);
+
+  const std::vector<Pose> granted{{0.0, 0.5, 1.5}, {0.0, 0.5, 0.2}, {1.0, 1.0, 0.2}, {1.0, 1.0, 1.5}};
+  const auto on_travel = [&](double slew, double trolley) {
+    return std::vector<Pose>{{slew, trolley, 0.2}, granted[2], granted[3]};
+  };
+  const std::vector<Pose> none;
+  EXPECT_FALSE(narrows(granted, none, granted)) << "the whole grant is not progress";
+  EXPECT_TRUE(narrows(granted, none, std::vector<Pose>(granted.begin() + 1, granted.end()))) << "a waypoint reached";
+  EXPECT_TRUE(narrows(granted, none, on_travel(0.4, 0.5)));
+  EXPECT_TRUE(narrows(granted, on_travel(0.4, 0.5), on_travel(0.4, 0.6))) << "one axis further, none back";
+  EXPECT_FALSE(narrows(granted, on_travel(0.4, 0.6), on_travel(0.5, 0.5))) << "the trolley back: it would widen";
+  EXPECT_FALSE(narrows(granted, on_travel(0.4, 0.6), on_travel(0.4, 0.6)));
+  EXPECT_TRUE(narrows(granted, on_travel(0.9, 0.9), std::vector<Pose>(granted.begin() + 2, granted.end())));
+  EXPECT_TRUE(narrows(granted, on_travel(0.9, 0.9), std::vector<Pose>{granted[3]}));
+  EXPECT_FALSE(narrows(granted, std::vector<Pose>(granted.begin() + 2, granted.end()), on_travel(0.9, 0.9)))
+      << "an earlier segment";
+  // Off the segment: the trolley beyond its end, the hoist on a travel segment, the segment's end
+  // itself with the waypoints of the segment before.
+  EXPECT_FALSE(narrows(granted, none, on_travel(0.5, 1.1)));
+  std::vector<Pose> hook_down = on_travel(0.5, 0.7);
+  hook_down[0].cable_length = 0.3;
+  EXPECT_FALSE(narrows(granted, none, hook_down));
+  EXPECT_FALSE(narrows(granted, none, on_travel(1.0, 1.0)));
+  // Another tail, a longer path than the grant, nothing, or a waypoint within kPathTolerance (the
+  // site link's rounding of a cable length).
+  std::vector<Pose> other_tail = on_travel(0.5, 0.7);
+  other_tail[2].cable_length = 1.4;
+  EXPECT_FALSE(narrows(granted, none, other_tail));
+  std::vector<Pose> longer = granted;
+  longer.push_back({1.0, 1.0, 0.2});
+  EXPECT_FALSE(narrows(granted, none, longer));
+  EXPECT_FALSE(narrows(granted, none, none));
+  EXPECT_FALSE(narrows(none, none, granted));
+  std::vector<Pose> rounded = on_travel(0.5, 0.7);
+  rounded[1].cable_length += 1e-9;
+  EXPECT_TRUE(narrows(granted, none, rounded));
+  // A point of a hoist-only segment (the cable 0.85 m, half way up).
+  EXPECT_TRUE(narrows(granted, none, std::vector<Pose>{{0.0, 0.5, 0.85}, granted[1], granted[2], granted[3]}));
+}
+
+// The site service takes a crane's progress within a segment: what the crane has passed is free
+// for the others before it reaches its next waypoint; a report that would widen what it holds, or
+// one off its path, changes nothing.
+TEST(SiteService, ACraneFreesTheSegmentItHasPassed) {
+  SiteService service(two_towers(), ArbiterMode::coordinated, 77);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  // B slews its load, hook down at 1.5 m (from 3.0 m to 1.5 m high), away from over A's jib line.
+  const std::vector<Pose> b_path{{kPi, 1.0, 1.5}, {kPi - 1.5, 1.0, 1.5}};
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.0), "");
+  ASSERT_EQ(service.report(at_rest(1, b_path[0], 5, b_path), 0.0), "");
+  auto orders = service.step(0.01);
+  ASSERT_EQ(orders.size(), 1u);
+  ASSERT_EQ(orders[0].crane, 1u);
+  CraneReport moving;
+  moving.crane = 1;
+  moving.moving = true;
+  moving.instruction_epoch = 77;
+  moving.instruction_seq = orders[0].seq;
+  moving.waypoints = b_path;
+  ASSERT_EQ(service.report(moving, 0.1), "");
+  // A asks to turn its jib to heading 0, under where B's load starts: it waits for B.
+  ASSERT_EQ(service.report(at_rest(0, a_rest, 9, {a_rest, {0.0, 0.5, 0.2}}), 0.2), "");
+  EXPECT_TRUE(service.step(0.2).empty());
+  ASSERT_EQ(service.arbiter().waits_for(0), std::vector<std::size_t>{1u});
+  // B has passed 0.1 rad of its slew: its load still over A's jib line. A waits.
+  moving.waypoints = {{kPi - 0.1, 1.0, 1.5}, b_path[1]};
+  ASSERT_EQ(service.report(moving, 0.3), "");
+  EXPECT_NEAR(service.arbiter().held(1).boxes[0].slew_high, kPi - 0.1, 1e-12);
+  EXPECT_TRUE(service.step(0.3).empty());
+  // A report off B's path, and one behind what it holds, change nothing.
+  CraneReport off = moving;
+  off.waypoints[0].trolley = 0.8;
+  ASSERT_EQ(service.report(off, 0.35), "");
+  CraneReport behind = moving;
+  behind.waypoints[0] = {kPi - 0.05, 1.0, 1.5};
+  ASSERT_EQ(service.report(behind, 0.35), "");
+  EXPECT_NEAR(service.arbiter().held(1).boxes[0].slew_high, kPi - 0.1, 1e-12);
+  // 0.7 rad on, B's load 0.64 m off A's jib line (1.0 sin 0.7): A goes, B still on its way.
+  moving.waypoints = {{kPi - 0.7, 1.0, 1.5}, b_path[1]};
+  ASSERT_EQ(service.report(moving, 0.4), "");
+  orders = service.step(0.4);
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].crane, 0u);
+  EXPECT_EQ(orders[0].request_id, 9u);
+  EXPECT_EQ(service.arbiter().holding(1), Holding::path);
+}
+
 TEST(SiteService, AGrantIsHeldUntilCarriedOutThenFollowsTheCranesProgress) {
   SiteService service(two_towers(), ArbiterMode::coordinated, 77);
   EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);  // nothing allowed by default

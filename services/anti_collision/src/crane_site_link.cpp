@@ -236,6 +236,7 @@ Request CraneSiteLink::disobey(const Pose& to, const Pose& here) {
   arrived_at_.reset();
   path_ = {here, to};
   waypoint_ = 1;
+  passed_ = here;
   yielding_ = true;  // its leg is not a job's
   request_id_ = 0;
   request_.clear();
@@ -326,12 +327,25 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
       changed_ = true;
     }
     ++waypoint_;
+    passed_ = path_[waypoint_ - 1];
     attempts_ = 0;
     goal_ = move_to(path_[waypoint_]);
     goal_taken_ = false;
     goal_sent_ = time;
     arrived_at_.reset();
     return goal_;
+  }
+
+  // Progress within the segment under way (grant_guard.hpp, kProgressStep): what the crane has
+  // passed on each axis is free for the others. Not while the link is lost: the service holds its
+  // whole reach, and the guard holds what lay ahead at the loss.
+  if (phase_ == Phase::moving && !link_lost_ && waypoint_ >= 1 && waypoint_ < path_.size()) {
+    const Pose passed = passed_point(path_[waypoint_ - 1], path_[waypoint_], pose_, passed_);
+    if (passed.slew != passed_.slew || passed.trolley != passed_.trolley || passed.cable_length != passed_.cable_length) {
+      passed_ = passed;
+      guard_.progress(path_airspace(rest_of_path(), layout_.paths));
+      changed_ = true;
+    }
   }
 
   // A goal the planner has not answered is sent again.
@@ -414,9 +428,7 @@ std::optional<CraneReport> CraneSiteLink::report() const {
   r.crane = crane_;
   r.moving = phase_ == Phase::moving || phase_ == Phase::dwelling || phase_ == Phase::halting;
   if (r.moving) {
-    // The rest of its path from the last waypoint it reached.
-    const std::size_t reached = waypoint_ == 0 ? 0 : (start_next_ || phase_ == Phase::dwelling ? waypoint_ : waypoint_ - 1);
-    r.waypoints.assign(path_.begin() + static_cast<std::ptrdiff_t>(std::min(reached, path_.size() - 1)), path_.end());
+    r.waypoints = rest_of_path();
   } else {
     r.waypoints = {pose_};
   }
@@ -427,6 +439,13 @@ std::optional<CraneReport> CraneSiteLink::report() const {
     r.request = request_;
   }
   return r;
+}
+
+std::vector<Pose> CraneSiteLink::rest_of_path() const {
+  const std::size_t reached = waypoint_ == 0 ? 0 : (start_next_ || phase_ == Phase::dwelling ? waypoint_ : waypoint_ - 1);
+  std::vector<Pose> rest(path_.begin() + static_cast<std::ptrdiff_t>(std::min(reached, path_.size() - 1)), path_.end());
+  if (reached + 1 == waypoint_ && waypoint_ < path_.size()) rest.front() = passed_;
+  return rest;
 }
 
 bool CraneSiteLink::report_changed() noexcept { return std::exchange(changed_, false); }

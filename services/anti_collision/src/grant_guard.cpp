@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +30,89 @@ bool contains(const Airspace& airspace, const Pose& pose, double tolerance) noex
     if (in_box(airspace.boxes[i], pose, tolerance)) return true;
   }
   return false;
+}
+
+namespace {
+
+bool same(const Pose& a, const Pose& b) noexcept {
+  return std::abs(a.slew - b.slew) <= kPathTolerance && std::abs(a.trolley - b.trolley) <= kPathTolerance &&
+         std::abs(a.cable_length - b.cable_length) <= kPathTolerance;
+}
+
+// A place on a granted path: segment k (granted[k] -> granted[k + 1]) and the point of it.
+struct Place {
+  std::size_t segment{0};
+  Pose at{};
+};
+
+bool between(double a, double b, double x) noexcept {
+  return x >= std::min(a, b) - kPathTolerance && x <= std::max(a, b) + kPathTolerance;
+}
+
+// Where part[0] lies on `granted` when part's other waypoints are granted's last ones (narrows());
+// nullopt when it is not on it.
+std::optional<Place> place_on(std::span<const Pose> granted, std::span<const Pose> part) noexcept {
+  const std::size_t n = part.size();
+  const std::size_t m = granted.size();
+  if (n == 0 || n > m) return std::nullopt;
+  for (std::size_t k = 1; k < n; ++k) {
+    if (!same(part[k], granted[m - n + k])) return std::nullopt;
+  }
+  const std::size_t segment = m - n;
+  const Pose& p = part[0];
+  if (same(p, granted[segment])) return Place{segment, granted[segment]};
+  if (segment + 1 >= m) return std::nullopt;
+  const Pose& from = granted[segment];
+  const Pose& to = granted[segment + 1];
+  if (!between(from.slew, to.slew, p.slew) || !between(from.trolley, to.trolley, p.trolley) ||
+      !between(from.cable_length, to.cable_length, p.cable_length) || same(p, to)) {
+    return std::nullopt;
+  }
+  return Place{segment, p};
+}
+
+// True when `later` is further along the path than `earlier` (see narrows()).
+bool further(std::span<const Pose> granted, const Place& later, const Place& earlier) noexcept {
+  if (later.segment != earlier.segment) return later.segment > earlier.segment;
+  const Pose& from = granted[later.segment];
+  bool ahead = false;
+  const auto axis = [&](double start, double l, double e) {
+    const double dl = std::abs(l - start);
+    const double de = std::abs(e - start);
+    ahead = ahead || dl > de + kPathTolerance;
+    return dl >= de - kPathTolerance;
+  };
+  const bool slew = axis(from.slew, later.at.slew, earlier.at.slew);
+  const bool trolley = axis(from.trolley, later.at.trolley, earlier.at.trolley);
+  const bool cable = axis(from.cable_length, later.at.cable_length, earlier.at.cable_length);
+  return slew && trolley && cable && ahead;
+}
+
+// One axis of passed_point().
+double passed_on_axis(double from, double to, double position, double passed) noexcept {
+  const double travel = std::abs(to - from);
+  // 1e-9: a whole number of steps in decimal (0.6 / 0.1 = 5.999999999999999) counts as whole.
+  const double last = std::floor(travel / kProgressStep + 1e-9) - 1.0;  // at least a step short of `to`
+  if (!(last >= 1.0) || !std::isfinite(position)) return passed;
+  const double come = std::clamp((position - from) / (to - from), 0.0, 1.0) * travel;
+  const double steps = std::min(std::floor(come / kProgressStep + 1e-9), last);
+  const double here = from + std::copysign(steps * kProgressStep, to - from);
+  return std::abs(here - from) > std::abs(passed - from) ? here : passed;
+}
+
+}  // namespace
+
+Pose passed_point(const Pose& from, const Pose& to, const Pose& pose, const Pose& passed) noexcept {
+  return {passed_on_axis(from.slew, to.slew, pose.slew, passed.slew),
+          passed_on_axis(from.trolley, to.trolley, pose.trolley, passed.trolley),
+          passed_on_axis(from.cable_length, to.cable_length, pose.cable_length, passed.cable_length)};
+}
+
+bool narrows(std::span<const Pose> granted, std::span<const Pose> held, std::span<const Pose> reported) noexcept {
+  if (granted.empty()) return false;
+  const std::optional<Place> now = held.empty() ? std::optional<Place>(Place{0, granted[0]}) : place_on(granted, held);
+  const std::optional<Place> next = place_on(granted, reported);
+  return now && next && further(granted, *next, *now);
 }
 
 const char* to_string(GrantAction action) noexcept {

@@ -64,7 +64,7 @@ std::string SiteService::report(const CraneReport& r, double time) {
   const auto rest = [&] {
     arbiter_.rest(r.crane, here);
     link.rest_pose = here;
-    link.progress_count = 0;
+    link.progressed.clear();
     dirty_ = true;
   };
   switch (arbiter_.holding(r.crane)) {
@@ -87,9 +87,9 @@ std::string SiteService::report(const CraneReport& r, double time) {
       if (!link.carried_out) break;  // it has not heard, or not started, its instruction yet
       if (!r.moving) {
         rest();
-      } else if (r.waypoints.size() != link.progress_count) {
-        arbiter_.progress(r.crane, r.waypoints);  // a waypoint reached: what it left is free
-        link.progress_count = r.waypoints.size();
+      } else if (narrows(link.last_order.waypoints, link.progressed, r.waypoints)) {
+        arbiter_.progress(r.crane, r.waypoints);  // further along its path: what it left is free
+        link.progressed = r.waypoints;
         dirty_ = true;
       }
       break;
@@ -140,6 +140,7 @@ std::vector<SiteOrder> SiteService::step(double time) {
       link.pending_id = 0;
     }
     link.last_order = order;
+    link.progressed.clear();
     link.carried_out = false;
     link.last_sent = time;
     out.push_back(std::move(order));

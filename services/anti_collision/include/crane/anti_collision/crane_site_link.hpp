@@ -29,10 +29,12 @@
 // again the same way but is not an attempt: the link never gives up on a crane that only stalls.
 //
 // Its report (report()) is its whole state: at rest at its pose, or moving with the rest of its
-// path from the last waypoint it reached; the last instruction it carried out (the epoch and seq
-// of the go or yield it started); the leg it asks for while it waits at rest. A crane braked by its
-// supervisor (a latched fault) stops reporting and asking, for good: the service then holds its
-// whole reach, as for a crane that went silent.
+// path from the last waypoint it reached, or, every kProgressStep of an axis's travel, from the
+// point of the segment it has passed on each axis (grant_guard.hpp; its guard holds the same);
+// the last instruction it carried out (the epoch and seq of the go or yield it started); the leg
+// it asks for while it waits at rest. A crane braked by its supervisor (a latched fault) stops
+// reporting and asking, for good: the service then holds its whole reach, as for a crane that went
+// silent.
 //
 // The link: the crane hears the service (heard(): its heartbeat, any instruction) and keeps its
 // own GrantGuard (grant_guard.hpp) on what it was granted. When nothing was heard for the site's
@@ -184,6 +186,9 @@ class CraneSiteLink {
   std::optional<protocol::MoveRequest> advance(double time, const protocol::CraneState& estimate,
                                                const protocol::Reference& reference, bool braked);
   protocol::MoveRequest move_to(const Pose& to);
+  /// What it holds of its path: from the last waypoint it reached, or from the point of the segment
+  /// under way it has reported passing (passed_, when it is not the segment's start), to the end.
+  [[nodiscard]] std::vector<Pose> rest_of_path() const;
   void rest_at(const Pose& here, double time);
 
   SiteLayout layout_;
@@ -201,6 +206,7 @@ class CraneSiteLink {
   double lost_from_{0.0};            // [s] the last message heard before the loss
   std::vector<Pose> path_;           // the granted path or yield, path_[0] where it started
   std::size_t waypoint_{0};          // the waypoint being moved to
+  Pose passed_{};                    // the point of the segment to waypoint_ reported passed (passed_point)
   bool yielding_{false};
   bool gave_up_{false};              // phase aborted, or a yield from it
   bool start_next_{false};           // the move to waypoint_ + 1 starts at the next step

@@ -45,6 +45,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 
 #include "crane/anti_collision/airspace.hpp"
 #include "crane/anti_collision/crane_geometry.hpp"
@@ -57,6 +58,41 @@ inline constexpr double kContainmentTolerance = 0.02;
 
 /// True when `pose` lies within `tolerance` of at least one box of `airspace` on every axis.
 [[nodiscard]] bool contains(const Airspace& airspace, const Pose& pose, double tolerance = kContainmentTolerance) noexcept;
+
+// Progress within a segment (docs/site.md, "Progress within a segment"). A crane moving from one
+// waypoint of its grant to the next tells the site service, every kProgressStep of an axis's
+// travel, the point of the segment it has passed on each axis; it then holds the segment from
+// that point on, and the service frees what lies behind it for the other cranes. The crane's guard
+// holds the same. It only narrows: each axis of the point lies between the segment's ends, so the
+// box from it to the segment's end lies in the segment's box, and keeps the tracking allowance
+// on either side of the new start.
+
+/// [m or rad] of an axis's travel on a segment between two reports of a crane's progress on it;
+/// none is made on an axis within its last step (the waypoint's own report follows).
+inline constexpr double kProgressStep = 0.1;
+/// [m or rad] how far a reported pose may lie outside the grant's own waypoints, or the segment
+/// between two of them, and still be on the path (a double sent over DDS is exact; the site link
+/// rounds a cable length within 1e-9 of its travel length to it).
+inline constexpr double kPathTolerance = 1e-6;
+
+/// The point of the segment `from` -> `to` that a crane at `pose` has passed, given the point
+/// `passed` it had passed before (`from` at first): on each axis the further of `passed` and the
+/// whole kProgressStep the pose has come from `from` toward `to`, at least a step short of `to`. An
+/// axis that travels less than two steps stays at `from`; a pose behind, or not finite, passes
+/// nothing new.
+[[nodiscard]] Pose passed_point(const Pose& from, const Pose& to, const Pose& pose, const Pose& passed) noexcept;
+
+/// True when `reported` is a crane's progress on the grant through `granted` past `held`: both are
+/// the rest of that path from a place on it (their waypoints after the first are granted's last
+/// ones, each axis within kPathTolerance; their first is the waypoint before those, or a point of
+/// the segment from it to the next: each axis between the two ends), and `reported` starts
+/// further along: on a later segment, or on the same one with every axis at least as far from the
+/// segment's start and one further (an empty `held`: the whole grant). What the crane holds only
+/// narrows: the site service and the crane's supervisor take a report only when this holds.
+/// noexcept, no allocation; false for anything else (an empty `reported`, one longer than
+/// `granted`, a point off the segment).
+[[nodiscard]] bool narrows(std::span<const Pose> granted, std::span<const Pose> held,
+                           std::span<const Pose> reported) noexcept;
 
 /// Where the planner's reference rests on each axis a grant bounds: set for an axis whose reference
 /// speed and acceleration are both within kReferenceAtRest of zero, std::nullopt for one that moves

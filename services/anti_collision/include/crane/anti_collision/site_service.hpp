@@ -17,7 +17,8 @@
 //       on an axis since the box was taken); moving -> the whole reach (moving without a grant);
 //   path or yield: before the crane has carried out that instruction, nothing (it holds the
 //       path already); after, moving -> the rest of the path (SiteArbiter::progress, when it
-//       reached another waypoint), at rest -> the pose's box (the path is done).
+//       has come further along it: another waypoint reached, or a point of the segment under way
+//       passed, grant_guard.hpp's narrows()), at rest -> the pose's box (the path is done).
 // A request id the service has not seen is a new request (SiteArbiter::request); a report with
 // none withdraws the pending one. step() marks every crane heard from for no longer than the
 // site's link_deadline as lost (it holds its whole reach, its request is dropped), runs the rules
@@ -37,6 +38,7 @@
 #include <vector>
 
 #include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
 #include "crane/anti_collision/site_layout.hpp"
 
@@ -96,7 +98,7 @@ class SiteService {
     SiteOrder last_order;          // its last instruction (seq 0: none)
     double last_sent{0.0};
     Pose rest_pose{};                // where its rest box was taken
-    std::size_t progress_count{0};   // waypoints left at its last progress (0: none yet)
+    std::vector<Pose> progressed;    // the rest of its path at its last progress taken (empty: none yet)
   };
 
   SiteArbiter arbiter_;
