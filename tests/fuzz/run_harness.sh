@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # tests/fuzz/run_harness.sh FUZZ_BUILD_DIR NAME SECONDS: runs the libFuzzer harness fuzz_NAME of
-# FUZZ_BUILD_DIR for SECONDS on its seed corpus (tests/fuzz/corpus/NAME) and its working corpus
-# (FUZZ_BUILD_DIR/fuzz-corpus/NAME, which grows from run to run). Prints the executions and, on a
+# FUZZ_BUILD_DIR for SECONDS on its seed corpus (tests/fuzz/corpus/NAME; for stack_config also the
+# shipped configurations, deploy/config, read where they are so that the seeds never fall out of
+# step with them) and its working corpus (FUZZ_BUILD_DIR/fuzz-corpus/NAME, which grows from run to
+# run). Prints the executions and, on a
 # finding, the crash file and the sanitizer's report. Exit 0: no finding; 77: the harness is not
 # built (ctest skips: deploy/crane fuzz builds it); otherwise libFuzzer's exit status.
 # Used by deploy/crane fuzz and by the ctest tests fuzz.NAME (docs/robustness.md).
@@ -14,10 +16,13 @@ if [ ! -x "$exe" ]; then
   exit 77
 fi
 mkdir -p "$dir/fuzz-corpus/$name" "$dir/fuzz-artifacts/$name"
+seeds=()
+[ -d "$here/corpus/$name" ] && seeds+=("$here/corpus/$name")
+[ "$name" = stack_config ] && seeds+=("$here/../../deploy/config")
 log="$dir/fuzz-artifacts/$name/last-run.log"
 # -timeout: an input running 10 s is a hang (reported as a finding); -rss_limit_mb: libFuzzer's default.
 "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
-  -artifact_prefix="$dir/fuzz-artifacts/$name/" "$dir/fuzz-corpus/$name" "$here/corpus/$name" >"$log" 2>&1
+  -artifact_prefix="$dir/fuzz-artifacts/$name/" "$dir/fuzz-corpus/$name" "${seeds[@]}" >"$log" 2>&1
 rc=$?
 executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
 corpus=$(ls "$dir/fuzz-corpus/$name" | wc -l)
