@@ -148,12 +148,14 @@ class SiteCrane {
     crane::protocol::to_dds(m, out);
     instruction_writer_->write(out);
   }
-  // tc1's report as its site link sends it, moving on the last grant, the waypoints from `from` on.
-  void report_progress(std::size_t from) {
+  // tc1's report as its site link sends it, moving on the last grant: the rest of the path from the
+  // point of its first segment at `trolley` [m] (grant_guard.hpp, progress within a segment).
+  void report_progress_at(double trolley) {
     ac::CraneReport r;
     r.crane = 0;
     r.moving = true;
-    r.waypoints.assign(granted_.begin() + static_cast<std::ptrdiff_t>(from), granted_.end());
+    r.waypoints.assign(granted_.begin() + 1, granted_.end());
+    r.waypoints.insert(r.waypoints.begin(), {0.0, trolley, 1.0});
     r.instruction_epoch = kEpoch;
     r.instruction_seq = seq_;
     crane::protocol::SiteReport m{};
@@ -296,13 +298,13 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
   }
   EXPECT_TRUE(aborted_for_site) << "the planner's soft stop names the site";
 
-  // 4. The crane's progress narrows its guard's grant: granted from where it rests out to 0.75 m
-  // and back to 0.65 m, it reaches 0.75 m and its site link reports the rest of the path from
-  // there; a move back to where it started (inside the first segment's box, outside the rest's:
-  // 0.75 -> 0.65 m holds [0.61, 0.86] m with the tracking and overshoot allowances) is braked.
+  // 4. The crane's progress narrows its guard's grant: granted from where it rests out to 0.75 m,
+  // it gets there and its site link reports the rest of the segment from 0.70 m, a point it has
+  // passed; a move back to where it started (inside the granted box, outside the narrowed one:
+  // 0.70 -> 0.75 m holds [0.66, 0.86] m with the tracking and overshoot allowances) is braked.
   crane.heartbeat = true;
   const double from = crane.trolley();
-  crane.grant(from, 0.65, 0.75);
+  crane.grant(from, 0.75);
   ASSERT_TRUE(crane.wait(10.0, [&] { return crane.ready() && crane.status()->mode == Status::MODE_READY; }))
       << "the soft stop did not end; see " << crane.dir();
   crane.move(0.75);
@@ -310,7 +312,7 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
     return std::fabs(crane.trolley() - 0.75) < 0.02 && std::fabs(crane.status()->trolley_velocity) < 0.01;
   })) << "the move to 0.75 m did not end; trolley " << crane.trolley() << " m; see " << crane.dir();
   ASSERT_EQ(crane.status()->latched_faults & Status::FAULT_SITE_GRANT, 0u);
-  crane.report_progress(1);
+  crane.report_progress_at(0.70);
   crane.run_for(0.3);
   crane.move(from + 0.02, 0.2);
   ASSERT_TRUE(crane.wait(10.0, [&] { return (crane.status()->latched_faults & Status::FAULT_SITE_GRANT) != 0; }))
@@ -318,7 +320,7 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
       << " m; see " << crane.dir();
   std::printf("[ figure   ] back into what it had left (0.75 -> %.3f m): braked at %.3f m\n", from + 0.02,
               crane.trolley());
-  EXPECT_GT(crane.trolley(), 0.61 - 0.1) << "braked near the narrowed box's edge";
+  EXPECT_GT(crane.trolley(), 0.66 - 0.1) << "braked near the narrowed box's edge";
 }
 
 }  // namespace
