@@ -341,7 +341,8 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
   // whole reach, and the guard holds what lay ahead at the loss.
   if (phase_ == Phase::moving && !link_lost_ && waypoint_ >= 1 && waypoint_ < path_.size()) {
     const Pose passed = passed_point(path_[waypoint_ - 1], path_[waypoint_], pose_, passed_);
-    if (passed.slew != passed_.slew || passed.trolley != passed_.trolley || passed.cable_length != passed_.cable_length) {
+    if (passed.slew != passed_.slew || passed.trolley != passed_.trolley ||
+        passed.cable_length != passed_.cable_length) {
       passed_ = passed;
       guard_.progress(path_airspace(rest_of_path(), layout_.paths));
       changed_ = true;
@@ -442,8 +443,10 @@ std::optional<CraneReport> CraneSiteLink::report() const {
 }
 
 std::vector<Pose> CraneSiteLink::rest_of_path() const {
-  const std::size_t reached = waypoint_ == 0 ? 0 : (start_next_ || phase_ == Phase::dwelling ? waypoint_ : waypoint_ - 1);
-  std::vector<Pose> rest(path_.begin() + static_cast<std::ptrdiff_t>(std::min(reached, path_.size() - 1)), path_.end());
+  const std::size_t reached =
+      waypoint_ == 0 ? 0 : (start_next_ || phase_ == Phase::dwelling ? waypoint_ : waypoint_ - 1);
+  std::vector<Pose> rest(path_.begin() + static_cast<std::ptrdiff_t>(std::min(reached, path_.size() - 1)),
+                         path_.end());
   if (reached + 1 == waypoint_ && waypoint_ < path_.size()) rest.front() = passed_;
   return rest;
 }

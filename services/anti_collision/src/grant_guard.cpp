@@ -22,18 +22,6 @@ bool in_box(const JointBox& b, const Pose& p, double tolerance) noexcept {
          within(p.cable_length, b.cable_low, b.cable_high, tolerance);
 }
 
-}  // namespace
-
-bool contains(const Airspace& airspace, const Pose& pose, double tolerance) noexcept {
-  const std::size_t count = std::min(airspace.count, Airspace::kMaxBoxes);
-  for (std::size_t i = 0; i < count; ++i) {
-    if (in_box(airspace.boxes[i], pose, tolerance)) return true;
-  }
-  return false;
-}
-
-namespace {
-
 bool same(const Pose& a, const Pose& b) noexcept {
   return std::abs(a.slew - b.slew) <= kPathTolerance && std::abs(a.trolley - b.trolley) <= kPathTolerance &&
          std::abs(a.cable_length - b.cable_length) <= kPathTolerance;
@@ -45,8 +33,9 @@ struct Place {
   Pose at{};
 };
 
+// x between the segment's ends a and b (either order), within kPathTolerance.
 bool between(double a, double b, double x) noexcept {
-  return x >= std::min(a, b) - kPathTolerance && x <= std::max(a, b) + kPathTolerance;
+  return within(x, std::min(a, b), std::max(a, b), kPathTolerance);
 }
 
 // Where part[0] lies on `granted` when part's other waypoints are granted's last ones (narrows());
@@ -101,6 +90,14 @@ double passed_on_axis(double from, double to, double position, double passed) no
 }
 
 }  // namespace
+
+bool contains(const Airspace& airspace, const Pose& pose, double tolerance) noexcept {
+  const std::size_t count = std::min(airspace.count, Airspace::kMaxBoxes);
+  for (std::size_t i = 0; i < count; ++i) {
+    if (in_box(airspace.boxes[i], pose, tolerance)) return true;
+  }
+  return false;
+}
 
 Pose passed_point(const Pose& from, const Pose& to, const Pose& pose, const Pose& passed) noexcept {
   return {passed_on_axis(from.slew, to.slew, pose.slew, passed.slew),

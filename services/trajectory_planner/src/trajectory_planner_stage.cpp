@@ -272,7 +272,9 @@ PlanRequest TrajectoryPlannerStage::plan_of(const protocol::MoveRequest& r, cons
   plan_on_pendulum(plan, params.manual.pendulum(), false, params);
   if (cycle_estimate_ != nullptr && cycle_estimate_->swing_length_confident) {
     const EquivalentPendulum learnt{cycle_estimate_->swing_length_scale, cycle_estimate_->swing_length_offset};
-    if (swings_down_to(learnt, std::min(plan.cable_from, plan.cable_target))) plan_on_pendulum(plan, learnt, true, params);
+    if (swings_down_to(learnt, std::min(plan.cable_from, plan.cable_target))) {
+      plan_on_pendulum(plan, learnt, true, params);
+    }
   }
   return plan;
 }
