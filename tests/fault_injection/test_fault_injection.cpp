@@ -148,11 +148,19 @@ bool energized(const BoardMonitor::Write& w) { return w.digital == hb::all_outpu
 /// The hardware-in-the-loop stack plus this process's participant (observer, operator, rogue).
 class HilStack {
  public:
+  /// `iceoryx`: the stack on Cyclone DDS and iceoryx, RouDi its first process; this process's
+  /// participant stays on UDP with the same QoS (RouDi would end it when it stops).
   HilStack(const std::string& name, std::uint32_t domain, const std::string& config = kConfig,
-           double initial_trolley = 0.25, const std::map<std::string, std::string>& dds_per_process = {})
-      : dir_(fresh_directory(name)), board_name_("fi_" + name + "_" + std::to_string(getpid())), domain_(domain) {
+           double initial_trolley = 0.25, const std::map<std::string, std::string>& dds_per_process = {},
+           bool iceoryx = false)
+      : dir_(fresh_directory(name)), board_name_("fi_" + name + "_" + std::to_string(getpid())), domain_(domain),
+        iceoryx_(iceoryx) {
     crane::launch::StackOptions options;
     options.dds_per_process = dds_per_process;
+    if (iceoryx) {
+      options.dds = "cyclone";
+      options.iceoryx = true;
+    }
     options.config_path = config;
     options.binary_directory = kBin;
     options.log_directory = dir_.string();
@@ -169,6 +177,7 @@ class HilStack {
     p.domain_id = domain;
     p.security_directory = security_directory();
     p.identity = "operator";
+    if (iceoryx) p.liveliness = crane::transport::Liveliness::watchdogs;
     participant_ = std::make_unique<crane::transport::Participant>(p);
     status_reader_ = participant_->make_recording_reader<tp::SafetyStatus>(&wakeup_, 4096);
     sensors_reader_ = participant_->make_recording_reader<tp::Sensors>(&wakeup_, 4096);
@@ -183,6 +192,17 @@ class HilStack {
     // Readers before writers of the same topic (transport note), then the processes.
     monitor_.reset();
     group_.stop_all();
+    // A process killed -9 leaves its iceoryx runtime's socket and lock in /tmp
+    // (iceoryx_rt_<pid>_<time>, Cyclone DDS's name for it); one that exits removes its own.
+    if (iceoryx_) {
+      for (const auto& [name, pid] : pids_) {
+        const std::string prefix = "iceoryx_rt_" + std::to_string(pid) + "_";
+        std::error_code error;
+        for (const auto& entry : fs::directory_iterator("/tmp", error)) {
+          if (entry.path().filename().string().rfind(prefix, 0) == 0) fs::remove(entry.path(), error);
+        }
+      }
+    }
   }
 
   const fs::path& dir() const { return dir_; }
@@ -291,6 +311,7 @@ class HilStack {
   fs::path dir_;
   std::string board_name_;
   std::uint32_t domain_;
+  bool iceoryx_;
   std::uint32_t next_goal_id_{7};
   ProcessGroup group_;
   std::map<std::string, pid_t> pids_;
@@ -371,15 +392,21 @@ double travel_after(const std::vector<tp::msgs::SensorSample_>& sensors, std::in
 
 // ---- kill -9 of each stage of the chain in mid-move ----
 
-// kill -9 of `stage` in mid-move; `dds_per_process` puts some processes on another vendor.
+// kill -9 of `stage` in mid-move; `dds_per_process` puts some processes on another vendor; `iceoryx`
+// the whole stack on Cyclone DDS and iceoryx shared memory.
 void kill_stage_in_mid_move(const std::string& stage, std::uint32_t domain,
-                            const std::map<std::string, std::string>& dds_per_process) {
+                            const std::map<std::string, std::string>& dds_per_process, bool iceoryx = false) {
   std::string vendors;
   for (const auto& [name, vendor] : dds_per_process) vendors += " " + name + "=" + vendor;
+  if (iceoryx) vendors = " iceoryx";
   if (!dds_per_process.empty() && !security_directory().empty()) {
     GTEST_SKIP() << "mixed vendors do not handshake secured with the Debian packages (docs/deployment.md, \"Security\")";
   }
-  HilStack stack("kill_" + stage + (dds_per_process.empty() ? "" : "_mixed"), domain, kConfig, 0.25, dds_per_process);
+  if (iceoryx && !security_directory().empty()) {
+    GTEST_SKIP() << "iceoryx carries no DDS Security: a secured participant refuses it (transport/participant.hpp)";
+  }
+  HilStack stack("kill_" + stage + (dds_per_process.empty() ? "" : "_mixed") + (iceoryx ? "_iceoryx" : ""), domain,
+                 kConfig, 0.25, dds_per_process, iceoryx);
   ASSERT_TRUE(stack.wait_ready());
   ASSERT_TRUE(stack.start_move(1.0));
 
@@ -446,10 +473,23 @@ TEST_P(KillCycloneStage, BrakesAndZeroVoltsWithinTheWatchdogTimeout) {
   kill_stage_in_mid_move(GetParam(), domain++, {{GetParam(), "cyclone"}});
 }
 
+// The same with the stack on iceoryx shared memory (docs/architecture.md, "Shared memory"): no DDS
+// liveliness or deadline on the chain there; the supervisor's receive-time watchdog and the bridge's
+// command-age watchdog must give the same bound by themselves.
+class KillStageOnIceoryx : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(KillStageOnIceoryx, BrakesAndZeroVoltsWithinTheWatchdogTimeout) {
+  static std::uint32_t domain = 100;
+  kill_stage_in_mid_move(GetParam(), domain++, {}, true);
+}
+
 INSTANTIATE_TEST_SUITE_P(Chain, KillStage,
                          ::testing::Values("state_estimator", "trajectory_planner", "anti_swing", "tracking",
                                            "friction_compensation"));
 INSTANTIATE_TEST_SUITE_P(MixedVendors, KillCycloneStage,
+                         ::testing::Values("state_estimator", "trajectory_planner", "anti_swing", "tracking",
+                                           "friction_compensation"));
+INSTANTIATE_TEST_SUITE_P(Iceoryx, KillStageOnIceoryx,
                          ::testing::Values("state_estimator", "trajectory_planner", "anti_swing", "tracking",
                                            "friction_compensation"));
 

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "crane/launch/process_group.hpp"
@@ -219,6 +220,64 @@ TEST(Lockstep, RepeatedRunsAreBitIdenticalWithLostSamplesAndUnderLoad) {
       }
     }
   }
+}
+
+// Packets sent on this network namespace's loopback interface so far (/proc/net/dev, which shows the
+// namespace of the reading process; /sys/class/net shows the one sysfs was mounted in).
+long loopback_packets_sent() {
+  std::ifstream dev("/proc/net/dev");
+  std::string line;
+  while (std::getline(dev, line)) {
+    const auto colon = line.find(':');
+    if (colon == std::string::npos || line.substr(0, colon).find("lo") == std::string::npos) continue;
+    std::istringstream fields(line.substr(colon + 1));
+    long value = 0;
+    for (int i = 0; i < 10 && (fields >> value); ++i) {
+    }
+    return value;  // the 10th field: transmitted packets
+  }
+  return -1;
+}
+
+// The stack on iceoryx shared memory (docs/architecture.md, "Shared memory"): the same maneuvers
+// give crane_sim's files to the last bit, as on UDP, and the samples leave the network stack. On
+// UDP every cycle sends at least 6 packets for the chain's hops alone (and their copies to the
+// supervisor and the recorder); on iceoryx only discovery is left, which goes with the wall time,
+// not the cycles (2026-11-28: 2905 packets against 46831 for the trolley move, all of them to
+// discovery ports). Both counted here, in this test's private network namespace (the integration
+// tests run alone).
+TEST(Lockstep, OnIceoryxTheDemoIsCraneSimToTheBitAndOffTheNetwork) {
+  const std::vector<std::string> maneuvers{"--maneuver", "trolley", "--maneuver", "combined",
+                                           "--friction-compensation", "on"};
+  auto options = maneuvers;
+  options.insert(options.end(), {"--dds", "cyclone"});
+  auto with_iceoryx = options;
+  with_iceoryx.push_back("--iceoryx");
+  const long before_udp = loopback_packets_sent();
+  ASSERT_GE(before_udp, 0) << "no loopback interface in /proc/net/dev";
+  const auto udp = run_demo("iceoryx_udp", 36, options);
+  const long udp_packets = loopback_packets_sent() - before_udp;
+  const auto iceoryx = run_demo("iceoryx", 37, with_iceoryx);
+  const long iceoryx_packets = loopback_packets_sent() - before_udp - udp_packets;
+  ASSERT_FALSE(udp.is_null());
+  ASSERT_FALSE(iceoryx.is_null());
+  ASSERT_EQ(iceoryx["maneuvers"].size(), 2U);
+  const fs::path out = fs::temp_directory_path() / ("crane_test_iceoryx_" + std::to_string(getpid()));
+  expect_sim_equals_demo(iceoryx, out, run_sim("iceoryx_sim", maneuvers));
+  double cycles = 0.0;
+  for (const auto& m : iceoryx["maneuvers"]) {
+    EXPECT_EQ(m["braked_cycles"].get<int>(), 0) << m["csv"];
+    EXPECT_EQ(m["missing_samples"].get<int>(), 0) << m["csv"];
+    cycles += m["samples"].get<double>();
+  }
+  EXPECT_EQ(iceoryx["loop"]["overruns"].get<int>(), 0);
+  std::printf("[ figure   ] %.0f cycles: %ld packets on loopback over UDP (%.1f a cycle), %ld on iceoryx (%.2f a "
+              "cycle); %.0fx vs %.0fx real time\n",
+              cycles, udp_packets, static_cast<double>(udp_packets) / cycles, iceoryx_packets,
+              static_cast<double>(iceoryx_packets) / cycles, udp["loop"]["real_time_factor"].get<double>(),
+              iceoryx["loop"]["real_time_factor"].get<double>());
+  EXPECT_GE(static_cast<double>(udp_packets), 6.0 * cycles) << "the UDP run must carry the chain on loopback";
+  EXPECT_LT(5 * iceoryx_packets, udp_packets) << "on iceoryx the samples must leave the network stack";
 }
 
 // `maneuvers` (crane_demo options) of `config` run twice, lockstep: with the plant on DDS, and through

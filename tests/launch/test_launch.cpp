@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "crane/stack/maneuver_metrics.hpp"
+#include "crane/launch/iceoryx.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -337,6 +339,95 @@ TEST(DdsMix, ParsesAndOverridesPerProcess) {
     EXPECT_EQ(*(at + 1), cyclone ? "cyclone" : "fast") << spec.name;
   }
   EXPECT_TRUE(crane::launch::parse_dds_mix("", known).empty());
+}
+
+// A stack on iceoryx (docs/architecture.md, "Shared memory"): RouDi first, every other process with
+// --iceoryx, none on another vendor than Cyclone DDS, nothing that leaves the machine; start_roudi
+// false leaves RouDi to run_beside_roudi().
+TEST(Iceoryx, RoudiFirstAndEveryProcessOnItOnCycloneOnly) {
+  if (la::find_executable("iox-roudi").empty()) GTEST_SKIP() << "iox-roudi not installed (Debian package iceoryx)";
+  la::StackOptions o;
+  o.config_path = "c.yaml";
+  o.binary_directory = "/bin";
+  o.dds = "cyclone";
+  o.iceoryx = true;
+  o.log_directory = "/logs";
+  const auto specs = la::stack_processes(o);
+  ASSERT_GT(specs.size(), 3U);
+  EXPECT_EQ(specs.front().name, la::kRoudiProcess);
+  EXPECT_EQ(specs.front().executable, la::find_executable("iox-roudi"));
+  EXPECT_EQ(specs.front().log_path, "/logs/iox_roudi.log");
+  for (std::size_t i = 1; i < specs.size(); ++i) {
+    const auto& a = specs[i].arguments;
+    EXPECT_NE(std::find(a.begin(), a.end(), "--iceoryx"), a.end()) << specs[i].name;
+  }
+  EXPECT_EQ(la::stack_process_names(o).front(), la::kRoudiProcess);
+  o.start_roudi = false;
+  EXPECT_EQ(la::stack_processes(o).front().name, "supervisor");
+  const auto refused = [](la::StackOptions bad, const std::string& named) {
+    try {
+      (void)la::stack_processes(bad);
+      ADD_FAILURE() << "accepted; expected a refusal naming '" << named << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
+  auto mixed = o;
+  mixed.dds_per_process = {{"tracking", "fast"}};
+  refused(mixed, "tracking is on 'fast'");
+  auto fast = o;
+  fast.dds = "fast";
+  refused(fast, "Cyclone DDS");
+  auto lan = o;
+  lan.lan = true;
+  refused(lan, "--lan");
+  auto secured = o;
+  secured.security_directory = "/security";
+  refused(secured, "--security");
+}
+
+// find_executable: as the shell finds a command on PATH.
+TEST(FindExecutable, FindsWhatThePathHasAndNothingElse) {
+  const std::string sh = la::find_executable("sh");
+  ASSERT_FALSE(sh.empty());
+  EXPECT_EQ(access(sh.c_str(), X_OK), 0) << sh;
+  EXPECT_EQ(std::filesystem::path(sh).filename(), "sh");
+  EXPECT_TRUE(la::find_executable("crane_no_such_command_anywhere").empty());
+}
+
+// run_beside_roudi: RouDi runs while the body's process does, stops after it, and the body's exit
+// code comes back; a second RouDi (one runs already) ends at once and takes its body with it.
+// RouDi's shared memory (/dev/shm/iceoryx_mgmt, iceoryx 2.0's name) tells whether it runs.
+TEST(Iceoryx, RoudiRunsBesideTheBodyAndStopsAfterIt) {
+  if (la::find_executable("iox-roudi").empty()) GTEST_SKIP() << "iox-roudi not installed (Debian package iceoryx)";
+  const std::filesystem::path management = "/dev/shm/iceoryx_mgmt";
+  ASSERT_FALSE(std::filesystem::exists(management)) << "a RouDi runs already on this machine";
+  const std::string log = "/tmp/crane_test_roudi_" + std::to_string(getpid()) + ".log";
+  const auto started = std::chrono::steady_clock::now();
+  const int code = la::run_beside_roudi(log, [&] {
+    for (int i = 0; i < 250 && !std::filesystem::exists(management); ++i) std::this_thread::sleep_for(20ms);
+    if (!std::filesystem::exists(management)) return 10;  // RouDi never came up
+    // A second one beside it: RouDi refuses to start twice; its body is stopped, the result nonzero.
+    const auto nested_start = std::chrono::steady_clock::now();
+    const int nested = la::run_beside_roudi(log + ".nested", [] {
+      std::this_thread::sleep_for(30s);
+      return 0;
+    });
+    if (nested == 0) return 11;
+    if (std::chrono::steady_clock::now() - nested_start > 20s) return 12;
+    return std::filesystem::exists(management) ? 3 : 13;  // the first RouDi still runs
+  });
+  EXPECT_EQ(code, 3) << "see " << log << " (10: RouDi never came up, 11: a second RouDi ran, 12: its body was "
+                                         "not stopped, 13: the first RouDi went with it)";
+  EXPECT_FALSE(std::filesystem::exists(management)) << "RouDi still runs after its body";
+  EXPECT_LT(std::chrono::steady_clock::now() - started, 30s);
+  std::ifstream text(log);
+  const std::string output((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+  EXPECT_NE(output.find("RouDi is ready for clients"), std::string::npos) << output;
+  if (!HasFailure()) {
+    std::filesystem::remove(log);
+    std::filesystem::remove(log + ".nested");
+  }
 }
 
 // The follower's filter (state_estimator::for_follower): the state_estimator process, and it alone,

@@ -297,4 +297,57 @@ TEST(CycloneDomain, SecondParticipantWithAnotherNetworkConfigurationIsRefused) {
   }
 }
 
+// A stack on iceoryx (docs/architecture.md, "Shared memory"): the stream and safety profiles lose
+// their deadlines and lease, for Cyclone DDS to deliver through shared memory, and nothing else;
+// command and diagnostics, which have neither, are the same.
+TEST(Iceoryx, TheWatchdogProfilesDropTheDeadlinesAndTheLeaseAndNothingElse) {
+  using std::chrono::milliseconds;
+  for (const auto kind : {QosKind::stream, QosKind::command, QosKind::safety, QosKind::diagnostics}) {
+    SCOPED_TRACE(static_cast<int>(kind));
+    const QosProfile network = qos_profile(kind);
+    const QosProfile iceoryx = qos_profile(kind, Liveliness::watchdogs);
+    EXPECT_EQ(iceoryx.reliability, network.reliability);
+    EXPECT_EQ(iceoryx.durability, network.durability);
+    EXPECT_EQ(iceoryx.history_depth, network.history_depth);
+    EXPECT_EQ(iceoryx.writer_deadline.count(), 0);
+    EXPECT_EQ(iceoryx.reader_deadline.count(), 0);
+    EXPECT_FALSE(iceoryx.manual_by_topic_liveliness);
+    EXPECT_EQ(iceoryx.liveliness_lease.count(), 0);
+  }
+  // The network's profiles keep theirs (qos.hpp).
+  EXPECT_EQ(qos_profile(QosKind::stream).writer_deadline, milliseconds(20));
+  EXPECT_EQ(qos_profile(QosKind::safety).reader_deadline, milliseconds(30));
+  EXPECT_TRUE(qos_profile(QosKind::safety).manual_by_topic_liveliness);
+  EXPECT_EQ(qos_profile(QosKind::stream).liveliness_lease, milliseconds(100));
+  ParticipantOptions o;
+  o.iceoryx = true;
+  EXPECT_EQ(effective_liveliness(o), Liveliness::watchdogs);
+  o.iceoryx = false;
+  EXPECT_EQ(effective_liveliness(o), Liveliness::dds);
+}
+
+// A participant on iceoryx is Cyclone DDS on loopback, with no profile and no DDS Security (its
+// samples lie unencrypted in shared memory): anything else is refused, naming what.
+TEST(Iceoryx, AParticipantOnItIsCycloneOnLoopbackWithoutAProfileOrSecurity) {
+  const auto refused = [](ParticipantOptions o, const std::string& named) {
+    o.iceoryx = true;
+    try {
+      Participant p(o);
+      ADD_FAILURE() << "accepted; expected a refusal naming '" << named << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
+  refused(options_for(Vendor::fast_dds, "iceoryx_fast"), "fast");
+  auto lan = options_for(Vendor::cyclone_dds, "iceoryx_lan");
+  lan.loopback_only = false;
+  refused(lan, "--lan");
+  auto profile = options_for(Vendor::cyclone_dds, "iceoryx_profile");
+  profile.profile_file = std::string(CRANE_SOURCE_DIR) + "/deploy/dds/cyclone_lan_unicast.xml";
+  refused(profile, "cyclone_lan_unicast.xml");
+  auto secured = options_for(Vendor::cyclone_dds, "iceoryx_secured");
+  secured.security_directory = "/nonexistent/security";
+  refused(secured, "--security /nonexistent/security");
+}
+
 }  // namespace

@@ -33,6 +33,7 @@
 #include <thread>
 #include <vector>
 
+#include "crane/launch/iceoryx.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/messages.hpp"
@@ -337,6 +338,10 @@ int main(int argc, char** argv) {
   std::string dds_mix;
   latency_cmd->add_option("--dds", dds, "DDS vendor of every process: fast | cyclone")
       ->check(CLI::IsMember({"fast", "cyclone"}));
+  bool iceoryx = false;
+  latency_cmd->add_flag("--iceoryx", iceoryx,
+                        "the stack's samples through iceoryx shared memory (Cyclone DDS, RouDi started first), the "
+                        "bench's own readers too; the floor stays on UDP");
   latency_cmd->add_option("--dds-mix", dds_mix, "vendor per process, overriding --dds, e.g. "
                                                 "plant=cyclone,state_estimator=cyclone (names: the stages, bench)");
   bool lan = false;
@@ -397,205 +402,229 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  try {
-    runtime::configure_logging("warn", "bench");
-    // The configuration at the requested rate.
-    std::ifstream in(config_path);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string yaml = text.str();
-    const std::string key = "sample_period:";
-    const auto at = yaml.find(key);
-    if (at == std::string::npos) throw std::invalid_argument(config_path + ": no plant.sample_period");
-    const auto end = yaml.find_first_of("#\n", at);
-    char period[64];
-    std::snprintf(period, sizeof(period), " %.9g ", 1.0 / rate);
-    yaml.replace(at + key.size(), end - at - key.size(), period);
-    const fs::path dir = fs::temp_directory_path() / ("crane_bench_" + std::to_string(getpid()));
-    fs::create_directories(dir);
-    const fs::path config = dir / "bench.yaml";
-    std::ofstream(config) << yaml;
+  // The run's folder (logs, the configuration at the rate), named before RouDi's fork (--iceoryx).
+  const fs::path dir = fs::temp_directory_path() / ("crane_bench_" + std::to_string(getpid()));
+  const auto latency_run = [&]() -> int {
+    try {
+      runtime::configure_logging("warn", "bench");
+      // The configuration at the requested rate.
+      std::ifstream in(config_path);
+      std::stringstream text;
+      text << in.rdbuf();
+      std::string yaml = text.str();
+      const std::string key = "sample_period:";
+      const auto at = yaml.find(key);
+      if (at == std::string::npos) throw std::invalid_argument(config_path + ": no plant.sample_period");
+      const auto end = yaml.find_first_of("#\n", at);
+      char period[64];
+      std::snprintf(period, sizeof(period), " %.9g ", 1.0 / rate);
+      yaml.replace(at + key.size(), end - at - key.size(), period);
+      fs::create_directories(dir);
+      const fs::path config = dir / "bench.yaml";
+      std::ofstream(config) << yaml;
 
-    launch::StackOptions stack;
-    stack.config_path = config.string();
-    stack.binary_directory = launch::executable_directory();
-    stack.log_directory = dir.string();
-    stack.domain_id = domain;
-    stack.lockstep = lockstep;
-    stack.wake = wake;
-    stack.plant_stats_path = (dir / "plant_stats.json").string();
-    if (latency_priority > 0) {
-      const std::string rt_failure = launch::probe_realtime(latency_priority + 10);
-      if (rt_failure.empty()) {
-        stack.realtime_priority = latency_priority;
-      } else {
-        std::fprintf(stderr, "crane_bench latency: --realtime-priority %d: %s (the stack runs at normal priority)\n",
-                     latency_priority, rt_failure.c_str());
-      }
-    }
-    stack.lan = lan;
-    stack.dds = dds;
-    {
-      auto known = launch::stack_process_names(stack);
-      known.push_back("bench");
-      stack.dds_per_process = launch::parse_dds_mix(dds_mix, known);
-    }
-    if (!dds_profile.empty()) stack.dds_profile = fs::absolute(dds_profile).string();
-    if (!security.security_directory.empty()) {
-      stack.security_directory = fs::absolute(security.security_directory).string();
-    }
-    stack.insecure_lan = security.insecure_lan;
-    runtime::check_network_security(!lan, stack.dds_profile, stack.security_directory, stack.insecure_lan);
-    launch::ProcessGroup group;
-    for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
-
-    runtime::NodeOptions node;
-    node.dds = launch::vendor_of(stack, "bench");
-    node.domain_id = domain;
-    node.loopback_only = !lan;
-    node.dds_profile = stack.dds_profile;
-    node.security_directory = stack.security_directory;
-    node.identity = security.identity.empty() ? "operator" : security.identity;  // it writes the goals
-    node.insecure_lan = stack.insecure_lan;
-    auto participant = runtime::make_participant(node, "bench");
-    transport::Wakeup wakeup;
-    runtime::install_stop_handlers(&wakeup);
-    auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
-    auto sensors = participant->make_recording_reader<tp::Sensors>(&wakeup, 8192);
-    auto estimate = participant->make_recording_reader<tp::StateEstimate>(&wakeup, 8192);
-    auto reference = participant->make_recording_reader<tp::Reference>(&wakeup, 8192);
-    auto anti_swing = participant->make_recording_reader<tp::AntiSwing>(&wakeup, 8192);
-    auto linear = participant->make_recording_reader<tp::LinearCommand>(&wakeup, 8192);
-    auto actuators = participant->make_recording_reader<tp::Actuators>(&wakeup, 8192);
-    tp::msgs::SupervisorStatus_ status;
-    const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
-    while (status.stages_alive() != Status::STAGES_ALL && Clock::now() < ready_deadline) {
-      status_reader->take_latest(status);
-      wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
-    }
-    if (status.stages_alive() != Status::STAGES_ALL) throw std::runtime_error("the stack did not become ready; see " + dir.string());
-    std::this_thread::sleep_for(std::chrono::seconds(1));
-    // Forget what came before; record `duration` seconds.
-    std::map<std::uint64_t, std::array<double, 6>> stamps;  // seq -> write stamps [ns] per stage
-    auto drain = [&] {
-      auto take = [&](auto& reader, std::size_t index) {
-        typename std::remove_reference_t<decltype(*reader)>::Message m;
-        while (reader->take_next(m)) {
-          auto& row = stamps.try_emplace(m.header().seq(), std::array<double, 6>{NAN, NAN, NAN, NAN, NAN, NAN}).first->second;
-          if (std::isnan(row[index])) row[index] = ns(m.header().stamp());
+      launch::StackOptions stack;
+      stack.config_path = config.string();
+      stack.binary_directory = launch::executable_directory();
+      stack.log_directory = dir.string();
+      stack.domain_id = domain;
+      stack.lockstep = lockstep;
+    // In lockstep the stack as the demo runs it: no operator relay, whose readers of the status and
+    // the estimate (woken every cycle) compete with the chain for the cores.
+    stack.operator_relay = !lockstep;
+      stack.wake = wake;
+      stack.plant_stats_path = (dir / "plant_stats.json").string();
+      if (latency_priority > 0) {
+        const std::string rt_failure = launch::probe_realtime(latency_priority + 10);
+        if (rt_failure.empty()) {
+          stack.realtime_priority = latency_priority;
+        } else {
+          std::fprintf(stderr, "crane_bench latency: --realtime-priority %d: %s (the stack runs at normal priority)\n",
+                       latency_priority, rt_failure.c_str());
         }
+      }
+      stack.lan = lan;
+      stack.dds = dds;
+      stack.iceoryx = iceoryx;
+      stack.start_roudi = false;  // run_beside_roudi() below
+      {
+        auto known = launch::stack_process_names(stack);
+        known.push_back("bench");
+        stack.dds_per_process = launch::parse_dds_mix(dds_mix, known);
+      }
+      if (!dds_profile.empty()) stack.dds_profile = fs::absolute(dds_profile).string();
+      if (!security.security_directory.empty()) {
+        stack.security_directory = fs::absolute(security.security_directory).string();
+      }
+      stack.insecure_lan = security.insecure_lan;
+      runtime::check_network_security(!lan, stack.dds_profile, stack.security_directory, stack.insecure_lan);
+      launch::ProcessGroup group;
+      for (const auto& spec : launch::stack_processes(stack)) group.start(spec);
+
+      runtime::NodeOptions node;
+      node.dds = launch::vendor_of(stack, "bench");
+      node.domain_id = domain;
+      node.loopback_only = !lan;
+      node.dds_profile = stack.dds_profile;
+      node.security_directory = stack.security_directory;
+      node.identity = security.identity.empty() ? "operator" : security.identity;  // it writes the goals
+      node.insecure_lan = stack.insecure_lan;
+      node.iceoryx = iceoryx;  // every reader of the chain on shared memory, or each writer also sends UDP
+      auto participant = runtime::make_participant(node, "bench");
+      transport::Wakeup wakeup;
+      runtime::install_stop_handlers(&wakeup);
+      auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
+      auto sensors = participant->make_recording_reader<tp::Sensors>(&wakeup, 8192);
+      auto estimate = participant->make_recording_reader<tp::StateEstimate>(&wakeup, 8192);
+      auto reference = participant->make_recording_reader<tp::Reference>(&wakeup, 8192);
+      auto anti_swing = participant->make_recording_reader<tp::AntiSwing>(&wakeup, 8192);
+      auto linear = participant->make_recording_reader<tp::LinearCommand>(&wakeup, 8192);
+      auto actuators = participant->make_recording_reader<tp::Actuators>(&wakeup, 8192);
+      // seq -> write stamps [ns] per stage. Taken as they come, also before the recording: a reader on
+      // iceoryx may hold only so many samples (TOO_MANY_CHUNKS_HELD_IN_PARALLEL).
+      std::map<std::uint64_t, std::array<double, 6>> stamps;
+      auto drain = [&] {
+        auto take = [&](auto& reader, std::size_t index) {
+          typename std::remove_reference_t<decltype(*reader)>::Message m;
+          while (reader->take_next(m)) {
+            auto& row = stamps.try_emplace(m.header().seq(), std::array<double, 6>{NAN, NAN, NAN, NAN, NAN, NAN}).first->second;
+            if (std::isnan(row[index])) row[index] = ns(m.header().stamp());
+          }
+        };
+        take(sensors, 0);
+        take(estimate, 1);
+        take(reference, 2);
+        take(anti_swing, 3);
+        take(linear, 4);
+        take(actuators, 5);
       };
-      take(sensors, 0);
-      take(estimate, 1);
-      take(reference, 2);
-      take(anti_swing, 3);
-      take(linear, 4);
-      take(actuators, 5);
-    };
-    drain();
-    stamps.clear();
-    const auto end_time = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(duration));
-    while (Clock::now() < end_time && !runtime::stop_requested()) {
+      tp::msgs::SupervisorStatus_ status;
+      const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
+      while (status.stages_alive() != Status::STAGES_ALL && Clock::now() < ready_deadline) {
+        status_reader->take_latest(status);
+        drain();
+        wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+      }
+      if (status.stages_alive() != Status::STAGES_ALL) throw std::runtime_error("the stack did not become ready; see " + dir.string());
+      for (const auto settled = Clock::now() + std::chrono::seconds(1); Clock::now() < settled;) {
+        drain();
+        wakeup.wait_until(Clock::now() + std::chrono::milliseconds(20));
+      }
+      // Forget what came before; record `duration` seconds.
       drain();
-      wakeup.wait_until(std::min(end_time, Clock::now() + std::chrono::milliseconds(20)));
-    }
-    drain();
-    for (const auto& exit : group.stop_all()) {
-      if (!(WIFEXITED(exit.status) && WEXITSTATUS(exit.status) == 0)) spdlog::warn("{}", exit.describe());
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-
-    // Hops: sensors -> estimator -> planner (needs the estimate) -> anti-swing (estimate) ->
-    // tracking (joins all three) -> friction compensation; the chain's own end.
-    const char* hop_names[] = {"sensors->state_estimator", "state_estimator->trajectory_planner",
-                               "state_estimator->anti_swing", "inputs->tracking", "tracking->friction_compensation"};
-    std::vector<double> hops[5], chain, sensor_stamps;
-    for (const auto& [seq, r] : stamps) {
-      if (std::isnan(r[0])) continue;
-      sensor_stamps.push_back(r[0]);
-      if (!std::isnan(r[1])) hops[0].push_back((r[1] - r[0]) / 1e3);
-      if (!std::isnan(r[2]) && !std::isnan(r[1])) hops[1].push_back((r[2] - r[1]) / 1e3);
-      if (!std::isnan(r[3]) && !std::isnan(r[1])) hops[2].push_back((r[3] - r[1]) / 1e3);
-      if (!std::isnan(r[4]) && !std::isnan(r[1]) && !std::isnan(r[2]) && !std::isnan(r[3])) {
-        hops[3].push_back((r[4] - std::max({r[1], r[2], r[3]})) / 1e3);
+      stamps.clear();
+      const auto end_time = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(duration));
+      while (Clock::now() < end_time && !runtime::stop_requested()) {
+        drain();
+        wakeup.wait_until(std::min(end_time, Clock::now() + std::chrono::milliseconds(20)));
       }
-      if (!std::isnan(r[5]) && !std::isnan(r[4])) hops[4].push_back((r[5] - r[4]) / 1e3);
-      if (!std::isnan(r[5])) chain.push_back((r[5] - r[0]) / 1e3);
-    }
-    std::vector<double> periods;
-    for (std::size_t i = 1; i < sensor_stamps.size(); ++i) periods.push_back((sensor_stamps[i] - sensor_stamps[i - 1]) / 1e3);
-    std::vector<double> jitter;
-    for (const double p : periods) jitter.push_back(std::fabs(p - 1e6 / rate));
-    std::vector<double> end_to_end;
-    json plant;
-    {
-      std::ifstream stats(stack.plant_stats_path);
-      if (stats) plant = json::parse(stats, nullptr, false);
-      if (plant.is_object()) end_to_end = plant.value("latency_us", std::vector<double>{});
-    }
-    // Floor between two processes: the plant's vendor pings; the echo takes the other vendor when
-    // the stack mixes them (the cross-vendor hop is the floor of a mixed stack), else the same.
-    const auto ping_vendor = launch::vendor_of(stack, "plant");
-    auto echo_vendor = ping_vendor;
-    for (const auto& name : launch::stack_process_names(stack)) {
-      if (launch::vendor_of(stack, name) != ping_vendor) echo_vendor = launch::vendor_of(stack, name);
-    }
-    const auto floor = ping_pong(domain + 1, 1000, ping_vendor, echo_vendor, (dir / "bench_pong.log").string());
+      drain();
+      for (const auto& exit : group.stop_all()) {
+        if (!(WIFEXITED(exit.status) && WEXITSTATUS(exit.status) == 0)) spdlog::warn("{}", exit.describe());
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
 
-    json j;
-    j["rate_hz"] = rate;
-    j["duration_s"] = duration;
-    j["dds"] = dds;
-    j["dds_mix"] = stack.dds_per_process;
-    j["floor_vendors"] = ping_vendor + "->" + echo_vendor;
-    j["end_to_end"] = summary(end_to_end);  // plant: sensor sample -> command arrival (all cycles of the run)
-    j["chain_sensors_to_actuators"] = summary(chain);
-    for (int h = 0; h < 5; ++h) j["hops"][hop_names[h]] = summary(hops[h]);
-    j["sensor_jitter"] = summary(jitter);
-    j["floor_one_way"] = summary(floor);
-    j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
-    j["clock"] = lockstep ? "lockstep" : "realtime";
-    j["wake"] = wake.empty() ? "listener" : wake;
-    if (plant.is_object() && plant.contains("step_us")) j["plant_step"] = plant["step_us"];
-    if (lockstep && sensor_stamps.size() > 1) {
-      // Cycles stepped per second of wall time while recording.
-      const double wall = (sensor_stamps.back() - sensor_stamps.front()) / 1e9;
-      j["real_time_factor"] = static_cast<double>(sensor_stamps.size() - 1) / rate / wall;
-    }
-    if (!floor.empty() && !end_to_end.empty()) {
-      j["p99_ratio_to_floor"] = j["end_to_end"]["p99_us"].get<double>() / j["floor_one_way"]["p99_us"].get<double>();
-    }
-    if (as_json) {
-      std::printf("%s\n", j.dump(2).c_str());
-    } else {
-      auto line = [](const char* name, const json& s) {
-        if (s["samples"].get<int>() == 0) {
-          std::printf("%-38s no samples\n", name);
-          return;
+      // Hops: sensors -> estimator -> planner (needs the estimate) -> anti-swing (estimate) ->
+      // tracking (joins all three) -> friction compensation; the chain's own end.
+      const char* hop_names[] = {"sensors->state_estimator", "state_estimator->trajectory_planner",
+                                 "state_estimator->anti_swing", "inputs->tracking", "tracking->friction_compensation"};
+      std::vector<double> hops[5], chain, sensor_stamps;
+      for (const auto& [seq, r] : stamps) {
+        if (std::isnan(r[0])) continue;
+        sensor_stamps.push_back(r[0]);
+        if (!std::isnan(r[1])) hops[0].push_back((r[1] - r[0]) / 1e3);
+        if (!std::isnan(r[2]) && !std::isnan(r[1])) hops[1].push_back((r[2] - r[1]) / 1e3);
+        if (!std::isnan(r[3]) && !std::isnan(r[1])) hops[2].push_back((r[3] - r[1]) / 1e3);
+        if (!std::isnan(r[4]) && !std::isnan(r[1]) && !std::isnan(r[2]) && !std::isnan(r[3])) {
+          hops[3].push_back((r[4] - std::max({r[1], r[2], r[3]})) / 1e3);
         }
-        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us  (%d)\n", name, s["p50_us"].get<double>(),
-                    s["p99_us"].get<double>(), s["max_us"].get<double>(), s["samples"].get<int>());
-      };
-      std::string vendors = dds;
-      for (const auto& [name, vendor] : stack.dds_per_process) vendors += ", " + name + "=" + vendor;
-      std::printf("dds %s, %.0f Hz, %.0f s, %d overruns\n", vendors.c_str(), rate, duration, j["overruns"].get<int>());
-      line("end to end (sample -> command at plant)", j["end_to_end"]);
-      line("chain (sensor stamp -> actuator stamp)", j["chain_sensors_to_actuators"]);
-      for (int h = 0; h < 5; ++h) line(hop_names[h], j["hops"][hop_names[h]]);
-      line("sensor period jitter", j["sensor_jitter"]);
-      line("floor: DDS one-way (ping-pong / 2)", j["floor_one_way"]);
-      if (j.contains("p99_ratio_to_floor")) std::printf("end-to-end p99 / floor p99 = %.2f\n", j["p99_ratio_to_floor"].get<double>());
-      if (j.contains("plant_step")) {
-        std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us\n", "plant step (integrator, one cycle)",
-                    j["plant_step"]["p50"].get<double>(), j["plant_step"]["p99"].get<double>(),
-                    j["plant_step"]["max"].get<double>());
+        if (!std::isnan(r[5]) && !std::isnan(r[4])) hops[4].push_back((r[5] - r[4]) / 1e3);
+        if (!std::isnan(r[5])) chain.push_back((r[5] - r[0]) / 1e3);
       }
-      if (j.contains("real_time_factor")) {
-        std::printf("lockstep speed: %.1f x real time\n", j["real_time_factor"].get<double>());
+      std::vector<double> periods;
+      for (std::size_t i = 1; i < sensor_stamps.size(); ++i) periods.push_back((sensor_stamps[i] - sensor_stamps[i - 1]) / 1e3);
+      std::vector<double> jitter;
+      for (const double p : periods) jitter.push_back(std::fabs(p - 1e6 / rate));
+      std::vector<double> end_to_end;
+      json plant;
+      {
+        std::ifstream stats(stack.plant_stats_path);
+        if (stats) plant = json::parse(stats, nullptr, false);
+        if (plant.is_object()) end_to_end = plant.value("latency_us", std::vector<double>{});
       }
+      // Floor between two processes: the plant's vendor pings; the echo takes the other vendor when
+      // the stack mixes them (the cross-vendor hop is the floor of a mixed stack), else the same.
+      const auto ping_vendor = launch::vendor_of(stack, "plant");
+      auto echo_vendor = ping_vendor;
+      for (const auto& name : launch::stack_process_names(stack)) {
+        if (launch::vendor_of(stack, name) != ping_vendor) echo_vendor = launch::vendor_of(stack, name);
+      }
+      const auto floor = ping_pong(domain + 1, 1000, ping_vendor, echo_vendor, (dir / "bench_pong.log").string());
+
+      json j;
+      j["rate_hz"] = rate;
+      j["duration_s"] = duration;
+      j["dds"] = dds;
+      j["dds_mix"] = stack.dds_per_process;
+      j["iceoryx"] = iceoryx;
+      j["floor_vendors"] = ping_vendor + "->" + echo_vendor;
+      j["end_to_end"] = summary(end_to_end);  // plant: sensor sample -> command arrival (all cycles of the run)
+      j["chain_sensors_to_actuators"] = summary(chain);
+      for (int h = 0; h < 5; ++h) j["hops"][hop_names[h]] = summary(hops[h]);
+      j["sensor_jitter"] = summary(jitter);
+      j["floor_one_way"] = summary(floor);
+      j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
+      j["clock"] = lockstep ? "lockstep" : "realtime";
+      j["wake"] = wake.empty() ? "listener" : wake;
+      if (plant.is_object() && plant.contains("step_us")) j["plant_step"] = plant["step_us"];
+      if (lockstep && sensor_stamps.size() > 1) {
+        // Cycles stepped per second of wall time while recording.
+        const double wall = (sensor_stamps.back() - sensor_stamps.front()) / 1e9;
+        j["real_time_factor"] = static_cast<double>(sensor_stamps.size() - 1) / rate / wall;
+      }
+      if (!floor.empty() && !end_to_end.empty()) {
+        j["p99_ratio_to_floor"] = j["end_to_end"]["p99_us"].get<double>() / j["floor_one_way"]["p99_us"].get<double>();
+      }
+      if (as_json) {
+        std::printf("%s\n", j.dump(2).c_str());
+      } else {
+        auto line = [](const char* name, const json& s) {
+          if (s["samples"].get<int>() == 0) {
+            std::printf("%-38s no samples\n", name);
+            return;
+          }
+          std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us  (%d)\n", name, s["p50_us"].get<double>(),
+                      s["p99_us"].get<double>(), s["max_us"].get<double>(), s["samples"].get<int>());
+        };
+        std::string vendors = dds + (iceoryx ? " on iceoryx" : "");
+        for (const auto& [name, vendor] : stack.dds_per_process) vendors += ", " + name + "=" + vendor;
+        std::printf("dds %s, %.0f Hz, %.0f s, %d overruns\n", vendors.c_str(), rate, duration, j["overruns"].get<int>());
+        line("end to end (sample -> command at plant)", j["end_to_end"]);
+        line("chain (sensor stamp -> actuator stamp)", j["chain_sensors_to_actuators"]);
+        for (int h = 0; h < 5; ++h) line(hop_names[h], j["hops"][hop_names[h]]);
+        line("sensor period jitter", j["sensor_jitter"]);
+        line("floor: DDS one-way (ping-pong / 2)", j["floor_one_way"]);
+        if (j.contains("p99_ratio_to_floor")) std::printf("end-to-end p99 / floor p99 = %.2f\n", j["p99_ratio_to_floor"].get<double>());
+        if (j.contains("plant_step")) {
+          std::printf("%-38s p50 %8.1f us  p99 %8.1f us  max %9.1f us\n", "plant step (integrator, one cycle)",
+                      j["plant_step"]["p50"].get<double>(), j["plant_step"]["p99"].get<double>(),
+                      j["plant_step"]["max"].get<double>());
+        }
+        if (j.contains("real_time_factor")) {
+          std::printf("lockstep speed: %.1f x real time\n", j["real_time_factor"].get<double>());
+        }
+      }
+      fs::remove_all(dir);
+      return 0;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "crane_bench: %s\n", error.what());
+      return 1;
     }
-    fs::remove_all(dir);
-    return 0;
+  };
+  if (!iceoryx) return latency_run();
+  try {
+    fs::create_directories(dir);
+    return launch::run_beside_roudi((dir / "iox_roudi.log").string(), latency_run);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_bench: %s\n", error.what());
     return 1;

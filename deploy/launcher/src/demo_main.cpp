@@ -16,6 +16,7 @@
 #include <optional>
 #include <thread>
 
+#include "crane/launch/iceoryx.hpp"
 #include "crane/launch/process_group.hpp"
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/dds.hpp"
@@ -56,6 +57,7 @@ struct DemoOptions {
   double plant_cable_length_factor{1.0};
   double plant_load_mass_factor{1.0};
   std::string security_directory;  // --security: every process and the operator secured (DDS Security)
+  bool iceoryx{false};             // --iceoryx: every process and the operator on iceoryx shared memory
 };
 
 struct ProcessRecord {
@@ -210,6 +212,8 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   stack.dds = options.dds;
   stack.dds_per_process = options.dds_per_process;
   stack.security_directory = options.security_directory;
+  stack.iceoryx = options.iceoryx;
+  stack.start_roudi = false;  // run_beside_roudi() in main()
   stack.domain_id = domain_id;
   stack.lockstep = !options.realtime;
   stack.initial_trolley_position = m.initial_trolley_position;
@@ -505,6 +509,9 @@ int main(int argc, char** argv) {
   app.add_option("--security", options.security_directory,
                  "DDS Security material (deploy/crane security init): every process with its own identity")
       ->check(CLI::ExistingDirectory);
+  app.add_flag("--iceoryx", options.iceoryx,
+               "every process and this one's operator on iceoryx shared memory (Cyclone DDS; RouDi started "
+               "beside the runs and stopped after them)");
   app.add_option("--plot-script", options.plot_script, "matplotlib script that draws the PNG plots");
   app.add_option("--python", options.python, "python interpreter with matplotlib");
   app.add_option("--ready-timeout", options.ready_timeout, "[s] longest wait for the stack to become ready");
@@ -538,182 +545,193 @@ int main(int argc, char** argv) {
   }
   options.profile_code = stack::profile_code(options.profile);
 
-  try {
-    runtime::configure_logging("info", "demo");
-    const stack::StackConfig cfg = stack::load_stack_config(options.config_path);
-    std::vector<stack::ManeuverConfig> selected;
-    for (const auto& m : cfg.maneuvers) {
-      if (options.maneuvers.empty() ||
-          std::find(options.maneuvers.begin(), options.maneuvers.end(), m.name) != options.maneuvers.end()) {
-        selected.push_back(m);
-      }
-    }
-    for (const auto& name : options.maneuvers) {
-      if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
-        throw std::invalid_argument("--maneuver '" + name + "' is not in " + options.config_path);
-      }
-    }
-    std::vector<bool> settings;
-    if (options.compensation != "off") settings.push_back(true);
-    if (options.compensation != "on") settings.push_back(false);
-    fs::create_directories(options.out_dir);
-
-    {
-      launch::StackOptions all;
-      all.hardware = options.hardware == "shm" ? "shm:x" : "";
-      auto known = launch::stack_process_names(all);
-      known.push_back("operator");
-      options.dds_per_process = launch::parse_dds_mix(options.dds_mix, known);
-    }
-    runtime::NodeOptions node;
-    node.dds = options.dds_per_process.count("operator") != 0 ? options.dds_per_process.at("operator") : options.dds;
-    if (!options.security_directory.empty()) {
-      options.security_directory = fs::absolute(options.security_directory).string();
-    }
-    node.security_directory = options.security_directory;
-
-    // Each run gets a fresh DDS domain and a fresh operator participant: nothing of one run's
-    // discovery (participants still being removed while the next stack starts) reaches the next.
-    // Fast DDS 2.9 can abort in PDP::check_remote_participant_liveliness when a remote participant
-    // is removed while its lease timer fires (docs/architecture.md, "Transport").
-    std::vector<RunResult> results;
-    std::uint32_t request_id = 1;
-    unsigned run_index = 0;
-    const auto demo_start = Clock::now();
-    for (const auto& m : selected) {
-      for (const bool compensation : settings) {
-        node.domain_id = (options.domain_id + run_index++) % 233U;
-        std::unique_ptr<transport::Participant> participant = runtime::make_participant(node, "operator");
-        auto op = std::make_unique<Operator>(*participant);
-        runtime::install_stop_handlers(&op->wakeup());
-        try {
-          results.push_back(run_maneuver(options, cfg, m, compensation, *op, request_id, node.domain_id));
-          request_id += 2;  // the probe's and the move's
-        } catch (...) {
-          runtime::install_stop_handlers(nullptr);
-          throw;
+  const auto demo = [&]() -> int {
+    try {
+      runtime::configure_logging("info", "demo");
+      const stack::StackConfig cfg = stack::load_stack_config(options.config_path);
+      std::vector<stack::ManeuverConfig> selected;
+      for (const auto& m : cfg.maneuvers) {
+        if (options.maneuvers.empty() ||
+            std::find(options.maneuvers.begin(), options.maneuvers.end(), m.name) != options.maneuvers.end()) {
+          selected.push_back(m);
         }
-        runtime::install_stop_handlers(nullptr);
-        op.reset();
-        participant.reset();
-        const auto& r = results.back();
-        spdlog::info("{} (friction compensation {}): settle {} s, position error {} mm, residual swing {} deg",
-                     r.maneuver, r.friction_compensation ? "on" : "off", format_number(r.metrics.settle_time, 2),
-                     format_number(r.metrics.final_position_error * 1e3, 2), format_number(r.metrics.residual_swing * 180 / kPi, 3));
       }
-    }
-
-    // summary.json
-    json summary;
-    summary["config"] = fs::absolute(options.config_path).string();
-    summary["clock"] = options.realtime ? "realtime" : "lockstep";
-    summary["sensor_writer"] = options.hardware.empty() ? "plant" : "hardware_bridge (emulated board, plant behind it)";
-    summary["dds"] = options.dds;
-    summary["dds_mix"] = options.dds_per_process;
-    summary["profile"] = options.profile;
-    summary["plant_cable_length_factor"] = options.plant_cable_length_factor;
-    summary["plant_load_mass_factor"] = options.plant_load_mass_factor;
-    summary["controller"] = options.controller;
-    json maneuvers = json::array();
-    std::vector<double> all_latencies;
-    double wall_time = 0.0, simulated_time = 0.0, startup_time = 0.0;
-    std::vector<std::string> failures;
-    std::uint64_t cycles = 0, overruns = 0, supervisor_overruns = 0, nonfinite = 0;
-    json processes = json::array();
-    bool diagnostics_complete = true;
-    for (const auto& r : results) {
-      json j;
-      j["name"] = r.maneuver;
-      j["controller"] = r.controller;
-      j["friction_compensation"] = r.friction_compensation;
-      j["settle_time_s"] = std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time) : json(nullptr);
-      j["settle_time_periods"] =
-          std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time / r.swing_period) : json(nullptr);
-      j["minimum_time_s"] = std::isfinite(r.metrics.minimum_time) ? json(r.metrics.minimum_time) : json(nullptr);
-      j["final_position_error_m"] = r.metrics.final_position_error;
-      j["final_slew_error_rad"] = r.metrics.final_slew_error;
-      if (cfg.facts.crane_kind == common::CraneKind::overhead) j["final_bridge_error_m"] = r.metrics.final_bridge_error;
-      j["max_swing_rad"] = r.metrics.max_swing;
-      j["residual_swing_rad"] = r.metrics.residual_swing;
-      j["max_voltage_V"] = r.metrics.max_voltage;
-      j["samples"] = r.samples;
-      j["missing_samples"] = r.missing;
-      j["braked_cycles"] = r.braked_cycles;
-      j["csv"] = r.csv;
-      j["plant_cycles"] = r.cycles;
-      j["overruns"] = r.overruns;
-      j["supervisor_timer_overruns"] = r.supervisor_timer_overruns;
-      j["diagnostics_missing"] = r.diagnostics_missing;
-      j["domain_id"] = r.domain_id;
-      j["move_start_cycle"] = r.move_start_cycle;
-      j["startup_s"] = r.startup_s;
-      j["wall_time_s"] = r.wall_time_s;
-      j["simulated_time_s"] = r.simulated_time_s;
-      j["failures"] = r.failures;
-      j["failed"] = !r.failures.empty();
-      maneuvers.push_back(j);
-      wall_time += r.wall_time_s;
-      simulated_time += r.simulated_time_s;
-      startup_time += r.startup_s;
-      for (const auto& f : r.failures) failures.push_back(r.maneuver + (r.friction_compensation ? "_fc_on: " : "_fc_off: ") + f);
-      all_latencies.insert(all_latencies.end(), r.latencies_us.begin(), r.latencies_us.end());
-      cycles += r.cycles;
-      overruns += r.overruns;
-      supervisor_overruns += r.supervisor_timer_overruns;
-      nonfinite += r.nonfinite_rejected;
-      diagnostics_complete = diagnostics_complete && r.diagnostics_complete;
-      for (const auto& p : r.processes) {
-        processes.push_back({{"name", p.name}, {"pid", p.pid}, {"dds", p.dds}, {"run", p.run}});
+      for (const auto& name : options.maneuvers) {
+        if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
+          throw std::invalid_argument("--maneuver '" + name + "' is not in " + options.config_path);
+        }
       }
-    }
-    processes.push_back({{"name", "operator"}, {"pid", getpid()}, {"dds", node.dds}, {"run", "all"}});
-    summary["maneuvers"] = maneuvers;
-    summary["loop"] = {{"cycles", cycles},
-                       {"overruns", overruns},
-                       {"supervisor_timer_overruns", supervisor_overruns},
-                       {"nonfinite_rejected", nonfinite},
-                       {"diagnostics_complete", diagnostics_complete},
-                       {"wall_time_s", wall_time},
-                       {"simulated_time_s", simulated_time},
-                       {"real_time_factor", wall_time > 0.0 ? simulated_time / wall_time : 0.0},
-                       {"startup_s", startup_time},
-                       {"demo_wall_time_s", std::chrono::duration<double>(Clock::now() - demo_start).count()},
-                       {"failures", failures},
-                       {"latency_us",
-                        {{"p50", percentile(all_latencies, 50)},
-                         {"p99", percentile(all_latencies, 99)},
-                         {"max", all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end())},
-                         {"samples", all_latencies.size()}}},
-                       {"processes", processes}};
-    const fs::path summary_path = fs::path(options.out_dir) / "summary.json";
-    std::ofstream(summary_path) << summary.dump(2) << '\n';
+      std::vector<bool> settings;
+      if (options.compensation != "off") settings.push_back(true);
+      if (options.compensation != "on") settings.push_back(false);
+      fs::create_directories(options.out_dir);
 
-    // Table (stack::table_row: one place with crane_sim).
-    const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
-    std::printf("\n%s\n", stack::table_header(bridge).c_str());
-    for (const auto& r : results) {
-      std::printf("%s\n", stack::table_row(r.maneuver, r.friction_compensation, r.metrics, r.swing_period, bridge).c_str());
-    }
-    std::printf("\nloop: %llu cycles, %llu overruns, latency sensor->command p50 %.0f us, p99 %.0f us, max %.0f us (%s)\n",
-                static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(overruns),
-                percentile(all_latencies, 50), percentile(all_latencies, 99),
-                all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end()),
-                options.realtime ? "realtime" : "lockstep");
-    std::printf("speed: %.1f s simulated in %.2f s of stepping (%.0fx real time); stack start-up %.1f s over %zu runs\n",
-                simulated_time, wall_time, wall_time > 0.0 ? simulated_time / wall_time : 0.0, startup_time,
-                results.size());
-    std::printf("summary: %s\n", summary_path.string().c_str());
-    for (const auto& f : failures) std::printf("FAILED: %s\n", f.c_str());
+      {
+        launch::StackOptions all;
+        all.hardware = options.hardware == "shm" ? "shm:x" : "";
+        auto known = launch::stack_process_names(all);
+        known.push_back("operator");
+        options.dds_per_process = launch::parse_dds_mix(options.dds_mix, known);
+      }
+      runtime::NodeOptions node;
+      node.dds = options.dds_per_process.count("operator") != 0 ? options.dds_per_process.at("operator") : options.dds;
+      if (!options.security_directory.empty()) {
+        options.security_directory = fs::absolute(options.security_directory).string();
+      }
+      node.security_directory = options.security_directory;
+      node.iceoryx = options.iceoryx;
 
-    if (!options.plot_script.empty()) {
-      const std::string command = "'" + options.python + "' '" + options.plot_script + "' --out '" + options.out_dir + "'";
-      const int rc = std::system(command.c_str());
-      if (rc != 0) throw std::runtime_error("plot script failed: " + command);
+      // Each run gets a fresh DDS domain and a fresh operator participant: nothing of one run's
+      // discovery (participants still being removed while the next stack starts) reaches the next.
+      // Fast DDS 2.9 can abort in PDP::check_remote_participant_liveliness when a remote participant
+      // is removed while its lease timer fires (docs/architecture.md, "Transport").
+      std::vector<RunResult> results;
+      std::uint32_t request_id = 1;
+      unsigned run_index = 0;
+      const auto demo_start = Clock::now();
+      for (const auto& m : selected) {
+        for (const bool compensation : settings) {
+          node.domain_id = (options.domain_id + run_index++) % 233U;
+          std::unique_ptr<transport::Participant> participant = runtime::make_participant(node, "operator");
+          auto op = std::make_unique<Operator>(*participant);
+          runtime::install_stop_handlers(&op->wakeup());
+          try {
+            results.push_back(run_maneuver(options, cfg, m, compensation, *op, request_id, node.domain_id));
+            request_id += 2;  // the probe's and the move's
+          } catch (...) {
+            runtime::install_stop_handlers(nullptr);
+            throw;
+          }
+          runtime::install_stop_handlers(nullptr);
+          op.reset();
+          participant.reset();
+          const auto& r = results.back();
+          spdlog::info("{} (friction compensation {}): settle {} s, position error {} mm, residual swing {} deg",
+                       r.maneuver, r.friction_compensation ? "on" : "off", format_number(r.metrics.settle_time, 2),
+                       format_number(r.metrics.final_position_error * 1e3, 2), format_number(r.metrics.residual_swing * 180 / kPi, 3));
+        }
+      }
+
+      // summary.json
+      json summary;
+      summary["config"] = fs::absolute(options.config_path).string();
+      summary["clock"] = options.realtime ? "realtime" : "lockstep";
+      summary["sensor_writer"] = options.hardware.empty() ? "plant" : "hardware_bridge (emulated board, plant behind it)";
+      summary["dds"] = options.dds;
+      summary["dds_mix"] = options.dds_per_process;
+      summary["profile"] = options.profile;
+      summary["plant_cable_length_factor"] = options.plant_cable_length_factor;
+      summary["plant_load_mass_factor"] = options.plant_load_mass_factor;
+      summary["controller"] = options.controller;
+      json maneuvers = json::array();
+      std::vector<double> all_latencies;
+      double wall_time = 0.0, simulated_time = 0.0, startup_time = 0.0;
+      std::vector<std::string> failures;
+      std::uint64_t cycles = 0, overruns = 0, supervisor_overruns = 0, nonfinite = 0;
+      json processes = json::array();
+      bool diagnostics_complete = true;
+      for (const auto& r : results) {
+        json j;
+        j["name"] = r.maneuver;
+        j["controller"] = r.controller;
+        j["friction_compensation"] = r.friction_compensation;
+        j["settle_time_s"] = std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time) : json(nullptr);
+        j["settle_time_periods"] =
+            std::isfinite(r.metrics.settle_time) ? json(r.metrics.settle_time / r.swing_period) : json(nullptr);
+        j["minimum_time_s"] = std::isfinite(r.metrics.minimum_time) ? json(r.metrics.minimum_time) : json(nullptr);
+        j["final_position_error_m"] = r.metrics.final_position_error;
+        j["final_slew_error_rad"] = r.metrics.final_slew_error;
+        if (cfg.facts.crane_kind == common::CraneKind::overhead) j["final_bridge_error_m"] = r.metrics.final_bridge_error;
+        j["max_swing_rad"] = r.metrics.max_swing;
+        j["residual_swing_rad"] = r.metrics.residual_swing;
+        j["max_voltage_V"] = r.metrics.max_voltage;
+        j["samples"] = r.samples;
+        j["missing_samples"] = r.missing;
+        j["braked_cycles"] = r.braked_cycles;
+        j["csv"] = r.csv;
+        j["plant_cycles"] = r.cycles;
+        j["overruns"] = r.overruns;
+        j["supervisor_timer_overruns"] = r.supervisor_timer_overruns;
+        j["diagnostics_missing"] = r.diagnostics_missing;
+        j["domain_id"] = r.domain_id;
+        j["move_start_cycle"] = r.move_start_cycle;
+        j["startup_s"] = r.startup_s;
+        j["wall_time_s"] = r.wall_time_s;
+        j["simulated_time_s"] = r.simulated_time_s;
+        j["failures"] = r.failures;
+        j["failed"] = !r.failures.empty();
+        maneuvers.push_back(j);
+        wall_time += r.wall_time_s;
+        simulated_time += r.simulated_time_s;
+        startup_time += r.startup_s;
+        for (const auto& f : r.failures) failures.push_back(r.maneuver + (r.friction_compensation ? "_fc_on: " : "_fc_off: ") + f);
+        all_latencies.insert(all_latencies.end(), r.latencies_us.begin(), r.latencies_us.end());
+        cycles += r.cycles;
+        overruns += r.overruns;
+        supervisor_overruns += r.supervisor_timer_overruns;
+        nonfinite += r.nonfinite_rejected;
+        diagnostics_complete = diagnostics_complete && r.diagnostics_complete;
+        for (const auto& p : r.processes) {
+          processes.push_back({{"name", p.name}, {"pid", p.pid}, {"dds", p.dds}, {"run", p.run}});
+        }
+      }
+      processes.push_back({{"name", "operator"}, {"pid", getpid()}, {"dds", node.dds}, {"run", "all"}});
+      summary["maneuvers"] = maneuvers;
+      summary["loop"] = {{"cycles", cycles},
+                         {"overruns", overruns},
+                         {"supervisor_timer_overruns", supervisor_overruns},
+                         {"nonfinite_rejected", nonfinite},
+                         {"diagnostics_complete", diagnostics_complete},
+                         {"wall_time_s", wall_time},
+                         {"simulated_time_s", simulated_time},
+                         {"real_time_factor", wall_time > 0.0 ? simulated_time / wall_time : 0.0},
+                         {"startup_s", startup_time},
+                         {"demo_wall_time_s", std::chrono::duration<double>(Clock::now() - demo_start).count()},
+                         {"failures", failures},
+                         {"latency_us",
+                          {{"p50", percentile(all_latencies, 50)},
+                           {"p99", percentile(all_latencies, 99)},
+                           {"max", all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end())},
+                           {"samples", all_latencies.size()}}},
+                         {"processes", processes}};
+      const fs::path summary_path = fs::path(options.out_dir) / "summary.json";
+      std::ofstream(summary_path) << summary.dump(2) << '\n';
+
+      // Table (stack::table_row: one place with crane_sim).
+      const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
+      std::printf("\n%s\n", stack::table_header(bridge).c_str());
+      for (const auto& r : results) {
+        std::printf("%s\n", stack::table_row(r.maneuver, r.friction_compensation, r.metrics, r.swing_period, bridge).c_str());
+      }
+      std::printf("\nloop: %llu cycles, %llu overruns, latency sensor->command p50 %.0f us, p99 %.0f us, max %.0f us (%s)\n",
+                  static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(overruns),
+                  percentile(all_latencies, 50), percentile(all_latencies, 99),
+                  all_latencies.empty() ? 0.0 : *std::max_element(all_latencies.begin(), all_latencies.end()),
+                  options.realtime ? "realtime" : "lockstep");
+      std::printf("speed: %.1f s simulated in %.2f s of stepping (%.0fx real time); stack start-up %.1f s over %zu runs\n",
+                  simulated_time, wall_time, wall_time > 0.0 ? simulated_time / wall_time : 0.0, startup_time,
+                  results.size());
+      std::printf("summary: %s\n", summary_path.string().c_str());
+      for (const auto& f : failures) std::printf("FAILED: %s\n", f.c_str());
+
+      if (!options.plot_script.empty()) {
+        const std::string command = "'" + options.python + "' '" + options.plot_script + "' --out '" + options.out_dir + "'";
+        const int rc = std::system(command.c_str());
+        if (rc != 0) throw std::runtime_error("plot script failed: " + command);
+      }
+      if (!failures.empty()) return 1;
+    } catch (const std::exception& error) {
+      spdlog::critical("{}", error.what());
+      return 1;
     }
-    if (!failures.empty()) return 1;
+    return 0;
+  };
+  if (!options.iceoryx) return demo();
+  try {
+    fs::create_directories(fs::path(options.out_dir) / "logs");
+    return launch::run_beside_roudi((fs::path(options.out_dir) / "logs" / "iox_roudi.log").string(), demo);
   } catch (const std::exception& error) {
-    spdlog::critical("{}", error.what());
+    std::fprintf(stderr, "crane_demo: %s\n", error.what());
     return 1;
   }
-  return 0;
 }

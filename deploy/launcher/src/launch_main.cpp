@@ -56,6 +56,9 @@ int main(int argc, char** argv) {
                  "DDS Security material of every process (deploy/crane security init; default: $CRANE_SECURITY), "
                  "each with its own identity")
       ->check(CLI::ExistingDirectory);
+  app.add_flag("--iceoryx", stack.iceoryx,
+               "the stack's samples through iceoryx shared memory (Cyclone DDS in every process; RouDi started "
+               "first; docs/architecture.md, \"Shared memory\")");
   app.add_flag("--insecure-lan", stack.insecure_lan,
                "allow --lan or --dds-profile without --security: anyone on that network can read and command the crane");
   app.add_flag("--lockstep", lockstep, "plant in lockstep (faster than real time) instead of realtime");
@@ -164,6 +167,9 @@ int main(int argc, char** argv) {
     }
     node.security_directory = stack.security_directory;
     node.insecure_lan = stack.insecure_lan;
+    // Off iceoryx (RouDi, stopped with the stack, ends every client still registered), with the QoS of
+    // a stack on it.
+    if (stack.iceoryx) node.liveliness = transport::Liveliness::watchdogs;
     // Refused here, before any stage starts (each stage would refuse it too).
     runtime::check_network_security(node.loopback_only, node.dds_profile, node.security_directory, node.insecure_lan);
     if (!lockstep && realtime_priority > 0) {

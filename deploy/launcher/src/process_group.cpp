@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -118,6 +119,21 @@ std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
 
 std::string executable_directory() {
   return std::filesystem::canonical("/proc/self/exe").parent_path().string();
+}
+
+std::string find_executable(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return {};
+  const std::string directories(path);
+  std::size_t begin = 0;
+  while (begin <= directories.size()) {
+    const std::size_t end = std::min(directories.find(':', begin), directories.size());
+    const std::string directory = directories.substr(begin, end - begin);
+    const std::string candidate = (directory.empty() ? "." : directory) + "/" + name;
+    if (access(candidate.c_str(), X_OK) == 0 && std::filesystem::is_regular_file(candidate)) return candidate;
+    begin = end + 1;
+  }
+  return {};
 }
 
 std::string probe_realtime(int priority) {

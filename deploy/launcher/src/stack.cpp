@@ -27,7 +27,9 @@ bool is_stage(const std::string& name) {
 }  // namespace
 
 std::vector<std::string> stack_process_names(const StackOptions& o) {
-  std::vector<std::string> names{"supervisor"};
+  std::vector<std::string> names;
+  if (o.iceoryx && o.start_roudi) names.push_back(kRoudiProcess);
+  names.push_back("supervisor");
   if (o.operator_relay) names.push_back("operator_relay");
   names.insert(names.end(), kStages.begin(), kStages.end());
   if (o.hardware.empty()) {
@@ -84,14 +86,28 @@ std::string vendor_of(const StackOptions& o, const std::string& name) {
 }
 
 std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
+  if (o.iceoryx && (o.lan || !o.dds_profile.empty() || !o.security_directory.empty())) {
+    throw std::invalid_argument("--iceoryx keeps the stack's samples on this machine, unencrypted in shared memory: "
+                                "not with --lan, --dds-profile or --security");
+  }
   std::vector<ProcessSpec> specs;
   const bool bridge = !o.hardware.empty();
   for (const auto& name : stack_process_names(o)) {
     ProcessSpec spec;
     spec.name = name;
+    if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
+    if (name == kRoudiProcess) {
+      specs.push_back(roudi_process(spec.log_path));
+      continue;
+    }
     spec.executable = o.binary_directory + "/" + name;
     const auto vendor = vendor_of(o, name);
+    if (o.iceoryx && vendor != "cyclone") {
+      throw std::invalid_argument("--iceoryx: " + name + " is on '" + vendor +
+                                  "'; iceoryx shared memory needs Cyclone DDS in every process (--dds cyclone)");
+    }
     spec.arguments = {"--dds", vendor, "--domain", std::to_string(o.domain_id), "--log-level", o.log_level};
+    if (o.iceoryx) spec.arguments.push_back("--iceoryx");
     // The site link reads the crane's config from the site file; it works at normal priority.
     if (name != "site_link") spec.arguments.insert(spec.arguments.begin(), {"--config", o.config_path});
     if (o.lan) spec.arguments.push_back("--lan");
@@ -153,7 +169,6 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       spec.arguments.insert(spec.arguments.end(), {"--controller", o.tracking_controller});
     }
     if (name == "tracking" && o.tracking_acceleration_feedforward) spec.arguments.push_back("--acceleration-feedforward");
-    if (!o.log_directory.empty()) spec.log_path = o.log_directory + "/" + name + ".log";
     specs.push_back(std::move(spec));
   }
   return specs;

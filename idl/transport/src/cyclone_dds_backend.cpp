@@ -36,6 +36,13 @@ constexpr const char* kLoopbackConfig =
     "<LeaseDuration>3s</LeaseDuration></Discovery>"
     "</Domain></CycloneDDS>";
 
+// Added to kLoopbackConfig for ParticipantOptions::iceoryx: the samples between processes of this
+// machine through iceoryx (RouDi's default memory pools hold the control bus's fixed-size types),
+// iceoryx's own log at warnings.
+constexpr const char* kIceoryxConfig =
+    "<CycloneDDS><Domain Id=\"any\"><SharedMemory><Enable>true</Enable><LogLevel>warn</LogLevel>"
+    "</SharedMemory></Domain></CycloneDDS>";
+
 std::string error_text(dds_return_t code) { return dds_strretcode(code); }
 
 dds_duration_t to_duration(std::chrono::nanoseconds value) {
@@ -134,10 +141,11 @@ class CBuffer {
 
 class CycloneWriter final : public WriterBackend {
  public:
-  CycloneWriter(dds_entity_t participant, dds_entity_t topic, const CycloneTypeSupport& type, QosKind kind)
+  CycloneWriter(dds_entity_t participant, dds_entity_t topic, const CycloneTypeSupport& type, QosKind kind,
+                Liveliness liveliness)
       : type_(type), buffer_(type.c_size) {
     Qos qos;
-    apply_profile(qos_profile(kind), true, qos);
+    apply_profile(qos_profile(kind, liveliness), true, qos);
     dds_listener_t* listener = dds_create_listener(this);
     dds_lset_publication_matched(listener, [](dds_entity_t, const dds_publication_matched_status_t s, void* self) {
       static_cast<CycloneWriter*>(self)->matched_.store(static_cast<std::int32_t>(s.current_count));
@@ -170,9 +178,9 @@ class CycloneWriter final : public WriterBackend {
 class CycloneReader final : public ReaderBackend {
  public:
   CycloneReader(dds_entity_t participant, dds_entity_t topic, const CycloneTypeSupport& type, QosKind kind,
-                Wakeup* wakeup, std::int32_t history_depth)
+                Liveliness liveliness, Wakeup* wakeup, std::int32_t history_depth)
       : type_(type), wakeup_(wakeup), buffer_(type.c_size) {
-    QosProfile profile = qos_profile(kind);
+    QosProfile profile = qos_profile(kind, liveliness);
     if (history_depth > 0) profile.history_depth = history_depth;
     Qos qos;
     apply_profile(profile, false, qos);
@@ -281,7 +289,8 @@ void apply_security(const SecurityFiles& files, dds_qos_t* qos) {
 
 class CycloneParticipant final : public ParticipantBackend {
  public:
-  CycloneParticipant(const ParticipantOptions& options, const SecurityFiles* security) : domain_id_(options.domain_id) {
+  CycloneParticipant(const ParticipantOptions& options, const SecurityFiles* security)
+      : domain_id_(options.domain_id), liveliness_(effective_liveliness(options)) {
     std::string config;
     if (!options.profile_file.empty()) {
       std::ifstream in(options.profile_file);
@@ -294,6 +303,7 @@ class CycloneParticipant final : public ParticipantBackend {
       config = text.str();
     } else if (options.loopback_only) {
       config = kLoopbackConfig;
+      if (options.iceoryx) config += std::string(",") + kIceoryxConfig;
     }  // else: Cyclone's own defaults (CYCLONEDDS_URI if set)
     DomainRegistry::instance().acquire(domain_id_, config);
     Qos qos;
@@ -359,12 +369,12 @@ class CycloneParticipant final : public ParticipantBackend {
   }
   std::unique_ptr<WriterBackend> create_writer(const TopicDescriptor& topic) override {
     const auto& [entity, type] = topic_for(topic);
-    return std::make_unique<CycloneWriter>(participant_, entity, *type, topic.qos);
+    return std::make_unique<CycloneWriter>(participant_, entity, *type, topic.qos, liveliness_);
   }
   std::unique_ptr<ReaderBackend> create_reader(const TopicDescriptor& topic, Wakeup* wakeup,
                                                std::int32_t history_depth) override {
     const auto& [entity, type] = topic_for(topic);
-    return std::make_unique<CycloneReader>(participant_, entity, *type, topic.qos, wakeup, history_depth);
+    return std::make_unique<CycloneReader>(participant_, entity, *type, topic.qos, liveliness_, wakeup, history_depth);
   }
 
  private:
@@ -380,6 +390,7 @@ class CycloneParticipant final : public ParticipantBackend {
   }
 
   dds_domainid_t domain_id_;
+  Liveliness liveliness_;
   dds_entity_t participant_{0};
   dds_entity_t builtin_participants_{0};
   dds_entity_t builtin_publications_{0};

@@ -56,8 +56,8 @@ void apply_common(const QosProfile& p, Qos& qos) {
   }
 }
 
-dds::DataWriterQos writer_qos(QosKind kind) {
-  const QosProfile p = qos_profile(kind);
+dds::DataWriterQos writer_qos(QosKind kind, Liveliness liveliness) {
+  const QosProfile p = qos_profile(kind, liveliness);
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
   apply_common(p, qos);
   qos.deadline().period = to_duration(p.writer_deadline);
@@ -68,8 +68,8 @@ dds::DataWriterQos writer_qos(QosKind kind) {
   return qos;
 }
 
-dds::DataReaderQos reader_qos(QosKind kind, std::int32_t history_depth) {
-  QosProfile p = qos_profile(kind);
+dds::DataReaderQos reader_qos(QosKind kind, Liveliness liveliness, std::int32_t history_depth) {
+  QosProfile p = qos_profile(kind, liveliness);
   if (history_depth > 0) p.history_depth = history_depth;
   dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
   apply_common(p, qos);
@@ -89,8 +89,9 @@ dds::DataReaderQos reader_qos(QosKind kind, std::int32_t history_depth) {
 
 class FastWriter final : public WriterBackend, public dds::DataWriterListener {
  public:
-  FastWriter(dds::Publisher* publisher, dds::Topic* topic, QosKind kind) : publisher_(publisher) {
-    writer_ = publisher->create_datawriter(topic, writer_qos(kind), this, dds::StatusMask::all());
+  FastWriter(dds::Publisher* publisher, dds::Topic* topic, QosKind kind, Liveliness liveliness)
+      : publisher_(publisher) {
+    writer_ = publisher->create_datawriter(topic, writer_qos(kind, liveliness), this, dds::StatusMask::all());
     if (writer_ == nullptr) {
       throw std::runtime_error(std::string("fast dds: cannot create a writer on ") + topic->get_name() +
                                " (with DDS Security: not in this identity's permissions to publish)");
@@ -122,9 +123,10 @@ class FastWriter final : public WriterBackend, public dds::DataWriterListener {
 
 class FastReader final : public ReaderBackend, public dds::DataReaderListener {
  public:
-  FastReader(dds::Subscriber* subscriber, dds::Topic* topic, QosKind kind, Wakeup* wakeup, std::int32_t depth)
+  FastReader(dds::Subscriber* subscriber, dds::Topic* topic, QosKind kind, Liveliness liveliness, Wakeup* wakeup,
+             std::int32_t depth)
       : subscriber_(subscriber), wakeup_(wakeup) {
-    reader_ = subscriber->create_datareader(topic, reader_qos(kind, depth), this, dds::StatusMask::all());
+    reader_ = subscriber->create_datareader(topic, reader_qos(kind, liveliness, depth), this, dds::StatusMask::all());
     if (reader_ == nullptr) {
       throw std::runtime_error(std::string("fast dds: cannot create a reader on ") + topic->get_name() +
                                " (with DDS Security: not in this identity's permissions to subscribe)");
@@ -297,7 +299,8 @@ std::shared_ptr<eprosima::fastdds::rtps::UDPv4TransportDescriptor> udp_transport
 
 class FastParticipant final : public ParticipantBackend {
  public:
-  FastParticipant(const ParticipantOptions& options, const SecurityFiles* security) {
+  FastParticipant(const ParticipantOptions& options, const SecurityFiles* security)
+      : liveliness_(effective_liveliness(options)) {
     dds::DomainParticipantQos qos = dds::PARTICIPANT_QOS_DEFAULT;
     qos.name(options.name);
     // Faster detection of vanished participants than the 20 s default; stages are watched by
@@ -375,11 +378,11 @@ class FastParticipant final : public ParticipantBackend {
     return discovery_.snapshot(hex(participant_->guid().guidPrefix));
   }
   std::unique_ptr<WriterBackend> create_writer(const TopicDescriptor& topic) override {
-    return std::make_unique<FastWriter>(publisher_, topic_for(topic), topic.qos);
+    return std::make_unique<FastWriter>(publisher_, topic_for(topic), topic.qos, liveliness_);
   }
   std::unique_ptr<ReaderBackend> create_reader(const TopicDescriptor& topic, Wakeup* wakeup,
                                               std::int32_t history_depth) override {
-    return std::make_unique<FastReader>(subscriber_, topic_for(topic), topic.qos, wakeup, history_depth);
+    return std::make_unique<FastReader>(subscriber_, topic_for(topic), topic.qos, liveliness_, wakeup, history_depth);
   }
 
  private:
@@ -398,6 +401,7 @@ class FastParticipant final : public ParticipantBackend {
     return created;
   }
 
+  Liveliness liveliness_;
   DiscoveryListener discovery_;  // declared before participant_: outlives it
   dds::DomainParticipant* participant_{nullptr};
   dds::Publisher* publisher_{nullptr};

@@ -89,6 +89,15 @@ void Wakeup::stop_dispatch() {
 
 Participant::Participant(const ParticipantOptions& options) : options_(options) {
   options_.profile_file = profile_for_vendor(options.profile_file, options.vendor);
+  if (options_.iceoryx && (options_.vendor != Vendor::cyclone_dds || !options_.loopback_only ||
+                           !options_.profile_file.empty() || !options_.security_directory.empty())) {
+    throw std::invalid_argument(
+        std::string("iceoryx shared memory needs Cyclone DDS on loopback without a network profile or DDS "
+                    "Security (its samples lie unencrypted in shared memory); this participant is ") +
+        vendor_name(options_.vendor) + (options_.loopback_only ? "" : " with --lan") +
+        (options_.profile_file.empty() ? "" : " with the profile " + options_.profile_file) +
+        (options_.security_directory.empty() ? "" : " with --security " + options_.security_directory));
+  }
   std::optional<SecurityFiles> security;
   if (!options_.security_directory.empty()) {
     if (options_.identity.empty()) options_.identity = options_.name;

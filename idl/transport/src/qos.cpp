@@ -4,7 +4,7 @@ namespace crane::transport {
 
 using std::chrono::milliseconds;
 
-QosProfile qos_profile(QosKind kind) noexcept {
+QosProfile qos_profile(QosKind kind, Liveliness liveliness) noexcept {
   QosProfile p;
   switch (kind) {
     case QosKind::stream:
@@ -35,6 +35,11 @@ QosProfile qos_profile(QosKind kind) noexcept {
       p.durability = Durability::volatile_;
       p.history_depth = 1;
       break;
+  }
+  if (liveliness == Liveliness::watchdogs) {
+    p.writer_deadline = p.reader_deadline = std::chrono::nanoseconds(0);
+    p.manual_by_topic_liveliness = false;
+    p.liveliness_lease = std::chrono::nanoseconds(0);
   }
   return p;
 }

@@ -42,6 +42,9 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
   app.add_option("--realtime-priority", options.realtime_priority,
                  "SCHED_FIFO priority (1-99) and locked memory, where the system allows it (0: normal priority)")
       ->check(CLI::Range(0, 99));
+  app.add_flag("--iceoryx", options.iceoryx,
+               "the stack's samples through iceoryx shared memory (Cyclone DDS on loopback; the launcher's "
+               "--iceoryx starts RouDi): AUTOMATIC liveliness and no deadlines on the control bus");
   add_security_options(app, options);
 }
 
@@ -65,6 +68,8 @@ void add_site_network_option(CLI::App& app, bool& site_lan) {
 
 NodeOptions site_domain_options(NodeOptions options, std::uint32_t site_domain, bool site_lan) {
   options.domain_id = site_domain;
+  options.iceoryx = false;
+  options.liveliness = transport::Liveliness::dds;
   if (site_lan) options.loopback_only = false;
   return options;
 }
@@ -125,6 +130,8 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
   p.domain_id = options.domain_id;
   p.loopback_only = options.loopback_only;
   p.shared_memory = options.shared_memory;
+  p.iceoryx = options.iceoryx;
+  p.liveliness = options.liveliness;
   p.profile_file = options.dds_profile;
   if (p.profile_file.empty()) {
     if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;

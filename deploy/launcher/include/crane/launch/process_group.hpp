@@ -59,6 +59,10 @@ class ProcessGroup {
 /// Absolute path of the directory holding this executable (/proc/self/exe).
 std::string executable_directory();
 
+/// The first executable file `name` in the directories of $PATH, as the shell would find it; empty
+/// when there is none (or PATH is unset).
+std::string find_executable(const std::string& name);
+
 /// Whether a process started from here may run on SCHED_FIFO at `priority` and lock its memory, as
 /// every stage does with --realtime-priority: a forked child tries both and exits. Empty string if
 /// it may, else what failed and why ("SCHED_FIFO 80: Operation not permitted", "mlockall: ...").

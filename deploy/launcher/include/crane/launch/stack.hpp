@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "crane/launch/iceoryx.hpp"
 #include "crane/launch/process_group.hpp"
 
 namespace crane::launch {
@@ -57,19 +58,29 @@ struct StackOptions {
                                       // already matched with the supervisor; off: they make a participant each
   std::string wake;                   // the chain's --wake (the stages and the plant): listener | thread; empty:
                                       // their default, listener (runtime::ListenerDispatch)
+  bool iceoryx{false};                // every process --iceoryx (Cyclone DDS for all; docs/architecture.md,
+                                      // "Shared memory")
+  bool start_roudi{true};             // with iceoryx: RouDi is the stack's first process (false: it runs
+                                      // already, run_beside_roudi())
   int realtime_priority{0};           // > 0: every process --realtime-priority: the sensor writer (plant or
                                       // bridge) this + 10, the supervisor + 5, the chain this (as the
                                       // systemd units); 0: normal priority
 };
 
-/// The processes of the stack in start order: supervisor first (then the operator relay, when
-/// options.operator_relay), the sensor writer (plant or hardware_bridge) last of the chain; with shm:NAME the plant behind the board comes just before the bridge; the site link after all (options.site_jobs).
-/// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH, and for
-/// site_jobs without site_file and site_crane.
+/// The processes of the stack in start order: with options.iceoryx and start_roudi, RouDi first
+/// (iox_roudi; launch/iceoryx.hpp); the
+/// supervisor (then the operator relay, when options.operator_relay), the sensor writer (plant or
+/// hardware_bridge) last of the chain; with shm:NAME the plant behind the board comes just before
+/// the bridge; the site link after all (options.site_jobs). RouDi needs no stop order: stopped with
+/// the others, it waits for its clients to exit (it sends them SIGTERM itself).
+/// Throws std::invalid_argument for a `hardware` that is neither empty, shm:NAME nor comedi:PATH, for
+/// site_jobs without site_file and site_crane, and with options.iceoryx for lan, a dds_profile, a
+/// security_directory, a process on another vendor than Cyclone DDS or iox-roudi not on PATH.
 std::vector<ProcessSpec> stack_processes(const StackOptions& options);
 
 /// Names of the processes, in the order stack_processes() returns them.
 std::vector<std::string> stack_process_names(const StackOptions& options);
+
 
 /// Parses a vendor mix "plant=cyclone,state_estimator=cyclone" (--dds-mix) into process name ->
 /// vendor ("fast" or "cyclone"). `known` lists the names a mix may use. Empty text: empty map.

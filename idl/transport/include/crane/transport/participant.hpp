@@ -55,6 +55,14 @@ struct ParticipantOptions {
                                   // replaces loopback_only/shared_memory; empty: none. Fast DDS uses its
                                   // participant profile "crane_participant", Cyclone DDS the whole file.
   Vendor vendor{Vendor::fast_dds};
+  Liveliness liveliness{Liveliness::dds};  // the stream and safety topics' failure detection (qos.hpp): watchdogs
+                                  // on a stack on iceoryx and on every participant that talks to one
+  bool iceoryx{false};            // Cyclone DDS with loopback_only and no profile: the samples between the
+                                  // processes of this machine through iceoryx shared memory (the RouDi
+                                  // daemon must run: StackOptions::iceoryx starts it), with
+                                  // Liveliness::watchdogs whatever `liveliness` says; discovery stays on
+                                  // UDP. Participant() throws std::invalid_argument for Fast DDS, --lan,
+                                  // a profile or DDS Security
   std::string security_directory;  // DDS Security material (security.hpp; deploy/crane security init): every
                                    // participant authenticated (PKI-DH), its topics limited by signed
                                    // permissions, RTPS encrypted (AES-GCM); empty: no security
@@ -212,8 +220,14 @@ class Reader {
   std::unique_ptr<detail::ReaderBackend> backend_;
 };
 
+/// The liveliness a participant's endpoints use: Liveliness::watchdogs on iceoryx, else options.liveliness.
+[[nodiscard]] inline Liveliness effective_liveliness(const ParticipantOptions& options) noexcept {
+  return options.iceoryx ? Liveliness::watchdogs : options.liveliness;
+}
+
 /// A DDS domain participant of the chosen vendor. Throws std::runtime_error if the vendor cannot
-/// create it (message names the vendor and domain); with options.security_directory, first
+/// create it (message names the vendor and domain), std::invalid_argument for options.iceoryx with
+/// Fast DDS, without loopback_only, with a profile or with security; with options.security_directory, first
 /// SecurityError naming the security file that is missing, tampered with or expired (security.hpp).
 /// With security, make_writer/make_reader throw std::runtime_error when the permissions do not
 /// allow the topic (the vendor refuses the endpoint).

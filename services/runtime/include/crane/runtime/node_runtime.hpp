@@ -55,10 +55,14 @@ struct NodeOptions {
                                    // else none (transport/security.hpp)
   std::string identity;            // identity in it; empty: the participant's name (tools: their role)
   bool insecure_lan{false};        // the network without security, said explicitly (else refused)
+  bool iceoryx{false};             // the crane's domain on iceoryx shared memory (transport::ParticipantOptions::
+                                   // iceoryx: Cyclone DDS on loopback, RouDi running); never the site's domain
+  transport::Liveliness liveliness{transport::Liveliness::dds};  // watchdogs: a participant off iceoryx that talks
+                                   // to a stack on it (a launcher's own, a test's monitor; transport/qos.hpp)
 };
 
-/// Adds --config, --dds, --domain, --lan, --log-level, --dds-profile, --realtime-priority and the
-/// security options (add_security_options) to `app`, bound to `options`.
+/// Adds --config, --dds, --domain, --lan, --log-level, --dds-profile, --realtime-priority, --iceoryx
+/// and the security options (add_security_options) to `app`, bound to `options`.
 void add_node_options(CLI::App& app, NodeOptions& options);
 
 /// Adds --security DIR, --identity NAME and --insecure-lan to `app` (every node and tool).
@@ -72,7 +76,8 @@ void add_security_options(CLI::App& app, NodeOptions& options);
 void add_site_network_option(CLI::App& app, bool& site_lan);
 
 /// The options of the participant on the site's domain `site_domain`: the crane's `options` on that
-/// domain, on every interface when `site_lan` (else as the crane's own). The network rule
+/// domain, on every interface when `site_lan` (else as the crane's own), never on iceoryx (the site
+/// spans hosts; its guards rely on DDS liveliness and deadlines). The network rule
 /// (check_network_security) applies to it when the participant is made.
 [[nodiscard]] NodeOptions site_domain_options(NodeOptions options, std::uint32_t site_domain, bool site_lan);
 

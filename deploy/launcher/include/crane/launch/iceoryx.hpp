@@ -1,0 +1,34 @@
+#pragma once
+// iceoryx's RouDi daemon for a stack on shared memory (StackOptions::iceoryx; docs/architecture.md,
+// "Shared memory").
+//
+// RouDi must outlive every process registered with it: when it stops, it sends SIGTERM to each of
+// them and, after its kill delay, SIGKILL. A launcher whose own participant is on iceoryx (crane_bench,
+// crane_demo, crane_launch) therefore cannot be RouDi's parent and stop it: run_beside_roudi() forks
+// the launcher's work into a child and stops RouDi only once that child has exited. A stack started
+// from a process that stays off iceoryx (a test's monitor) lists RouDi as its first process instead.
+// One RouDi runs per machine (a second one aborts: "Could not acquire lock").
+
+#include <functional>
+#include <string>
+
+#include "crane/launch/process_group.hpp"
+
+namespace crane::launch {
+
+/// RouDi's process name (its log: <log directory>/iox_roudi.log).
+inline constexpr const char* kRoudiProcess = "iox_roudi";
+
+/// iox-roudi (found on PATH) at warning log level, its output to `log_path` (empty: inherited).
+/// Throws std::invalid_argument when iox-roudi is not on PATH (Debian package iceoryx).
+ProcessSpec roudi_process(const std::string& log_path);
+
+/// Starts RouDi, runs `body` in a forked child process (its return value is the child's exit code,
+/// an exception its message on stderr and code 1), and stops RouDi once that child has exited.
+/// SIGINT and SIGTERM to this process are passed to the child. If RouDi exits first, the child
+/// gets SIGTERM and the result is nonzero. Call it before any thread is started. Returns the
+/// child's exit code (128 + the signal if a signal ended it). Throws what roudi_process() throws
+/// and std::runtime_error if fork fails.
+int run_beside_roudi(const std::string& roudi_log, const std::function<int()>& body);
+
+}  // namespace crane::launch
