@@ -11,17 +11,41 @@ namespace {
 // A segment in plan view swept by a disc of `radius`, times the heights [z_low, z_high] (see the
 // header).
 struct Slab {
+  Slab() = default;
+  Slab(const Vector3& from, const Vector3& to, double disc, double low, double high) noexcept
+      : a(from), b(to), radius(disc), z_low(low), z_high(high), middle((from + to) / 2.0),
+        half_length((to - from).norm() / 2.0) {}
   Vector3 a{Vector3::Zero()};  // plan points (z = 0)
   Vector3 b{Vector3::Zero()};
   double radius{0.0};
   double z_low{0.0};
   double z_high{0.0};
+  Vector3 middle{Vector3::Zero()};  // of [a, b], and half its length: may_be_closer()'s bound
+  double half_length{0.0};
 };
+
+double height_apart(const Slab& p, const Slab& q) noexcept {
+  return std::max({0.0, q.z_low - p.z_high, p.z_low - q.z_high});
+}
 
 double slab_distance(const Slab& p, const Slab& q) noexcept {
   const double plan = std::max(0.0, segment_distance(p.a, p.b, q.a, q.b) - p.radius - q.radius);
-  const double height = std::max({0.0, q.z_low - p.z_high, p.z_low - q.z_high});
+  const double height = height_apart(p, q);
+  // hypot(x, 0) is |x| exactly: the common cases skip glibc's careful hypot (most of a site run).
+  if (height == 0.0) return plan;
+  if (plan == 0.0) return height;
   return std::hypot(plan, height);
+}
+
+// Whether slab_distance(p, q) can be below `best`, from a lower bound of it: the plan distance of
+// two segments is at least their middles' distance less both half lengths (triangle inequality),
+// and slab_distance at least its plan and its height parts. 1 nm of slack covers the bound's
+// rounding, so a pair it skips could not have been kept (keep() takes only a smaller distance):
+// airspace_distance gives the same answer with or without it, only sooner.
+bool may_be_closer(const Slab& p, const Slab& q, double best) noexcept {
+  if (height_apart(p, q) >= best) return false;
+  const double reach = best + p.half_length + q.half_length + p.radius + q.radius + 1e-9;
+  return (p.middle - q.middle).squaredNorm() < reach * reach;
 }
 
 // The parts of one sample that turn with the slew.
@@ -136,13 +160,21 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
   for (std::size_t i = 0; i < b.count; ++i) {
     sample(second, b.boxes[i], sb);
     for (std::size_t s = 0; s < sb.count; ++s) {
-      for (std::size_t q = 0; q < kMovingParts; ++q) keep(best, slab_distance(mast_a, sb.parts[s][q]), Part::mast, kPartOf[q]);
+      for (std::size_t q = 0; q < kMovingParts; ++q) {
+        if (may_be_closer(mast_a, sb.parts[s][q], best.distance)) {
+          keep(best, slab_distance(mast_a, sb.parts[s][q]), Part::mast, kPartOf[q]);
+        }
+      }
     }
   }
   for (std::size_t i = 0; i < a.count; ++i) {
     sample(first, a.boxes[i], sa);
     for (std::size_t s = 0; s < sa.count; ++s) {
-      for (std::size_t p = 0; p < kMovingParts; ++p) keep(best, slab_distance(sa.parts[s][p], mast_b), kPartOf[p], Part::mast);
+      for (std::size_t p = 0; p < kMovingParts; ++p) {
+        if (may_be_closer(sa.parts[s][p], mast_b, best.distance)) {
+          keep(best, slab_distance(sa.parts[s][p], mast_b), kPartOf[p], Part::mast);
+        }
+      }
     }
     for (std::size_t j = 0; j < b.count; ++j) {
       sample(second, b.boxes[j], sb);
@@ -150,7 +182,9 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
         for (std::size_t t = 0; t < sb.count; ++t) {
           for (std::size_t p = 0; p < kMovingParts; ++p) {
             for (std::size_t q = 0; q < kMovingParts; ++q) {
-              keep(best, slab_distance(sa.parts[s][p], sb.parts[t][q]), kPartOf[p], kPartOf[q]);
+              if (may_be_closer(sa.parts[s][p], sb.parts[t][q], best.distance)) {
+                keep(best, slab_distance(sa.parts[s][p], sb.parts[t][q]), kPartOf[p], kPartOf[q]);
+              }
             }
           }
         }
