@@ -386,6 +386,30 @@ TEST(Iceoryx, RoudiFirstAndEveryProcessOnItOnCycloneOnly) {
   refused(secured, "--security");
 }
 
+// --iceoryx on a process: on loopback it joins iceoryx; with --lan or a profile it keeps the stack's
+// QoS over UDP (a monitor on another machine); a site's domain is never on iceoryx.
+TEST(Iceoryx, AProcessJoinsOnLoopbackAndSpeaksTheStacksQosOverTheNetwork) {
+  using crane::transport::Liveliness;
+  crane::runtime::NodeOptions node;
+  node.dds = "cyclone";
+  EXPECT_FALSE(crane::runtime::participant_options(node, "p").iceoryx);
+  EXPECT_EQ(crane::runtime::participant_options(node, "p").liveliness, Liveliness::dds);
+  node.iceoryx = true;
+  const auto local = crane::runtime::participant_options(node, "p");
+  EXPECT_TRUE(local.iceoryx);
+  EXPECT_EQ(crane::transport::effective_liveliness(local), Liveliness::watchdogs);
+  auto lan = node;
+  lan.loopback_only = false;
+  EXPECT_FALSE(crane::runtime::participant_options(lan, "p").iceoryx);
+  EXPECT_EQ(crane::runtime::participant_options(lan, "p").liveliness, Liveliness::watchdogs);
+  auto profile = node;
+  profile.dds_profile = "cyclone_lan_unicast.xml";
+  EXPECT_FALSE(crane::runtime::participant_options(profile, "p").iceoryx);
+  const auto site = crane::runtime::participant_options(crane::runtime::site_domain_options(node, 10, false), "p");
+  EXPECT_FALSE(site.iceoryx);
+  EXPECT_EQ(site.liveliness, Liveliness::dds);
+}
+
 // find_executable: as the shell finds a command on PATH.
 TEST(FindExecutable, FindsWhatThePathHasAndNothingElse) {
   const std::string sh = la::find_executable("sh");

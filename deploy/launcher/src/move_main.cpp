@@ -427,6 +427,7 @@ int main(int argc, char** argv) {
   app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
   bool lan = false;
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  runtime::add_iceoryx_option(app, node);
   runtime::add_security_options(app, node);  // identity: the participant's, "operator"
   app.add_option("--trolley", o.trolley, "[m] trolley target")->check(CLI::Range(-100.0, 100.0));
   app.add_option("--slew", o.slew_deg, "[deg] slew target")->check(CLI::Range(-3600.0, 3600.0));

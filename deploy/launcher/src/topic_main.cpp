@@ -283,6 +283,7 @@ int main(int argc, char** argv) {
     sub->add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
     sub->add_flag("--lan", lan, "use the network (UDP on every interface, no shared memory: as from another "
                                 "machine) instead of loopback only");
+    runtime::add_iceoryx_option(*sub, node);
     runtime::add_security_options(*sub, node);
   };
   auto* list_cmd = app.add_subcommand("list", "topics from discovery: types, writers, readers, QoS");

@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
   app.add_option("--domain", node.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--dds-profile", node.dds_profile, "network profile (deploy/dds/*.xml)")->check(CLI::ExistingFile);
   app.add_flag("--lan", lan, "reach the stack over the network (UDP) instead of loopback only");
+  runtime::add_iceoryx_option(app, node);
   runtime::add_security_options(app, node);
   std::string config_path;
   app.add_option("--config", config_path, "the stack's configuration (YAML): the crane and the no-go zones the page draws")
@@ -195,9 +196,9 @@ int main(int argc, char** argv) {
     std::unique_ptr<transport::Participant> site_participant;
     std::unique_ptr<anti_collision::SiteWatch> site_watch;  // the site page's (/site/view.json)
     if (!site_path.empty()) {
-      runtime::NodeOptions site_node = node;
       auto layout = anti_collision::load_site_layout(site_path);
-      site_node.domain_id = static_cast<std::uint32_t>(layout.domain_id);
+      const runtime::NodeOptions site_node =
+          runtime::site_domain_options(node, static_cast<std::uint32_t>(layout.domain_id), !node.loopback_only);
       site_watch = std::make_unique<anti_collision::SiteWatch>(std::move(layout));
       site_participant = runtime::make_participant(site_node, "crane_web");
     }

@@ -42,10 +42,15 @@ void add_node_options(CLI::App& app, NodeOptions& options) {
   app.add_option("--realtime-priority", options.realtime_priority,
                  "SCHED_FIFO priority (1-99) and locked memory, where the system allows it (0: normal priority)")
       ->check(CLI::Range(0, 99));
-  app.add_flag("--iceoryx", options.iceoryx,
-               "the stack's samples through iceoryx shared memory (Cyclone DDS on loopback; the launcher's "
-               "--iceoryx starts RouDi): AUTOMATIC liveliness and no deadlines on the control bus");
+  add_iceoryx_option(app, options);
   add_security_options(app, options);
+}
+
+void add_iceoryx_option(CLI::App& app, NodeOptions& options) {
+  app.add_flag("--iceoryx", options.iceoryx,
+               "the stack runs on iceoryx shared memory (its launcher's --iceoryx): join it there (Cyclone DDS, "
+               "its RouDi running; RouDi ends this process when it stops), or with --lan or a profile speak its "
+               "QoS over UDP");
 }
 
 void add_security_options(CLI::App& app, NodeOptions& options) {
@@ -125,25 +130,32 @@ std::unique_ptr<transport::Participant> make_participant(const NodeOptions& opti
       spdlog::warn("real time not available ({}): running at normal priority", failure);
     }
   }
-  transport::ParticipantOptions p;
-  p.name = name;
-  p.domain_id = options.domain_id;
-  p.loopback_only = options.loopback_only;
-  p.shared_memory = options.shared_memory;
-  p.iceoryx = options.iceoryx;
-  p.liveliness = options.liveliness;
-  p.profile_file = options.dds_profile;
-  if (p.profile_file.empty()) {
-    if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;
-  }
-  p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
-  p.security_directory = security_directory_of(options);
-  p.identity = options.identity;
+  const transport::ParticipantOptions p = participant_options(options, name);
   check_network_security(p.loopback_only, p.profile_file, p.security_directory, options.insecure_lan);
   if (!p.security_directory.empty()) {
     spdlog::info("DDS Security: identity '{}' of {}", p.identity.empty() ? name : p.identity, p.security_directory);
   }
   return std::make_unique<transport::Participant>(p);
+}
+
+transport::ParticipantOptions participant_options(const NodeOptions& options, const std::string& name) {
+  transport::ParticipantOptions p;
+  p.name = name;
+  p.domain_id = options.domain_id;
+  p.loopback_only = options.loopback_only;
+  p.shared_memory = options.shared_memory;
+  p.profile_file = options.dds_profile;
+  if (p.profile_file.empty()) {
+    if (const char* env = std::getenv("CRANE_DDS_PROFILE"); env != nullptr) p.profile_file = env;
+  }
+  // --iceoryx: the stack runs on iceoryx. On its machine a process joins it there; over the network
+  // (--lan, a profile) it speaks that stack's QoS over UDP.
+  p.iceoryx = options.iceoryx && p.loopback_only && p.profile_file.empty();
+  p.liveliness = options.iceoryx ? transport::Liveliness::watchdogs : options.liveliness;
+  p.vendor = options.dds.empty() ? transport::vendor_from_environment() : transport::parse_vendor(options.dds);
+  p.security_directory = security_directory_of(options);
+  p.identity = options.identity;
+  return p;
 }
 
 std::string security_directory_of(const NodeOptions& options) {

@@ -55,8 +55,9 @@ struct NodeOptions {
                                    // else none (transport/security.hpp)
   std::string identity;            // identity in it; empty: the participant's name (tools: their role)
   bool insecure_lan{false};        // the network without security, said explicitly (else refused)
-  bool iceoryx{false};             // the crane's domain on iceoryx shared memory (transport::ParticipantOptions::
-                                   // iceoryx: Cyclone DDS on loopback, RouDi running); never the site's domain
+  bool iceoryx{false};             // the stack runs on iceoryx shared memory: on loopback the participant joins it
+                                   // (transport::ParticipantOptions::iceoryx: Cyclone DDS, RouDi running), else it
+                                   // speaks its QoS over UDP (add_iceoryx_option); never the site's domain
   transport::Liveliness liveliness{transport::Liveliness::dds};  // watchdogs: a participant off iceoryx that talks
                                    // to a stack on it (a launcher's own, a test's monitor; transport/qos.hpp)
 };
@@ -64,6 +65,11 @@ struct NodeOptions {
 /// Adds --config, --dds, --domain, --lan, --log-level, --dds-profile, --realtime-priority, --iceoryx
 /// and the security options (add_security_options) to `app`, bound to `options`.
 void add_node_options(CLI::App& app, NodeOptions& options);
+
+/// Adds --iceoryx to `app` (every node, and the tools that read or write the stack's topics): the
+/// stack runs on iceoryx shared memory. make_participant() then joins iceoryx on loopback, and speaks
+/// the stack's QoS (transport::Liveliness::watchdogs) over UDP with --lan or a profile.
+void add_iceoryx_option(CLI::App& app, NodeOptions& options);
 
 /// Adds --security DIR, --identity NAME and --insecure-lan to `app` (every node and tool).
 void add_security_options(CLI::App& app, NodeOptions& options);
@@ -110,6 +116,13 @@ void leave_realtime_this_thread() noexcept;
 /// (check_network_security), transport::SecurityError naming a bad security file,
 /// std::runtime_error if DDS fails.
 std::unique_ptr<transport::Participant> make_participant(const NodeOptions& options, const std::string& name);
+
+/// The transport's options make_participant() creates the participant with: the profile from
+/// $CRANE_DDS_PROFILE when options name none, the vendor from $CRANE_DDS when options.dds is empty,
+/// the security folder from $CRANE_SECURITY; --iceoryx joins iceoryx on loopback without a
+/// profile, else keeps the stack's QoS (Liveliness::watchdogs) over UDP. Throws
+/// std::invalid_argument on a bad vendor name.
+[[nodiscard]] transport::ParticipantOptions participant_options(const NodeOptions& options, const std::string& name);
 
 /// The DDS Security material a participant of `options` uses: --security, else $CRANE_SECURITY,
 /// else "" (none).
