@@ -147,8 +147,11 @@ Airspace whole_reach(const SiteCrane& c, const PathAllowance& allowance) noexcep
   return out;
 }
 
-PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const SiteCrane& second,
-                               const Airspace& b) noexcept {
+namespace {
+
+// The one loop: with kPrune, a pair may_be_closer() rules out is skipped (the same answer, sooner).
+template <bool kPrune>
+PairDistance closest(const SiteCrane& first, const Airspace& a, const SiteCrane& second, const Airspace& b) noexcept {
   PairDistance best{std::numeric_limits<double>::infinity(), Part::jib, Part::jib};
   if (a.count == 0 || b.count == 0) return best;
   const Slab mast_a = mast(first);
@@ -161,7 +164,7 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
     sample(second, b.boxes[i], sb);
     for (std::size_t s = 0; s < sb.count; ++s) {
       for (std::size_t q = 0; q < kMovingParts; ++q) {
-        if (may_be_closer(mast_a, sb.parts[s][q], best.distance)) {
+        if (!kPrune || may_be_closer(mast_a, sb.parts[s][q], best.distance)) {
           keep(best, slab_distance(mast_a, sb.parts[s][q]), Part::mast, kPartOf[q]);
         }
       }
@@ -171,7 +174,7 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
     sample(first, a.boxes[i], sa);
     for (std::size_t s = 0; s < sa.count; ++s) {
       for (std::size_t p = 0; p < kMovingParts; ++p) {
-        if (may_be_closer(sa.parts[s][p], mast_b, best.distance)) {
+        if (!kPrune || may_be_closer(sa.parts[s][p], mast_b, best.distance)) {
           keep(best, slab_distance(sa.parts[s][p], mast_b), kPartOf[p], Part::mast);
         }
       }
@@ -182,7 +185,7 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
         for (std::size_t t = 0; t < sb.count; ++t) {
           for (std::size_t p = 0; p < kMovingParts; ++p) {
             for (std::size_t q = 0; q < kMovingParts; ++q) {
-              if (may_be_closer(sa.parts[s][p], sb.parts[t][q], best.distance)) {
+              if (!kPrune || may_be_closer(sa.parts[s][p], sb.parts[t][q], best.distance)) {
                 keep(best, slab_distance(sa.parts[s][p], sb.parts[t][q]), kPartOf[p], kPartOf[q]);
               }
             }
@@ -193,5 +196,19 @@ PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const 
   }
   return best;
 }
+
+}  // namespace
+
+PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const SiteCrane& second,
+                               const Airspace& b) noexcept {
+  return closest<true>(first, a, second, b);
+}
+
+namespace internal {
+PairDistance airspace_distance_every_pair(const SiteCrane& first, const Airspace& a, const SiteCrane& second,
+                                          const Airspace& b) noexcept {
+  return closest<false>(first, a, second, b);
+}
+}  // namespace internal
 
 }  // namespace crane::anti_collision
