@@ -374,7 +374,8 @@ TEST(Iceoryx, RoudiFirstAndEveryProcessOnItOnCycloneOnly) {
   };
   auto mixed = o;
   mixed.dds_per_process = {{"tracking", "fast"}};
-  refused(mixed, "tracking is on 'fast'");
+  refused(mixed, "--iceoryx: tracking: ");
+  refused(mixed, "this participant is on fast");
   auto fast = o;
   fast.dds = "fast";
   refused(fast, "Cyclone DDS");
@@ -383,7 +384,16 @@ TEST(Iceoryx, RoudiFirstAndEveryProcessOnItOnCycloneOnly) {
   refused(lan, "--lan");
   auto secured = o;
   secured.security_directory = "/security";
-  refused(secured, "--security");
+  refused(secured, "--security /security");
+  auto profiled = o;
+  profiled.dds_profile = "/lan.xml";
+  refused(profiled, "with the network profile /lan.xml");
+  // Every reason named at once, in the transport's words (crane/transport/iceoryx_rule.hpp, the rule
+  // transport::Participant applies too).
+  auto all = fast;
+  all.lan = true;
+  all.security_directory = "/security";
+  refused(all, "this participant is on fast, with --lan, with --security /security");
 }
 
 // --iceoryx on a process: on loopback it joins iceoryx; with --lan or a profile it keeps the stack's

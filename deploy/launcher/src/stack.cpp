@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "crane/transport/iceoryx_rule.hpp"
+
 namespace crane::launch {
 
 namespace {
@@ -86,10 +88,6 @@ std::string vendor_of(const StackOptions& o, const std::string& name) {
 }
 
 std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
-  if (o.iceoryx && (o.lan || !o.dds_profile.empty() || !o.security_directory.empty())) {
-    throw std::invalid_argument("--iceoryx keeps the stack's samples on this machine, unencrypted in shared memory: "
-                                "not with --lan, --dds-profile or --security");
-  }
   std::vector<ProcessSpec> specs;
   const bool bridge = !o.hardware.empty();
   for (const auto& name : stack_process_names(o)) {
@@ -102,9 +100,10 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
     }
     spec.executable = o.binary_directory + "/" + name;
     const auto vendor = vendor_of(o, name);
-    if (o.iceoryx && vendor != "cyclone") {
-      throw std::invalid_argument("--iceoryx: " + name + " is on '" + vendor +
-                                  "'; iceoryx shared memory needs Cyclone DDS in every process (--dds cyclone)");
+    if (o.iceoryx) {
+      const std::string refusal = transport::iceoryx_refusal(vendor == "cyclone", vendor, o.lan, o.dds_profile,
+                                                             o.security_directory);
+      if (!refusal.empty()) throw std::invalid_argument("--iceoryx: " + name + ": " + refusal);
     }
     spec.arguments = {"--dds", vendor, "--domain", std::to_string(o.domain_id), "--log-level", o.log_level};
     if (o.iceoryx) spec.arguments.push_back("--iceoryx");

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "crane/transport/iceoryx_rule.hpp"
+
 namespace crane::transport {
 
 Vendor parse_vendor(std::string_view text) {
@@ -89,14 +91,10 @@ void Wakeup::stop_dispatch() {
 
 Participant::Participant(const ParticipantOptions& options) : options_(options) {
   options_.profile_file = profile_for_vendor(options.profile_file, options.vendor);
-  if (options_.iceoryx && (options_.vendor != Vendor::cyclone_dds || !options_.loopback_only ||
-                           !options_.profile_file.empty() || !options_.security_directory.empty())) {
-    throw std::invalid_argument(
-        std::string("iceoryx shared memory needs Cyclone DDS on loopback without a network profile or DDS "
-                    "Security (its samples lie unencrypted in shared memory); this participant is ") +
-        vendor_name(options_.vendor) + (options_.loopback_only ? "" : " with --lan") +
-        (options_.profile_file.empty() ? "" : " with the profile " + options_.profile_file) +
-        (options_.security_directory.empty() ? "" : " with --security " + options_.security_directory));
+  if (options_.iceoryx) {
+    const std::string refusal = iceoryx_refusal(options_.vendor == Vendor::cyclone_dds, vendor_name(options_.vendor),
+                                                !options_.loopback_only, options_.profile_file, options_.security_directory);
+    if (!refusal.empty()) throw std::invalid_argument(refusal);
   }
   std::optional<SecurityFiles> security;
   if (!options_.security_directory.empty()) {
