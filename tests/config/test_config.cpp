@@ -661,18 +661,30 @@ TEST_F(LabConfigText, PlantHookAndWindAreOffAndValidatedLikeTheRest) {
   EXPECT_EQ(on.plant.wind.seed, 1U);
 }
 
-TEST_F(LabConfigText, TheRobustPlanIsOffAndItsRangesAreValidated) {
+// The lab crane plans robustly near its mast only (docs/optimal_control.md, "Robust near the mast");
+// the ranges are validated, and the radius is a tower crane's.
+TEST_F(LabConfigText, TheRobustPlanIsNearTheMastAndItsRangesAreValidated) {
   const auto c = cfg::parse_stack_config(text_, "test.yaml");
-  EXPECT_EQ(c.trajectory_planner.robust_length_range, 0.0);  // off: every plan as before
+  EXPECT_EQ(c.trajectory_planner.robust_length_range, 0.2);
   EXPECT_EQ(c.trajectory_planner.robust_margin, 0.2);
+  EXPECT_EQ(c.trajectory_planner.robust_within_radius, 0.5);
   auto message = error_of(edit_line(text_, "trajectory_planner:", "robust_length_range:", "robust_length_range: 0.6").text);
   EXPECT_TRUE(contains(message, "trajectory_planner.robust_length_range = 0.6")) << message;
   EXPECT_TRUE(contains(message, "[0, 0.5]")) << message;
   message = error_of(edit_line(text_, "trajectory_planner:", "robust_margin:", "robust_margin: -0.1").text);
   EXPECT_TRUE(contains(message, "trajectory_planner.robust_margin = -0.1")) << message;
-  const auto on = cfg::parse_stack_config(
-      edit_line(text_, "trajectory_planner:", "robust_length_range:", "robust_length_range: 0.2").text, "test.yaml");
-  EXPECT_EQ(on.trajectory_planner.robust_length_range, 0.2);
+  message = error_of(edit_line(text_, "trajectory_planner:", "robust_within_radius:", "robust_within_radius: -1").text);
+  EXPECT_TRUE(contains(message, "trajectory_planner.robust_within_radius = -1")) << message;
+  const auto off = cfg::parse_stack_config(
+      edit_line(text_, "trajectory_planner:", "robust_length_range:", "robust_length_range: 0").text, "test.yaml");
+  EXPECT_EQ(off.trajectory_planner.robust_length_range, 0.0);
+  for (const char* name : {"gantry_crane.yaml", "overhead_crane.yaml"}) {
+    const std::string text = read_text(std::string(CRANE_SOURCE_DIR) + "/deploy/config/" + name);
+    EXPECT_EQ(cfg::parse_stack_config(text, name).trajectory_planner.robust_within_radius, 0.0) << name;
+    message = error_of(edit_line(text, "trajectory_planner:", "robust_within_radius:", "robust_within_radius: 0.5").text);
+    EXPECT_TRUE(contains(message, "trajectory_planner.robust_within_radius = 0.5")) << name << ": " << message;
+    EXPECT_TRUE(contains(message, "tower crane only")) << name << ": " << message;
+  }
 }
 
 TEST_F(LabConfigText, ManualShapingAndItsSwingModelAreValidated) {

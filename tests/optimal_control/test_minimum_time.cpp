@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #include "crane/common/validation.hpp"
 #include "crane/optimal_control/minimum_time.hpp"
@@ -214,16 +215,27 @@ TEST(MinimumTime, ARobustSolveOverItsIterationsGivesThePlainLeastEffortPlan) {
 }
 
 // The planner's request to the problem (optimal_control::minimum_time_problem): a request robust to
-// the configured pendulum carries its two detuned pendulums and its margin; the shipped config plans
-// as before (no detuned pendulum, the least-effort margin 0.01).
+// the configured pendulum carries its two detuned pendulums and its margin. The shipped config plans
+// robustly near the mast only: the demo trolley move, ending 1.0 m out, as before (no detuned
+// pendulum, the least-effort margin 0.01); the same move back toward the mast, ending at 0.25 m,
+// with them; with a radius of 0, every move.
 TEST(MinimumTime, ARobustRequestCarriesItsDetunedPendulumsAndMargin) {
   auto cfg = config("lab_tower_crane.yaml");
-  const auto& m = stack::find_maneuver(cfg, "trolley");
+  auto m = stack::find_maneuver(cfg, "trolley");
+  ASSERT_GT(m.trolley_target, cfg.trajectory_planner.robust_within_radius);
   const auto plain = stack::bound_problem(cfg, m, 50);
   EXPECT_TRUE(plain.detuned_pendulums.empty());
   EXPECT_EQ(plain.least_effort_margin, 0.01);
+  auto back = m;
+  std::swap(back.initial_trolley_position, back.trolley_target);
+  ASSERT_LT(back.trolley_target, cfg.trajectory_planner.robust_within_radius);
+  const auto near = stack::bound_problem(cfg, back, 50);
+  ASSERT_EQ(near.detuned_pendulums.size(), 2U);
+  EXPECT_EQ(near.detuned_pendulums[0], 1.0 - cfg.trajectory_planner.robust_length_range);
+  EXPECT_EQ(near.least_effort_margin, cfg.trajectory_planner.robust_margin);
   cfg.trajectory_planner.robust_length_range = 0.25;
   cfg.trajectory_planner.robust_margin = 0.3;
+  cfg.trajectory_planner.robust_within_radius = 0.0;
   const auto robust = stack::bound_problem(cfg, m, 50);
   ASSERT_EQ(robust.detuned_pendulums.size(), 2U);
   EXPECT_EQ(robust.detuned_pendulums[0], 0.75);

@@ -214,6 +214,30 @@ TEST(PlannerStage, AMinimumTimePlanSwingsTheLearntPendulumWhenItSwingsOverTheMov
   }
 }
 
+// Robust near the mast only (TrajectoryPlannerParams::robust_within_radius): a plan on the configured
+// pendulum whose trolley ends within the radius (the bound included) is robust, one further out or
+// on a learnt pendulum is not; a radius of 0 makes every plan on the configured pendulum robust.
+TEST(PlannerStage, ARobustPlanNearTheMastOnly) {
+  trajectory_planner::TrajectoryPlannerParams params;
+  params.robust_length_range = 0.2;
+  params.robust_margin = 0.15;
+  const trajectory_planner::EquivalentPendulum configured{};
+  const auto range_of = [&](double radius, double target, bool learnt) {
+    params.robust_within_radius = radius;
+    trajectory_planner::PlanRequest r;
+    r.trolley_target = target;
+    trajectory_planner::plan_on_pendulum(r, configured, learnt, params);
+    EXPECT_EQ(r.robust_margin, 0.15);
+    return r.robust_length_range;
+  };
+  EXPECT_EQ(range_of(0.5, 0.3, false), 0.2);
+  EXPECT_EQ(range_of(0.5, 0.5, false), 0.2);
+  EXPECT_EQ(range_of(0.5, 0.51, false), 0.0);
+  EXPECT_EQ(range_of(0.5, 0.3, true), 0.0);
+  EXPECT_EQ(range_of(0.0, 1.0, false), 0.2);
+  EXPECT_EQ(range_of(0.0, 1.0, true), 0.0);
+}
+
 TEST(PlannerStage, AMinimumTimeGoalHoldsForItsPlanThenRunsItsPathWithItsLaw) {
   HeardPlanner p;
   auto& [stage, reference, status] = p;

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "crane/common/validation.hpp"
+#include "crane/plant/tower_crane_model.hpp"
 
 #include "crane/tracking/trajectory_feedback.hpp"
 
@@ -85,6 +86,7 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
   common::require_greater("follower.hold.weights.swing_rate", h.swing_rate, 0.0);
   common::require_greater("follower.hold.weights.voltage", h.voltage, 0.0);
   common::require_in_range("follower.hold.sliding_friction_scale", params.hold.sliding_friction_scale, 0.0, 1.0);
+  common::require_greater("follower.hold.slew_sideways", params.hold.slew_sideways, 0.0);
   common::require_in_range("follower.trajectory_sliding_friction_scale", params.trajectory_sliding_friction_scale, 0.0,
                            1.0);
   if (!(trajectory.solved || trajectory.fallback) || trajectory.nodes.size() < 2 ||
@@ -195,8 +197,15 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     Qw = q.asDiagonal();
     Rw = Eigen::MatrixXd::Identity(m, m) / (bw.voltage * bw.voltage);
   };
+  // The hold's slew weight at the target's radius (FollowerHold::slew_sideways; a tower crane's slew,
+  // not an overhead crane's bridge).
+  FollowerWeights hold = h;
+  const double radius = samples_[count].state.position[kTrolleyIndex];
+  if (second_drive_ && dynamic_cast<const plant::TowerCraneModel*>(&model) != nullptr && radius > 0.0) {
+    hold.second_position = std::max(h.second_position, params.hold.slew_sideways / radius);
+  }
   Eigen::MatrixXd Q, R;
-  bryson(h, Q, R);  // the hold's, for the stationary solution; the trajectory's below
+  bryson(hold, Q, R);  // the hold's, for the stationary solution; the trajectory's below
   const auto riccati_step = [&](const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& P,
                                 Eigen::MatrixXd& K) {
     K = (R + B.transpose() * P * B).ldlt().solve(B.transpose() * P * A);

@@ -38,6 +38,7 @@ CalibratedStack calibrate_swing_on(const StackConfig& config, const plant::Plant
   CalibratedStack out{config, swing_calibration::fit_swing(record, options), run.maneuver.name};
   out.config.trajectory_planner.manual.swing_length_scale = out.fit.length_scale;
   out.config.trajectory_planner.manual.swing_length_offset = out.fit.length_offset;
+  out.config.trajectory_planner.robust_length_range = 0.0;  // known now (crane_calibrate prints the same line)
   trajectory_planner::validate(out.config.trajectory_planner.manual);
   return out;
 }

@@ -658,6 +658,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     double solve_seconds{0.0};
     bool least_effort{false};  // the trajectory is the least-effort solve's (MinimumTimeResult::least_effort)
     bool robust{false};        // ... with the detuned pendulums (MinimumTimeResult::robust)
+    bool asked_robust{false};  // the planner asked for them (trajectory_planner::plan_on_pendulum)
     std::string error;
   };
   std::vector<MoveResult> results(maneuvers.size());
@@ -670,6 +671,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
         results[i].solve_seconds = bound.solve_seconds;
         results[i].least_effort = bound.least_effort;
         results[i].robust = bound.robust;
+        results[i].asked_robust = stack::plan_request_of(cfg, maneuvers[i]).robust_length_range > 0.0;
         for (std::size_t p = 0; p < plants.size(); ++p) {
           if (!calibrated[p]) {
             results[i].runs.push_back(stack::compare_move(
@@ -723,6 +725,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
   std::vector<double> solve_times;
   std::size_t least_effort = 0;
   std::size_t robust = 0;
+  std::size_t asked_robust = 0;
   std::string slowest;  // the move of the longest solve
   double slowest_seconds = -1.0;
   for (std::size_t i = 0; i < maneuvers.size(); ++i) {
@@ -739,6 +742,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
     }
     if (r.least_effort) ++least_effort;
     if (r.robust) ++robust;
+    if (r.asked_robust) ++asked_robust;
     for (const auto& run : r.runs) {
       const bool nominal = stack::mismatch_label(run.mismatch) == "nominal";
       (nominal ? (i < demo_count ? demo_nominal : random_nominal) : at_corners).push_back(run);
@@ -817,10 +821,11 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
                 intervals, stack::nearest_rank_quantile(solve_times, 0.5), solve_times.back(), slowest.c_str(),
                 solve_times.size(), wall, std::max(1U, jobs), least_effort);
     if (cfg.trajectory_planner.robust_length_range > 0.0) {
-      std::printf("robust to the pendulum's length (trajectory_planner.robust_length_range %.2f): %zu of the "
-                  "least-effort trajectories; the others over the robust solve's %d IPOPT iterations, planned as "
-                  "with it off\n",
-                  cfg.trajectory_planner.robust_length_range, robust,
+      std::printf("robust to the pendulum's length (trajectory_planner.robust_length_range %.2f): %zu of the %zu "
+                  "moves asked for it (robust_within_radius %.2f m; 0: all); the others over the robust solve's %d "
+                  "IPOPT iterations, planned as with it off\n",
+                  cfg.trajectory_planner.robust_length_range, robust, asked_robust,
+                  cfg.trajectory_planner.robust_within_radius,
                   optimal_control::MinimumTimeProblem{}.detuned_max_iterations);
     }
   }
@@ -979,6 +984,10 @@ void add_follower_options(CLI::App* cmd, optimal_control::FollowerParams& params
                   "along the trajectory: the fraction of the sliding friction compensated on the measured speed; "
                   "the rest fed forward at the reference speed [-]")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--hold-slew-sideways", params.hold.slew_sideways,
+                  "at the target: the slew held no tighter than this sideways displacement of the trolley "
+                  "(radius times angle; a tower crane) [m]")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--hold-sliding-friction-scale", params.hold.sliding_friction_scale,
                   "at the target: the fraction of the plant's sliding friction compensated, the plant's estimated "
                   "along the move [-]")

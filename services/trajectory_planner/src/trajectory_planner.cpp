@@ -60,6 +60,7 @@ TrajectoryPlanner::TrajectoryPlanner(const TrajectoryPlannerParams& params) : pa
   validate(params.manual);
   common::require_in_range("trajectory_planner.robust_length_range", params.robust_length_range, 0.0, 0.5);
   common::require_in_range("trajectory_planner.robust_margin", params.robust_margin, 0.0, 0.5);
+  common::require_in_range("trajectory_planner.robust_within_radius", params.robust_within_radius, 0.0, 1000.0);
   // The calibrated equivalent pendulum must be one over the whole cable range (a > 0: its shortest
   // is at the shortest cable), or the minimum-time plans have no pendulum to swing.
   if (!swings_down_to(params.manual.pendulum(), params.cable_min_length)) {

@@ -46,8 +46,14 @@ TrajectoryPlannerParams read_params(config::YamlSection& s, const common::StackF
   m.finish();
   p.robust_length_range = s.number("robust_length_range", 0.0, 0.5);
   p.robust_margin = s.number("robust_margin", 0.0, 0.5);
+  p.robust_within_radius = s.number("robust_within_radius", 0.0, 1000.0);
   s.finish();
   p.site = facts.site;
+  if (p.robust_within_radius > 0.0 && facts.crane_kind != common::CraneKind::tower) {
+    throw common::ConfigError("trajectory_planner.robust_within_radius = " + common::format_value(p.robust_within_radius) +
+                              ": a radius about the slew axis, for a tower crane only (crane.kind = " +
+                              common::to_string(facts.crane_kind) + "); 0 here");
+  }
   if (p.bridge_enabled && !p.site.zones.empty()) {
     throw common::ConfigError("site.zones: no-go zones are planned around for a slewing crane only (crane.kind = "
                               "overhead has " + std::to_string(p.site.zones.size()) + " zones)");

@@ -24,7 +24,8 @@
 namespace crane::stack {
 
 struct CalibratedStack {
-  StackConfig config;                 // the given config, its manual.swing_length_scale and _offset the fit's
+  StackConfig config;                 // the given config, its manual.swing_length_scale and _offset the fit's,
+                                      // its robust_length_range 0 (the pendulum is known)
   swing_calibration::SwingFit fit;    // a, c, the damping ratio and the residual
   std::string maneuver;               // the recorded maneuver's name
 };

@@ -66,6 +66,13 @@ struct TrajectoryPlannerParams {
   /// plans every move as before. A plan on a learnt pendulum is never made robust.
   double robust_length_range{0.0};    // [-]
   double robust_margin{0.2};          // [-]
+  /// [m] >= 0: where > 0, only a plan whose trolley ends within this radius of the slew axis is made
+  /// robust (a tower crane). Near the mast the slew is a weak actuator for the out-of-plane swing (a
+  /// slew angle moves the trolley sideways by the radius times it), so the hold at the target damps
+  /// the swing a longer cable leaves slowly, with the slew outside its settle band meanwhile; further
+  /// out the hold does, and a robust plan's margin costs more than it saves (docs/optimal_control.md,
+  /// "Robust near the mast"). 0: every plan on the configured pendulum.
+  double robust_within_radius{0.0};
   common::Site site{};                // the no-go zones (goals refused inside, paths planned around)
   // An overhead crane's bridge (crane.kind = overhead; false elsewhere): its runway travel (its manual
   // motion is manual.bridge). The planner stage runs it as the trolley of a second planner
@@ -94,12 +101,15 @@ struct TrajectoryPlannerParams {
   }
 };
 
-/// Plans `r` on `pendulum`: robust to its length (params.robust_length_range and robust_margin) where
-/// it is the configured one (`learnt` false), fast on it where the state estimator learnt it.
+/// Plans `r` (its trolley_target set) on `pendulum`: robust to its length (params.robust_length_range
+/// and robust_margin) where it is the configured one (`learnt` false) and the trolley ends within
+/// params.robust_within_radius (where > 0), fast on it otherwise: where the state estimator learnt it,
+/// or further out.
 inline void plan_on_pendulum(PlanRequest& r, const EquivalentPendulum& pendulum, bool learnt,
                              const TrajectoryPlannerParams& params) noexcept {
   r.swing = pendulum;
-  r.robust_length_range = learnt ? 0.0 : params.robust_length_range;
+  const bool near_the_mast = params.robust_within_radius <= 0.0 || r.trolley_target <= params.robust_within_radius;
+  r.robust_length_range = learnt || !near_the_mast ? 0.0 : params.robust_length_range;
   r.robust_margin = params.robust_margin;
 }
 
