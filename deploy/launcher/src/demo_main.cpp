@@ -104,18 +104,32 @@ struct Recording {
 class Operator {
  public:
   explicit Operator(transport::Participant& participant)
-      // The recorders do not wake this process on every sample (four wake-ups a cycle would take
-      // the cores from the chain in lockstep): it polls them every 20 ms, 8192 samples deep.
-      : status_(participant.make_reader<tp::SafetyStatus>(&wakeup_)),
-        sensors_(participant.make_recording_reader<tp::Sensors>(nullptr, 8192)),
-        references_(participant.make_recording_reader<tp::Reference>(nullptr, 8192)),
-        linear_(participant.make_recording_reader<tp::LinearCommand>(nullptr, 8192)),
-        actuators_(participant.make_recording_reader<tp::Actuators>(nullptr, 8192)),
-        diagnostics_(participant.make_recording_reader<tp::LoopDiagnostics>(nullptr, 256)),
-        move_status_(participant.make_recording_reader<tp::MoveStatus>(nullptr, 64)),
-        goal_(participant.make_writer<tp::Goal>()) {}
+      : participant_(participant), goal_(participant.make_writer<tp::Goal>()) {
+    make_readers();
+  }
 
   transport::Wakeup& wakeup() { return wakeup_; }
+
+  /// On iceoryx (Cyclone DDS 0.10.2), a reader keeps each sample that reaches it before its
+  /// participant has discovered the sample's writer: the chunk is never released
+  /// (cyclonedds#1409, fixed upstream after 0.10.2), and after 256 such samples the reader takes
+  /// nothing more ("TOO_MANY_CHUNKS_HELD_IN_PARALLEL"). In lockstep the stack runs thousands of
+  /// cycles a second before a move, so a writer this process discovers late leaves its reader
+  /// deaf for the run (seen once in 8 demo runs under a loaded CI: the actuators, "actuators 0").
+  /// Once every reader has matched a writer, the readers are made again: the new ones start with
+  /// every writer known. Returns whether that happened (once per run; before the move, whose
+  /// samples are the recording).
+  bool renew_readers_once_matched() {
+    if (renewed_) return false;
+    const std::int32_t matched[] = {status_->health().matched_writers,     sensors_->health().matched_writers,
+                                    references_->health().matched_writers, linear_->health().matched_writers,
+                                    actuators_->health().matched_writers,  diagnostics_->health().matched_writers,
+                                    move_status_->health().matched_writers};
+    if (std::any_of(std::begin(matched), std::end(matched), [](std::int32_t n) { return n < 1; })) return false;
+    make_readers();
+    renewed_ = true;
+    return true;
+  }
 
   void drain_all() {
     tp::msgs::SupervisorStatus_ s;
@@ -173,6 +187,21 @@ class Operator {
 
  private:
   transport::Wakeup wakeup_;
+  // The recorders do not wake this process on every sample (four wake-ups a cycle would take
+  // the cores from the chain in lockstep): it polls them every 20 ms, 8192 samples deep.
+  void make_readers() {
+    status_.reset();
+    status_ = participant_.make_reader<tp::SafetyStatus>(&wakeup_);
+    sensors_ = participant_.make_recording_reader<tp::Sensors>(nullptr, 8192);
+    references_ = participant_.make_recording_reader<tp::Reference>(nullptr, 8192);
+    linear_ = participant_.make_recording_reader<tp::LinearCommand>(nullptr, 8192);
+    actuators_ = participant_.make_recording_reader<tp::Actuators>(nullptr, 8192);
+    diagnostics_ = participant_.make_recording_reader<tp::LoopDiagnostics>(nullptr, 256);
+    move_status_ = participant_.make_recording_reader<tp::MoveStatus>(nullptr, 64);
+  }
+
+  transport::Participant& participant_;
+  bool renewed_{false};
   std::unique_ptr<transport::Reader<tp::SafetyStatus>> status_;
   std::unique_ptr<transport::Reader<tp::Sensors>> sensors_;
   std::unique_ptr<transport::Reader<tp::Reference>> references_;
@@ -274,6 +303,10 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   const auto ready_deadline = Clock::now() + std::chrono::duration<double>(options.ready_timeout);
   while (true) {
     check_children(group);
+    if (options.iceoryx) {
+      op.record(rec);  // what the old readers hold, before they go
+      if (op.renew_readers_once_matched()) spdlog::info("{}: readers made again, every writer known", run_name);
+    }
     const auto status = op.latest_status();
     op.record(rec);
     // The plant itself reports brakes released: the supervisor's "ready" has reached it.
