@@ -101,6 +101,39 @@ TEST(TrajectoryFollower, EndsTheSlewAtRestOnItsModel) {
   EXPECT_LT(max_swing, b.problem.max_swing);
 }
 
+// The hold's slew weight (FollowerHold::slew_sideways, "Robust near the mast"): after a plan robust to
+// the pendulum's length and near the mast (the slew at 0.3 m: max(0.01 rad, 6 mm / 0.3 m) = 0.02 rad)
+// the hold's slew position gain is smaller than after the same plan not robust; 0.9 m out (6.7 mrad
+// < 0.01 rad) the hold is the same either way.
+TEST(TrajectoryFollower, TheHoldLoosensTheSlewAfterARobustPlanNearTheMastOnly) {
+  auto cfg = config("lab_tower_crane.yaml");
+  cfg.trajectory_planner.robust_length_range = 0.0;  // the plain plan: only the result's flag differs
+  for (const double radius : {0.3, 0.9}) {
+    auto m = stack::find_maneuver(cfg, "slew");
+    m.initial_trolley_position = radius;
+    m.trolley_target = radius;
+    Solved b = solve(cfg, m);
+    ASSERT_TRUE(b.result.solved) << b.result.status;
+    ASSERT_FALSE(b.result.robust);
+    const optimal_control::FollowerParams params;
+    const optimal_control::TrajectoryFollower plain(b.problem, b.result, params);
+    b.result.robust = true;
+    const optimal_control::TrajectoryFollower robust(b.problem, b.result, params);
+    const std::size_t end = plain.samples() + 10;
+    // Rows: trolley and slew voltage; columns: the model's slots, positions first (trolley, in-plane
+    // swing, slew, out-of-plane swing), then their rates.
+    const double plain_gain = plain.gain(end)(1, 2);
+    const double robust_gain = robust.gain(end)(1, 2);
+    std::printf("slew at %.1f m: hold's slew position gain %.3f V/rad plain, %.3f robust\n", radius, plain_gain,
+                robust_gain);
+    if (radius < 0.6) {
+      EXPECT_LT(std::abs(robust_gain), 0.9 * std::abs(plain_gain));
+    } else {
+      EXPECT_EQ(robust.gain(end), plain.gain(end));
+    }
+  }
+}
+
 // On the reference the output is the feedforward alone: the bound's voltage less the part of its
 // friction that the compensation stage adds on the measured speed (trajectory_sliding_friction_scale;
 // the rest is fed forward at the reference speed). After the trajectory the hold's scale applies.

@@ -197,11 +197,12 @@ TrajectoryFollower::TrajectoryFollower(const MinimumTimeProblem& problem, const 
     Qw = q.asDiagonal();
     Rw = Eigen::MatrixXd::Identity(m, m) / (bw.voltage * bw.voltage);
   };
-  // The hold's slew weight at the target's radius (FollowerHold::slew_sideways; a tower crane's slew,
-  // not an overhead crane's bridge).
+  // The hold's slew weight at the target's radius (FollowerHold::slew_sideways): a tower crane's slew
+  // (not an overhead crane's bridge), after a plan robust to the pendulum's length.
   FollowerWeights hold = h;
   const double radius = samples_[count].state.position[kTrolleyIndex];
-  if (second_drive_ && dynamic_cast<const plant::TowerCraneModel*>(&model) != nullptr && radius > 0.0) {
+  if (trajectory.robust && second_drive_ && dynamic_cast<const plant::TowerCraneModel*>(&model) != nullptr &&
+      radius > 0.0) {
     hold.second_position = std::max(h.second_position, params.hold.slew_sideways / radius);
   }
   Eigen::MatrixXd Q, R;

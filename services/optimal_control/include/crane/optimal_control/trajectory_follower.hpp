@@ -85,13 +85,17 @@ struct FollowerHold {
                           .speed = 0.05,
                           .swing_rate = 0.05,
                           .voltage = 0.2};
-  /// [m] > 0, a tower crane's: the slew is held no tighter than this sideways displacement of the
-  /// trolley (the target's radius times the slew angle), its weight max(weights.second_position,
-  /// slew_sideways / radius). Near the mast the slew is a weak actuator for the out-of-plane swing
-  /// (an angle moves the trolley sideways by the radius times it); held at 0.01 rad there, the slew
-  /// and the out-of-plane swing a 20 % longer cable leaves ring together for periods, the slew outside
-  /// its settle band (docs/optimal_control.md, "Robust near the mast"). At 0.006 m every target
-  /// beyond 0.6 m keeps 0.01 rad. The bridge (overhead crane) keeps weights.second_position.
+  /// [m] > 0, a tower crane's, after a plan robust to the pendulum's length (MinimumTimeResult::robust:
+  /// the configured pendulum, near the mast): the slew is held no tighter than this sideways
+  /// displacement of the trolley (the target's radius times the slew angle), its weight
+  /// max(weights.second_position, slew_sideways / radius). Near the mast the slew is a weak actuator
+  /// for the out-of-plane swing (an angle moves the trolley sideways by the radius times it); held at
+  /// 0.01 rad there, the slew and the out-of-plane swing a 20 % longer cable leaves ring together for
+  /// periods, the slew outside its settle band (docs/optimal_control.md, "Robust near the mast"). On
+  /// a known pendulum (learnt) there is little swing to damp, and the looser slew sticks further off
+  /// its target with 30 % more friction (1.10 -> 1.62 T*), so it applies after a robust plan only. At
+  /// 0.006 m every target beyond 0.6 m keeps 0.01 rad. The bridge (overhead crane) keeps
+  /// weights.second_position.
   double slew_sideways{0.006};
   /// [-] in [0, 1]: the fraction of the plant's sliding friction (Coulomb and viscous, (3.1),
   /// (3.3)) the compensation applies while a drive slides after the trajectory; the stiction part
