@@ -115,10 +115,11 @@ class Operator {
   /// (cyclonedds#1409, fixed upstream after 0.10.2), and after 256 such samples the reader takes
   /// nothing more ("TOO_MANY_CHUNKS_HELD_IN_PARALLEL"). In lockstep the stack runs thousands of
   /// cycles a second before a move, so a writer this process discovers late leaves its reader
-  /// deaf for the run (seen once in 8 demo runs under a loaded CI: the actuators, "actuators 0").
+  /// deaf for the run (seen once, in a full test run on a loaded VM: the actuators, "actuators 0").
   /// Once every reader has matched a writer, the readers are made again: the new ones start with
-  /// every writer known. Returns whether that happened (once per run; before the move, whose
-  /// samples are the recording).
+  /// those writers known (the diagnostics' several writers may still be discovered later; they
+  /// write a few samples a second). Returns whether that happened (once per run; before the move,
+  /// whose samples are the recording).
   bool renew_readers_once_matched() {
     if (renewed_) return false;
     const std::int32_t matched[] = {status_->health().matched_writers,     sensors_->health().matched_writers,
