@@ -117,9 +117,9 @@ class Operator {
   /// cycles a second before a move, so a writer this process discovers late leaves its reader
   /// deaf for the run (seen once, in a full test run on a loaded VM: the actuators, "actuators 0").
   /// Once every reader has matched a writer, the readers are made again: the new ones start with
-  /// those writers known (the diagnostics' several writers may still be discovered later; they
-  /// write a few samples a second). Returns whether that happened (once per run; before the move,
-  /// whose samples are the recording).
+  /// those writers known (the diagnostics' several writers may still be discovered later; each
+  /// writes once a second of wall time). Returns whether that happened (once per run; before the
+  /// move, whose samples are the recording).
   bool renew_readers_once_matched() {
     if (renewed_) return false;
     const std::int32_t matched[] = {status_->health().matched_writers,     sensors_->health().matched_writers,
