@@ -321,7 +321,71 @@ TEST_F(ProcessGroupTest, DestructorStopsRunningChildren) {
   EXPECT_EQ(errno, ECHILD);
 }
 
+// iceoryx's runtime leaves its socket and lock behind when a signal ends the process: the group
+// removes them for a child that a signal ended, and leaves a cleanly exited child's files alone
+// (iceoryx removes its own then; a file left on a clean exit is not the group's to judge).
+TEST_F(ProcessGroupTest, AChildEndedByASignalLosesItsIceoryxRuntimeFiles) {
+  namespace fs = std::filesystem;
+  const auto files_of = [](pid_t pid) {
+    std::vector<fs::path> files;
+    for (const char* suffix : {"_1795851044607436901", "_1795851044607436901.lock"}) {
+      files.push_back(fs::path(la::kIceoryxRuntimeDirectory) / ("iceoryx_rt_" + std::to_string(pid) + suffix));
+    }
+    return files;
+  };
+  const std::string make = "touch " + std::string(la::kIceoryxRuntimeDirectory) + "/iceoryx_rt_$$_1795851044607436901 " +
+                           la::kIceoryxRuntimeDirectory + "/iceoryx_rt_$$_1795851044607436901.lock; ";
+  la::ProcessGroup group;
+  const pid_t killed = group.start({"killed", "/bin/bash", {"-c", make + "kill -9 $$"}, log("killed")});
+  auto exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value());
+  ASSERT_EQ(exit->pid, killed);
+  ASSERT_TRUE(WIFSIGNALED(exit->status)) << exit->describe() << ": " << read_text(log("killed"));
+  for (const auto& file : files_of(killed)) EXPECT_FALSE(fs::exists(file)) << file;
+
+  const pid_t clean = group.start({"clean", "/bin/bash", {"-c", make + "exit 0"}, log("clean")});
+  exit = poll_until_exit(group);
+  ASSERT_TRUE(exit.has_value());
+  ASSERT_EQ(exit->pid, clean);
+  ASSERT_TRUE(WIFEXITED(exit->status)) << exit->describe();
+  for (const auto& file : files_of(clean)) {
+    EXPECT_TRUE(fs::exists(file)) << file;
+    fs::remove(file);
+  }
+
+  // stop_all's SIGKILL after the grace: the same.
+  const std::string stubborn_log = log("stubborn");
+  const pid_t stubborn =
+      group.start({"stubborn", "/bin/bash", {"-c", "trap '' TERM; " + make + "echo ready; exec /bin/sleep 30"}, stubborn_log});
+  ASSERT_TRUE(wait_for_text(stubborn_log, "ready")) << read_text(stubborn_log);
+  for (const auto& file : files_of(stubborn)) ASSERT_TRUE(fs::exists(file)) << file;
+  const auto exits = group.stop_all(200ms);
+  ASSERT_EQ(exits.size(), 1U);
+  ASSERT_TRUE(WIFSIGNALED(exits[0].status)) << exits[0].describe();
+  for (const auto& file : files_of(stubborn)) EXPECT_FALSE(fs::exists(file)) << file;
+}
+
 }  // namespace
+
+// Only the files of that pid: not another pid that begins with the same digits, not other names.
+TEST(Iceoryx, OnlyThatProcesssRuntimeFilesAreRemoved) {
+  namespace fs = std::filesystem;
+  const fs::path directory = fs::temp_directory_path() / ("crane_test_iceoryx_rt_" + std::to_string(getpid()));
+  fs::remove_all(directory);
+  fs::create_directories(directory);
+  const std::vector<std::string> gone = {"iceoryx_rt_4242_1795851044607436901", "iceoryx_rt_4242_1795851044607436901.lock",
+                                         "iceoryx_rt_4242_7"};
+  const std::vector<std::string> kept = {"iceoryx_rt_42420_1795851044607436901", "iceoryx_rt_424_1",
+                                         "xiceoryx_rt_4242_1", "iceoryx_rt_4242", "roudi.log"};
+  for (const auto& name : gone) std::ofstream(directory / name) << "x";
+  for (const auto& name : kept) std::ofstream(directory / name) << "x";
+  EXPECT_EQ(la::remove_iceoryx_runtime_files(4242, directory.string()), 3);
+  for (const auto& name : gone) EXPECT_FALSE(fs::exists(directory / name)) << name;
+  for (const auto& name : kept) EXPECT_TRUE(fs::exists(directory / name)) << name;
+  EXPECT_EQ(la::remove_iceoryx_runtime_files(4242, directory.string()), 0);
+  EXPECT_EQ(la::remove_iceoryx_runtime_files(4242, (directory / "missing").string()), 0);
+  fs::remove_all(directory);
+}
 
 // --dds-mix: vendor per process; every process not named keeps --dds.
 TEST(DdsMix, ParsesAndOverridesPerProcess) {

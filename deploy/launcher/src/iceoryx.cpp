@@ -12,6 +12,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
+#include <system_error>
 #include <stdexcept>
 #include <thread>
 
@@ -33,10 +35,7 @@ int exit_code(int status) {
 
 int wait_for(pid_t pid) {
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return 1;
-  }
-  return exit_code(status);
+  return reap(pid, status, true) ? exit_code(status) : 1;
 }
 
 }  // namespace
@@ -82,7 +81,7 @@ int run_beside_roudi(const std::string& roudi_log, const std::function<int()>& b
   int code = 1;
   for (;;) {
     int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid) {
+    if (reap(pid, status, false)) {
       code = exit_code(status);
       break;
     }
@@ -101,6 +100,18 @@ int run_beside_roudi(const std::string& roudi_log, const std::function<int()>& b
   sigaction(SIGTERM, &old_term, nullptr);
   roudi.stop_all(std::chrono::seconds(10));
   return code;
+}
+
+int remove_iceoryx_runtime_files(pid_t pid, const std::string& directory) {
+  const std::string prefix = "iceoryx_rt_" + std::to_string(pid) + "_";
+  int removed = 0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, error)) {
+    if (entry.path().filename().string().rfind(prefix, 0) != 0) continue;
+    std::error_code ignored;
+    if (std::filesystem::remove(entry.path(), ignored)) ++removed;
+  }
+  return removed;
 }
 
 }  // namespace crane::launch

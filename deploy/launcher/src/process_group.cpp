@@ -1,5 +1,7 @@
 #include "crane/launch/process_group.hpp"
 
+#include "crane/launch/iceoryx.hpp"
+
 #include <fcntl.h>
 #include <sched.h>
 #include <signal.h>
@@ -23,6 +25,19 @@ std::string ChildExit::describe() const {
   if (WIFEXITED(status)) return text + " exited with code " + std::to_string(WEXITSTATUS(status));
   if (WIFSIGNALED(status)) return text + " was killed by signal " + std::to_string(WTERMSIG(status));
   return text + " ended";
+}
+
+bool reap(pid_t pid, int& status, bool block) {
+  siginfo_t info{};
+  while (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOWAIT | (block ? 0 : WNOHANG)) != 0) {
+    if (errno != EINTR) return false;
+  }
+  if (info.si_pid != pid) return false;
+  if (info.si_code == CLD_KILLED || info.si_code == CLD_DUMPED) remove_iceoryx_runtime_files(pid);
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return false;
+  }
+  return true;
 }
 
 ProcessGroup::~ProcessGroup() { stop_all(); }
@@ -71,8 +86,7 @@ std::optional<ChildExit> ProcessGroup::poll() {
   for (auto& child : children_) {
     if (!child.running) continue;
     int status = 0;
-    const pid_t r = waitpid(child.pid, &status, WNOHANG);
-    if (r == child.pid) {
+    if (reap(child.pid, status, false)) {
       child.running = false;
       return ChildExit{child.name, child.pid, status};
     }
@@ -96,7 +110,7 @@ std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
     for (auto& child : children_) {
       if (!child.running) continue;
       int status = 0;
-      if (waitpid(child.pid, &status, WNOHANG) == child.pid) {
+      if (reap(child.pid, status, false)) {
         child.running = false;
         exits.push_back(ChildExit{child.name, child.pid, status});
       }
@@ -106,7 +120,7 @@ std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
         if (!child.running) continue;
         kill(child.pid, SIGKILL);
         int status = 0;
-        waitpid(child.pid, &status, 0);
+        reap(child.pid, status, true);
         child.running = false;
         exits.push_back(ChildExit{child.name, child.pid, status});
       }

@@ -9,6 +9,8 @@
 // from a process that stays off iceoryx (a test's monitor) lists RouDi as its first process instead.
 // One RouDi runs per machine (a second one aborts: "Could not acquire lock").
 
+#include <sys/types.h>
+
 #include <functional>
 #include <string>
 
@@ -30,5 +32,16 @@ ProcessSpec roudi_process(const std::string& log_path);
 /// child's exit code (128 + the signal if a signal ended it). Throws what roudi_process() throws
 /// and std::runtime_error if fork fails.
 int run_beside_roudi(const std::string& roudi_log, const std::function<int()>& body);
+
+/// Where iceoryx 2.0 on Linux puts each client runtime's socket and its lock file:
+/// <kIceoryxRuntimeDirectory>/iceoryx_rt_<pid>_<time> and the same with ".lock".
+inline constexpr const char* kIceoryxRuntimeDirectory = "/tmp";
+
+/// Removes the files whose names begin with "iceoryx_rt_<pid>_" in `directory`: what the iceoryx
+/// runtime of process `pid` leaves behind when a signal ends it (a clean exit removes them). Call it
+/// only while `pid` cannot be another process's, that is before its parent reaps it (ProcessGroup
+/// does, for a child that a signal ended). Returns how many files it removed; a file that is
+/// already gone or cannot be removed is skipped, and a missing directory gives 0.
+int remove_iceoryx_runtime_files(pid_t pid, const std::string& directory = kIceoryxRuntimeDirectory);
 
 }  // namespace crane::launch

@@ -56,6 +56,13 @@ class ProcessGroup {
   std::vector<Child> children_;
 };
 
+/// Reaps the child `pid` once it has ended, its raw waitpid status in `status`. `block`: waits for
+/// that; else returns false at once while it runs. Also false when `pid` is not a child of this
+/// process. A child that a signal ended first loses its iceoryx runtime's files
+/// (remove_iceoryx_runtime_files, launch/iceoryx.hpp): seen with WNOWAIT, it is still a zombie then,
+/// so no other process can hold its pid yet.
+bool reap(pid_t pid, int& status, bool block);
+
 /// Absolute path of the directory holding this executable (/proc/self/exe).
 std::string executable_directory();
 
