@@ -365,6 +365,48 @@ TEST_F(ProcessGroupTest, AChildEndedByASignalLosesItsIceoryxRuntimeFiles) {
   for (const auto& file : files_of(stubborn)) EXPECT_FALSE(fs::exists(file)) << file;
 }
 
+// A child that outlives the others (RouDi: ProcessSpec::outlive_killed) is stopped after them, and
+// no sooner than its time after the last child that a signal ended; with no such child, at once.
+TEST_F(ProcessGroupTest, AnOutlivingChildStopsLastAndAfterItsTimeSinceAKill) {
+  for (const bool kill_one : {true, false}) {
+    SCOPED_TRACE(kill_one ? "a child killed first" : "no child killed");
+    la::ProcessGroup group;
+    la::ProcessSpec outliving{"outliving", "/bin/sleep", {"30"}, ""};
+    outliving.outlive_killed = 400ms;
+    const pid_t last = group.start(outliving);
+    // It exits cleanly on SIGTERM, as the stages do (a sleep ended by SIGTERM would count as killed).
+    const std::string other_log = log(kill_one ? "other_after_a_kill" : "other");
+    const pid_t other =
+        group.start({"other", "/usr/bin/python3",
+                     {"-c", "import signal, sys, time\n"
+                            "signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))\n"
+                            "print('ready', flush=True)\n"
+                            "time.sleep(30)"},
+                     other_log});
+    ASSERT_TRUE(wait_for_text(other_log, "ready")) << read_text(other_log);
+    std::chrono::steady_clock::time_point killed_at{};
+    if (kill_one) {
+      const pid_t killed = group.start({"killed", "/bin/bash", {"-c", "kill -9 $$"}, ""});
+      const auto exit = poll_until_exit(group);
+      killed_at = std::chrono::steady_clock::now();
+      ASSERT_TRUE(exit.has_value());
+      ASSERT_EQ(exit->pid, killed);
+      ASSERT_TRUE(WIFSIGNALED(exit->status)) << exit->describe();
+    }
+    const auto begin = std::chrono::steady_clock::now();
+    const auto exits = group.stop_all(2000ms);
+    const auto done = std::chrono::steady_clock::now();
+    ASSERT_EQ(exits.size(), 2U);
+    EXPECT_EQ(exits[0].pid, other);
+    EXPECT_EQ(exits[1].pid, last);
+    if (kill_one) {
+      EXPECT_GE(done - killed_at, 400ms);
+    } else {
+      EXPECT_LT(done - begin, 400ms);
+    }
+  }
+}
+
 }  // namespace
 
 // Only the files of that pid: not another pid that begins with the same digits, not other names.

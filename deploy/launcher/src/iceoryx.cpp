@@ -49,6 +49,7 @@ ProcessSpec roudi_process(const std::string& log_path) {
   }
   spec.arguments = {"--log-level", "warning"};
   spec.log_path = log_path;
+  spec.outlive_killed = kRoudiOutlivesKilled;
   return spec;
 }
 
@@ -98,6 +99,9 @@ int run_beside_roudi(const std::string& roudi_log, const std::function<int()>& b
   body_pid.store(0);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
+  // A body that failed may have lost a client of RouDi's to a signal (itself, or a stage of its
+  // stack, which this group does not see end): RouDi must drop it before it stops.
+  if (code != 0 && roudi.children().front().running) std::this_thread::sleep_for(kRoudiOutlivesKilled);
   roudi.stop_all(std::chrono::seconds(10));
   return code;
 }

@@ -78,7 +78,7 @@ pid_t ProcessGroup::start(const ProcessSpec& spec) {
     (void)!write(STDERR_FILENO, message, std::strlen(message));
     _exit(127);
   }
-  children_.push_back(Child{spec.name, pid, true});
+  children_.push_back(Child{spec.name, pid, true, spec.outlive_killed});
   return pid;
 }
 
@@ -87,7 +87,7 @@ std::optional<ChildExit> ProcessGroup::poll() {
     if (!child.running) continue;
     int status = 0;
     if (reap(child.pid, status, false)) {
-      child.running = false;
+      ended(child, status, nullptr);
       return ChildExit{child.name, child.pid, status};
     }
   }
@@ -96,39 +96,60 @@ std::optional<ChildExit> ProcessGroup::poll() {
 
 std::vector<ChildExit> ProcessGroup::stop_all(std::chrono::milliseconds grace) {
   std::vector<ChildExit> exits;
-  for (auto& child : children_) {
-    if (child.running) kill(child.pid, SIGTERM);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + grace;
-  auto any_running = [this] {
-    for (const auto& c : children_) {
-      if (c.running) return true;
-    }
-    return false;
-  };
-  while (any_running()) {
+  stop_children(exits, grace, false);
+  stop_children(exits, grace, true);
+  return exits;
+}
+
+void ProcessGroup::ended(Child& child, int status, std::vector<ChildExit>* exits) {
+  child.running = false;
+  if (WIFSIGNALED(status)) last_killed_ = std::chrono::steady_clock::now();
+  if (exits != nullptr) exits->push_back(ChildExit{child.name, child.pid, status});
+}
+
+void ProcessGroup::stop_children(std::vector<ChildExit>& exits, std::chrono::milliseconds grace, bool outliving) {
+  const auto selected = [outliving](const Child& c) { return c.running && (c.outlive_killed.count() >= 0) == outliving; };
+  const auto reap_selected = [&] {
+    bool any = false;
     for (auto& child : children_) {
-      if (!child.running) continue;
+      if (!selected(child)) continue;
       int status = 0;
       if (reap(child.pid, status, false)) {
-        child.running = false;
-        exits.push_back(ChildExit{child.name, child.pid, status});
+        ended(child, status, &exits);
+      } else {
+        any = true;
       }
     }
+    return any;
+  };
+  if (outliving && last_killed_) {
+    // Give each one its time after the last child that a signal ended, unless it ends first.
+    for (auto& child : children_) {
+      if (!selected(child)) continue;
+      const auto until = *last_killed_ + child.outlive_killed;
+      while (child.running && std::chrono::steady_clock::now() < until) {
+        reap_selected();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+  }
+  for (auto& child : children_) {
+    if (selected(child)) kill(child.pid, SIGTERM);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + grace;
+  while (reap_selected()) {
     if (std::chrono::steady_clock::now() > deadline) {
       for (auto& child : children_) {
-        if (!child.running) continue;
+        if (!selected(child)) continue;
         kill(child.pid, SIGKILL);
         int status = 0;
         reap(child.pid, status, true);
-        child.running = false;
-        exits.push_back(ChildExit{child.name, child.pid, status});
+        ended(child, status, &exits);
       }
       break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  return exits;
 }
 
 std::string executable_directory() {

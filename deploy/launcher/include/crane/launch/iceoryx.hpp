@@ -11,6 +11,7 @@
 
 #include <sys/types.h>
 
+#include <chrono>
 #include <functional>
 #include <string>
 
@@ -21,7 +22,14 @@ namespace crane::launch {
 /// RouDi's process name (its log: <log directory>/iox_roudi.log).
 inline constexpr const char* kRoudiProcess = "iox_roudi";
 
-/// iox-roudi (found on PATH) at warning log level, its output to `log_path` (empty: inherited).
+/// How long RouDi outlives a client that a signal ended (ProcessSpec::outlive_killed): iceoryx 2.0
+/// drops a client whose keep-alive lapsed for PROCESS_KEEP_ALIVE_TIMEOUT (1.5 s); a RouDi stopped
+/// while it still holds a dead client fails to signal it and aborts
+/// (POSH__ROUDI_PROCESS_SHUTDOWN_FAILED), leaving its shared memory in /dev/shm.
+inline constexpr std::chrono::milliseconds kRoudiOutlivesKilled{2000};
+
+/// iox-roudi (found on PATH) at warning log level, its output to `log_path` (empty: inherited),
+/// stopped after the rest of its group (kRoudiOutlivesKilled).
 /// Throws std::invalid_argument when iox-roudi is not on PATH (Debian package iceoryx).
 ProcessSpec roudi_process(const std::string& log_path);
 

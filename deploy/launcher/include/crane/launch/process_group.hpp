@@ -20,6 +20,11 @@ struct ProcessSpec {
   std::string executable;          // absolute path
   std::vector<std::string> arguments;
   std::string log_path;            // stdout+stderr go here; empty: inherit
+  // >= 0: stop_all() stops this one only after every other child has ended, and no sooner than
+  // this after the last child that a signal ended, unless it ends by itself first (iceoryx's RouDi:
+  // it must see a killed client's keep-alive lapse before it stops, or it aborts; roudi_process()).
+  // < 0 (the default): with the others.
+  std::chrono::milliseconds outlive_killed{-1};
 };
 
 struct ChildExit {
@@ -42,18 +47,24 @@ class ProcessGroup {
   pid_t start(const ProcessSpec& spec);
   /// Reaps one child that exited, if any (non-blocking).
   std::optional<ChildExit> poll();
-  /// SIGTERM to every running child, wait up to `grace`, then SIGKILL. Returns how each ended.
+  /// SIGTERM to every running child, wait up to `grace`, then SIGKILL; then the same for those
+  /// that outlive the others (ProcessSpec::outlive_killed), after their wait. Returns how each ended.
   std::vector<ChildExit> stop_all(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
 
   struct Child {
     std::string name;
     pid_t pid;
     bool running;
+    std::chrono::milliseconds outlive_killed;
   };
   [[nodiscard]] const std::vector<Child>& children() const noexcept { return children_; }
 
  private:
+  void ended(Child& child, int status, std::vector<ChildExit>* exits);
+  void stop_children(std::vector<ChildExit>& exits, std::chrono::milliseconds grace, bool outliving);
+
   std::vector<Child> children_;
+  std::optional<std::chrono::steady_clock::time_point> last_killed_;  // the last child a signal ended
 };
 
 /// Reaps the child `pid` once it has ended, its raw waitpid status in `status`. `block`: waits for
