@@ -3,6 +3,7 @@
 // read_audit_data(), and crane_audit runs (CRANE_AUDIT_EXECUTABLE).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,14 +11,32 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <system_error>
 
 #include "crane/model_audit/model_audit.hpp"
 
 namespace crane::model_audit::test {
 
-/// Writes `text` to TMP/crane_audit_test_NAME and returns the path.
+/// This test process's own folder, TMP/crane_audit_test_PID (two test processes that run side by
+/// side write files of the same names), removed when the process exits.
+inline const std::filesystem::path& test_directory() {
+  struct Directory {
+    std::filesystem::path path;
+    Directory() : path(std::filesystem::temp_directory_path() / ("crane_audit_test_" + std::to_string(getpid()))) {
+      std::filesystem::create_directories(path);
+    }
+    ~Directory() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const Directory directory;
+  return directory.path;
+}
+
+/// Writes `text` to test_directory()/NAME and returns the path.
 inline std::filesystem::path write_file(const std::string& name, const std::string& text) {
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / ("crane_audit_test_" + name);
+  const std::filesystem::path path = test_directory() / name;
   std::ofstream(path) << text;
   return path;
 }

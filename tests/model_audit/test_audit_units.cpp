@@ -372,7 +372,7 @@ TEST(AuditData, BadInputIsRefusedNamingRowOrColumn) {
 }
 
 TEST(CraneAuditCli, WritesTheReportAndRefusesBadOptions) {
-  const fs::path dir = fs::temp_directory_path() / "crane_audit_cli_test";
+  const fs::path dir = crane::model_audit::test::test_directory() / "cli_test";
   fs::remove_all(dir);
   const fs::path data = dir.string() + "_case.csv";
   ASSERT_EQ(run_tool("generate --model axis --effect gain_error --seed 4 --out " + data.string()), 0);

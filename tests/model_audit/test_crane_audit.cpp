@@ -687,7 +687,7 @@ TEST(CraneAudit, CleanRecordingsGiveNoSecondCauseAndSingleCausesAreCounted) {
 // crane_audit end to end: the nominal from the lab configuration (--config) with the recording's
 // load mass given by --param; a clean recording gives none, a missing column exit code 2.
 TEST(CraneAuditCli, ConfigAndParamGiveTheNominalAndBadDataIsRefused) {
-  const fs::path dir = fs::temp_directory_path() / "crane_audit_crane_cli_test";
+  const fs::path dir = crane::model_audit::test::test_directory() / "crane_cli_test";
   fs::remove_all(dir);
   const fs::path data = dir.string() + "_case.csv";
   ASSERT_EQ(run_tool("generate --model crane --effect none --seed 31 --out " + data.string()), 0);
