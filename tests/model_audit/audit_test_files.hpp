@@ -3,7 +3,6 @@
 // read_audit_data(), and crane_audit runs (CRANE_AUDIT_EXECUTABLE).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -11,27 +10,24 @@
 #include <functional>
 #include <sstream>
 #include <string>
-#include <system_error>
 
 #include "crane/model_audit/model_audit.hpp"
+#include "crane/testing/scratch_directory.hpp"
 
 namespace crane::model_audit::test {
 
-/// This test process's own folder, TMP/crane_audit_test_PID (two test processes that run side by
-/// side write files of the same names), removed when the process exits.
+/// The running test's scratch directory (crane::testing::scratch_directory "audit_test": its own
+/// per process, removed when the test ends unless it failed), made at the test's first call.
 inline const std::filesystem::path& test_directory() {
-  struct Directory {
-    std::filesystem::path path;
-    Directory() : path(std::filesystem::temp_directory_path() / ("crane_audit_test_" + std::to_string(getpid()))) {
-      std::filesystem::create_directories(path);
-    }
-    ~Directory() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  };
-  static const Directory directory;
-  return directory.path;
+  static std::string test;
+  static std::filesystem::path path;
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string name = info != nullptr ? std::string(info->test_suite_name()) + "." + info->name() : std::string();
+  if (path.empty() || name != test) {
+    test = name;
+    path = crane::testing::scratch_directory("audit_test");
+  }
+  return path;
 }
 
 /// Writes `text` to test_directory()/NAME and returns the path.
