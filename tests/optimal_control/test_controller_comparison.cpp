@@ -10,6 +10,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "crane/stack/controller_comparison.hpp"
 #include "crane/trajectory_planner/trajectory_planner.hpp"
@@ -28,6 +29,41 @@ double rigid_time(double distance, double velocity, double acceleration) {
   distance = std::abs(distance);
   if (distance * acceleration > velocity * velocity) return distance / velocity + velocity / acceleration;
   return 2.0 * std::sqrt(distance / acceleration);
+}
+
+// The moves a tool runs by name (crane_sim and crane_demo alike): the demo maneuvers, then the
+// random ones, those named kept in that order; an unknown name refused naming it and what exists.
+TEST(ControllerComparison, MovesAreSelectedByNameAndAnUnknownOneIsNamed) {
+  const auto cfg = config("lab_tower_crane.yaml");
+  const auto names = [](const std::vector<stack::ManeuverConfig>& moves) {
+    std::vector<std::string> out;
+    for (const auto& m : moves) out.push_back(m.name);
+    return out;
+  };
+  const auto all = stack::select_moves(cfg, {}, 3, 1);
+  ASSERT_EQ(all.size(), cfg.maneuvers.size() + 3);
+  EXPECT_EQ(all.front().name, cfg.maneuvers.front().name);
+  EXPECT_EQ(all.back().name, "random_2");
+  EXPECT_EQ(all.back().trolley_target, stack::random_moves(cfg, 3, 1)[2].trolley_target);
+  EXPECT_EQ(names(stack::select_moves(cfg, {"random_1", "trolley"}, 3, 1)), (std::vector<std::string>{"trolley", "random_1"}));
+  EXPECT_EQ(names(stack::select_moves(cfg, {}, 2, 1, false)), (std::vector<std::string>{"random_0", "random_1"}));
+  EXPECT_EQ(stack::select_moves(cfg, {}).size(), cfg.maneuvers.size());
+  const auto message = [&](const std::vector<std::string>& asked, int count, bool demo) {
+    try {
+      (void)stack::select_moves(cfg, asked, count, 1, demo);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message({"random_3"}, 3, true),
+            "--maneuver 'random_3' is neither a demo maneuver of the configuration nor one of the 3 random moves "
+            "(random_0 .. random_2, --moves)");
+  EXPECT_EQ(message({"random_0"}, 0, true), "--maneuver 'random_0' is not a demo maneuver of the configuration");
+  EXPECT_EQ(message({"trolley"}, 2, false),
+            "--maneuver 'trolley' is not one of the 2 random moves (random_0 .. random_1, --moves)");
+  EXPECT_EQ(message({"trolley"}, 0, false),
+            "--maneuver 'trolley' is not a move: no demo maneuvers and no random moves asked for");
 }
 
 TEST(ControllerComparison, RandomMovesAreSeededAndStayInThePlannersRange) {

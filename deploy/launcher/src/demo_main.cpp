@@ -21,6 +21,7 @@
 #include "crane/launch/stack.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
+#include "crane/stack/controller_comparison.hpp"
 #include "crane/stack/maneuver_run.hpp"
 #include "crane/stack/stack_config.hpp"
 
@@ -43,6 +44,8 @@ struct DemoOptions {
   std::string dds_mix;                                 // --dds-mix text
   std::map<std::string, std::string> dds_per_process;  // parsed from dds_mix (stages and "operator")
   std::vector<std::string> maneuvers;
+  int moves{0};             // --moves: seeded random moves besides the demo maneuvers (crane_sim compare's)
+  std::uint64_t seed{1};    // --seed
   std::string compensation{"both"};
   bool realtime{false};
   bool acceleration_feedforward{false};  // tracking --acceleration-feedforward
@@ -529,7 +532,12 @@ int main(int argc, char** argv) {
   app.add_option("--dds-mix", options.dds_mix,
                  "vendor per process, overriding --dds, e.g. plant=cyclone,state_estimator=cyclone "
                  "(names: the stages, plant, hardware_bridge, operator)");
-  app.add_option("--maneuver", options.maneuvers, "maneuver names to run (default: all in the config)");
+  app.add_option("--maneuver", options.maneuvers,
+                 "maneuver names to run (default: all in the config, and the random moves of --moves)");
+  app.add_option("--moves", options.moves,
+                 "seeded random moves besides the demo maneuvers, random_0 .. (crane_sim compare's and demo's)")
+      ->check(CLI::Range(0, 1000));
+  app.add_option("--seed", options.seed, "the random moves' seed");
   app.add_option("--friction-compensation", options.compensation, "on | off | both")
       ->check(CLI::IsMember({"on", "off", "both"}));
   app.add_flag("--realtime", options.realtime, "plant on absolute 10 ms deadlines instead of lockstep");
@@ -583,18 +591,7 @@ int main(int argc, char** argv) {
     try {
       runtime::configure_logging("info", "demo");
       const stack::StackConfig cfg = stack::load_stack_config(options.config_path);
-      std::vector<stack::ManeuverConfig> selected;
-      for (const auto& m : cfg.maneuvers) {
-        if (options.maneuvers.empty() ||
-            std::find(options.maneuvers.begin(), options.maneuvers.end(), m.name) != options.maneuvers.end()) {
-          selected.push_back(m);
-        }
-      }
-      for (const auto& name : options.maneuvers) {
-        if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
-          throw std::invalid_argument("--maneuver '" + name + "' is not in " + options.config_path);
-        }
-      }
+      const auto selected = stack::select_moves(cfg, options.maneuvers, options.moves, options.seed);
       std::vector<bool> settings;
       if (options.compensation != "off") settings.push_back(true);
       if (options.compensation != "on") settings.push_back(false);

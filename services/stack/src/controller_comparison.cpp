@@ -53,6 +53,37 @@ std::vector<ComparedController> compared_controllers(const std::vector<std::stri
   return chosen;
 }
 
+std::vector<ManeuverConfig> select_moves(const StackConfig& cfg, const std::vector<std::string>& names, int random_count,
+                                         std::uint64_t seed, bool demo_maneuvers) {
+  std::vector<ManeuverConfig> pool;
+  if (demo_maneuvers) pool = cfg.maneuvers;
+  if (random_count > 0) {
+    const auto random = random_moves(cfg, random_count, seed);
+    pool.insert(pool.end(), random.begin(), random.end());
+  }
+  for (const auto& name : names) {
+    if (std::none_of(pool.begin(), pool.end(), [&](const auto& m) { return m.name == name; })) {
+      const std::string random = "the " + std::to_string(random_count) + " random moves (random_0 .. random_" +
+                                 std::to_string(random_count - 1) + ", --moves)";
+      std::string is = "' is not a move: no demo maneuvers and no random moves asked for";
+      if (demo_maneuvers && random_count > 0) {
+        is = "' is neither a demo maneuver of the configuration nor one of " + random;
+      } else if (demo_maneuvers) {
+        is = "' is not a demo maneuver of the configuration";
+      } else if (random_count > 0) {
+        is = "' is not one of " + random;
+      }
+      throw std::invalid_argument("--maneuver '" + name + is);
+    }
+  }
+  if (names.empty()) return pool;
+  std::vector<ManeuverConfig> out;  // in the pool's order: the demo maneuvers first
+  for (const auto& m : pool) {
+    if (std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
+  }
+  return out;
+}
+
 std::vector<ManeuverConfig> random_moves(const StackConfig& cfg, int count, std::uint64_t seed, double record_factor) {
   if (count < 1 || count > 1000) {
     throw std::invalid_argument("random moves: count " + std::to_string(count) + " outside [1, 1000]");

@@ -90,6 +90,8 @@ struct Selection {
   std::string integrator;  // empty: the configuration's plant.integrator
   double rtol{0.0};        // 0: the configuration's
   double atol{0.0};
+  int moves{0};            // demo: seeded random moves besides the demo maneuvers (crane_demo's --moves)
+  std::uint64_t seed{1};
 };
 
 // The configuration with the command line's integrator, if any.
@@ -106,44 +108,6 @@ std::string integrator_label(const plant::IntegratorSettings& i) {
   std::snprintf(b, sizeof(b), "%s rtol %.0e atol %.0e", std::string(plant::integration_method_name(i.method)).c_str(),
                 i.relative_tolerance, i.absolute_tolerance);
   return b;
-}
-
-std::vector<stack::ManeuverConfig> selected_maneuvers(const stack::StackConfig& cfg, const std::vector<std::string>& names) {
-  std::vector<stack::ManeuverConfig> out;
-  for (const auto& name : names) {
-    if (std::none_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& m) { return m.name == name; })) {
-      throw std::invalid_argument("--maneuver '" + name + "' is not in the configuration");
-    }
-  }
-  for (const auto& m : cfg.maneuvers) {
-    if (names.empty() || std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
-  }
-  return out;
-}
-
-// The moves of follow and compare: the demo maneuvers and `moves` seeded random moves (random_0 ..),
-// or of those the ones named by --maneuver. Throws std::invalid_argument naming a name that is neither.
-std::vector<stack::ManeuverConfig> chosen_moves(const stack::StackConfig& cfg, const std::vector<std::string>& names,
-                                                int moves, std::uint64_t seed, bool demo_maneuvers) {
-  std::vector<stack::ManeuverConfig> pool;
-  if (demo_maneuvers) pool = cfg.maneuvers;
-  if (moves > 0) {
-    const auto random = stack::random_moves(cfg, moves, seed);
-    pool.insert(pool.end(), random.begin(), random.end());
-  }
-  if (names.empty()) return pool;
-  for (const auto& name : names) {
-    if (std::none_of(pool.begin(), pool.end(), [&](const auto& x) { return x.name == name; })) {
-      throw std::invalid_argument("--maneuver '" + name + "' is neither a demo maneuver of the configuration nor one of " +
-                                  std::to_string(std::max(moves, 0)) + " random moves (random_0 .. random_" +
-                                  std::to_string(std::max(moves, 1) - 1) + ", --moves)");
-    }
-  }
-  std::vector<stack::ManeuverConfig> out;  // in the pool's order: the demo maneuvers first
-  for (const auto& m : pool) {
-    if (std::find(names.begin(), names.end(), m.name) != names.end()) out.push_back(m);
-  }
-  return out;
 }
 
 std::uint8_t profile_of(const std::string& controller, const Selection& s) {
@@ -172,7 +136,7 @@ std::vector<stack::InProcessRun> demo_runs(const stack::StackConfig& cfg, const 
   const std::string controller = default_controller(s);
   std::vector<stack::InProcessRun> runs;
   std::uint32_t request_id = 1;
-  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+  for (const auto& m : stack::select_moves(cfg, s.maneuvers, s.moves, s.seed)) {
     for (const bool compensation : {true, false}) {
       if ((compensation && s.compensation == "off") || (!compensation && s.compensation == "on")) continue;
       stack::InProcessRun run;
@@ -363,7 +327,7 @@ unsigned default_jobs() { return std::max(1U, std::thread::hardware_concurrency(
 int sweep(const Selection& s, const std::string& controllers_text, int grid, int random, unsigned seed, unsigned jobs,
           const std::string& out_dir, const std::string& plot_script, const std::string& python) {
   const auto cfg = load_config(s);
-  const auto maneuvers = selected_maneuvers(cfg, s.maneuvers.empty() ? std::vector<std::string>{"trolley"} : s.maneuvers);
+  const auto maneuvers = stack::select_moves(cfg, s.maneuvers.empty() ? std::vector<std::string>{"trolley"} : s.maneuvers);
   if (maneuvers.size() != 1) throw std::invalid_argument("sweep: give one --maneuver");
   const auto controllers = split_list(controllers_text);
   for (const auto& c : controllers) (void)stack::choose_controller(c, maneuvers[0], false);  // names checked first
@@ -458,7 +422,7 @@ int bench(Selection s, int cases) {
               former_speed, integrator_label(former.plant.integrator).c_str());
   std::printf("speed-up over the former integrator: %.2fx\n", speed / former_speed);
   // 2. A sweep on 1 thread and on every core, the same cases.
-  const auto maneuvers = selected_maneuvers(cfg, {"trolley"});
+  const auto maneuvers = stack::select_moves(cfg, {"trolley"});
   const auto all = sweep_cases({default_controller(s)}, 0, cases, 7);
   const unsigned cores = default_jobs();
   double one = 0.0, many = 0.0, sim = 0.0;
@@ -511,7 +475,7 @@ int bound(const Selection& s, int intervals, const std::string& out_dir) {
   std::printf("%-14s %9s %11s %9s %9s %6s %6s %8s %8s %10s\n", "maneuver", "T* [s]", "T*(2N) [s]", "change",
               "linear [s]", "iter", "effort", "solve s", "max |V|", "max swing");
   int failures = 0;
-  for (const auto& m : selected_maneuvers(cfg, s.maneuvers)) {
+  for (const auto& m : stack::select_moves(cfg, s.maneuvers)) {
     const auto coarse = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, intervals));
     const auto fine = optimal_control::solve_minimum_time(stack::bound_problem(cfg, m, 2 * intervals));
     double max_voltage = 0.0;
@@ -548,7 +512,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
   auto cfg = load_config(s);
   if (learn) cfg.state_estimator.swing_length.enabled = true;
   // The demo maneuvers, or with --moves the seeded random moves of crane_sim compare (those named).
-  const auto maneuvers = chosen_moves(cfg, s.maneuvers, moves, seed, moves <= 0);
+  const auto maneuvers = stack::select_moves(cfg, s.maneuvers, moves, seed, moves <= 0);
   if (!out_dir.empty()) fs::create_directories(out_dir);
   const bool bridge = cfg.facts.crane_kind == common::CraneKind::overhead;
   struct Corner {
@@ -622,7 +586,7 @@ int compare(const Selection& s, int moves, std::uint64_t seed, bool corners, boo
   const bool slews = cfg.facts.crane_kind == common::CraneKind::tower;
   const auto controllers = controllers_text.empty() ? stack::compared_controllers()
                                                     : stack::compared_controllers(split_list(controllers_text));
-  const auto maneuvers = chosen_moves(cfg, s.maneuvers, moves, seed, true);
+  const auto maneuvers = stack::select_moves(cfg, s.maneuvers, moves, seed, true);
   const auto demo_count = static_cast<std::size_t>(std::count_if(maneuvers.begin(), maneuvers.end(), [&](const auto& m) {
     return std::any_of(cfg.maneuvers.begin(), cfg.maneuvers.end(), [&](const auto& d) { return d.name == m.name; });
   }));
@@ -1025,6 +989,9 @@ int main(int argc, char** argv) {
   demo_cmd->add_option("--friction-compensation", s.compensation, "on | off | both")
       ->check(CLI::IsMember({"on", "off", "both"}));
   demo_cmd->add_option("--out", out_dir, "write <maneuver>_fc_<on|off>.csv here");
+  demo_cmd->add_option("--moves", s.moves, "seeded random moves besides the demo maneuvers (compare's; --maneuver random_N picks)")
+      ->check(CLI::Range(0, 1000));
+  demo_cmd->add_option("--seed", s.seed, "the random moves' seed");
 
   auto* sweep_cmd = app.add_subcommand("sweep", "plant mismatches over the controllers on every core, with heat maps");
   common_options(sweep_cmd);

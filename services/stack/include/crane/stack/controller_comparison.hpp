@@ -64,6 +64,15 @@ struct ComparedController {
 [[nodiscard]] std::vector<ManeuverConfig> random_moves(const StackConfig& config, int count, std::uint64_t seed,
                                                         double record_factor = 4.0);
 
+/// The moves a tool runs (crane_sim, crane_demo): `config`'s demo maneuvers (when `demo_maneuvers`)
+/// and then `random_count` (0..1000) random_moves of `seed`; of those, the ones named in `names`
+/// (all when empty), in that order. Throws std::invalid_argument naming a name that is neither
+/// ("--maneuver 'x' is not a demo maneuver of the configuration nor one of the 20 random moves ...")
+/// and what random_moves() throws.
+[[nodiscard]] std::vector<ManeuverConfig> select_moves(const StackConfig& config, const std::vector<std::string>& names,
+                                                        int random_count = 0, std::uint64_t seed = 1,
+                                                        bool demo_maneuvers = true);
+
 struct ControllerOutcome {
   std::string controller;
   trajectory_planner::EquivalentPendulum planned_swing{};  // the follower's plan's pendulum (FollowerResult)
