@@ -136,7 +136,9 @@ TEST(HiddenEffects, PendulumAuditNamesTheEffectRecoversItsSizeAndInventsNothing)
 }
 
 // The crane (full plant, three channels): env CRANE_AUDIT_CRANE_CASES effect cases (default 6: the
-// whole suite stays short; about 8 s per case on one core) and CRANE_AUDIT_CRANE_CLEAN_CASES clean
+// whole suite stays short; about 8 s per case on one core when it was written, 27 s for its first
+// case on 2026-11-28, the audit having grown second causes and pairs since; perf: the replays, no
+// single hot spot) and CRANE_AUDIT_CRANE_CLEAN_CASES clean
 // cases (default 1). Entries in steps of 9 through the 29-entry catalog (all in 29 cases). A long
 // run can be split: CRANE_AUDIT_CRANE_FIRST = the first case index to run (cases keep their seeds).
 TEST(CraneHiddenEffects, AuditNamesTheEffectRecoversItsSizeAndInventsNothing) {
