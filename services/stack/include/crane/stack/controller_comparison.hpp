@@ -66,8 +66,9 @@ struct ComparedController {
 
 /// The moves a tool runs (crane_sim, crane_demo): `config`'s demo maneuvers (when `demo_maneuvers`)
 /// and then `random_count` (0..1000) random_moves of `seed`; of those, the ones named in `names`
-/// (all when empty), in that order. Throws std::invalid_argument naming a name that is neither
-/// ("--maneuver 'x' is not a demo maneuver of the configuration nor one of the 20 random moves ...")
+/// (all when empty), in the order just given, whatever the order of `names`. Throws
+/// std::invalid_argument naming a name that is none of them ("--maneuver 'x' is neither a demo
+/// maneuver of the configuration nor one of the 20 random moves (random_0 .. random_19, --moves)")
 /// and what random_moves() throws.
 [[nodiscard]] std::vector<ManeuverConfig> select_moves(const StackConfig& config, const std::vector<std::string>& names,
                                                         int random_count = 0, std::uint64_t seed = 1,
