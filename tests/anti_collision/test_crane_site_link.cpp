@@ -273,6 +273,39 @@ TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
   EXPECT_EQ(link_->unsettled_moves(), 0);
 }
 
+// What the crane is doing, as the site's waits are counted by it: the segment under way (the one
+// about to start once it has settled at a waypoint), the dwell, a yield, a lost-link stop.
+TEST_F(Link, SaysWhatItIsDoingSegmentBySegment) {
+  using A = CraneSiteLink::Activity;
+  (void)step();
+  EXPECT_EQ(link_->activity(), A::at_rest) << "asking";
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  EXPECT_EQ(link_->activity(), A::travelling) << "the go taken: out along the jib, hook up";
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  estimate_.swing_in_plane = 0.0175;
+  (void)step();
+  EXPECT_EQ(link_->activity(), A::travelling) << "arrived, still swinging: the travel's settling";
+  estimate_.swing_in_plane = 0.0;
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(link_->activity(), A::lowering);
+  arrive(*g);
+  (void)step();
+  EXPECT_EQ(link_->activity(), A::dwelling);
+  g = next_goal(2.0);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(link_->activity(), A::raising);
+  arrive(*g);
+  (void)next_goal(0.05);
+  EXPECT_EQ(link_->activity(), A::at_rest) << "asking for the place";
+  ASSERT_TRUE(link_->instruction(yield(9, {{0.0, 0.9, 0.2}, {-0.5, 0.9, 0.2}}), kEpoch, t_));
+  EXPECT_EQ(link_->activity(), A::yielding);
+  EXPECT_STREQ(to_string(A::yielding), "yielding");
+  EXPECT_STREQ(to_string(A::at_rest), "at rest");
+}
+
 TEST_F(Link, ASwingThatDoesNotSettleEndsTheMoveAtTheSettleTimeout) {
   (void)step();
   ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));

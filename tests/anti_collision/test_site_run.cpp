@@ -39,10 +39,21 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
       EXPECT_TRUE(o->completed) << "seed " << seed;
       EXPECT_EQ(o->unresolved, 0u) << "seed " << seed;
       EXPECT_GE(o->min_distance, site.margins.stop) << "seed " << seed << ": " << o->closest;
+      double waiting = 0.0;
       for (const CraneOutcome& c : o->cranes) {
         EXPECT_EQ(c.jobs_done, 2) << c.name << ", seed " << seed;
         EXPECT_EQ(c.latched_faults, 0u) << c.name << ", seed " << seed;
+        waiting += c.waiting_time;
       }
+      // Where the waits go, counted cycle by cycle from what the service had each crane wait
+      // for, adds up to the waiting each crane's link timed from its ask to its go.
+      double counted = o->waited_for_none;
+      for (const double w : o->waited_for) {
+        EXPECT_GE(w, 0.0);
+        counted += w;
+      }
+      EXPECT_NEAR(counted, waiting, 1e-9 * waiting + 1e-9) << "seed " << seed;
+      EXPECT_GT(waiting, 0.0) << "seed " << seed << ": the jobs force conflicts";
     }
     coordinated_total += coordinated.total_time;
     serialized_total += serialized.total_time;

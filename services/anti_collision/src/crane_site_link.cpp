@@ -451,6 +451,37 @@ std::vector<Pose> CraneSiteLink::rest_of_path() const {
   return rest;
 }
 
+CraneSiteLink::Activity CraneSiteLink::activity() const noexcept {
+  switch (phase_) {
+    case Phase::moving: break;
+    case Phase::dwelling: return Activity::dwelling;
+    case Phase::halting: return Activity::stopping;
+    default: return Activity::at_rest;
+  }
+  if (yielding_) return Activity::yielding;
+  // The segment under way: the one about to start when it has reached a waypoint.
+  const std::size_t to = start_next_ ? waypoint_ + 1 : waypoint_;
+  if (to == 0 || to >= path_.size()) return Activity::travelling;
+  const Pose& from = path_[to - 1];
+  const Pose& end = path_[to];
+  if (from.slew != end.slew || from.trolley != end.trolley) return Activity::travelling;
+  return end.cable_length > from.cable_length ? Activity::lowering : Activity::raising;
+}
+
+const char* to_string(CraneSiteLink::Activity activity) noexcept {
+  using A = CraneSiteLink::Activity;
+  switch (activity) {
+    case A::at_rest: return "at rest";
+    case A::travelling: return "travelling";
+    case A::lowering: return "lowering";
+    case A::dwelling: return "dwelling";
+    case A::raising: return "raising";
+    case A::yielding: return "yielding";
+    case A::stopping: return "stopping";
+  }
+  return "unknown";
+}
+
 bool CraneSiteLink::report_changed() noexcept { return std::exchange(changed_, false); }
 
 }  // namespace crane::anti_collision

@@ -31,15 +31,18 @@
 #include <vector>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <numbers>
+#include <numeric>
 #include <string>
 
 #include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/common/validation.hpp"
 #include "crane/stack/maneuver_metrics.hpp"
@@ -255,6 +258,22 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
               guard_emergency, guard_soft, guard_first.empty() ? "" : "; first: ", guard_first.c_str());
   std::printf("  coordinated: %d yields, %.1f s waiting per set\n", yields,
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));
+  // Where the waits go: what the cranes waited for were doing (SiteOutcome::waited_for).
+  std::array<double, CraneSiteLink::kActivityCount> waited_for{};
+  double waited_for_none = 0.0;
+  for (const SetResult& r : results) {
+    if (!r.error.empty()) continue;
+    for (std::size_t a = 0; a < waited_for.size(); ++a) waited_for[a] += r.coordinated.waited_for[a];
+    waited_for_none += r.coordinated.waited_for_none;
+  }
+  const double asked = std::accumulate(waited_for.begin(), waited_for.end(), waited_for_none);
+  if (asked > 0.0) {
+    std::printf("  coordinated waits, by what the crane waited for was doing [%% of %.0f crane-seconds]:", asked);
+    for (std::size_t a = 0; a < waited_for.size(); ++a) {
+      std::printf(" %s %.1f,", to_string(static_cast<CraneSiteLink::Activity>(a)), 100.0 * waited_for[a] / asked);
+    }
+    std::printf(" no crane (the request or the go on their way, the service down) %.1f\n", 100.0 * waited_for_none / asked);
+  }
   const bool safe = !min_distance.empty() && crane::stack::nearest_rank_quantile(min_distance, 0.0) >= site.margins.stop;
   return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
 }

@@ -112,6 +112,19 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       up[i] = !service_down && std::none_of(options.faults.begin(), options.faults.end(),
                                             [&](const LinkFault& f) { return f.crane == i && active(f); });
     }
+    // Where the waits go: each crane that asked over the cycle now ending, by what the cranes the
+    // service's last decision had it wait for were doing.
+    for (std::size_t i = 0; k > 0 && i < n; ++i) {
+      if (cranes[i].link->phase() != ac::CraneSiteLink::Phase::asking) continue;
+      const std::vector<std::size_t>& blockers = service->arbiter().waits_for(i);
+      if (service_down || blockers.empty()) {
+        out.waited_for_none += dt;
+        continue;
+      }
+      for (const std::size_t j : blockers) {
+        out.waited_for[static_cast<std::size_t>(cranes[j].link->activity())] += dt / static_cast<double>(blockers.size());
+      }
+    }
     // The reports of the last cycle's state, then the service's rules and its instructions.
     if (!service_down) {
       for (std::size_t i = 0; i < n; ++i) {

@@ -109,6 +109,14 @@ class CraneSiteLink {
     aborted,   // its planner ended kMoveAttempts moves to one waypoint short: at rest, asks for nothing more
   };
 
+  /// What the crane is doing, as the site's waits are counted by it (docs/site.md, "Where the
+  /// waits go"): at rest (resting, asking, halted, done, aborted, braked); on a leg, travelling (the
+  /// segment under way moves the slew or the trolley), lowering or raising (the hoist alone), each
+  /// until the crane has settled at the segment's end; dwelling at the work height; yielding (a
+  /// yield, or a move it was told to make without asking); stopping (halting, the link lost).
+  enum class Activity : std::uint8_t { at_rest, travelling, lowering, dwelling, raising, yielding, stopping };
+  static constexpr std::size_t kActivityCount = 7;
+
   /// Crane `crane` of `layout` (copied) with its `jobs`, in order. Its goals to the planner get
   /// request ids from `first_goal_id` up (the planner takes only ids above the last it took).
   /// Throws as the header says.
@@ -140,6 +148,8 @@ class CraneSiteLink {
   [[nodiscard]] bool report_changed() noexcept;
 
   [[nodiscard]] Phase phase() const noexcept { return phase_; }
+  /// What it is doing now (Activity). noexcept.
+  [[nodiscard]] Activity activity() const noexcept;
   [[nodiscard]] std::size_t crane() const noexcept { return crane_; }
   [[nodiscard]] int jobs_done() const noexcept { return jobs_done_; }
   [[nodiscard]] std::size_t jobs() const noexcept { return legs_.size() / 2; }
@@ -259,5 +269,8 @@ class CraneSiteLink {
 /// [rad]), its trolley at `trolley` [m]. std::out_of_range for a crane index not on the site.
 [[nodiscard]] Pose site_start_pose(const SiteLayout& layout, std::size_t crane, double planner_slew_min,
                                    double planner_slew_max, double trolley);
+
+/// "at rest", "travelling", "lowering", "dwelling", "raising", "yielding", "stopping".
+[[nodiscard]] const char* to_string(CraneSiteLink::Activity activity) noexcept;
 
 }  // namespace crane::anti_collision

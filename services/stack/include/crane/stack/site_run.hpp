@@ -28,6 +28,7 @@
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
 // outside a crane's reach or a job list not one per crane.
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -98,6 +99,14 @@ struct CraneOutcome {
 
 struct SiteOutcome {
   std::vector<CraneOutcome> cranes;
+  // Where the waits go [s]: crane-seconds the cranes spent asking for a leg, by what the cranes
+  // the site service had them wait for were doing (SiteArbiter::waits_for at its last decision;
+  // index: CraneSiteLink::Activity; a crane that waits for k cranes counts 1/k to each), and
+  // asking while it waited for no crane (`waited_for_none`: its request or the go on their way,
+  // or the service down). On a fault-free run they add up to the cranes' waiting_time; a lost link
+  // that cuts an ask short counts here and not there.
+  std::array<double, anti_collision::CraneSiteLink::kActivityCount> waited_for{};
+  double waited_for_none{0.0};
   bool completed{false};     // every job done within the time limit (no crane braked by its guard)
   double total_time{0.0};    // [s] the last crane's finish time
   double min_distance{0.0};  // [m] true, between any two parts of any two cranes, over the run
