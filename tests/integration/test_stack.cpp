@@ -642,6 +642,30 @@ TEST(SimMatchesDemo, ARandomMoveNearTheMastOverDdsIsCraneSimToTheBit) {
                          run_sim("sim_random", options));
 }
 
+// A mismatch corner over DDS: the plant process's cable 20 % longer, its load 20 % heavier and its
+// friction 30 % higher than every controller assumes (crane_demo --plant-*-factor), random move 17
+// of seed 1, the slowest corner of crane_sim compare's sweep (2.32 T*). Over DDS it settles, no
+// brake, and gives crane_sim demo --mismatch 1.2 1.2 1.3's CSV to the last bit.
+TEST(SimMatchesDemo, AMismatchCornerOverDdsIsCraneSimToTheBit) {
+  const std::vector<std::string> options{"--moves", "20", "--seed", "1", "--maneuver", "random_17",
+                                         "--friction-compensation", "on", "--controller", "follower"};
+  std::vector<std::string> dds = options;
+  dds.insert(dds.end(), {"--plant-cable-length-factor", "1.2", "--plant-load-mass-factor", "1.2",
+                         "--plant-friction-factor", "1.3"});
+  std::vector<std::string> sim = options;
+  sim.insert(sim.end(), {"--mismatch", "1.2", "1.2", "1.3"});
+  const auto summary = run_demo("sim_vs_demo_corner", 39, dds);
+  ASSERT_FALSE(summary.is_null());
+  ASSERT_EQ(summary["maneuvers"].size(), 1U);
+  EXPECT_TRUE(summary["loop"]["failures"].empty()) << summary["loop"]["failures"];
+  EXPECT_EQ(summary["plant_friction_factor"], 1.3);
+  const auto& m = summary["maneuvers"][0];
+  EXPECT_TRUE(m["settle_time_s"].is_number()) << m.dump();
+  EXPECT_EQ(m["braked_cycles"], 0);
+  expect_sim_equals_demo(summary, fs::temp_directory_path() / ("crane_test_sim_vs_demo_corner_" + std::to_string(getpid())),
+                         run_sim("sim_corner", sim));
+}
+
 // Starts crane_launch (`config`, simulated plant, lockstep, DDS domain `domain`, its log in `dir`)
 // in `launcher`; true once every stage is matched and alive (within 60 s).
 bool launch_stack(ProcessGroup& launcher, const fs::path& dir, const std::string& config, const std::string& domain) {

@@ -59,6 +59,7 @@ struct DemoOptions {
   std::string controller;             // --controller, see main(); "auto" picks per maneuver (time_optimal)
   double plant_cable_length_factor{1.0};
   double plant_load_mass_factor{1.0};
+  double plant_friction_factor{1.0};
   std::string security_directory;  // --security: every process and the operator secured (DDS Security)
   bool iceoryx{false};             // --iceoryx: every process and the operator on iceoryx shared memory
 };
@@ -256,6 +257,7 @@ RunResult run_maneuver(const DemoOptions& options, const stack::StackConfig& cfg
   stack.plant_stats_path = (log_dir / "plant_stats.json").string();
   stack.plant_cable_length_factor = options.plant_cable_length_factor;
   stack.plant_load_mass_factor = options.plant_load_mass_factor;
+  stack.plant_friction_factor = options.plant_friction_factor;
   // What the controller name stands for (one place for crane_demo and crane_sim).
   const auto choice = stack::choose_controller(options.controller, m, options.acceleration_feedforward);
   stack.anti_swing_controller = std::string(anti_swing::law_name(choice.anti_swing));
@@ -564,6 +566,10 @@ int main(int argc, char** argv) {
   app.add_option("--plant-load-mass-factor", options.plant_load_mass_factor,
                  "robustness: the simulated load mass (so m_t, m_r) is this times the configured one")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--plant-friction-factor", options.plant_friction_factor,
+                 "robustness: every friction coefficient of both simulated drives is this times the configured "
+                 "one (crane_sim's --mismatch L m f is these three factors)")
+      ->check(CLI::Range(0.0, 10.0));
   auto* profile_option =
       app.add_option("--profile", options.profile,
                      "reference profile of every move: step | trapezoid (3.43) | zv | zvd | ei | time_optimal | minimum_time "
@@ -653,6 +659,7 @@ int main(int argc, char** argv) {
       summary["profile"] = options.profile;
       summary["plant_cable_length_factor"] = options.plant_cable_length_factor;
       summary["plant_load_mass_factor"] = options.plant_load_mass_factor;
+      summary["plant_friction_factor"] = options.plant_friction_factor;
       summary["controller"] = options.controller;
       json maneuvers = json::array();
       std::vector<double> all_latencies;

@@ -85,6 +85,11 @@ int main(int argc, char** argv) {
                  "--sim: the simulated pendulum is this times the cable the hoist reports (the controllers assume "
                  "the configured pendulum; the online estimate, state_estimator.swing_length, finds it)")
       ->check(CLI::Range(0.1, 10.0));
+  app.add_option("--plant-friction-factor", stack.plant_friction_factor,
+                 "--sim: every friction coefficient of both simulated drives is this times the configured one (the "
+                 "friction compensation assumes the configuration; the tracking stage estimates the factor along a "
+                 "move)")
+      ->check(CLI::Range(0.0, 10.0));
   auto* site_option = app.add_option("--site", stack.site_file,
                                      "the crane is on this site (docs/site.md): its supervisor enforces its grant")
                           ->check(CLI::ExistingFile);

@@ -129,9 +129,10 @@ std::vector<ProcessSpec> stack_processes(const StackOptions& o) {
       if (!bridge && !o.plant_stats_path.empty()) {
         spec.arguments.insert(spec.arguments.end(), {"--stats-out", o.plant_stats_path});
       }
-      if (o.plant_cable_length_factor != 1.0 || o.plant_load_mass_factor != 1.0) {
+      if (o.plant_cable_length_factor != 1.0 || o.plant_load_mass_factor != 1.0 || o.plant_friction_factor != 1.0) {
         spec.arguments.insert(spec.arguments.end(), {"--cable-length-factor", number(o.plant_cable_length_factor),
-                                                     "--load-mass-factor", number(o.plant_load_mass_factor)});
+                                                     "--load-mass-factor", number(o.plant_load_mass_factor),
+                                                     "--friction-factor", number(o.plant_friction_factor)});
       }
       if (bridge) spec.arguments.insert(spec.arguments.end(), {"--board", o.hardware});
     }

@@ -3,8 +3,10 @@
 //
 //   crane_sim demo  --config FILE [--controller C] [--profile P] [--maneuver M ...]
 //                   [--friction-compensation on|off|both] [--acceleration-feedforward] [--out DIR]
+//                   [--moves N --seed S] [--mismatch L m f]
 //       the demo maneuvers: crane_demo's table (to the printed digit: the same stages on the same
-//       inputs) and its CSV files, and the speed in multiples of real time;
+//       inputs) and its CSV files, and the speed in multiples of real time; --mismatch: the plant's
+//       cable length, load mass and friction factors (crane_demo's --plant-*-factor);
 //   crane_sim sweep --config FILE [--controllers C,C,...] [--grid N | --random N --seed S]
 //                   [--maneuver M] [--jobs J] [--out DIR] [--plot-script F --python P]
 //       plant mismatches (cable length, load mass, friction level, sensor delay) over the
@@ -92,6 +94,7 @@ struct Selection {
   double atol{0.0};
   int moves{0};            // demo: seeded random moves besides the demo maneuvers (crane_demo's --moves)
   std::uint64_t seed{1};
+  plant::PlantMismatch mismatch{};  // demo: the plant's (crane_demo's --plant-*-factor)
 };
 
 // The configuration with the command line's integrator, if any.
@@ -145,6 +148,7 @@ std::vector<stack::InProcessRun> demo_runs(const stack::StackConfig& cfg, const 
       run.controller = stack::choose_controller(controller, m, s.acceleration_feedforward);
       run.profile = profile_of(controller, s);
       run.request_id = request_id++;
+      run.mismatch = s.mismatch;
       runs.push_back(run);
     }
   }
@@ -992,6 +996,12 @@ int main(int argc, char** argv) {
   demo_cmd->add_option("--moves", s.moves, "seeded random moves besides the demo maneuvers (compare's; --maneuver random_N picks)")
       ->check(CLI::Range(0, 1000));
   demo_cmd->add_option("--seed", s.seed, "the random moves' seed");
+  std::vector<double> demo_mismatch;
+  demo_cmd->add_option("--mismatch", demo_mismatch,
+                       "the plant's cable length, load mass and friction factors (crane_demo's --plant-cable-length-"
+                       "factor, --plant-load-mass-factor, --plant-friction-factor)")
+      ->expected(3)
+      ->check(CLI::Range(0.0, 10.0));
 
   auto* sweep_cmd = app.add_subcommand("sweep", "plant mismatches over the controllers on every core, with heat maps");
   common_options(sweep_cmd);
@@ -1093,7 +1103,14 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*gantry_cmd) return gantry_gains(full_forward_gain);
-    if (*demo_cmd) return demo(s, out_dir);
+    if (*demo_cmd) {
+      if (demo_mismatch.size() == 3) {
+        s.mismatch.cable_length_factor = demo_mismatch[0];
+        s.mismatch.load_mass_factor = demo_mismatch[1];
+        s.mismatch.friction_factor = demo_mismatch[2];
+      }
+      return demo(s, out_dir);
+    }
     if (*sweep_cmd) {
       if (grid == 0 && random == 0) random = 200;
       return sweep(s, controllers, grid, random, seed, jobs, out_dir, plot_script, python);

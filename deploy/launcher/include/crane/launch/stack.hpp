@@ -35,6 +35,7 @@ struct StackOptions {
                                       // (cycles, overruns, latency log) here on exit (optional)
   double plant_cable_length_factor{1.0};  // simulated L = factor * configured L (robustness)
   double plant_load_mass_factor{1.0};     // simulated m = factor * configured m (robustness)
+  double plant_friction_factor{1.0};      // every friction coefficient of both simulated drives x factor (robustness)
   std::string log_level{"info"};
   std::string anti_swing_controller;  // anti_swing --controller (none|pd|delay1|delay2|fuzzy); empty: its default
   std::string tracking_controller;    // tracking --controller (tracking|gain_scheduling_partial|gain_scheduling_full);
