@@ -274,7 +274,8 @@ TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
 }
 
 // What the crane is doing, as the site's waits are counted by it: the segment under way (the one
-// about to start once it has settled at a waypoint), the dwell, a yield, a lost-link stop.
+// about to start once it has settled at a waypoint), the dwell, a yield (a lost-link stop:
+// ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain).
 TEST_F(Link, SaysWhatItIsDoingSegmentBySegment) {
   using A = CraneSiteLink::Activity;
   (void)step();
@@ -418,6 +419,7 @@ TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
   EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
   EXPECT_NEAR(t_ - 0.01 - last_heard, layout_.link_deadline, 0.011);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
+  EXPECT_EQ(link_->activity(), CraneSiteLink::Activity::stopping);
   EXPECT_EQ(link_->halts(), 1);
   // The stop ends: at rest, it waits for the link.
   reference_.phase = Reference::PHASE_ARRIVED;
@@ -425,6 +427,7 @@ TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
   (void)link_->step(t_, estimate_, reference_, false);
   t_ += 0.01;
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halted);
+  EXPECT_EQ(link_->activity(), CraneSiteLink::Activity::at_rest);
   ASSERT_EQ(link_->reactions().size(), 1u);
   EXPECT_NEAR(link_->reactions()[0], t_ - 0.01 - last_heard, 0.011);
   ASSERT_TRUE(link_->longest_reaction().has_value());
