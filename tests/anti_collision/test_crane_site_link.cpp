@@ -3,8 +3,9 @@
 // moves waypoint by waypoint as the reference arrives and the crane settles, the dwell at the work
 // height, the job counted, the yield, a goal sent again until the planner answers, a move the
 // planner ends short sent again and at last given up, the lost link
-// (a soft stop in shared airspace, the move ended at its waypoint when a soft stop would leave the
-// grant, the path finished outside it), the brakes, and bad jobs and job files refused.
+// (a soft stop in shared airspace, a stop of the axes whose stop stays in the grant while the others
+// run on to the waypoint, the move ended at its waypoint when no stop would stay in the grant, the
+// path finished outside it), the brakes, and bad jobs and job files refused.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -417,6 +418,8 @@ TEST_F(Link, ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain) {
   const auto stop = silent(100, true);
   ASSERT_TRUE(stop.has_value());
   EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
+  EXPECT_EQ(stop->axes, MoveRequest::AXIS_TROLLEY | MoveRequest::AXIS_SLEW | MoveRequest::AXIS_HOIST);
+  EXPECT_EQ(link_->halts_per_axis(), 0);
   EXPECT_NEAR(t_ - 0.01 - last_heard, layout_.link_deadline, 0.011);
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halting);
   EXPECT_EQ(link_->activity(), CraneSiteLink::Activity::stopping);
@@ -458,6 +461,38 @@ TEST_F(Link, ALostLinkEndsTheMoveAtItsWaypointWhenASoftStopWouldLeaveTheGrant) {
   EXPECT_EQ(link_->longest_reaction()->seconds, link_->reactions()[0]);
   EXPECT_STREQ(to_string(CraneSiteLink::ReactionEnd::at_waypoint),
                "at rest at its move's waypoint (a soft stop would have left the grant)");
+}
+
+TEST_F(Link, ALostLinkStopsTheAxesThatStayInsideAndLetsTheOthersRunOnToTheWaypoint) {
+  // A pick at slew 1.0 rad: the travel turns the jib and runs the trolley out. The link is lost with
+  // the trolley 2 cm short of 0.9 m at 0.5 m/s (its soft stop runs past it) and the slew at 0.3 rad
+  // turning at 0.3 rad/s (its soft stop ends near 0.59 rad, well short of 1.0): the stop names the
+  // slew and the resting hoist, and the trolley goes on to the waypoint
+  // (GrantGuard.ASoftStopOfTheAxesThatStayInsideLetsTheOthersRunOnToTheirTarget computes the ends).
+  SiteJob turn;
+  turn.pick = {1.0, 0.9, 1.5};
+  turn.place = {-1.5, 0.5, 1.2};
+  link_.emplace(layout_, 0, params_, std::vector<SiteJob>{turn}, kFirstGoal);
+  moving_at({0.3, 0.88, 0.2}, 0.5);
+  ASSERT_EQ(link_->path()[link_->waypoint()].slew, 1.0);
+  reference_.slew_rate = 0.3;
+  estimate_.slew_rate = 0.3;
+  const auto stop = silent(100, true);
+  ASSERT_TRUE(stop.has_value());
+  EXPECT_EQ(stop->command, MoveRequest::COMMAND_STOP);
+  EXPECT_EQ(stop->axes, MoveRequest::AXIS_SLEW | MoveRequest::AXIS_HOIST);
+  EXPECT_EQ(link_->halts(), 1);
+  EXPECT_EQ(link_->halts_per_axis(), 1);
+  EXPECT_EQ(link_->halts_at_waypoint(), 0);
+  // At rest, the trolley at the waypoint and the slew short of it: safe, and the reaction says how.
+  reference_.phase = Reference::PHASE_ARRIVED;
+  at({0.6, 0.9, 0.2});
+  (void)link_->step(t_, estimate_, reference_, false);
+  t_ += 0.01;
+  ASSERT_EQ(link_->reactions().size(), 1u);
+  ASSERT_TRUE(link_->longest_reaction().has_value());
+  EXPECT_EQ(link_->longest_reaction()->end, CraneSiteLink::ReactionEnd::per_axis);
+  EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::halted);
 }
 
 TEST_F(Link, ALostLinkStopsSoftlyWhenTheReferenceRestsWhateverTheMeasuredSpeed) {

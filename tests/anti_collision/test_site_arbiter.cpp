@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 #include <random>
@@ -422,6 +423,60 @@ TEST(GrantGuard, EachRuleByHand) {
   EXPECT_THROW(GrantGuard(site, 2), std::out_of_range);
 }
 
+
+// A lost link in the middle of a move of both axes (slew 0 -> 0.8 rad, trolley 0.3 -> 0.9 m, on
+// 0.2 m of cable; the path's box is slew [0, 0.8], trolley [0.3, 0.9]): the trolley 2 cm short of
+// its goal at 0.5 m/s, the slew at 0.3 rad turning at 0.3 rad/s. ZVD on 0.2 m of cable: T = 2 pi
+// sqrt(0.2 / 9.80665) = 0.89729 s. The trolley's soft stop runs 0.5 x 0.1 + 0.5^2 / (2 x 0.5) +
+// 0.5 x 0.89729 / 2 = 0.52432 m, to 1.44 m with the margin: far past 0.9 m. The slew's runs 0.3 x
+// 0.1 + 0.3^2 / (2 x 0.5) + 0.3 x 0.89729 / 2 = 0.25459 rad, to 0.5946 rad with the margin: inside
+// 0.8. So the slew stops (and the hoist, at rest, is named too) while the trolley runs on to 0.9 m.
+TEST(GrantGuard, ASoftStopOfTheAxesThatStayInsideLetsTheOthersRunOnToTheirTarget) {
+  const SiteLayout site = two_towers();
+  GrantGuard guard(site, 0);
+  const Pose target{0.8, 0.9, 0.2};
+  EXPECT_FALSE(guard.soft_stop_axes(CraneMotion{}, {}, target).has_value()) << "no grant";
+  guard.grant(path_airspace(std::vector<Pose>{{0.0, 0.3, 0.2}, target}, site.paths), 10.0);
+  CraneMotion m;
+  m.slew = 0.3;
+  m.slew_rate = 0.3;
+  m.trolley = 0.88;
+  m.trolley_velocity = 0.5;
+  m.cable_length = 0.2;
+  const double period = 2.0 * kPi * std::sqrt(0.2 / kStandardGravity);
+  const StoppingTravel stop = stopping_travel(site.cranes[0], m, StopKind::soft);
+  EXPECT_NEAR(stop.trolley, 0.05 + 0.25 + 0.5 * period / 2.0, 1e-12);
+  EXPECT_NEAR(stop.slew, 0.03 + 0.09 + 0.3 * period / 2.0, 1e-12);
+  EXPECT_FALSE(guard.soft_stop_stays_in_grant(m));
+  const auto axes = guard.soft_stop_axes(m, {}, target);
+  ASSERT_TRUE(axes.has_value());
+  EXPECT_EQ(*axes, kStopSlew | kStopHoist);
+  // The other way round: the slew 0.05 rad short of its goal, the trolley slow and far from its
+  // own (0.1 m/s at 0.5 m: 0.01 + 0.01 + 0.04486 = 0.06486 m, to 0.605 m).
+  m.slew = 0.75;
+  m.trolley = 0.5;
+  m.trolley_velocity = 0.1;
+  EXPECT_EQ(guard.soft_stop_axes(m, {}, target), std::optional<std::uint8_t>(kStopTrolley | kStopHoist));
+  // Both near their goals: no choice but the move's own end stays inside.
+  m.trolley = 0.88;
+  m.trolley_velocity = 0.5;
+  EXPECT_FALSE(guard.soft_stop_axes(m, {}, target).has_value());
+  // Both slow: every axis stops, as soft_stop_stays_in_grant says.
+  m.slew = 0.3;
+  m.trolley = 0.5;
+  m.trolley_velocity = 0.1;
+  ASSERT_TRUE(guard.soft_stop_stays_in_grant(m));
+  EXPECT_EQ(guard.soft_stop_axes(m, {}, target), std::optional<std::uint8_t>(kStopTrolley | kStopSlew | kStopHoist));
+  // A trolley whose reference rests at its goal ends there (reference_rest_of): every axis stops.
+  m.trolley = 0.88;
+  m.trolley_velocity = 0.5;
+  ReferenceRest rest;
+  rest.trolley = 0.9;
+  EXPECT_EQ(guard.soft_stop_axes(m, rest, target), std::optional<std::uint8_t>(kStopTrolley | kStopSlew | kStopHoist));
+  // A target outside the grant is no place to run on to; a non-finite one is refused.
+  EXPECT_FALSE(guard.soft_stop_axes(m, {}, {0.8, 1.2, 0.2}).has_value());
+  EXPECT_FALSE(guard.soft_stop_axes(m, {}, {0.8, std::nan(""), 0.2}).has_value());
+}
 
 // The site service's protocol (site_service.hpp) over the same two towers: reports that carry
 // each crane's whole state, instructions numbered and sent again until carried out.

@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include "crane/anti_swing/anti_swing_stage.hpp"
@@ -79,6 +80,90 @@ TEST(PlannerStage, AGoalOutOfRangeIsRejectedWithTheValueAndTheBound) {
   EXPECT_EQ(feedback[0].bound_min, 0.1);
   EXPECT_EQ(feedback[0].bound_max, 1.2);
   EXPECT_EQ(feedback[0].header.seq, 1U);
+}
+
+// A stop that names the slew (the site link's, when the trolley's own stop would run past its goal:
+// docs/site.md): the trolley runs on along its profile, cycle for cycle the reference of the move
+// never stopped, and rests at its target; the slew stops as it does in a stop of every axis. A stop
+// naming no axis, or every one, stops every axis (the trolley then runs past its target), and so
+// does one on a move with a waypoint still ahead.
+TEST(PlannerStage, AStopNamingTheSlewLetsTheTrolleyRunOnToItsTarget) {
+  Request goal = trolley_goal(1, 0.6);
+  goal.axes |= Request::AXIS_SLEW;
+  goal.slew_target = 2.5;
+  const auto stop_of = [](std::uint8_t axes) {
+    Request r;
+    r.request_id = 2;
+    r.command = Request::COMMAND_STOP;
+    r.axes = axes;
+    return r;
+  };
+  constexpr std::uint64_t kStop = 101;  // 1.0 s into the move: the trolley (0.35 m) decelerates
+  struct Run {
+    trajectory_planner::TrajectoryPlannerStage stage = lab_planner();
+    std::vector<protocol::Reference> references;
+    std::vector<Feedback> feedback;
+  };
+  const auto run_with = [&](std::optional<Request> stop, const Request& move) {
+    Run r;
+    protocol::Reference reference;
+    for (std::uint64_t k = 0; k < 700; ++k) {
+      std::vector<Request> now;
+      if (k == 1) now.push_back(move);
+      if (k == kStop && stop) now.push_back(*stop);
+      EXPECT_EQ(r.stage.step(at_rest(k), now, reference), common::StepStatus::ok);
+      r.references.push_back(reference);
+      for (const auto& f : r.stage.move_statuses()) r.feedback.push_back(f);
+    }
+    return r;
+  };
+  const Run free = run_with(std::nullopt, goal);
+  const Run slew = run_with(stop_of(Request::AXIS_SLEW), goal);
+  const Run every = run_with(stop_of(0), goal);
+  const Run named = run_with(stop_of(Request::AXIS_TROLLEY | Request::AXIS_SLEW | Request::AXIS_HOIST), goal);
+  ASSERT_LT(free.references[kStop].trolley_position, 0.6);
+  ASSERT_GT(free.references[kStop].trolley_velocity, 0.1);
+  for (std::size_t k = 0; k < free.references.size(); ++k) {
+    EXPECT_EQ(slew.references[k].trolley_position, free.references[k].trolley_position) << k;
+    EXPECT_EQ(slew.references[k].trolley_velocity, free.references[k].trolley_velocity) << k;
+    EXPECT_EQ(slew.references[k].trolley_acceleration, free.references[k].trolley_acceleration) << k;
+    EXPECT_EQ(slew.references[k].slew_angle, every.references[k].slew_angle) << k;
+    EXPECT_EQ(slew.references[k].slew_rate, every.references[k].slew_rate) << k;
+    EXPECT_EQ(named.references[k].trolley_position, every.references[k].trolley_position) << k;
+    EXPECT_EQ(named.references[k].slew_angle, every.references[k].slew_angle) << k;
+  }
+  const auto& last = slew.references.back();
+  EXPECT_EQ(last.trolley_position, 0.6);
+  EXPECT_GT(every.references.back().trolley_position, 0.6 + 0.05) << "a stop of every axis runs past the target";
+  EXPECT_LT(last.slew_angle, 2.0);
+  EXPECT_EQ(last.phase, protocol::Reference::PHASE_HOLDING);
+  // The stop's feedback: stopping, resting where each axis ends (the trolley at its target); then
+  // arrived; the goal aborted (stopped).
+  bool stopping = false, arrived = false, aborted = false;
+  for (const auto& f : slew.feedback) {
+    if (f.request_id == 2 && f.result == Feedback::RESULT_STOPPING) {
+      stopping = true;
+      EXPECT_EQ(f.rest_trolley_position, 0.6);
+      EXPECT_NEAR(f.rest_slew_angle, last.slew_angle, 1e-9);
+    }
+    arrived = arrived || (f.request_id == 2 && f.result == Feedback::RESULT_ARRIVED);
+    aborted = aborted || (f.request_id == 1 && f.result == Feedback::RESULT_ABORTED && f.reason == Feedback::REASON_STOPPED);
+  }
+  EXPECT_TRUE(stopping);
+  EXPECT_TRUE(arrived);
+  EXPECT_TRUE(aborted);
+
+  // A waypoint ahead: every axis stops.
+  Request via = goal;
+  via.waypoint_count = 1;
+  via.waypoint_trolley[0] = 0.9;
+  via.waypoint_slew[0] = 0.5;
+  via.waypoint_cable_length[0] = 1.0;
+  const Run via_slew = run_with(stop_of(Request::AXIS_SLEW), via);
+  const Run via_every = run_with(stop_of(0), via);
+  for (std::size_t k = 0; k < via_slew.references.size(); ++k) {
+    EXPECT_EQ(via_slew.references[k].trolley_position, via_every.references[k].trolley_position) << k;
+  }
 }
 
 TEST(PlannerStage, AMoveReportsWaitingMovingEveryTenCyclesAndArrived) {

@@ -54,6 +54,7 @@ void write_summary(const std::string& path, const std::string& name, const ac::C
                    {"unsettled_moves", link.unsettled_moves()},
                    {"halts", link.halts()},
                    {"halts_at_waypoint", link.halts_at_waypoint()},
+                   {"halts_per_axis", link.halts_per_axis()},
                    {"aborted_moves", link.aborted_moves()},
                    {"reactions_s", link.reactions()}};
   const std::string tmp = path + ".tmp";

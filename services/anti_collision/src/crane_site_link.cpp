@@ -48,6 +48,10 @@ void check_point(const SiteCrane& c, const WorkPoint& w, std::size_t job, const 
 
 }  // namespace
 
+static_assert(kStopTrolley == protocol::MoveRequest::AXIS_TROLLEY && kStopSlew == protocol::MoveRequest::AXIS_SLEW &&
+                  kStopHoist == protocol::MoveRequest::AXIS_HOIST,
+              "a stop's axes are the MoveRequest's AXIS bits");
+
 const char* to_string(CraneSiteLink::ReactionEnd end) noexcept {
   using E = CraneSiteLink::ReactionEnd;
   switch (end) {
@@ -55,6 +59,7 @@ const char* to_string(CraneSiteLink::ReactionEnd end) noexcept {
     case E::at_rest_already: return "at rest already";
     case E::soft_stop: return "at rest after its soft stop";
     case E::at_waypoint: return "at rest at its move's waypoint (a soft stop would have left the grant)";
+    case E::per_axis: return "at rest after a stop of some axes, the others at their waypoint (stopping them would have left the grant)";
   }
   return "?";
 }
@@ -289,12 +294,21 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
         arrived_at_.reset();
         ended_short_at_.reset();
         ++halts_;
-        halt_at_waypoint_ =
-            !(start_next_ || guard_.soft_stop_stays_in_grant(motion_of(estimate), reference_rest_of(reference)));
+        constexpr std::uint8_t kEveryAxis = kStopTrolley | kStopSlew | kStopHoist;
+        // At rest at a waypoint it was about to leave: every axis. Otherwise the axes whose soft stop
+        // stays inside the grant, the others on to the move's waypoint (GrantGuard::soft_stop_axes).
+        const std::optional<std::uint8_t> stopped =
+            start_next_ ? std::optional<std::uint8_t>(kEveryAxis)
+                        : guard_.soft_stop_axes(motion_of(estimate), reference_rest_of(reference),
+                                                path_[std::min(waypoint_, path_.size() - 1)]);
+        halt_at_waypoint_ = !stopped.has_value();
+        halt_per_axis_ = stopped.has_value() && *stopped != kEveryAxis;
         if (!halt_at_waypoint_) {
+          if (halt_per_axis_) ++halts_per_axis_;
           Request stop{};
           stop.request_id = ++goal_id_;
           stop.command = Request::COMMAND_STOP;
+          stop.axes = *stopped;
           goal_ = stop;
           goal_taken_ = false;
           goal_sent_ = time;
@@ -359,7 +373,10 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
     // A soft stop's reference moves until it arrives; a crane settling at a waypoint holds at once.
     if (reference.phase != protocol::Reference::PHASE_MOVING && at_rest(estimate)) {
       yielding_ = false;
-      record_reaction(halt_from_, time, halt_at_waypoint_ ? ReactionEnd::at_waypoint : ReactionEnd::soft_stop);
+      record_reaction(halt_from_, time,
+                      halt_at_waypoint_ ? ReactionEnd::at_waypoint
+                      : halt_per_axis_  ? ReactionEnd::per_axis
+                                        : ReactionEnd::soft_stop);
       phase_ = link_lost_ ? Phase::halted : gave_up_ ? Phase::aborted : Phase::resting;
       changed_ = true;
     }

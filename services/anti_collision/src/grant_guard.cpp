@@ -1,6 +1,7 @@
 #include "crane/anti_collision/grant_guard.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -154,22 +155,81 @@ bool GrantGuard::must_leave_shared_airspace(double time) const noexcept {
   return has_grant_ && granted_shared_ && link_lost(time);
 }
 
+namespace {
+
+// Where an axis ends in a soft stop: inside the box by kContainmentTolerance on each axis the stop
+// carries further than that (carried 2 x kContainmentTolerance further, then contained with the
+// tolerance): the tolerance is the drives' tracking, not the stopping model's error. An axis at
+// rest (its measured speed's noise) is contained as it stands; one whose reference rests ends there.
+double soft_stop_end(const std::optional<double>& rest, double position, double travel) noexcept {
+  if (rest) return std::isfinite(*rest) ? *rest : std::numeric_limits<double>::quiet_NaN();
+  return position + travel +
+         (travel > kContainmentTolerance    ? 2.0 * kContainmentTolerance
+          : travel < -kContainmentTolerance ? -2.0 * kContainmentTolerance
+                                            : 0.0);
+}
+
+}  // namespace
+
 bool GrantGuard::soft_stop_stays_in_grant(const CraneMotion& m, const ReferenceRest& reference) const noexcept {
   if (!has_grant_ || !is_finite(m)) return false;
   const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
-  // The predicted end inside the box by kContainmentTolerance on each axis the stop carries further
-  // than that (carried 2 x kContainmentTolerance further, then contained with the tolerance): the
-  // tolerance is the drives' tracking, not the stopping model's error. An axis at rest (its
-  // measured speed's noise) is contained as it stands; one whose reference rests ends there.
-  const auto end = [](const std::optional<double>& rest, double position, double travel) {
-    if (rest) return std::isfinite(*rest) ? *rest : std::numeric_limits<double>::quiet_NaN();
-    return position + travel +
-           (travel > kContainmentTolerance    ? 2.0 * kContainmentTolerance
-            : travel < -kContainmentTolerance ? -2.0 * kContainmentTolerance
-                                              : 0.0);
-  };
-  return contains(granted_, {end(reference.slew, m.slew, stop.slew), end(reference.trolley, m.trolley, stop.trolley),
-                             end(reference.cable_length, m.cable_length, stop.cable)});
+  return contains(granted_, {soft_stop_end(reference.slew, m.slew, stop.slew),
+                             soft_stop_end(reference.trolley, m.trolley, stop.trolley),
+                             soft_stop_end(reference.cable_length, m.cable_length, stop.cable)});
+}
+
+std::optional<std::uint8_t> GrantGuard::soft_stop_axes(const CraneMotion& m, const ReferenceRest& reference,
+                                                       const Pose& targets) const noexcept {
+  if (!has_grant_ || !is_finite(m) || !std::isfinite(targets.slew) || !std::isfinite(targets.trolley) ||
+      !std::isfinite(targets.cable_length)) {
+    return std::nullopt;
+  }
+  const StoppingTravel stop = stopping_travel(layout_.cranes[crane_], m, StopKind::soft);
+  // Per axis, in the order slew, trolley, cable length.
+  const std::array<std::optional<double>, 3> rest{reference.slew, reference.trolley, reference.cable_length};
+  const std::array<double, 3> position{m.slew, m.trolley, m.cable_length};
+  const std::array<double, 3> travel{stop.slew, stop.trolley, stop.cable};
+  const std::array<double, 3> target{targets.slew, targets.trolley, targets.cable_length};
+  const std::array<double, 3> speed{m.slew_rate, m.trolley_velocity, m.cable_rate};
+  const std::array<std::uint8_t, 3> bit{kStopSlew, kStopTrolley, kStopHoist};
+  // The axes that move: their reference does not rest, and their stop carries them further than
+  // the tolerance (not the measured speed's noise).
+  std::uint8_t moving = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!rest[i] && std::abs(travel[i]) > kContainmentTolerance) moving = static_cast<std::uint8_t>(moving | (1U << i));
+  }
+  std::optional<std::uint8_t> best;
+  int best_stopped = -1;
+  double best_time = std::numeric_limits<double>::infinity();
+  // Every choice of the moving axes that run on (bit i: axis i); all of them is the move's own end.
+  for (unsigned run_on = 0; run_on < 8U; ++run_on) {
+    if ((run_on & ~static_cast<unsigned>(moving)) != 0 || (moving != 0 && run_on == moving)) continue;
+    std::array<double, 3> end{};
+    int stopped = 0;
+    double time = 0.0;  // [s] the longest time to go of the axes that run on
+    for (std::size_t i = 0; i < 3; ++i) {
+      if ((run_on & (1U << i)) != 0) {
+        end[i] = target[i];
+        // Decelerating evenly to the target takes twice distance over speed.
+        time = std::max(time, 2.0 * std::abs(target[i] - position[i]) / std::max(std::abs(speed[i]), 1e-3));
+      } else {
+        end[i] = soft_stop_end(rest[i], position[i], travel[i]);
+        if ((moving & (1U << i)) != 0) ++stopped;
+      }
+    }
+    if (!contains(granted_, {end[0], end[1], end[2]})) continue;
+    if (stopped > best_stopped || (stopped == best_stopped && time < best_time)) {
+      std::uint8_t axes = 0;
+      for (std::size_t i = 0; i < 3; ++i) {
+        if ((run_on & (1U << i)) == 0) axes = static_cast<std::uint8_t>(axes | bit[i]);
+      }
+      best = axes;
+      best_stopped = stopped;
+      best_time = time;
+    }
+  }
+  return best;
 }
 
 GrantCheck GrantGuard::check(const CraneMotion& m, double time) const noexcept {

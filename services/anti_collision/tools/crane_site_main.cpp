@@ -223,7 +223,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   std::printf("  distance-watching rule on the coordinated runs (counted, not applied): %d slow-downs, %d stops, %d "
               "emergency stops\n", slow, stops, emergency);
   std::vector<double> reactions;
-  int halts = 0, at_waypoint = 0;
+  int halts = 0, at_waypoint = 0, per_axis = 0;
   std::string longest_reaction;
   double longest_reaction_seconds = 0.0;
   for (std::size_t s = 0; s < results.size(); ++s) {
@@ -231,6 +231,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     reactions.insert(reactions.end(), r.coordinated.reactions.begin(), r.coordinated.reactions.end());
     halts += r.coordinated.halts;
     at_waypoint += r.coordinated.halts_at_waypoint;
+    per_axis += r.coordinated.halts_per_axis;
     if (r.coordinated.longest_reaction_seconds > longest_reaction_seconds) {
       longest_reaction_seconds = r.coordinated.longest_reaction_seconds;
       longest_reaction = "set seed " + std::to_string(seed + s) + ", " + r.coordinated.longest_reaction;
@@ -238,9 +239,9 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   }
   if (faults > 0) {
     std::printf("  link faults: %d per coordinated set (a crane's link lost 0.5-30 s, or the site service killed and "
-                "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d stops (%d of them at the "
-                "waypoint: a soft stop would have left the grant)\n",
-                faults, reactions.size(), site.link_deadline, halts, at_waypoint);
+                "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d stops (%d of them of some axes, "
+                "the others on to the waypoint, and %d at the waypoint: a soft stop would have left the grant)\n",
+                faults, reactions.size(), site.link_deadline, halts, per_axis, at_waypoint);
     std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace [ms]: min %.0f  median %.0f  "
                 "p90 %.0f  p99 %.0f  max %.0f\n",
                 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.0), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.5), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.9),

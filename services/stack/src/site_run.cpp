@@ -262,6 +262,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     }
     out.halts += link.halts();
     out.halts_at_waypoint += link.halts_at_waypoint();
+    out.halts_per_axis += link.halts_per_axis();
     out.cranes.push_back(c.outcome);
   }
   out.simulated_seconds = static_cast<double>(k) * dt * static_cast<double>(n);

@@ -119,6 +119,10 @@ void SpeedReference::start(const common::MotionReference& from) noexcept {
   axes_[2].start(from.cable_length.position, from.cable_length.velocity);
 }
 
+void SpeedReference::start_axis(std::size_t axis, const common::AxisReference& from) noexcept {
+  if (axis < axes_.size()) axes_[axis].start(from.position, from.velocity);
+}
+
 const char* to_string(SpeedShaping shaping) noexcept {
   switch (shaping) {
     case SpeedShaping::none: return "none";

@@ -239,6 +239,19 @@ std::size_t TrajectoryPlanner::segment_index() const noexcept {
   return phase_ == MovePhase::holding ? 0 : static_cast<std::size_t>(&segment_at(time_in_move_) - segments_.data());
 }
 
+bool TrajectoryPlanner::last_segment_axes_independent() const noexcept {
+  if (!ready_ || phase_ != MovePhase::moving || segment_index() + 1 != segment_count_) return false;
+  const Segment& s = segments_[segment_count_ - 1];
+  return s.trolley.kind != ProfileKind::planned && s.slew.kind != ProfileKind::planned &&
+         s.cable.kind != ProfileKind::planned;
+}
+
+common::MotionReference TrajectoryPlanner::sample_end() const noexcept {
+  const Segment& s = segments_[segment_count_ - 1];
+  return {s.trolley.active().sample(s.trolley.active().duration()), s.slew.active().sample(s.slew.active().duration()),
+          s.cable.active().sample(s.cable.active().duration())};
+}
+
 common::MotionReference TrajectoryPlanner::sample_now() const noexcept {
   const Segment& s = segment_at(time_in_move_);
   const double t = time_in_move_ - s.start_time;

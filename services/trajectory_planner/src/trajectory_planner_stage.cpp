@@ -217,8 +217,16 @@ protocol::MoveStatus* TrajectoryPlannerStage::report(std::uint32_t request_id, s
 
 void TrajectoryPlannerStage::report_rest(protocol::MoveStatus& s) const noexcept {
   const auto& p = planner_.params();
-  const auto rest = speed_.rest(sample_period_, p.manual, p.manual.shaping, p.speed_bounds());
+  auto rest = speed_.rest(sample_period_, p.manual, p.manual.shaping, p.speed_bounds());
   const auto now = speed_.reference();
+  if (finishing_axes_ != 0) {
+    // The axes that run on rest at their targets.
+    const auto end = planner_.sample_end();
+    const double ends[3] = {end.trolley.position, end.slew.position, end.cable_length.position};
+    for (std::size_t i = 0; i < 3; ++i) {
+      if ((finishing_axes_ & (1U << i)) != 0) rest[i] = ends[i];
+    }
+  }
   s.rest_trolley_position = rest[0];
   s.rest_slew_angle = rest[1];
   s.rest_cable_length = rest[2];
@@ -311,9 +319,13 @@ bool TrajectoryPlannerStage::moving() const noexcept {
                                   : output_.phase == MovePhase::moving;
 }
 
-void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id) noexcept {
+void TrajectoryPlannerStage::soft_stop(std::uint32_t stop_id, std::uint8_t stopped_axes) noexcept {
   paused_.reset();
+  finishing_axes_ = 0;
   if (source_ == Source::profile) {
+    if (!bridge_ && planner_.last_segment_axes_independent()) {
+      finishing_axes_ = static_cast<std::uint8_t>(kEveryAxis & ~stopped_axes);
+    }
     speed_.start(planner_.sample_now());
     if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
     source_ = Source::speed;
@@ -431,6 +443,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       here.slew.position = current.slew_angle;
       here.cable_length.position = current.cable_length;
       speed_.start(here);
+      finishing_axes_ = 0;
       if (bridge_) {
         common::MotionReference bridge_here;
         bridge_here.trolley.position = estimate.bridge_position;
@@ -708,7 +721,8 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
         continue;
       }
       abort_active(Feedback::REASON_STOPPED);
-      soft_stop(request.request_id);
+      const std::uint8_t named = request.axes & kEveryAxis;
+      soft_stop(request.request_id, named == 0 ? kEveryAxis : named);
       continue;
     }
     if (request.header.seq > seq) {
@@ -750,6 +764,7 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
     if (active_ && (output_.phase == MovePhase::moving || paused_)) abort_active(Feedback::REASON_MANUAL_MOTION);
     active_ = false;
     paused_.reset();
+    finishing_axes_ = 0;
     speed_.start(planner_.sample_now());
     if (bridge_) bridge_->speed.start(bridge_->planner.sample_now());
     source_ = Source::speed;
@@ -782,6 +797,21 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
                                                                                         : params.manual.shaping;
     held_axes_ = speed_.step(targets, sample_period_, params.manual, shaping, params.speed_bounds(), params.site,
                              zones_enabled_);
+    // A stop naming axes: the others run on along planner_'s profile to their targets.
+    const std::uint8_t ran_on = finishing_axes_;
+    PlannerOutput run_on;
+    if (ran_on != 0) {
+      (void)planner_.step(sample_period_, run_on);
+      const common::AxisReference* axes[3] = {&run_on.reference.trolley, &run_on.reference.slew,
+                                              &run_on.reference.cable_length};
+      for (std::size_t i = 0; i < 3; ++i) {
+        const auto bit = static_cast<std::uint8_t>(1U << i);
+        if ((ran_on & bit) == 0) continue;
+        speed_.start_axis(i, *axes[i]);
+        // A profile is at rest only at its ends: this axis has arrived.
+        if (axes[i]->velocity == 0.0 && axes[i]->acceleration == 0.0) finishing_axes_ &= static_cast<std::uint8_t>(~bit);
+      }
+    }
     bool at_rest = speed_.at_rest();
     if (bridge_) {
       const auto& b = bridge_->params;
@@ -791,6 +821,9 @@ common::StepStatus TrajectoryPlannerStage::step(const PlannerCycle& cycle, proto
       at_rest = at_rest && bridge_->speed.at_rest();
     }
     output_.reference = speed_.reference();
+    if ((ran_on & protocol::MoveRequest::AXIS_TROLLEY) != 0) output_.reference.trolley = run_on.reference.trolley;
+    if ((ran_on & protocol::MoveRequest::AXIS_SLEW) != 0) output_.reference.slew = run_on.reference.slew;
+    if ((ran_on & protocol::MoveRequest::AXIS_HOIST) != 0) output_.reference.cable_length = run_on.reference.cable_length;
     output_.request_id = stop_id_;
     output_.phase = at_rest ? MovePhase::arrived : MovePhase::moving;
     const bool released = was_commanding_ && !commanding;

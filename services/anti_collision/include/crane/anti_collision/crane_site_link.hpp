@@ -40,10 +40,12 @@
 // own GrantGuard (grant_guard.hpp) on what it was granted. When nothing was heard for the site's
 // link_deadline, the service holds this crane's whole reach; on its own, the crane then
 //   - moving on a path in shared airspace (the guard's rule 4): stops. A soft stop (the planner's
-//     COMMAND_STOP), or, when a soft stop decided now would run out of the grant (a fast slew near
-//     its goal, GrantGuard::soft_stop_stays_in_grant, which takes an axis whose reference rests as
-//     ending there: reference_rest_of), the move under way ends at its waypoint and
-//     no further one starts; then it waits at rest;
+//     COMMAND_STOP) of every axis; or, when that would run out of the grant (a fast trolley near
+//     its goal: the shaped stop runs past it), of the axes whose stop stays inside, the others
+//     going on to the move's waypoint (COMMAND_STOP naming the axes it stops,
+//     GrantGuard::soft_stop_axes, which takes an axis whose reference rests as ending there:
+//     reference_rest_of); or, when no such choice stays inside, the move under way ends at its
+//     waypoint. No further move starts; then it waits at rest;
 //   - moving on a path outside shared airspace: finishes it, then waits at rest;
 //   - at rest: waits.
 // When the service is heard again, a crane waiting at rest reports where it rests and asks again
@@ -159,6 +161,8 @@ class CraneSiteLink {
   [[nodiscard]] int unsettled_moves() const noexcept { return unsettled_moves_; }
   [[nodiscard]] int halts() const noexcept { return halts_; }
   [[nodiscard]] int halts_at_waypoint() const noexcept { return halts_at_waypoint_; }
+  /// Of halts(), the stops of some axes only, the others going on to the move's waypoint.
+  [[nodiscard]] int halts_per_axis() const noexcept { return halts_per_axis_; }
   /// Moves its planner ended short (aborted or rejected), each sent again or, the last, given up.
   [[nodiscard]] int aborted_moves() const noexcept { return aborted_moves_; }
   /// [s] from each link loss that lasted link_deadline to the crane safe: at rest after its stop,
@@ -170,6 +174,7 @@ class CraneSiteLink {
     at_rest_already,  // it was not moving
     soft_stop,        // at rest after its soft stop
     at_waypoint,      // at rest at the waypoint its move went on to (a soft stop would have left the grant)
+    per_axis,         // at rest after a stop of some axes, the others gone on to the waypoint (soft_stop_axes)
   };
   struct Reaction {
     double lost_at{0.0};  // [s] the link's last message (the loss counted link_deadline later)
@@ -242,11 +247,13 @@ class CraneSiteLink {
   int unsettled_moves_{0};
   int halts_{0};
   int halts_at_waypoint_{0};
+  int halts_per_axis_{0};
   int aborted_moves_{0};
   std::vector<double> reactions_;
   std::optional<Reaction> longest_reaction_;
   double halt_from_{0.0};
   bool halt_at_waypoint_{false};  // the halt under way ends the move at its waypoint
+  bool halt_per_axis_{false};     // the halt under way stops some axes, the others go on to the waypoint
 
   void record_reaction(double lost_at, double time, ReactionEnd end);
 };

@@ -102,6 +102,11 @@ struct ReferenceRest {
   std::optional<double> trolley;       // [m]
   std::optional<double> cable_length;  // [m]
 };
+/// The axes of a stop (GrantGuard::soft_stop_axes): MoveRequest's AXIS_TROLLEY, AXIS_SLEW,
+/// AXIS_HOIST (crane_site_link.cpp checks that they are the same).
+inline constexpr std::uint8_t kStopTrolley = 1;
+inline constexpr std::uint8_t kStopSlew = 2;
+inline constexpr std::uint8_t kStopHoist = 4;
 /// [m/s, rad/s, m/s^2, rad/s^2]: a reference axis's speed and acceleration this close to zero is at rest.
 inline constexpr double kReferenceAtRest = 1e-9;
 
@@ -153,6 +158,19 @@ class GrantGuard {
   /// waypoint is the shorter way to rest inside what it holds.
   [[nodiscard]] bool soft_stop_stays_in_grant(const CraneMotion& motion,
                                               const ReferenceRest& reference = {}) const noexcept;
+  /// The axes a soft stop decided now should stop so that the crane rests inside its grant, when
+  /// the others run on to `targets` ([rad, m, m]: the targets of the move under way): bits
+  /// kStopTrolley, kStopSlew, kStopHoist (the MoveRequest AXIS_* bits its COMMAND_STOP names).
+  /// Every axis when soft_stop_stays_in_grant(motion, reference). Otherwise, of the choices whose
+  /// end (a stopped axis as soft_stop_stays_in_grant ends it, one that runs on at its target) lies
+  /// inside the grant, the one that stops the most moving axes (an axis whose reference rests, or
+  /// whose stop carries it no further than kContainmentTolerance, is not moving: it is named), then the one whose axes that run on have the least time to
+  /// go (twice their distance to go over their measured speed). A fast trolley just short of its
+  /// goal, whose shaped stop would run past it, goes on to the goal while the slew stops. nullopt
+  /// when no choice but every moving axis running on (the move's own end) stays inside, or with no
+  /// grant, a non-finite motion or target: the move under way ends at its waypoint.
+  [[nodiscard]] std::optional<std::uint8_t> soft_stop_axes(const CraneMotion& motion, const ReferenceRest& reference,
+                                                           const Pose& targets) const noexcept;
 
  private:
   SiteLayout layout_;

@@ -127,6 +127,7 @@ struct SiteOutcome {
   double longest_reaction_seconds{0.0};
   int halts{0};  // stops for a lost link: a soft stop, or the move under way ended at its waypoint
   int halts_at_waypoint{0};  // of them, those whose soft stop would have run out of the grant
+  int halts_per_axis{0};     // of them, stops of some axes, the others gone on to the waypoint
   // Each crane's guard on its grant (grant_guard.hpp): the cranes it braked (leaving their grant:
   // applied, the crane stays braked), the cycles on which it would have asked for a soft stop for
   // a swing wider than the grant (counted, not applied), and its first verdict ("tc1 at 12.3 s:

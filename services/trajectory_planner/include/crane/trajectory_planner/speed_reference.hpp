@@ -149,6 +149,11 @@ class SpeedReference {
  public:
   /// Hands over from `from` (positions and velocities of a running reference, or at rest).
   void start(const common::MotionReference& from) noexcept;
+  /// Hands axis `axis` (0 trolley, 1 slew, 2 hoist; others ignored) over from `from` as start() does
+  /// every axis: its position and velocity, the history filled with that velocity. The planner stage
+  /// calls it each cycle for an axis that runs on to its target while the others stop, so that the
+  /// axis rests where its profile ends.
+  void start_axis(std::size_t axis, const common::AxisReference& from) noexcept;
 
   /// One cycle of dt [s] toward the target speeds (axis units; non-finite = 0), shaped for the cable
   /// length of the reference with `shaping`. `site` and `zones_enabled` (bit i: site.zones[i]) are the

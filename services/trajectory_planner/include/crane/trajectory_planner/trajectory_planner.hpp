@@ -223,6 +223,13 @@ class TrajectoryPlanner {
   /// The segment of the current move the reference is on: 0 .. its waypoint count (the waypoints
   /// before it are passed); 0 while holding.
   [[nodiscard]] std::size_t segment_index() const noexcept;
+  /// True while a move runs its last segment (every waypoint passed) with each axis on a profile of
+  /// its own (not a planned path, whose axes share one law): an axis may then run on to its target
+  /// while the others are stopped (TrajectoryPlannerStage, a stop naming axes).
+  [[nodiscard]] bool last_segment_axes_independent() const noexcept;
+  /// Where the current move ends (each axis's target, at rest); the held position while holding.
+  /// Precondition: a hold()/start_move() happened.
+  [[nodiscard]] common::MotionReference sample_end() const noexcept;
 
  private:
   struct Axis {

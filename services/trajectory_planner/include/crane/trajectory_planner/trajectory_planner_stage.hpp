@@ -19,7 +19,11 @@
 //  - a stop request (MoveRequest.command COMMAND_STOP) is a controlled anti-sway stop: the running
 //    reference is handed over to the speed reference (speed_reference.hpp) with every speed 0; its
 //    feedback (RESULT_STOPPING, with the predicted stopping position) is written in the cycle the
-//    deceleration starts, before that cycle's reference; RESULT_ARRIVED when at rest. The same stop
+//    deceleration starts, before that cycle's reference; RESULT_ARRIVED when at rest. A stop whose
+//    `axes` names some of the trolley, slew and hoist (0 names every one) stops those; the others run
+//    on to their targets, when the move runs its last segment with a profile per axis (not a planned
+//    minimum-time path, not an overhead crane's bridge; otherwise every axis stops). The site link
+//    asks for such a stop when stopping an axis would carry it past its target (docs/site.md). The same stop
 //    answers a change of operating mode while moving and the supervisor's warnings zone_approach
 //    and speed_limited (a travel or slew limit approached faster than its approach speed);
 //  - operating modes (OPC 40020) come from the supervisor's status: goals are refused in MANUAL and
@@ -184,6 +188,8 @@ class TrajectoryPlannerStage {
 
  private:
   enum class Source : std::uint8_t { profile, speed };
+  static constexpr std::uint8_t kEveryAxis =
+      protocol::MoveRequest::AXIS_TROLLEY | protocol::MoveRequest::AXIS_SLEW | protocol::MoveRequest::AXIS_HOIST;
   void record(const GoalOutcome& outcome) noexcept;
   protocol::MoveStatus* report(std::uint32_t request_id, std::uint8_t result, std::uint8_t reason = 0) noexcept;
   void abort_active(std::uint8_t reason) noexcept;
@@ -197,8 +203,11 @@ class TrajectoryPlannerStage {
   /// Drops a goal waiting for its plan, reported aborted for `reason`.
   void cancel_plan(std::uint8_t reason) noexcept;
   /// Hands the running reference over to the speed reference with every speed 0; `stop_id` (0:
-  /// none) is the stop request answered when at rest.
-  void soft_stop(std::uint32_t stop_id) noexcept;
+  /// none) is the stop request answered when at rest. `stopped_axes` (AXIS bits; every axis by
+  /// default): the axes the stop decelerates. The others run on to their targets on their profile
+  /// when the move runs its last segment with a profile per axis
+  /// (TrajectoryPlanner::last_segment_axes_independent); otherwise every axis stops.
+  void soft_stop(std::uint32_t stop_id, std::uint8_t stopped_axes = kEveryAxis) noexcept;
   [[nodiscard]] bool moving() const noexcept;
   void take_speeds(std::span<const protocol::OperatorSpeed> speeds, std::uint64_t seq) noexcept;
   /// The operator's speed targets: trolley, slew, hoist, bridge (0 without a bridge).
@@ -226,6 +235,9 @@ class TrajectoryPlannerStage {
   std::optional<BridgeAxis> bridge_;
   SpeedReference speed_{};
   Source source_{Source::profile};
+  // Under a stop naming axes: the AXIS bits still running on to their targets on planner_'s profile
+  // (the speed reference takes each cycle's sample; a bit clears when its axis rests at its target).
+  std::uint8_t finishing_axes_{0};
   std::uint8_t operating_mode_{protocol::SupervisorStatus::OPERATION_FULLAUTOMATIC};
   std::uint32_t zones_enabled_{0};
   bool supervisor_stopped_{false};   // the supervisor reports a fault or an emergency stop
