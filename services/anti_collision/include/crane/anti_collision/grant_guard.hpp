@@ -164,8 +164,9 @@ class GrantGuard {
   /// Every axis when soft_stop_stays_in_grant(motion, reference). Otherwise, of the choices whose
   /// end (a stopped axis as soft_stop_stays_in_grant ends it, one that runs on at its target) lies
   /// inside the grant, the one that stops the most moving axes (an axis whose reference rests, or
-  /// whose stop carries it no further than kContainmentTolerance, is not moving: it is named), then the one whose axes that run on have the least time to
-  /// go (twice their distance to go over their measured speed). A fast trolley just short of its
+  /// whose stop carries it no further than kContainmentTolerance, is not moving: it is named), then
+  /// the one whose axes that run on have the least time to go (twice their distance to go over
+  /// their measured speed). A fast trolley just short of its
   /// goal, whose shaped stop would run past it, goes on to the goal while the slew stops. nullopt
   /// when no choice but every moving axis running on (the move's own end) stays inside, or with no
   /// grant, a non-finite motion or target: the move under way ends at its waypoint.
