@@ -35,10 +35,13 @@ for index, setting in enumerate(settings):
     js = [json.load(open("%s/setting%d_%d.json" % (out, index, r))) for r in range(1, runs + 1)]
     rt = [j["real_time_factor"] for j in js]
     first = first or med(rt)
+    # A figure the runs did not measure (crane_bench --sensors-only: no hop readers) prints as -.
+    def us(figures, key):
+        values = [f[key] for f in figures if key in f]
+        return "%.0f" % med(values) if values else "-"
     chain = [j["chain_sensors_to_actuators"] for j in js]
-    print("| %s | %.1f (%.1f-%.1f) | %.2f | %.0f / %.0f | %s | %.0f |" % (
-        setting.split("=", 1)[0], med(rt), min(rt), max(rt), med(rt) / first, med([c["p50_us"] for c in chain]),
-        med([c["p99_us"] for c in chain]),
-        " | ".join("%.0f" % med([j["hops"][h]["p50_us"] for j in js]) for h in hops),
+    print("| %s | %.1f (%.1f-%.1f) | %.2f | %s / %s | %s | %.0f |" % (
+        setting.split("=", 1)[0], med(rt), min(rt), max(rt), med(rt) / first, us(chain, "p50_us"),
+        us(chain, "p99_us"), " | ".join(us([j["hops"][h] for j in js], "p50_us") for h in hops),
         med([j["floor_one_way"]["p50_us"] for j in js])))
 PY

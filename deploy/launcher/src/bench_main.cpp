@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "crane/launch/iceoryx.hpp"
@@ -329,6 +330,10 @@ int main(int argc, char** argv) {
   latency_cmd->add_flag("--lockstep", lockstep,
                         "plant in lockstep (as the demo): where a cycle's time goes when nothing waits on a clock, "
                         "and the speed in multiples of real time");
+  bool sensors_only = false;
+  latency_cmd->add_flag("--sensors-only", sensors_only,
+                        "the bench reads the sensor clock alone (no per-hop readers, no hop or chain figures): the "
+                        "stack's speed with one observer, as the supervisor and the plant see it");
   std::string wake;
   latency_cmd->add_option("--wake", wake,
                           "the chain's --wake (stages and plant): listener (their default: one thread wake-up per "
@@ -478,16 +483,22 @@ int main(int argc, char** argv) {
       // iceoryx 36.1x with chain p99 823 us polled, 43.0x and 318 us woken, minutes apart.
       auto status_reader = participant->make_reader<tp::SafetyStatus>(&wakeup);
       auto sensors = participant->make_recording_reader<tp::Sensors>(&wakeup, 8192);
-      auto estimate = participant->make_recording_reader<tp::StateEstimate>(&wakeup, 8192);
-      auto reference = participant->make_recording_reader<tp::Reference>(&wakeup, 8192);
-      auto anti_swing = participant->make_recording_reader<tp::AntiSwing>(&wakeup, 8192);
-      auto linear = participant->make_recording_reader<tp::LinearCommand>(&wakeup, 8192);
-      auto actuators = participant->make_recording_reader<tp::Actuators>(&wakeup, 8192);
+      // With --sensors-only the chain's topics have one reader fewer each: no delivery to the bench
+      // on the chain's path (on iceoryx, each reader is one more wake-up per sample).
+      const auto hop_reader = [&]<typename T>(std::type_identity<T>) {
+        return sensors_only ? nullptr : participant->make_recording_reader<T>(&wakeup, 8192);
+      };
+      auto estimate = hop_reader(std::type_identity<tp::StateEstimate>{});
+      auto reference = hop_reader(std::type_identity<tp::Reference>{});
+      auto anti_swing = hop_reader(std::type_identity<tp::AntiSwing>{});
+      auto linear = hop_reader(std::type_identity<tp::LinearCommand>{});
+      auto actuators = hop_reader(std::type_identity<tp::Actuators>{});
       // seq -> write stamps [ns] per stage. Taken as they come, also before the recording: a reader on
       // iceoryx may hold only so many samples (TOO_MANY_CHUNKS_HELD_IN_PARALLEL).
       std::map<std::uint64_t, std::array<double, 6>> stamps;
       auto drain = [&] {
         auto take = [&](auto& reader, std::size_t index) {
+          if (!reader) return;
           typename std::remove_reference_t<decltype(*reader)>::Message m;
           while (reader->take_next(m)) {
             auto& row = stamps.try_emplace(m.header().seq(), std::array<double, 6>{NAN, NAN, NAN, NAN, NAN, NAN}).first->second;
@@ -578,6 +589,7 @@ int main(int argc, char** argv) {
       j["floor_one_way"] = summary(floor);
       j["overruns"] = plant.is_object() ? plant.value("overruns", -1) : -1;
       j["clock"] = lockstep ? "lockstep" : "realtime";
+      j["sensors_only"] = sensors_only;
       j["wake"] = wake.empty() ? "listener" : wake;
       if (plant.is_object() && plant.contains("step_us")) j["plant_step"] = plant["step_us"];
       if (lockstep && sensor_stamps.size() > 1) {
@@ -601,7 +613,8 @@ int main(int argc, char** argv) {
         };
         std::string vendors = dds + (iceoryx ? " on iceoryx" : "");
         for (const auto& [name, vendor] : stack.dds_per_process) vendors += ", " + name + "=" + vendor;
-        std::printf("dds %s, %.0f Hz, %.0f s, %d overruns\n", vendors.c_str(), rate, duration, j["overruns"].get<int>());
+        std::printf("dds %s, %.0f Hz, %.0f s, %d overruns%s\n", vendors.c_str(), rate, duration, j["overruns"].get<int>(),
+                    sensors_only ? " (the bench reads the sensors alone)" : "");
         line("end to end (sample -> command at plant)", j["end_to_end"]);
         line("chain (sensor stamp -> actuator stamp)", j["chain_sensors_to_actuators"]);
         for (int h = 0; h < 5; ++h) line(hop_names[h], j["hops"][hop_names[h]]);
