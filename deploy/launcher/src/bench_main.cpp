@@ -333,7 +333,7 @@ int main(int argc, char** argv) {
   bool sensors_only = false;
   latency_cmd->add_flag("--sensors-only", sensors_only,
                         "the bench reads the sensor clock alone (no per-hop readers, no hop or chain figures): the "
-                        "stack's speed with one observer, as the supervisor and the plant see it");
+                        "stack's speed without the bench's readers on its chain");
   std::string wake;
   latency_cmd->add_option("--wake", wake,
                           "the chain's --wake (stages and plant): listener (their default: one thread wake-up per "
