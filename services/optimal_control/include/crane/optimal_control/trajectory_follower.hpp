@@ -72,16 +72,18 @@ struct FollowerHold {
   /// commands the breakaway of a trolley whose stiction is under-compensated by 30 % (0.23 deg;
   /// 0.2 deg drives the trolley unstable on a random tower move with a 20 % shorter cable and 30 %
   /// less friction: docs/optimal_control.md, "The swing weights"). The second axis looser and the
-  /// out-of-plane swing tighter (0.01 rad or m, 0.003 rad = 0.17 deg): a slew held as tightly as
+  /// out-of-plane swing tighter (0.01 rad or m, 0.0025 rad = 0.14 deg): a slew held as tightly as
   /// the trolley damps the out-of-plane swing a 20 % longer cable leaves only through its slower
   /// period; the tracking stage's breakaway ramp (tracking/breakaway_ramp.hpp) brings back a drive
   /// that friction holds off the target (docs/optimal_control.md, "Breaking the drive loose at the
-  /// target"). The trolley stays at 0.005 m: at 0.0075 or 0.01 m the gantry's trolley overshot into
-  /// its travel limiter's stop margin.
+  /// target"). The out-of-plane swing was 0.003 rad until the slew was held to a sideways distance
+  /// near the mast (slew_sideways); with it, 0.002-0.00275 rad settle more mismatch corners
+  /// ("Robust near the mast": 0.0025, session 28). The trolley stays at 0.005 m: at 0.0075 or
+  /// 0.01 m the gantry's trolley overshot into its travel limiter's stop margin.
   FollowerWeights weights{.position = 0.005,
                           .second_position = 0.01,
                           .swing = 0.004,
-                          .out_of_plane_swing = 0.003,
+                          .out_of_plane_swing = 0.0025,
                           .speed = 0.05,
                           .swing_rate = 0.05,
                           .voltage = 0.2};
