@@ -78,8 +78,9 @@ struct FollowerHold {
   /// that friction holds off the target (docs/optimal_control.md, "Breaking the drive loose at the
   /// target"). The out-of-plane swing was 0.003 rad until the slew was held to a sideways distance
   /// near the mast (slew_sideways); with it, 0.002-0.00275 rad settle more mismatch corners
-  /// ("Robust near the mast": 0.0025, session 28). The trolley stays at 0.005 m: at 0.0075 or
-  /// 0.01 m the gantry's trolley overshot into its travel limiter's stop margin.
+  /// (docs/optimal_control.md, "The out-of-plane swing's hold weight, chosen again"). The trolley
+  /// stays at 0.005 m: at 0.0075 or 0.01 m the gantry's trolley overshot into its travel limiter's
+  /// stop margin.
   FollowerWeights weights{.position = 0.005,
                           .second_position = 0.01,
                           .swing = 0.004,
