@@ -6,9 +6,12 @@
 // crane runs as that crane alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/stack/site_run.hpp"
@@ -59,6 +62,62 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
     serialized_total += serialized.total_time;
   }
   EXPECT_LT(coordinated_total, serialized_total);
+}
+
+// The job draw: with SiteJobDraw{1, true} every point lies within another crane's reach, with
+// {0, true} every point is clear of the other cranes' jibs, each checked here from the site file's
+// bases, jibs and margins and the planner's travel (as site_run.hpp defines them); the default draw
+// is unchanged by the option (the same points as {0.7, false}) and puts about 0.7 of the points in
+// another's reach.
+TEST(SiteRun, TheJobDrawPlacesPointsWithinOrOutsideTheOtherCranesReachAsAsked) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_site_crane_config(site);
+  const double r_low = config.trajectory_planner.trolley_min_position + 0.1;
+  const double r_high = config.trajectory_planner.trolley_max_position - 0.05;
+  const auto share_in_other = [&](const std::vector<std::vector<SiteJob>>& jobs, bool under_jib = false) {
+    int in_other = 0, points = 0;
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      const auto& c = site.cranes[i];
+      for (const SiteJob& job : jobs[i]) {
+        for (const WorkPoint& w : {job.pick, job.place}) {
+          const double heading = c.slew_zero_heading + w.slew;
+          const double x = c.base[0] + w.trolley * std::cos(heading);
+          const double y = c.base[1] + w.trolley * std::sin(heading);
+          bool inside = false;
+          for (std::size_t j = 0; j < site.cranes.size(); ++j) {
+            const double d = std::hypot(x - site.cranes[j].base[0], y - site.cranes[j].base[1]);
+            const auto& o = site.cranes[j];
+            const double jib_circle = std::max(o.jib_length, o.counter_jib_length) + site.margins.slow_down;
+            inside = inside || (j != i && (under_jib ? d <= jib_circle : d > r_low && d < r_high));
+          }
+          in_other += inside ? 1 : 0;
+          ++points;
+        }
+      }
+    }
+    return static_cast<double>(in_other) / points;
+  };
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    EXPECT_EQ(share_in_other(random_site_jobs(site, config, 5, seed, SiteJobDraw{1.0, true})), 1.0) << seed;
+    EXPECT_EQ(share_in_other(random_site_jobs(site, config, 5, seed, SiteJobDraw{0.0, true}), true), 0.0) << seed;
+    const auto by_default = random_site_jobs(site, config, 5, seed);
+    const auto explicit_default = random_site_jobs(site, config, 5, seed, SiteJobDraw{0.7, false});
+    for (std::size_t i = 0; i < by_default.size(); ++i) {
+      for (std::size_t j = 0; j < by_default[i].size(); ++j) {
+        EXPECT_EQ(by_default[i][j].pick.slew, explicit_default[i][j].pick.slew);
+        EXPECT_EQ(by_default[i][j].place.trolley, explicit_default[i][j].place.trolley);
+      }
+    }
+  }
+  // By default 0.7 of the points are drawn within another's reach, and a few of the others fall
+  // there by chance: over 3000 points the share lies within a few standard deviations (0.008) of that.
+  double share = 0.0;
+  for (std::uint64_t seed = 1; seed <= 100; ++seed) share += share_in_other(random_site_jobs(site, config, 5, seed)) / 100;
+  std::printf("default draw: %.3f of the points within another crane's reach\n", share);
+  EXPECT_GT(share, 0.67);
+  EXPECT_LT(share, 0.85);
+  EXPECT_THROW((void)random_site_jobs(site, config, 1, 1, SiteJobDraw{1.5, true}), std::invalid_argument);
+  EXPECT_THROW((void)random_site_jobs(site, config, 1, 1, SiteJobDraw{std::nan(""), false}), std::invalid_argument);
 }
 
 // Link faults: each crane's link lost in turn for 5 s while the site works, then the site service

@@ -122,7 +122,8 @@ struct SetResult {
   std::string error;
 };
 
-int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults) {
+int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults,
+         const crane::stack::SiteJobDraw& draw, bool draw_given) {
   using namespace crane::stack;
   SiteLayout site;
   StackConfig config;
@@ -139,7 +140,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     for (int s = next++; s < sets; s = next++) {
       SetResult& r = results[static_cast<std::size_t>(s)];
       try {
-        const auto set = random_site_jobs(site, config, jobs, seed + static_cast<std::uint64_t>(s));
+        const auto set = random_site_jobs(site, config, jobs, seed + static_cast<std::uint64_t>(s), draw);
         SiteRunOptions options;
         options.faults = random_link_faults(site, faults, seed + static_cast<std::uint64_t>(s));
         r.coordinated = run_site(site, config, set, options);
@@ -162,8 +163,13 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     std::cerr << "set 0: " << first.error << "\n";
     return 1;
   }
-  std::printf("site '%s', %d set(s) of %d job(s) per crane, seeds %llu..%llu\n\n", site.name.c_str(), sets, jobs,
+  std::printf("site '%s', %d set(s) of %d job(s) per crane, seeds %llu..%llu", site.name.c_str(), sets, jobs,
               static_cast<unsigned long long>(seed), static_cast<unsigned long long>(seed + sets - 1));
+  if (draw_given) {
+    std::printf("; points within another crane's reach with probability %.2f, the others clear of every other jib",
+                draw.shared_probability);
+  }
+  std::printf("\n\n");
   std::printf("set 0 (seed %llu):\n%-12s %-6s %5s %10s %10s %7s %10s %7s\n", static_cast<unsigned long long>(seed),
               "mode", "crane", "jobs", "finish_s", "waiting_s", "yields", "unsettled", "faults");
   for (const auto* o : {&first.coordinated, &first.serialized, &first.solo}) {
@@ -326,6 +332,13 @@ int main(int argc, char** argv) {
   demo_command->add_option("--threads", threads, "sets run in parallel")->check(CLI::Range(1, 256));
   int faults = 0;
   demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
+  crane::stack::SiteJobDraw draw;
+  CLI::Option* shared_option =
+      demo_command
+          ->add_option("--shared-points", draw.shared_probability,
+                       "probability that a pick or place point lies within another crane's reach, the others then "
+                       "clear of every other crane's jib (default: 0.7, the others anywhere: the jobs of docs/site.md)")
+          ->check(CLI::Range(0.0, 1.0));
   std::string out;
   CLI::App* jobs_command = app.add_subcommand("jobs", "a seeded job set written as one job file per crane (site_link --jobs)");
   jobs_command->add_option("--site", site_path, "the site file")->required();
@@ -335,6 +348,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (check_command->parsed()) return check(site_path);
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
-  if (demo_command->parsed()) return demo(site_path, sets, jobs, seed, threads, faults);
+  if (demo_command->parsed()) {
+    draw.others_clear = shared_option->count() > 0;
+    return demo(site_path, sets, jobs, seed, threads, faults, draw, draw.others_clear);
+  }
   return 1;
 }

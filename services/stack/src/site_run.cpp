@@ -9,6 +9,7 @@
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include "crane/anti_collision/crane_geometry.hpp"
 #include "crane/anti_collision/crane_site_link.hpp"
@@ -335,7 +336,11 @@ std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count,
 }
 
 std::vector<std::vector<SiteJob>> random_site_jobs(const ac::SiteLayout& site, const StackConfig& config, int per_crane,
-                                                   std::uint64_t seed) {
+                                                   std::uint64_t seed, const SiteJobDraw& draw) {
+  if (!(draw.shared_probability >= 0.0 && draw.shared_probability <= 1.0)) {
+    throw std::invalid_argument("random_site_jobs: shared_probability " + std::to_string(draw.shared_probability) +
+                                " outside [0, 1]");
+  }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const auto& planner = config.trajectory_planner;
@@ -347,7 +352,8 @@ std::vector<std::vector<SiteJob>> random_site_jobs(const ac::SiteLayout& site, c
     const double s_low = std::max(c.slew_min, planner.slew_min_angle) + 0.2;
     const double s_high = std::min(c.slew_max, planner.slew_max_angle) - 0.2;
     const auto point = [&]() {
-      const bool shared = site.cranes.size() > 1 && unit(rng) < 0.7;
+      const bool shared = site.cranes.size() > 1 && unit(rng) < draw.shared_probability;
+      const bool clear_point = site.cranes.size() > 1 && !shared && draw.others_clear;
       WorkPoint w;
       for (int attempt = 0; attempt < 1000; ++attempt) {
         w.slew = s_low + (s_high - s_low) * unit(rng);
@@ -356,12 +362,15 @@ std::vector<std::vector<SiteJob>> random_site_jobs(const ac::SiteLayout& site, c
         const double x = c.base[0] + w.trolley * std::cos(heading);
         const double y = c.base[1] + w.trolley * std::sin(heading);
         bool in_other = false;
+        bool under_other_jib = false;
         for (std::size_t j = 0; j < site.cranes.size(); ++j) {
           if (j == i) continue;
           const double d = std::hypot(x - site.cranes[j].base[0], y - site.cranes[j].base[1]);
           in_other = in_other || (d > r_low && d < r_high);
+          const auto& o = site.cranes[j];
+          under_other_jib = under_other_jib || d <= std::max(o.jib_length, o.counter_jib_length) + site.margins.slow_down;
         }
-        if (!shared || in_other) break;
+        if (shared ? in_other : (!clear_point || !under_other_jib)) break;
       }
       const double height = c.hook_height_min + 0.8 * unit(rng);
       w.cable_length = std::clamp(c.jib_height - height, planner.cable_min_length, planner.cable_max_length);

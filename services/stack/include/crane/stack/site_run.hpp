@@ -153,12 +153,26 @@ struct SiteOutcome {
 [[nodiscard]] std::vector<LinkFault> random_link_faults(const anti_collision::SiteLayout& site, int count,
                                                         std::uint64_t seed);
 
+/// How random_site_jobs places a point with respect to the other cranes. A point is "within another
+/// crane's reach" when its distance from that crane's slew axis lies strictly between the planner's
+/// trolley_min_position + 0.1 and trolley_max_position - 0.05 [m]; "clear of the other cranes" when
+/// it lies further from every other crane's slew axis than that crane's jib or counter-jib, whichever
+/// is longer, plus the site's margins.slow_down [m]: no other jib passes over it.
+struct SiteJobDraw {
+  double shared_probability{0.7};  // [-] in [0, 1]: a point is drawn within another crane's reach
+  bool others_clear{false};        // the other points: false, anywhere in the crane's reach (in another's
+                                   // too, by chance); true, clear of the other cranes
+};
+
 /// `per_crane` seeded random jobs for each crane of `site`: pick and place points within the
 /// planner's reach of `config`, at random work heights in the lowest 0.8 m of the crane's hook
-/// range; with probability 0.7 a point lies within another crane's reach too (jobs that force
-/// conflicts). Deterministic in `seed`.
+/// range; by default a point lies within another crane's reach too with probability 0.7, and
+/// anywhere otherwise (jobs that force conflicts). Where 1000 draws find no point as `draw` asks,
+/// the last one is taken. Deterministic in `seed`; the default draw is the one every figure of
+/// docs/site.md was measured on. Throws std::invalid_argument for a shared_probability outside
+/// [0, 1] or NaN.
 [[nodiscard]] std::vector<std::vector<SiteJob>> random_site_jobs(const anti_collision::SiteLayout& site,
                                                                  const StackConfig& config, int per_crane,
-                                                                 std::uint64_t seed);
+                                                                 std::uint64_t seed, const SiteJobDraw& draw = {});
 
 }  // namespace crane::stack
