@@ -190,6 +190,72 @@ TEST(SiteRun, ASiteOfOneCraneRunsAsThatCraneAlone) {
   EXPECT_EQ(on_site.total_time, alone.total_time);
 }
 
+// A degraded link (LinkFault::delay, loss): alone on the site, each leg's report reaches the
+// service one delay late and the go comes back one delay later, so each of the 4 legs waits one
+// cycle plus two delays (by hand: 0.01 + 2 x 0.2 s); with every message lost once, each way costs
+// one kResendDelay more. Nothing else changes: the same jobs done, and the messages counted.
+TEST(SiteRun, ADegradedLinkDelaysEachGrantByTheDelayBothWays) {
+  auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  site.cranes.resize(1);
+  const StackConfig config = load_site_crane_config(site);
+  const double dt = config.facts.sample_period;
+  const auto jobs = random_site_jobs(site, config, 2, 7);
+  SiteRunOptions delayed = in_mode(SiteMode::coordinated);
+  delayed.faults = {LinkFault{0, 0.0, 1e4, 0.2, 0.0}};
+  const SiteOutcome late = run_site(site, config, jobs, delayed);
+  ASSERT_TRUE(late.completed);
+  EXPECT_EQ(late.cranes[0].jobs_done, 2);
+  EXPECT_NEAR(late.cranes[0].waiting_time, 4 * (dt + 2 * 0.2), 1e-6);
+  EXPECT_GT(late.delayed_messages, 0u);
+  EXPECT_EQ(late.resent_messages, 0u);
+
+  SiteRunOptions lossy = delayed;
+  lossy.faults[0].loss = 1.0;
+  const SiteOutcome resent = run_site(site, config, jobs, lossy);
+  ASSERT_TRUE(resent.completed);
+  EXPECT_NEAR(resent.cranes[0].waiting_time, 4 * (dt + 2 * (0.2 + kResendDelay)), 1e-6);
+  EXPECT_EQ(resent.resent_messages, resent.delayed_messages);
+
+  // The service's host degraded delays the one crane's link the same way.
+  SiteRunOptions service_host = delayed;
+  service_host.faults[0].crane = kSiteService;
+  EXPECT_NEAR(run_site(site, config, jobs, service_host).cranes[0].waiting_time, 4 * (dt + 2 * 0.2), 1e-6);
+
+  SiteRunOptions bad = delayed;
+  bad.faults[0].loss = 1.5;
+  EXPECT_THROW((void)run_site(site, config, jobs, bad), std::invalid_argument);
+  bad.faults[0] = LinkFault{0, 0.0, 1.0, std::nan(""), 0.0};
+  EXPECT_THROW((void)run_site(site, config, jobs, bad), std::invalid_argument);
+}
+
+// The three-tower site with degraded links and lost links together (seeded, as `crane_site demo
+// --faults 2 --degraded 3`): every job done, the stop margin kept, no crane braked by its guard.
+TEST(SiteRun, DegradedAndLostLinksTogetherKeepTheStopMargin) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_site_crane_config(site);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SiteRunOptions options = in_mode(SiteMode::coordinated);
+    options.faults = random_link_faults(site, 2, seed);
+    const auto slow = random_degraded_links(site, 3, seed);
+    options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+    options.loss_seed = seed;
+    for (const LinkFault& f : slow) {
+      EXPECT_TRUE(f.degraded());
+      EXPECT_LE(f.delay, 0.2);
+      EXPECT_LE(f.loss, 0.3);
+      EXPECT_GE(f.duration, 5.0);
+      EXPECT_LE(f.duration, 30.0);
+    }
+    const SiteOutcome o = run_site(site, config, random_site_jobs(site, config, 2, seed), options);
+    EXPECT_TRUE(o.completed) << "seed " << seed << ": " << o.guard_first;
+    EXPECT_GE(o.min_distance, site.margins.stop) << "seed " << seed << ": " << o.closest;
+    EXPECT_EQ(o.guard_emergency_stops, 0) << "seed " << seed << ": " << o.guard_first;
+    EXPECT_GT(o.delayed_messages, 0u) << "seed " << seed;
+    EXPECT_GT(o.resent_messages, 0u) << "seed " << seed;
+    for (const CraneOutcome& c : o.cranes) EXPECT_EQ(c.jobs_done, 2) << c.name << ", seed " << seed;
+  }
+}
+
 TEST(SiteRun, JobListsMustMatchTheCranes) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   const StackConfig config = load_site_crane_config(site);

@@ -17,7 +17,8 @@
 //       first set per crane, then over all sets the minimum true distance between any two cranes'
 //       parts (its distribution), the total times and their ratios, waits, yields and faults.
 //       --faults K injects K random link faults in each coordinated set (stack::random_link_faults)
-//       and prints the reaction times.
+//       and prints the reaction times; --degraded D, D random degraded links (delay and loss,
+//       stack::random_degraded_links); --shared-points P draws jobs that share fewer points.
 //
 //   crane_site jobs --site FILE [--jobs J] [--seed S] --out DIR
 //       the demo's seeded job set S (the same jobs `demo --sets 1 --seed S` runs) written as one job
@@ -122,7 +123,7 @@ struct SetResult {
   std::string error;
 };
 
-int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults,
+int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults, int degraded,
          const crane::stack::SiteJobDraw& draw, bool draw_given) {
   using namespace crane::stack;
   SiteLayout site;
@@ -143,6 +144,9 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         const auto set = random_site_jobs(site, config, jobs, seed + static_cast<std::uint64_t>(s), draw);
         SiteRunOptions options;
         options.faults = random_link_faults(site, faults, seed + static_cast<std::uint64_t>(s));
+        const auto slow = random_degraded_links(site, degraded, seed + static_cast<std::uint64_t>(s));
+        options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+        options.loss_seed = seed + static_cast<std::uint64_t>(s);
         r.coordinated = run_site(site, config, set, options);
         options.faults.clear();
         options.mode = SiteMode::serialized;
@@ -248,11 +252,22 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 "restarted after 0.5-10 s); %zu link losses past the %.3f s deadline, %d stops (%d of them of some axes, "
                 "the others on to the waypoint, and %d at the waypoint: a soft stop would have left the grant)\n",
                 faults, reactions.size(), site.link_deadline, halts, per_axis, at_waypoint);
-    std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace [ms]: min %.0f  median %.0f  "
-                "p90 %.0f  p99 %.0f  max %.0f\n",
+  }
+  if (!reactions.empty()) {  // with --degraded alone too: a late message past the deadline is a loss
+    std::printf("  reaction, link lost -> crane at rest or on a path outside shared airspace (%zu losses) [ms]: min %.0f  "
+                "median %.0f  p90 %.0f  p99 %.0f  max %.0f\n", reactions.size(),
                 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.0), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.5), 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.9),
                 1e3 * crane::stack::nearest_rank_quantile(reactions, 0.99), 1e3 * crane::stack::nearest_rank_quantile(reactions, 1.0));
     if (!longest_reaction.empty()) std::printf("  the longest: %s\n", longest_reaction.c_str());
+  }
+  if (degraded > 0) {
+    std::uint64_t delayed = 0, resent = 0;
+    for (const SetResult& r : results) delayed += r.coordinated.delayed_messages, resent += r.coordinated.resent_messages;
+    std::printf("  degraded links: %d per coordinated set (a crane's link, or the site service's host, for 5-30 s: "
+                "0-200 ms each way, 0-30 %% of the messages lost and sent again %.0f ms later); %llu messages delayed, "
+                "%llu of them sent again\n",
+                degraded, 1e3 * crane::stack::kResendDelay, static_cast<unsigned long long>(delayed),
+                static_cast<unsigned long long>(resent));
   }
   int guard_emergency = 0, guard_soft = 0;
   std::string guard_first;
@@ -332,6 +347,9 @@ int main(int argc, char** argv) {
   demo_command->add_option("--threads", threads, "sets run in parallel")->check(CLI::Range(1, 256));
   int faults = 0;
   demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
+  int degraded = 0;
+  demo_command->add_option("--degraded", degraded, "degraded links (delay, loss) in each coordinated set")
+      ->check(CLI::Range(0, 20));
   crane::stack::SiteJobDraw draw;
   CLI::Option* shared_option =
       demo_command
@@ -350,7 +368,7 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    return demo(site_path, sets, jobs, seed, threads, faults, draw, draw.others_clear);
+    return demo(site_path, sets, jobs, seed, threads, faults, degraded, draw, draw.others_clear);
   }
   return 1;
 }

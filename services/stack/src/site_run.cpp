@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <deque>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -34,6 +35,20 @@ struct Crane {
 };
 
 std::uint32_t draw_epoch(std::uint32_t restarts) { return 7001u + 7919u * restarts; }
+
+// A message on its way between a crane and the site service: a report (up), an instruction or a
+// heartbeat (down), due at `at` [s].
+struct InFlight {
+  double at{0.0};
+  std::optional<ac::CraneReport> report;
+  std::optional<ac::SiteOrder> order;  // down: an instruction of epoch `epoch`; none: a heartbeat
+  std::uint32_t epoch{0};
+};
+
+// One crane's link: what is on its way each way, in the order sent.
+struct Wire {
+  std::deque<InFlight> up, down;
+};
 
 ac::Pose measured_pose(const InProcessStack& stack) {
   const auto& e = stack.estimate();
@@ -95,6 +110,9 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   out.min_distance = std::numeric_limits<double>::infinity();
   const auto limit = static_cast<std::uint64_t>(std::llround(options.time_limit / dt));
   std::vector<ac::Action> watched(n * n, ac::Action::clear);
+  std::vector<Wire> wires(n);
+  std::mt19937_64 loss_rng(options.loss_seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
   bool service_was_down = false;
   std::uint64_t k = 0;
   for (; k < limit; ++k) {
@@ -102,17 +120,43 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     // The links: a crane whose link is down neither reports nor hears; a killed service hears and
     // sends nothing, and restarts with no memory (another epoch).
     const auto active = [&](const LinkFault& f) { return t >= f.start && t < f.start + f.duration; };
-    const bool service_down = std::any_of(options.faults.begin(), options.faults.end(),
-                                          [&](const LinkFault& f) { return f.crane == kSiteService && active(f); });
+    const bool service_down = std::any_of(options.faults.begin(), options.faults.end(), [&](const LinkFault& f) {
+      return f.crane == kSiteService && !f.degraded() && active(f);
+    });
     if (service_was_down && !service_down) {
       service = std::make_unique<ac::SiteService>(site, arbiter_mode, draw_epoch(++restarts));
     }
     service_was_down = service_down;
     std::vector<bool> up(n);
+    std::vector<const LinkFault*> degraded(n, nullptr);  // the first active degradation of each link
     for (std::size_t i = 0; i < n; ++i) {
-      up[i] = !service_down && std::none_of(options.faults.begin(), options.faults.end(),
-                                            [&](const LinkFault& f) { return f.crane == i && active(f); });
+      up[i] = !service_down && std::none_of(options.faults.begin(), options.faults.end(), [&](const LinkFault& f) {
+        return f.crane == i && !f.degraded() && active(f);
+      });
+      // What was on its way over a link now down is lost (and to or from a killed service).
+      if (!up[i]) wires[i] = Wire{};
+      for (const LinkFault& f : options.faults) {
+        if (degraded[i] == nullptr && f.degraded() && (f.crane == i || f.crane == kSiteService) && active(f)) {
+          degraded[i] = &f;
+        }
+      }
     }
+    // Sends `m` on crane i's link: due now, or later on a degraded link, never before what was
+    // sent earlier the same way.
+    const auto send = [&](std::size_t i, std::deque<InFlight>& way, InFlight m) {
+      m.at = t;
+      if (const LinkFault* f = degraded[i]) {
+        ++out.delayed_messages;
+        m.at += f->delay;
+        if (f->loss > 0.0 && unit(loss_rng) < f->loss) {
+          ++out.resent_messages;
+          m.at += kResendDelay;
+        }
+      }
+      if (!way.empty()) m.at = std::max(m.at, way.back().at);
+      way.push_back(std::move(m));
+    };
+    const auto due = [&](std::deque<InFlight>& way) { return !way.empty() && way.front().at <= t + 1e-9; };
     // Where the waits go: each crane that asked over the cycle now ending, by what the cranes the
     // service's last decision had it wait for were doing.
     for (std::size_t i = 0; k > 0 && i < n; ++i) {
@@ -130,16 +174,26 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     if (!service_down) {
       for (std::size_t i = 0; i < n; ++i) {
         if (!up[i]) continue;
-        if (const auto report = cranes[i].link->report()) {
-          const std::string why = service->report(*report, t);
+        if (auto report = cranes[i].link->report()) send(i, wires[i].up, InFlight{0.0, std::move(report), {}, 0});
+        for (; due(wires[i].up); wires[i].up.pop_front()) {
+          const std::string why = service->report(*wires[i].up.front().report, t);
           if (!why.empty()) throw std::logic_error("site run: " + why);
         }
       }
       for (const ac::SiteOrder& order : service->step(t)) {
-        if (up[order.crane]) (void)cranes[order.crane].link->instruction(order, service->epoch(), t);
+        if (up[order.crane]) send(order.crane, wires[order.crane].down, InFlight{0.0, {}, order, service->epoch()});
       }
       for (std::size_t i = 0; i < n; ++i) {
-        if (up[i]) cranes[i].link->heard(t);  // its heartbeat
+        if (!up[i]) continue;
+        send(i, wires[i].down, InFlight{});  // its heartbeat
+        for (; due(wires[i].down); wires[i].down.pop_front()) {
+          const InFlight& m = wires[i].down.front();
+          if (m.order) {
+            (void)cranes[i].link->instruction(*m.order, m.epoch, t);
+          } else {
+            cranes[i].link->heard(t);
+          }
+        }
       }
     }
     // A crane that disobeys (SiteRunOptions::rogue): told to move off its grant, without asking.
@@ -300,6 +354,12 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
     throw std::invalid_argument("site run: " + std::to_string(jobs.size()) + " job lists for " +
                                 std::to_string(site.cranes.size()) + " cranes");
   }
+  for (const LinkFault& f : options.faults) {
+    if (!(f.delay >= 0.0 && f.delay <= 60.0) || !(f.loss >= 0.0 && f.loss <= 1.0)) {
+      throw std::invalid_argument("site run: a link fault's delay " + std::to_string(f.delay) + " s (in [0, 60]) or loss " +
+                                  std::to_string(f.loss) + " (in [0, 1]) is out of range");
+    }
+  }
   if (options.mode != SiteMode::solo) return run_together(site, config, jobs, options);
   SiteOutcome out;
   out.min_distance = std::numeric_limits<double>::infinity();
@@ -330,6 +390,25 @@ std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count,
       fault.crane = kSiteService;
       fault.duration = 0.5 + 9.5 * unit(rng);
     }
+    faults.push_back(fault);
+  }
+  return faults;
+}
+
+std::vector<LinkFault> random_degraded_links(const ac::SiteLayout& site, int count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed ^ 0x5eedde1a7ULL);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<LinkFault> faults;
+  for (int f = 0; f < count; ++f) {
+    LinkFault fault;
+    fault.start = 80.0 * unit(rng);
+    fault.duration = 5.0 + 25.0 * unit(rng);
+    fault.crane = unit(rng) < 0.75 ? std::min(site.cranes.size() - 1, static_cast<std::size_t>(
+                                                                          unit(rng) * static_cast<double>(site.cranes.size())))
+                                   : kSiteService;
+    fault.delay = 0.2 * unit(rng);
+    fault.loss = 0.3 * unit(rng);
+    if (!fault.degraded()) fault.delay = 0.001;  // 0 and 0 would be a lost link
     faults.push_back(fault);
   }
   return faults;

@@ -19,8 +19,9 @@
 // margins.stop, every one of them is a stop the grants made needless.
 //
 // A lost link (SiteRunOptions::faults): the crane's reports, the instructions to it and the
-// heartbeat are dropped; a killed site service hears and sends nothing and restarts with no memory
-// (another epoch). What the crane and the service then do is their cores' (crane_site_link.hpp,
+// heartbeat are dropped, and so are those on their way; a killed site service hears and sends
+// nothing and restarts with no memory (another epoch), and what was on its way to or from it is
+// lost. A degraded link delivers them late, in order (LinkFault). What the crane and the service then do is their cores' (crane_site_link.hpp,
 // site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
 // braked and stops reporting, so the service holds its whole reach); its swing rule is counted,
 // not applied (SiteOutcome::guard_*).
@@ -52,15 +53,24 @@ enum class SiteMode : std::uint8_t {
 };
 [[nodiscard]] const char* to_string(SiteMode mode) noexcept;
 
-/// A fault between the cranes and the site service, from `start` for `duration` [s]: crane
-/// `crane`'s link lost (both ways), or, with crane == kSiteService, the site service killed and
-/// restarted with no memory (every link down meanwhile; the new service holds every crane's whole
-/// reach until it reports).
+/// A fault between the cranes and the site service, from `start` for `duration` [s]. With `delay`
+/// and `loss` both 0: crane `crane`'s link lost (both ways), or, with crane == kSiteService, the
+/// site service killed and restarted with no memory (every link down meanwhile; the new service
+/// holds every crane's whole reach until it reports). Otherwise the link is degraded, the crane's
+/// (every crane's with kSiteService: the service's host): each message sent on it either way
+/// arrives `delay` late, and with probability `loss` one kResendDelay later still (the site's
+/// topics are reliable: a lost sample is sent again), in the order sent.
 struct LinkFault {
   std::size_t crane{0};
   double start{0.0};     // [s]
   double duration{1.0};  // [s]
+  double delay{0.0};     // [s] >= 0
+  double loss{0.0};      // [-] in [0, 1]
+  [[nodiscard]] bool degraded() const noexcept { return delay > 0.0 || loss > 0.0; }
 };
+/// [s] What a lost message on a degraded link costs: one round of the reliable protocol, taken as
+/// Cyclone DDS's default heartbeat interval (100 ms). An assumption of the model, not measured.
+inline constexpr double kResendDelay = 0.1;
 inline constexpr std::size_t kSiteService = static_cast<std::size_t>(-1);
 
 /// Cycles between two evaluations of the distance-watching rule (20 Hz at the stack's 100 Hz).
@@ -76,6 +86,7 @@ struct SiteRunOptions {
   // max_swing (0.6 rad) in 8 of 40 seeded job sets (docs/site.md).
   double slew_acceleration{1.0};
   std::vector<LinkFault> faults;
+  std::uint64_t loss_seed{1};  // draws which messages a degraded link loses
   // A crane that disobeys: at `time` [s] crane `crane` is told to move to `to` without asking the
   // site service (a test of its guard, grant_guard.hpp).
   struct Rogue {
@@ -128,6 +139,10 @@ struct SiteOutcome {
   int halts{0};  // stops for a lost link: a soft stop, or the move under way ended at its waypoint
   int halts_at_waypoint{0};  // of them, those whose soft stop would have run out of the grant
   int halts_per_axis{0};     // of them, stops of some axes, the others gone on to the waypoint
+  // Messages (reports, instructions, heartbeats) sent on a degraded link, and those of them lost
+  // once and sent again (LinkFault::loss).
+  std::uint64_t delayed_messages{0};
+  std::uint64_t resent_messages{0};
   // Each crane's guard on its grant (grant_guard.hpp): the cranes it braked (leaving their grant:
   // applied, the crane stays braked), the cycles on which it would have asked for a soft stop for
   // a swing wider than the grant (counted, not applied), and its first verdict ("tc1 at 12.3 s:
@@ -152,6 +167,13 @@ struct SiteOutcome {
 /// the site service killed and restarted after 0.5-10 s, each starting within the first 80 s.
 [[nodiscard]] std::vector<LinkFault> random_link_faults(const anti_collision::SiteLayout& site, int count,
                                                         std::uint64_t seed);
+
+/// `count` seeded random degraded links for `site`, the network faults of issue 34 that leave a
+/// link up: a crane's link (probability 0.75) or the site service's host (every link) degraded for
+/// 5-30 s, each starting in the first 80 s, with a delay of 0-200 ms each way and 0-30 % of the
+/// messages lost (LinkFault).
+[[nodiscard]] std::vector<LinkFault> random_degraded_links(const anti_collision::SiteLayout& site, int count,
+                                                           std::uint64_t seed);
 
 /// How random_site_jobs places a point with respect to the other cranes. A point is "within another
 /// crane's reach" when its distance from that crane's slew axis lies strictly between the planner's
