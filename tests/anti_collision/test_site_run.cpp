@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -226,6 +227,23 @@ TEST(SiteRun, ADegradedLinkDelaysEachGrantByTheDelayBothWays) {
   EXPECT_THROW((void)run_site(site, config, jobs, bad), std::invalid_argument);
   bad.faults[0] = LinkFault{0, 0.0, 1.0, std::nan(""), 0.0};
   EXPECT_THROW((void)run_site(site, config, jobs, bad), std::invalid_argument);
+}
+
+// The degraded link's rule by hand, the order kept: a message sent as a degradation ends, or as
+// its delay shrinks, does not overtake one sent before it.
+TEST(SiteRun, ADegradedLinkDeliversInTheOrderSent) {
+  const LinkFault slow{0, 0.0, 10.0, 0.2, 0.3};
+  const double none = -std::numeric_limits<double>::infinity();
+  EXPECT_DOUBLE_EQ(arrival_time(1.0, nullptr, false, none), 1.0);
+  EXPECT_DOUBLE_EQ(arrival_time(1.0, &slow, false, none), 1.2);
+  EXPECT_DOUBLE_EQ(arrival_time(1.0, &slow, true, none), 1.2 + kResendDelay);
+  // Sent at 1.01 s after a message lost at 1.0 s (due 1.3 s): it waits behind it.
+  EXPECT_DOUBLE_EQ(arrival_time(1.01, &slow, false, 1.3), 1.3);
+  // The degradation over at 1.02 s: still behind the messages on their way.
+  EXPECT_DOUBLE_EQ(arrival_time(1.02, nullptr, false, 1.3), 1.3);
+  EXPECT_DOUBLE_EQ(arrival_time(1.5, nullptr, false, 1.3), 1.5);
+  const LinkFault lost_link{0, 0.0, 10.0, 0.0, 0.0};  // not degraded: a lost link, handled apart
+  EXPECT_DOUBLE_EQ(arrival_time(1.0, &lost_link, true, none), 1.0);
 }
 
 // The three-tower site with degraded links and lost links together (seeded, as `crane_site demo

@@ -144,16 +144,11 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     // Sends `m` on crane i's link: due now, or later on a degraded link, never before what was
     // sent earlier the same way.
     const auto send = [&](std::size_t i, std::deque<InFlight>& way, InFlight m) {
-      m.at = t;
-      if (const LinkFault* f = degraded[i]) {
-        ++out.delayed_messages;
-        m.at += f->delay;
-        if (f->loss > 0.0 && unit(loss_rng) < f->loss) {
-          ++out.resent_messages;
-          m.at += kResendDelay;
-        }
-      }
-      if (!way.empty()) m.at = std::max(m.at, way.back().at);
+      const LinkFault* f = degraded[i];
+      const bool lost = f != nullptr && f->loss > 0.0 && unit(loss_rng) < f->loss;
+      out.delayed_messages += f != nullptr ? 1 : 0;
+      out.resent_messages += lost ? 1 : 0;
+      m.at = arrival_time(t, f, lost, way.empty() ? -std::numeric_limits<double>::infinity() : way.back().at);
       way.push_back(std::move(m));
     };
     const auto due = [&](std::deque<InFlight>& way) { return !way.empty() && way.front().at <= t + 1e-9; };
@@ -393,6 +388,12 @@ std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count,
     faults.push_back(fault);
   }
   return faults;
+}
+
+double arrival_time(double time, const LinkFault* fault, bool lost, double previous) noexcept {
+  double at = time;
+  if (fault != nullptr && fault->degraded()) at += fault->delay + (lost ? kResendDelay : 0.0);
+  return std::max(at, previous);
 }
 
 std::vector<LinkFault> random_degraded_links(const ac::SiteLayout& site, int count, std::uint64_t seed) {

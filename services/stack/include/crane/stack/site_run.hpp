@@ -168,6 +168,12 @@ struct SiteOutcome {
 [[nodiscard]] std::vector<LinkFault> random_link_faults(const anti_collision::SiteLayout& site, int count,
                                                         std::uint64_t seed);
 
+/// When a message sent at `time` [s] arrives over a link degraded by `fault` (nullptr, or a fault
+/// that is not degraded: at once): `delay` later, one kResendDelay more when it was `lost`, and
+/// never before `previous`, the arrival of the message sent before it the same way (-infinity:
+/// none). The one place of the degraded link's rule (LinkFault).
+[[nodiscard]] double arrival_time(double time, const LinkFault* fault, bool lost, double previous) noexcept;
+
 /// `count` seeded random degraded links for `site`, the network faults of issue 34 that leave a
 /// link up: a crane's link (probability 0.75) or the site service's host (every link) degraded for
 /// 5-30 s, each starting in the first 80 s, with a delay of 0-200 ms each way and 0-30 % of the
