@@ -124,7 +124,7 @@ struct SetResult {
 };
 
 int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults, int degraded,
-         const crane::stack::SiteJobDraw& draw, bool draw_given) {
+         const crane::stack::SiteJobDraw& draw) {
   using namespace crane::stack;
   SiteLayout site;
   StackConfig config;
@@ -169,7 +169,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   }
   std::printf("site '%s', %d set(s) of %d job(s) per crane, seeds %llu..%llu", site.name.c_str(), sets, jobs,
               static_cast<unsigned long long>(seed), static_cast<unsigned long long>(seed + sets - 1));
-  if (draw_given) {
+  if (draw.others_clear) {  // --shared-points
     std::printf("; points within another crane's reach with probability %.2f, the others clear of every other jib",
                 draw.shared_probability);
   }
@@ -368,7 +368,7 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    return demo(site_path, sets, jobs, seed, threads, faults, degraded, draw, draw.others_clear);
+    return demo(site_path, sets, jobs, seed, threads, faults, degraded, draw);
   }
   return 1;
 }

@@ -371,6 +371,11 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
   return out;
 }
 
+// One of the site's cranes, drawn uniformly from `u` in [0, 1).
+std::size_t crane_drawn(const ac::SiteLayout& site, double u) {
+  return std::min(site.cranes.size() - 1, static_cast<std::size_t>(u * static_cast<double>(site.cranes.size())));
+}
+
 std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -379,7 +384,7 @@ std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count,
     LinkFault fault;
     fault.start = 80.0 * unit(rng);
     if (unit(rng) < 0.6) {
-      fault.crane = std::min(site.cranes.size() - 1, static_cast<std::size_t>(unit(rng) * static_cast<double>(site.cranes.size())));
+      fault.crane = crane_drawn(site, unit(rng));
       fault.duration = 0.5 + 29.5 * unit(rng);
     } else {
       fault.crane = kSiteService;
@@ -404,9 +409,7 @@ std::vector<LinkFault> random_degraded_links(const ac::SiteLayout& site, int cou
     LinkFault fault;
     fault.start = 80.0 * unit(rng);
     fault.duration = 5.0 + 25.0 * unit(rng);
-    fault.crane = unit(rng) < 0.75 ? std::min(site.cranes.size() - 1, static_cast<std::size_t>(
-                                                                          unit(rng) * static_cast<double>(site.cranes.size())))
-                                   : kSiteService;
+    fault.crane = unit(rng) < 0.75 ? crane_drawn(site, unit(rng)) : kSiteService;
     fault.delay = 0.2 * unit(rng);
     fault.loss = 0.3 * unit(rng);
     if (!fault.degraded()) fault.delay = 0.001;  // 0 and 0 would be a lost link

@@ -21,8 +21,8 @@
 // A lost link (SiteRunOptions::faults): the crane's reports, the instructions to it and the
 // heartbeat are dropped, and so are those on their way; a killed site service hears and sends
 // nothing and restarts with no memory (another epoch), and what was on its way to or from it is
-// lost. A degraded link delivers them late, in order (LinkFault). What the crane and the service then do is their cores' (crane_site_link.hpp,
-// site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
+// lost. A degraded link delivers them late, in order (LinkFault). What the crane and the service
+// then do is their cores' (crane_site_link.hpp, site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
 // braked and stops reporting, so the service holds its whole reach); its swing rule is counted,
 // not applied (SiteOutcome::guard_*).
 //
