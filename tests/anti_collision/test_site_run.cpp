@@ -274,6 +274,102 @@ TEST(SiteRun, DegradedAndLostLinksTogetherKeepTheStopMargin) {
   }
 }
 
+// A crane's host stopped for good (HostStop): tc1's host stops before it has reported, so the site
+// service never hears from it and holds its whole reach for good. tc2, whose points all lie within
+// tc1's reach, asks for its first leg and waits: it is stuck once it has waited kStuckWait for the
+// stopped crane, and the run ends there, every second of the wait counted against the stopped host.
+// (Points clear of tc1's jib do not help here: the whole reach holds the swing of tc1's longest
+// cable, which covers most of tc2's.) tc1's plant, braked by its actuation gate, is at rest.
+TEST(SiteRun, AStoppedHostsCraneHoldsItsWholeReachForGood) {
+  auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  site.cranes.resize(2);
+  const StackConfig config = load_site_crane_config(site);
+  const double dt = config.facts.sample_period;
+  SiteRunOptions options = in_mode(SiteMode::coordinated);
+  options.host_stops = {HostStop{0, 0.0}};
+
+  const auto shared = random_site_jobs(site, config, 2, 5, SiteJobDraw{1.0, true});
+  const SiteOutcome o = run_site(site, config, shared, options);
+  EXPECT_TRUE(o.completed);
+  EXPECT_EQ(o.stopped_hosts, 1);
+  EXPECT_DOUBLE_EQ(o.cranes[0].host_stopped_at, 0.0);
+  EXPECT_NEAR(o.cranes[0].rest_after_host_stop, dt, 1e-9);  // it was at rest
+  EXPECT_EQ(o.cranes[0].jobs_done, 0);
+  EXPECT_FALSE(o.cranes[0].stuck);
+  EXPECT_TRUE(o.cranes[1].stuck);
+  EXPECT_EQ(o.cranes[1].jobs_done, 0);
+  EXPECT_TRUE(std::isnan(o.cranes[1].host_stopped_at));
+  // It asks from cycle 1 on; blocked by the stopped crane from the service's first decision.
+  EXPECT_NEAR(o.waited_for_stopped_host, kStuckWait, 3 * dt);
+  EXPECT_NEAR(o.simulated_seconds, 2 * (kStuckWait + 2 * dt), 3 * dt);
+  EXPECT_GE(o.min_distance, site.margins.stop) << o.closest;
+
+  // The same jobs with tc2 standing apart, out of tc1's reach: all done, no wait for tc1.
+  auto apart = site;
+  apart.cranes[1].base = {10.0, 0.0};
+  const SiteOutcome free = run_site(apart, config, shared, options);
+  EXPECT_TRUE(free.completed);
+  EXPECT_EQ(free.cranes[1].jobs_done, 2);
+  EXPECT_FALSE(free.cranes[1].stuck);
+  EXPECT_EQ(free.waited_for_stopped_host, 0.0);
+
+  // A stop after every job is done does not happen; solo, each crane keeps its own host stop.
+  SiteRunOptions late = in_mode(SiteMode::coordinated);
+  late.host_stops = {HostStop{1, 1000.0}};
+  const SiteOutcome done = run_site(site, config, shared, late);
+  EXPECT_EQ(done.stopped_hosts, 0);
+  EXPECT_TRUE(std::isnan(done.cranes[1].host_stopped_at));
+  EXPECT_EQ(done.cranes[1].jobs_done, 2);
+  SiteRunOptions solo = options;
+  solo.mode = SiteMode::solo;
+  const SiteOutcome alone = run_site(site, config, shared, solo);
+  EXPECT_DOUBLE_EQ(alone.cranes[0].host_stopped_at, 0.0);
+  EXPECT_TRUE(std::isnan(alone.cranes[1].host_stopped_at));
+  EXPECT_EQ(alone.cranes[1].jobs_done, 2);
+
+  SiteRunOptions bad = options;
+  bad.host_stops = {HostStop{2, 1.0}};
+  EXPECT_THROW((void)run_site(site, config, shared, bad), std::invalid_argument);
+  bad.host_stops = {HostStop{0, std::nan("")}};
+  EXPECT_THROW((void)run_site(site, config, shared, bad), std::invalid_argument);
+}
+
+// A host stopped among the network faults (seeded, as `crane_site demo --faults 2 --degraded 3
+// --stopped-hosts 1`): the stop margin kept, no crane braked by its guard, the stopped crane at
+// rest within its brakes' time, and every other crane done or stuck waiting for its reach.
+TEST(SiteRun, AStoppedHostAmongTheNetworkFaultsKeepsTheStopMargin) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_site_crane_config(site);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SiteRunOptions options = in_mode(SiteMode::coordinated);
+    options.faults = random_link_faults(site, 2, seed);
+    const auto slow = random_degraded_links(site, 3, seed);
+    options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+    options.host_stops = random_host_stops(site, 1, seed);
+    ASSERT_EQ(options.host_stops.size(), 1u);
+    EXPECT_LT(options.host_stops[0].crane, site.cranes.size());
+    EXPECT_GE(options.host_stops[0].time, 0.0);
+    EXPECT_LE(options.host_stops[0].time, 80.0);
+    options.loss_seed = seed;
+    const SiteOutcome o = run_site(site, config, random_site_jobs(site, config, 2, seed), options);
+    EXPECT_TRUE(o.completed) << "seed " << seed << ": " << o.guard_first;
+    EXPECT_GE(o.min_distance, site.margins.stop) << "seed " << seed << ": " << o.closest;
+    EXPECT_EQ(o.guard_emergency_stops, 0) << "seed " << seed << ": " << o.guard_first;
+    for (const CraneOutcome& c : o.cranes) {
+      EXPECT_EQ(c.latched_faults, 0u) << c.name << ", seed " << seed;
+      if (!std::isnan(c.host_stopped_at)) {
+        EXPECT_NEAR(c.host_stopped_at, options.host_stops[0].time, 0.006) << c.name << ", seed " << seed;
+        EXPECT_LE(c.rest_after_host_stop, 1.0) << c.name << ", seed " << seed;
+      } else {
+        EXPECT_TRUE(c.jobs_done == 2 || c.stuck) << c.name << ", seed " << seed;
+      }
+      std::printf("seed %llu %s: %d jobs, host stopped at %.2f s, at rest %.2f s later%s\n",
+                  static_cast<unsigned long long>(seed), c.name.c_str(), c.jobs_done, c.host_stopped_at,
+                  c.rest_after_host_stop, c.stuck ? ", stuck" : "");
+    }
+  }
+}
+
 TEST(SiteRun, JobListsMustMatchTheCranes) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   const StackConfig config = load_site_crane_config(site);

@@ -18,7 +18,8 @@
 //       parts (its distribution), the total times and their ratios, waits, yields and faults.
 //       --faults K injects K random link faults in each coordinated set (stack::random_link_faults)
 //       and prints the reaction times; --degraded D, D random degraded links (delay and loss,
-//       stack::random_degraded_links); --shared-points P draws jobs that share fewer points.
+//       stack::random_degraded_links); --stopped-hosts H, H cranes' hosts stopped for good
+//       (stack::random_host_stops); --shared-points P draws jobs that share fewer points.
 //
 //   crane_site jobs --site FILE [--jobs J] [--seed S] --out DIR
 //       the demo's seeded job set S (the same jobs `demo --sets 1 --seed S` runs) written as one job
@@ -118,13 +119,22 @@ int check(const std::string& path) {
   return 0;
 }
 
+// The faults each coordinated set gets (--faults, --degraded, --stopped-hosts).
+struct DemoFaults {
+  int lost{0};
+  int degraded{0};
+  int stopped_hosts{0};
+};
+
 struct SetResult {
   crane::stack::SiteOutcome coordinated, serialized, solo;
   std::string error;
 };
 
-int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, int faults, int degraded,
+int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, const DemoFaults& injected,
          const crane::stack::SiteJobDraw& draw) {
+  const int faults = injected.lost;
+  const int degraded = injected.degraded;
   using namespace crane::stack;
   SiteLayout site;
   StackConfig config;
@@ -146,9 +156,11 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         options.faults = random_link_faults(site, faults, seed + static_cast<std::uint64_t>(s));
         const auto slow = random_degraded_links(site, degraded, seed + static_cast<std::uint64_t>(s));
         options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+        options.host_stops = random_host_stops(site, injected.stopped_hosts, seed + static_cast<std::uint64_t>(s));
         options.loss_seed = seed + static_cast<std::uint64_t>(s);
         r.coordinated = run_site(site, config, set, options);
         options.faults.clear();
+        options.host_stops.clear();
         options.mode = SiteMode::serialized;
         r.serialized = run_site(site, config, set, options);
         options.mode = SiteMode::solo;
@@ -201,12 +213,22 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
       if (!o->completed) ++incomplete;
       for (const auto& c : o->cranes) faulted += c.latched_faults != 0 ? 1 : 0;
       simulated += o->simulated_seconds;
+      if (!o->completed || std::any_of(o->cranes.begin(), o->cranes.end(), [](const auto& c) { return c.latched_faults != 0; })) {
+        const char* mode = o == &r.coordinated ? "coordinated" : o == &r.serialized ? "serialized" : "solo";
+        std::fprintf(stderr, "set seed %llu, %s:%s", static_cast<unsigned long long>(seed + (&r - results.data())), mode,
+                     o->completed ? "" : " incomplete;");
+        for (const auto& c : o->cranes) {
+          std::fprintf(stderr, " %s %d jobs, faults 0x%x%s%s", c.name.c_str(), c.jobs_done, c.latched_faults,
+                       std::isnan(c.host_stopped_at) ? "" : " (its host stopped)", c.stuck ? " (stuck)" : "");
+        }
+        std::fprintf(stderr, "\n");
+      }
     }
     min_distance.push_back(r.coordinated.min_distance);
     serial_min.push_back(r.serialized.min_distance);
     // The time ratios of the sets that every mode completed (a crane braked by its guard leaves
-    // its jobs undone: no total time to compare).
-    if (r.coordinated.completed && r.serialized.completed && r.solo.completed) {
+    // its jobs undone: no total time to compare; so does a stopped host).
+    if (r.coordinated.completed && r.serialized.completed && r.solo.completed && r.coordinated.stopped_hosts == 0) {
       vs_serialized.push_back(r.coordinated.total_time / r.serialized.total_time);
       vs_solo.push_back(r.coordinated.total_time / r.solo.total_time);
     }
@@ -269,6 +291,30 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 degraded, 1e3 * crane::stack::kResendDelay, static_cast<unsigned long long>(delayed),
                 static_cast<unsigned long long>(resent));
   }
+  if (injected.stopped_hosts > 0) {
+    std::vector<double> rest;
+    int stopped = 0, stuck = 0, left = 0, total = 0, stopped_left = 0;
+    for (const SetResult& r : results) {
+      stopped += r.coordinated.stopped_hosts;
+      for (std::size_t i = 0; i < r.coordinated.cranes.size(); ++i) {
+        const auto& c = r.coordinated.cranes[i];
+        total += jobs;
+        if (!std::isnan(c.host_stopped_at)) {
+          stopped_left += jobs - c.jobs_done;
+          if (!std::isnan(c.rest_after_host_stop)) rest.push_back(c.rest_after_host_stop);
+          continue;
+        }
+        stuck += c.stuck ? 1 : 0;
+        left += jobs - c.jobs_done;
+      }
+    }
+    std::printf("  stopped hosts: %d per coordinated set (a crane's host stopped for good in the first 80 s); %d stopped, "
+                "%zu of their cranes at rest after it [ms]: min %.0f  median %.0f  max %.0f; %d jobs of %d left undone "
+                "by the stopped cranes and %d by the %d other cranes stuck waiting %.0f s for their reach\n",
+                injected.stopped_hosts, stopped, rest.size(), 1e3 * crane::stack::nearest_rank_quantile(rest, 0.0),
+                1e3 * crane::stack::nearest_rank_quantile(rest, 0.5), 1e3 * crane::stack::nearest_rank_quantile(rest, 1.0),
+                stopped_left, total, left, stuck, crane::stack::kStuckWait);
+  }
   int guard_emergency = 0, guard_soft = 0;
   std::string guard_first;
   for (const SetResult& r : results) {
@@ -282,19 +328,22 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
               min_distance.empty() ? 0.0 : waiting / static_cast<double>(min_distance.size()));
   // Where the waits go: what the cranes waited for were doing (SiteOutcome::waited_for).
   std::array<double, CraneSiteLink::kActivityCount> waited_for{};
-  double waited_for_none = 0.0;
+  double waited_for_none = 0.0, waited_for_stopped = 0.0;
   for (const SetResult& r : results) {
     if (!r.error.empty()) continue;
     for (std::size_t a = 0; a < waited_for.size(); ++a) waited_for[a] += r.coordinated.waited_for[a];
     waited_for_none += r.coordinated.waited_for_none;
+    waited_for_stopped += r.coordinated.waited_for_stopped_host;
   }
-  const double asked = std::accumulate(waited_for.begin(), waited_for.end(), waited_for_none);
+  const double asked = std::accumulate(waited_for.begin(), waited_for.end(), waited_for_none + waited_for_stopped);
   if (asked > 0.0) {
     std::printf("  coordinated waits, by what the crane waited for was doing [%% of %.0f crane-seconds]:", asked);
     for (std::size_t a = 0; a < waited_for.size(); ++a) {
       std::printf(" %s %.1f,", to_string(static_cast<CraneSiteLink::Activity>(a)), 100.0 * waited_for[a] / asked);
     }
-    std::printf(" no crane (the request or the go on their way, the service down) %.1f\n", 100.0 * waited_for_none / asked);
+    std::printf(" no crane (the request or the go on their way, the service down) %.1f", 100.0 * waited_for_none / asked);
+    if (waited_for_stopped > 0.0) std::printf(", a stopped host %.1f", 100.0 * waited_for_stopped / asked);
+    std::printf("\n");
   }
   const bool safe = !min_distance.empty() && crane::stack::nearest_rank_quantile(min_distance, 0.0) >= site.margins.stop;
   return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
@@ -345,10 +394,11 @@ int main(int argc, char** argv) {
   demo_command->add_option("--jobs", jobs, "pick-and-place jobs per crane and set")->check(CLI::Range(1, 100));
   demo_command->add_option("--seed", seed, "the first set's seed");
   demo_command->add_option("--threads", threads, "sets run in parallel")->check(CLI::Range(1, 256));
-  int faults = 0;
-  demo_command->add_option("--faults", faults, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
-  int degraded = 0;
-  demo_command->add_option("--degraded", degraded, "degraded links (delay, loss) in each coordinated set")
+  DemoFaults injected;
+  demo_command->add_option("--faults", injected.lost, "link faults injected in each coordinated set")->check(CLI::Range(0, 20));
+  demo_command->add_option("--degraded", injected.degraded, "degraded links (delay, loss) in each coordinated set")
+      ->check(CLI::Range(0, 20));
+  demo_command->add_option("--stopped-hosts", injected.stopped_hosts, "cranes' hosts stopped for good in each coordinated set")
       ->check(CLI::Range(0, 20));
   crane::stack::SiteJobDraw draw;
   CLI::Option* shared_option =
@@ -368,7 +418,7 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    return demo(site_path, sets, jobs, seed, threads, faults, degraded, draw);
+    return demo(site_path, sets, jobs, seed, threads, injected, draw);
   }
   return 1;
 }

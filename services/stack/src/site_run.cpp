@@ -31,7 +31,10 @@ struct Crane {
   std::unique_ptr<InProcessStack> stack;
   std::unique_ptr<ac::CraneSiteLink> link;
   bool braked{false};  // its guard braked it (it left its grant): it stays braked
+  std::uint64_t stop_cycle{std::numeric_limits<std::uint64_t>::max()};  // its host gone from this cycle on
+  double stuck_since{std::numeric_limits<double>::quiet_NaN()};  // [s] waiting for a stopped crane since
   CraneOutcome outcome;
+  [[nodiscard]] bool host_stopped(std::uint64_t k) const noexcept { return k >= stop_cycle; }
 };
 
 std::uint32_t draw_epoch(std::uint32_t restarts) { return 7001u + 7919u * restarts; }
@@ -93,7 +96,13 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   params.settle_timeout = options.settle_timeout;
   params.slew_acceleration = options.slew_acceleration;
   params.gravity = config.facts.crane.gravity;
+  const auto limit = static_cast<std::uint64_t>(std::llround(options.time_limit / dt));
   std::vector<Crane> cranes(n);
+  for (const HostStop& h : options.host_stops) {
+    cranes[h.crane].stop_cycle = std::min(cranes[h.crane].stop_cycle, static_cast<std::uint64_t>(std::llround(h.time / dt)));
+  }
+  double faults_end = 0.0;  // [s] the last link fault over
+  for (const LinkFault& f : options.faults) faults_end = std::max(faults_end, f.start + f.duration);
   for (std::size_t i = 0; i < n; ++i) {
     const ac::Pose start = ac::site_start_pose(site, i, config.trajectory_planner.slew_min_angle,
                                                config.trajectory_planner.slew_max_angle,
@@ -101,6 +110,10 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     InProcessOptions o;
     o.initial_slew_angle = start.slew;
     o.initial_trolley_position = start.trolley;
+    if (cranes[i].stop_cycle < limit) {  // from its host's stop on, nothing reaches its drives
+      o.lost_commands_from = cranes[i].stop_cycle;
+      o.lost_commands = limit + 1 - cranes[i].stop_cycle;
+    }
     cranes[i].stack = std::make_unique<InProcessStack>(config, o);
     cranes[i].link = std::make_unique<ac::CraneSiteLink>(site, i, params, jobs[i], 1);
     cranes[i].outcome.name = site.cranes[i].name;
@@ -108,7 +121,6 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
 
   SiteOutcome out;
   out.min_distance = std::numeric_limits<double>::infinity();
-  const auto limit = static_cast<std::uint64_t>(std::llround(options.time_limit / dt));
   std::vector<ac::Action> watched(n * n, ac::Action::clear);
   std::vector<Wire> wires(n);
   std::mt19937_64 loss_rng(options.loss_seed);
@@ -130,7 +142,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     std::vector<bool> up(n);
     std::vector<const LinkFault*> degraded(n, nullptr);  // the first active degradation of each link
     for (std::size_t i = 0; i < n; ++i) {
-      up[i] = !service_down && std::none_of(options.faults.begin(), options.faults.end(), [&](const LinkFault& f) {
+      up[i] = !service_down && !cranes[i].host_stopped(k) && std::none_of(options.faults.begin(), options.faults.end(), [&](const LinkFault& f) {
         return f.crane == i && !f.degraded() && active(f);
       });
       // What was on its way over a link now down is lost (and to or from a killed service).
@@ -155,14 +167,19 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     // Where the waits go: each crane that asked over the cycle now ending, by what the cranes the
     // service's last decision had it wait for were doing.
     for (std::size_t i = 0; k > 0 && i < n; ++i) {
-      if (cranes[i].link->phase() != ac::CraneSiteLink::Phase::asking) continue;
+      if (cranes[i].host_stopped(k) || cranes[i].link->phase() != ac::CraneSiteLink::Phase::asking) continue;
       const std::vector<std::size_t>& blockers = service->arbiter().waits_for(i);
       if (service_down || blockers.empty()) {
         out.waited_for_none += dt;
         continue;
       }
       for (const std::size_t j : blockers) {
-        out.waited_for[static_cast<std::size_t>(cranes[j].link->activity())] += dt / static_cast<double>(blockers.size());
+        const double share = dt / static_cast<double>(blockers.size());
+        if (cranes[j].host_stopped(k)) {
+          out.waited_for_stopped_host += share;
+        } else {
+          out.waited_for[static_cast<std::size_t>(cranes[j].link->activity())] += share;
+        }
       }
     }
     // The reports of the last cycle's state, then the service's rules and its instructions.
@@ -203,7 +220,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
       const auto phase = c.link->phase();
-      if (k == 0 || c.braked || phase == ac::CraneSiteLink::Phase::done) continue;  // no estimate at 0
+      if (k == 0 || c.braked || c.host_stopped(k) || phase == ac::CraneSiteLink::Phase::done) continue;  // no estimate at 0
       const ac::GrantCheck verdict = c.link->guard().check(ac::motion_of(c.stack->estimate()), t);
       if (verdict.action == ac::GrantAction::proceed || c.link->guard().must_leave_shared_airspace(t)) continue;
       if (out.guard_first.empty()) {
@@ -220,7 +237,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     }
     for (std::size_t i = 0; i < n; ++i) {
       Crane& c = cranes[i];
-      if (k > 0) {
+      if (k > 0 && !c.host_stopped(k)) {
         // Braked: by its guard, or by its supervisor for a fault of its own (the sway limiter, ...).
         const bool braked = c.braked || c.stack->status().latched_faults != 0;
         if (auto g = c.link->step(t, c.stack->estimate(), c.stack->reference(), braked)) {
@@ -232,6 +249,19 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       brake.command = protocol::SupervisorCommand::COMMAND_EMERGENCY_STOP;
       c.stack->step(goal[i] && !estop[i] ? std::span(&*goal[i], 1) : std::span<const Request>(), {},
                     estop[i] ? &brake : nullptr);
+      if (k == c.stop_cycle) {  // its supervisor's last word: what it latches later, on a dead host, is not heard
+        c.outcome.host_stopped_at = t;
+        c.outcome.latched_faults = c.stack->status().latched_faults;
+        ++out.stopped_hosts;
+      }
+      if (c.host_stopped(k)) {  // its plant runs on, braked: when it comes to rest
+        const plant::PlantState& s = c.stack->plant().simulator().state();
+        if (std::isnan(c.outcome.rest_after_host_stop) && std::abs(s.trolley_velocity) < 0.01 &&
+            std::abs(s.slew_rate) < 0.01 && std::abs(s.cable_length_rate) < 0.01) {
+          c.outcome.rest_after_host_stop = t + dt - c.outcome.host_stopped_at;
+        }
+        continue;
+      }
       for (const auto& status : c.stack->planner().move_statuses()) c.link->move_status(status, t);
       for (const auto& outcome : c.stack->planner().goal_outcomes()) {
         if (outcome.status != trajectory_planner::GoalStatus::accepted) {
@@ -285,9 +315,41 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
         }
       }
     }
-    if (std::all_of(cranes.begin(), cranes.end(), [](const Crane& c) {
-          return c.link->phase() == ac::CraneSiteLink::Phase::done || c.braked;
+    // With a host stopped: the cranes that wait for it, each asking with every crane it waits for
+    // stopped, done (it would have yielded if it could: a yield through the stopped crane's reach
+    // cannot be granted) or blocked so in turn (the service holds the stopped crane's whole reach
+    // for good).
+    if (out.stopped_hosts > 0) {
+      std::vector<bool> blocked(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        blocked[i] = cranes[i].host_stopped(k) || cranes[i].link->phase() == ac::CraneSiteLink::Phase::done;
+      }
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::vector<std::size_t>& blockers = service->arbiter().waits_for(i);
+          if (blocked[i] || cranes[i].link->phase() != ac::CraneSiteLink::Phase::asking || blockers.empty() ||
+              !std::all_of(blockers.begin(), blockers.end(), [&](std::size_t j) { return blocked[j]; })) {
+            continue;
+          }
+          blocked[i] = grew = true;
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        Crane& c = cranes[i];
+        if (!blocked[i] || c.host_stopped(k) || c.link->phase() == ac::CraneSiteLink::Phase::done) {
+          c.stuck_since = std::numeric_limits<double>::quiet_NaN();
+        } else if (std::isnan(c.stuck_since)) {
+          c.stuck_since = t;
+        }
+      }
+    }
+    if (std::all_of(cranes.begin(), cranes.end(), [&](const Crane& c) {
+          const bool stuck = c.stuck_since <= t - kStuckWait && t >= faults_end;
+          const bool stopped_at_rest = c.host_stopped(k) && !std::isnan(c.outcome.rest_after_host_stop);
+          return c.link->phase() == ac::CraneSiteLink::Phase::done || c.braked || stopped_at_rest || stuck;
         })) {
+      for (Crane& c : cranes) c.outcome.stuck = !std::isnan(c.stuck_since);
       break;
     }
   }
@@ -301,7 +363,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     c.outcome.waiting_time = link.waiting_time();
     c.outcome.yields = link.yields();
     c.outcome.unsettled_moves = link.unsettled_moves();
-    c.outcome.latched_faults = c.stack->status().latched_faults;
+    if (std::isnan(c.outcome.host_stopped_at)) c.outcome.latched_faults = c.stack->status().latched_faults;
     out.total_time = std::max(out.total_time, c.outcome.finish_time);
     out.reactions.insert(out.reactions.end(), link.reactions().begin(), link.reactions().end());
     if (const auto& longest = link.longest_reaction(); longest && longest->seconds > out.longest_reaction_seconds) {
@@ -355,6 +417,13 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
                                   std::to_string(f.loss) + " (in [0, 1]) is out of range");
     }
   }
+  for (const HostStop& h : options.host_stops) {
+    if (h.crane >= site.cranes.size() || !(h.time >= 0.0 && h.time <= options.time_limit)) {
+      throw std::invalid_argument("site run: a host stop of crane " + std::to_string(h.crane) + " (in [0, " +
+                                  std::to_string(site.cranes.size()) + ")) at " + std::to_string(h.time) +
+                                  " s (in [0, time_limit " + std::to_string(options.time_limit) + "]) is out of range");
+    }
+  }
   if (options.mode != SiteMode::solo) return run_together(site, config, jobs, options);
   SiteOutcome out;
   out.min_distance = std::numeric_limits<double>::infinity();
@@ -362,8 +431,21 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
   for (std::size_t i = 0; i < site.cranes.size(); ++i) {
     ac::SiteLayout alone = site;
     alone.cranes = {site.cranes[i]};
-    const SiteOutcome one = run_together(alone, config, {jobs[i]}, options);
+    // Its own faults and host stops, and the site service's, as crane 0 of a site of one.
+    SiteRunOptions own = options;
+    own.faults.clear();
+    own.host_stops.clear();
+    for (LinkFault f : options.faults) {
+      if (f.crane != i && f.crane != kSiteService) continue;
+      if (f.crane == i) f.crane = 0;
+      own.faults.push_back(f);
+    }
+    for (HostStop h : options.host_stops) {
+      if (h.crane == i) own.host_stops.push_back({0, h.time});
+    }
+    const SiteOutcome one = run_together(alone, config, {jobs[i]}, own);
     out.cranes.push_back(one.cranes[0]);
+    out.stopped_hosts += one.stopped_hosts;
     out.completed = out.completed && one.completed;
     out.total_time = std::max(out.total_time, one.total_time);
     out.simulated_seconds += one.simulated_seconds;
@@ -393,6 +475,19 @@ std::vector<LinkFault> random_link_faults(const ac::SiteLayout& site, int count,
     faults.push_back(fault);
   }
   return faults;
+}
+
+std::vector<HostStop> random_host_stops(const ac::SiteLayout& site, int count, std::uint64_t seed) {
+  std::mt19937_64 rng(seed ^ 0x57099edc0ULL);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<HostStop> stops;
+  for (int f = 0; f < count; ++f) {
+    HostStop stop;
+    stop.crane = crane_drawn(site, unit(rng));
+    stop.time = 80.0 * unit(rng);
+    stops.push_back(stop);
+  }
+  return stops;
 }
 
 double arrival_time(double time, const LinkFault* fault, bool lost, double previous) noexcept {

@@ -21,13 +21,14 @@
 // A lost link (SiteRunOptions::faults): the crane's reports, the instructions to it and the
 // heartbeat are dropped, and so are those on their way; a killed site service hears and sends
 // nothing and restarts with no memory (another epoch), and what was on its way to or from it is
-// lost. A degraded link delivers them late, in order (LinkFault). What the crane and the service
+// lost. A degraded link delivers them late, in order (LinkFault). A stopped host (HostStop) takes its
+// crane's stack and link away for good; its plant runs on, braked by its actuation gate. What the crane and the service
 // then do is their cores' (crane_site_link.hpp, site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
 // braked and stops reporting, so the service holds its whole reach); its swing rule is counted,
 // not applied (SiteOutcome::guard_*).
 //
 // Errors: common::ConfigError for an invalid site or stack config; std::invalid_argument for jobs
-// outside a crane's reach or a job list not one per crane.
+// outside a crane's reach, a job list not one per crane, or a fault or host stop out of range.
 
 #include <array>
 #include <cstdint>
@@ -73,6 +74,20 @@ struct LinkFault {
 inline constexpr double kResendDelay = 0.1;
 inline constexpr std::size_t kSiteService = static_cast<std::size_t>(-1);
 
+/// A crane's host stopped for good at `time` [s], as by a power cut (the hosts' `stop-host`): every
+/// process of its stack and its site link gone. Nothing reaches its drives any more, so the plant's
+/// actuation gate brakes it once its last command is older than the watchdog (actuation_gate.hpp:
+/// 30 ms on the lab crane; on a real crane, the drives' own watchdog or the spring-applied brakes of
+/// the power cut, taken to act as fast); it reports nothing, so the site service holds its whole
+/// reach once link_deadline has passed, for good.
+struct HostStop {
+  std::size_t crane{0};
+  double time{0.0};  // [s] >= 0
+};
+/// [s] How long a crane waits at rest for a stopped crane's reach (or for cranes that wait for it)
+/// before its run counts as over: the hosts' rule (`deploy/crane site run`, docs/site.md).
+inline constexpr double kStuckWait = 15.0;
+
 /// Cycles between two evaluations of the distance-watching rule (20 Hz at the stack's 100 Hz).
 inline constexpr int kWatchStride = 5;
 
@@ -86,6 +101,7 @@ struct SiteRunOptions {
   // max_swing (0.6 rad) in 8 of 40 seeded job sets (docs/site.md).
   double slew_acceleration{1.0};
   std::vector<LinkFault> faults;
+  std::vector<HostStop> host_stops;
   std::uint64_t loss_seed{1};  // draws which messages a degraded link loses
   // A crane that disobeys: at `time` [s] crane `crane` is told to move to `to` without asking the
   // site service (a test of its guard, grant_guard.hpp).
@@ -106,6 +122,11 @@ struct CraneOutcome {
   int unsettled_moves{0};    // moves ended by settle_timeout
   std::uint32_t latched_faults{0};  // its supervisor's, at the end (FAULT_* bits)
   double braked_at{std::numeric_limits<double>::quiet_NaN()};  // [s] when its guard braked it (NaN: never)
+  double host_stopped_at{std::numeric_limits<double>::quiet_NaN()};  // [s] its host stopped (NaN: never)
+  // [s] From its host's stop to its plant at rest (trolley and slew under 0.01 m/s and rad/s, the
+  // hoist under 0.01 m/s; NaN: not at rest by the run's end, or no stop).
+  double rest_after_host_stop{std::numeric_limits<double>::quiet_NaN()};
+  bool stuck{false};  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
 };
 
 struct SiteOutcome {
@@ -114,11 +135,16 @@ struct SiteOutcome {
   // the site service had them wait for were doing (SiteArbiter::waits_for at its last decision;
   // index: CraneSiteLink::Activity; a crane that waits for k cranes counts 1/k to each), and
   // asking while it waited for no crane (`waited_for_none`: its request or the go on their way,
-  // or the service down). On a fault-free run they add up to the cranes' waiting_time; a lost link
-  // that cuts an ask short counts here and not there.
+  // or the service down), and for a crane whose host had stopped (`waited_for_stopped_host`). On a
+  // fault-free run they add up to the cranes' waiting_time; a lost link that cuts an ask short
+  // counts here and not there.
   std::array<double, anti_collision::CraneSiteLink::kActivityCount> waited_for{};
   double waited_for_none{0.0};
-  bool completed{false};     // every job done within the time limit (no crane braked by its guard)
+  double waited_for_stopped_host{0.0};
+  // Every job done within the time limit (no crane braked by its guard), but those a stopped host
+  // left undone: its crane's, and those of the cranes stuck waiting for its reach.
+  bool completed{false};
+  int stopped_hosts{0};      // cranes whose host stopped (SiteRunOptions::host_stops)
   double total_time{0.0};    // [s] the last crane's finish time
   double min_distance{0.0};  // [m] true, between any two parts of any two cranes, over the run
   std::string closest;       // "tc1.jib-tc3.cable at 41.23 s"
@@ -159,7 +185,11 @@ struct SiteOutcome {
 [[nodiscard]] StackConfig load_site_crane_config(const anti_collision::SiteLayout& site);
 
 /// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`
-/// (its stack, load_site_crane_config; the site file gives where it stands and its shape).
+/// (its stack, load_site_crane_config; the site file gives where it stands and its shape). With a
+/// host stopped, the run ends once every other crane has done its jobs or is stuck (kStuckWait)
+/// and every link fault is over. Solo runs (SiteMode::solo) keep each crane's own faults and host
+/// stops and those of the site service. Throws std::invalid_argument for a fault or a host stop
+/// out of range (naming it), besides the errors above.
 [[nodiscard]] SiteOutcome run_site(const anti_collision::SiteLayout& site, const StackConfig& config,
                                    const std::vector<std::vector<SiteJob>>& jobs, const SiteRunOptions& options);
 
@@ -180,6 +210,11 @@ struct SiteOutcome {
 /// messages lost (LinkFault).
 [[nodiscard]] std::vector<LinkFault> random_degraded_links(const anti_collision::SiteLayout& site, int count,
                                                            std::uint64_t seed);
+
+/// `count` seeded random host stops for `site` (issue 34's "a crane's host stopped"): a crane drawn
+/// uniformly, its host stopped for good within the first 80 s. Deterministic in `seed`.
+[[nodiscard]] std::vector<HostStop> random_host_stops(const anti_collision::SiteLayout& site, int count,
+                                                      std::uint64_t seed);
 
 /// How random_site_jobs places a point with respect to the other cranes. A point is "within another
 /// crane's reach" when its distance from that crane's slew axis lies strictly between the planner's
