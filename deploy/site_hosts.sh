@@ -38,6 +38,12 @@
 #                     stop-host:CRANE:START           the crane's host stopped for good: every process
 #                                                     on it killed with -9 and its link down (a power
 #                                                     cut); the others then keep out of its whole reach
+#                     out-of-service:CRANE:START      not a fault: the site operator's word that the
+#                                                     stopped CRANE stands braked (crane_site_status
+#                                                     --out-of-service from the office, the operator's
+#                                                     identity); the service then holds where it stood
+#                                                     instead of its whole reach; the run fails when
+#                                                     the service does not take it within 10 s
 #                   HOST is a crane's name or "site" (the service's host). With a host stopped, the
 #                   run ends once the faults are over and every other crane has done its jobs or has
 #                   waited at rest for 15 s (for the stopped crane's reach); it is safe when no crane
@@ -45,7 +51,7 @@
 # Exit status: 0 done and safe, 1 not (the reason printed), 2 bad usage or no namespaces here.
 set -euo pipefail
 
-usage() { sed -n '17,43p' "$0" >&2; exit 2; }
+usage() { sed -n '17,51p' "$0" >&2; exit 2; }
 [ $# -ge 3 ] || usage
 BIN=$(cd "$1" && pwd) SITE=$(realpath "$2") OUT=$3
 shift 3
@@ -126,7 +132,7 @@ CRANE_NET=(--site-lan --insecure-lan --dds "$DDS")
 # in real time on one small machine miss cycles, and a long slew at the rated rate then overshot the
 # supervisor's overspeed limit (slew_overspeed, 2 of 6 runs on this 2-core machine under other load).
 SLEW_SPEED=0.7  # the site's network without DDS Security (docs/site.md says why)
-rm -f "$OUT/site_service.log" "$OUT/faults.log"
+rm -f "$OUT/site_service.log" "$OUT/faults.log" "$OUT/out_of_service.txt"
 "$BIN/crane_site" jobs --site "$SITE" --jobs "$JOBS" --seed "$SEED" --out "$OUT/jobs" > "$OUT/jobs.log"
 
 # The office's watchers first, so that they hear every instruction (rt/site/instruction keeps no
@@ -236,6 +242,13 @@ apply_fault() {  # index, spec, phase (on|off)
         ip link set "v-$host" down
         wait "${PIDS[$host]}" 2>/dev/null || true
       fi ;;
+    out-of-service)
+      if [ "$phase" = on ]; then
+        local rc=0
+        "$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --out-of-service "$host" --wait 10 \
+          > "$OUT/out_of_service_$host.txt" 2>&1 || rc=$?
+        echo "$host $rc" >> "$OUT/out_of_service.txt"
+      fi ;;
     kill-service)
       duration=$value start=$host
       if [ "$phase" = on ]; then
@@ -254,7 +267,7 @@ fault_times() {  # the spec's start and end, in whole seconds after ready
   case $kind in
     partition) echo "$b $((b + c))" ;;
     kill-service) echo "$a $((a + b))" ;;
-    stop-host) echo "$b $b" ;;
+    stop-host | out-of-service) echo "$b $b" ;;
     *) echo "$c $((c + d))" ;;
   esac
 }
@@ -316,6 +329,14 @@ import json, re, sys
 out, site, run_time, stopped, names = sys.argv[1], sys.argv[2], float(sys.argv[3]) / 1000.0, sys.argv[4].split(), sys.argv[5:]
 stop = float(re.search(r"^\s*stop:\s*([0-9.]+)", open(site).read(), re.M).group(1))
 problems = []
+put_out = {}  # the site operator's words (out-of-service:CRANE:START): crane -> crane_site_status's exit
+try:
+    for line in open(out + "/out_of_service.txt"):
+        crane, rc = line.split()
+        put_out[crane] = int(rc)
+        if int(rc) != 0: problems.append("the site service did not put %s out of service (exit %s)" % (crane, rc))
+except OSError:
+    pass
 print("crane  jobs  finish_s  waiting_s  yields  halts  aborted  phase")
 for name in names:
     try:
@@ -326,11 +347,14 @@ for name in names:
                                                      s["yields"], s["halts"], s.get("aborted_moves", 0), s["phase"]))
     if name in stopped:
         print("       its host was stopped (every process killed with -9)")
+        if name in put_out:
+            print("       put out of service by the site operator" if put_out[name] == 0 else
+                  "       NOT put out of service (crane_site_status exit %d: see out_of_service_%s.txt)" % (put_out[name], name))
         continue
     if s["jobs_done"] != s["jobs"] and not (stopped and s["phase"] in ("asking", "done")):
         problems.append("%s did %d of %d jobs" % (name, s["jobs_done"], s["jobs"]))
     elif s["jobs_done"] != s["jobs"]:
-        print("       waits at rest (the stopped crane's whole reach is held)")
+        print("       waits at rest (for what the stopped crane holds: its whole reach, or where it stood once out of service)")
     if s["phase"] == "braked": problems.append(name + " was braked")
     if s["reactions_s"]:
         print("       link losses: reactions [ms] " + " ".join("%.0f" % (1e3 * r) for r in s["reactions_s"]))

@@ -16,7 +16,8 @@ The identities: every participant name the topic graph shows (the stack's proces
 to publish exactly the topics it writes and to subscribe to those it reads), plus two tool roles:
   monitor   subscribes to every topic, publishes nothing (crane_topic, crane_web, a dashboard)
   operator  subscribes to every topic, publishes the operator's topics (goals, supervisor commands,
-            operator speed; crane_move, crane_safety, crane_jog)
+            operator speed; crane_move, crane_safety, crane_jog; the site's command,
+            crane_site_status --out-of-service)
 The graph is what DDS discovery reported of a running stack (endpoint_graph.sh, crane_topic list
 --json): the permissions come from the nodes' own make_writer/make_reader calls, not from a list.
 
@@ -35,7 +36,7 @@ import tempfile
 DOMAIN_RANGE = (0, 230)  # the domains (Cyclone DDS 0.10 refuses a governance or permissions naming one above 230)
 ORGANIZATION = "crane"
 # Tool roles: the operator's own topics (what the operator tools write); the monitor writes none.
-OPERATOR_TOPICS = ["rt/crane/planner/goal", "rt/crane/safety/command", "rt/crane/operator/speed"]
+OPERATOR_TOPICS = ["rt/crane/planner/goal", "rt/crane/safety/command", "rt/crane/operator/speed", "rt/site/command"]
 TOOL_ROLES = ("monitor", "operator")
 # Participants of the graph that are tools watching the stack, not identities of their own.
 GRAPH_TOOLS = ("crane_topic",)

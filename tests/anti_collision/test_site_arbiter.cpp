@@ -15,6 +15,7 @@
 #include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/anti_collision/site_messages.hpp"
 #include "crane/anti_collision/site_service.hpp"
 #include "crane/common/validation.hpp"
 
@@ -269,6 +270,57 @@ TEST(SiteArbiter, ALostCraneHoldsItsWholeReach) {
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
   arbiter.rest(0, {-1.5, 0.5, 0.2});  // A reports again, its jib away
   ASSERT_EQ(arbiter.decide().size(), 1u);
+}
+
+// An operator's word that a silent crane stands braked where it went silent (out_of_service): A,
+// lost from its rest pose with its jib away (heading -1.5 rad), no longer holds its whole reach but
+// its rest box, the swing widened to the travel swing of its cable (0.2 sin 0.3 m, by hand), so B
+// may lower its load at (1, 0). A crane lost on its path holds the rest of that path. Refused: a
+// crane that is not silent, one never known (a restarted arbiter), and one out of service that
+// moved (it forgets where it stood).
+TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
+  SiteLayout layout = two_towers();
+  layout.paths.travel_swing = 0.3;
+  SiteArbiter arbiter(layout, ArbiterMode::coordinated);
+  EXPECT_THROW(arbiter.out_of_service(0), std::logic_error);  // never known: its whole reach stays
+  arbiter.rest(0, {-1.5, 0.5, 0.2});
+  EXPECT_THROW(arbiter.out_of_service(0), std::logic_error);  // it reports
+  arbiter.rest(1, {kPi, 1.0, 0.2});
+  arbiter.lost(0);
+  arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
+  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
+  arbiter.out_of_service(0);
+  EXPECT_EQ(arbiter.holding(0), Holding::out_of_service);
+  EXPECT_STREQ(to_string(Holding::out_of_service), "out_of_service");
+  ASSERT_EQ(arbiter.held(0).count, 1u);
+  EXPECT_DOUBLE_EQ(arbiter.held(0).boxes[0].slew_low, -1.5);
+  EXPECT_DOUBLE_EQ(arbiter.held(0).boxes[0].swing_radius, 0.2 * std::sin(0.3));
+  EXPECT_DOUBLE_EQ(rest_airspace({-1.5, 0.5, 0.2}, layout.paths).boxes[0].swing_radius, 0.0);  // hoist_swing 0
+  const auto orders = arbiter.decide();
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].crane, 1u);
+  // It comes back at rest.
+  arbiter.rest(0, {-1.5, 0.5, 0.2});
+  EXPECT_EQ(arbiter.holding(0), Holding::rest);
+
+  // Lost on its path: the rest of the path, widened.
+  SiteArbiter moving(layout, ArbiterMode::coordinated);
+  moving.rest(0, {-1.5, 0.5, 0.2});
+  moving.rest(1, {kPi - 1.5, 0.5, 0.2});
+  const std::vector<Pose> path{{-1.5, 0.5, 0.2}, {-1.0, 0.5, 0.2}, {-1.0, 0.5, 1.0}};
+  moving.request(0, path, 0.0);
+  ASSERT_EQ(moving.decide().size(), 1u);
+  moving.lost(0);
+  moving.out_of_service(0);
+  ASSERT_EQ(moving.held(0).count, 2u);
+  EXPECT_DOUBLE_EQ(moving.held(0).boxes[1].swing_radius, 1.0 * std::sin(0.3));
+  // Moving without a grant while out of service: its whole reach, and it cannot be put out of
+  // service again before it rests.
+  moving.lost(0);
+  EXPECT_EQ(moving.holding(0), Holding::whole_reach);
+  EXPECT_THROW(moving.out_of_service(0), std::logic_error);
+  EXPECT_THROW(moving.out_of_service(5), std::out_of_range);
 }
 
 // A crane that reports reaching a waypoint holds only the rest of its path: B's load hangs low at
@@ -746,6 +798,47 @@ TEST(SiteService, ASilentCraneIsLostAndComesBackAtRest) {
   ASSERT_EQ(service.report(at_rest(0, {-1.2, 0.5, 0.2}), 0.5), "");
   EXPECT_EQ(service.arbiter().holding(0), Holding::rest);
   EXPECT_DOUBLE_EQ(service.arbiter().held(0).boxes[0].slew_low, -1.2);
+}
+
+// The operator's word through the service (rt/site/command): refused while the crane reports, for
+// an unknown crane and by a restarted service that never knew the crane; taken once the crane is
+// silent past link_deadline, shown in the status (HOLDING_OUT_OF_SERVICE), idempotent; the crane's
+// report at rest brings it back, one moving takes its whole reach.
+TEST(SiteService, AnOperatorPutsASilentCraneOutOfService) {
+  SiteLayout s = two_towers();
+  s.link_deadline = 0.3;
+  SiteService service(s, ArbiterMode::coordinated, 3);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.0), "");
+  ASSERT_EQ(service.report(at_rest(1, {kPi, 1.0, 0.2}, 6, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}), 0.0), "");
+  ASSERT_EQ(service.step(0.0).size(), 1u);  // B lowers
+  EXPECT_EQ(service.out_of_service(0, 0.1), "site service: a was heard 0.10 s ago: a crane that reports is not out of service");
+  EXPECT_EQ(service.out_of_service(2, 0.1), "site service: crane 2 is not on the site (2 cranes)");
+  EXPECT_EQ(service.out_of_service(0, 0.31), "");  // silent: lost, then out of service
+  EXPECT_EQ(service.arbiter().holding(0), Holding::out_of_service);
+  EXPECT_EQ(service.out_of_service(0, 0.4), "");
+  (void)service.step(0.4);
+  EXPECT_EQ(service.arbiter().holding(0), Holding::out_of_service);  // step does not take it back
+  crane::protocol::SiteStatus status;
+  to_message(service, status);
+  EXPECT_EQ(status.holding[0], crane::protocol::SiteStatus::HOLDING_OUT_OF_SERVICE);
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.5), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::rest);
+  (void)service.step(0.9);
+  ASSERT_EQ(service.out_of_service(0, 0.9), "");
+  CraneReport moving;
+  moving.crane = 0;
+  moving.moving = true;
+  moving.waypoints = {a_rest, {-1.0, 0.5, 0.2}};
+  ASSERT_EQ(service.report(moving, 1.0), "");
+  EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
+  EXPECT_EQ(service.moves_without_grant(), 1u);
+
+  SiteService restarted(s, ArbiterMode::coordinated, 4);
+  (void)restarted.step(1.0);
+  EXPECT_EQ(restarted.out_of_service(0, 1.0),
+            "site arbiter: crane a went silent before this service knew where it was: its whole reach stays held");
+  EXPECT_EQ(restarted.arbiter().holding(0), Holding::whole_reach);
 }
 
 // A crane that moves while the service holds only its rest box has no grant: its whole reach is

@@ -334,6 +334,40 @@ TEST(SiteRun, AStoppedHostsCraneHoldsItsWholeReachForGood) {
   EXPECT_THROW((void)run_site(site, config, shared, bad), std::invalid_argument);
 }
 
+// The site operator's word (HostStop::out_of_service_after, as `crane_site_status --out-of-service`):
+// tc1's host stops 1 s in and the operator puts it out of service 5 s later; the service then holds
+// where tc1 stood instead of its whole reach, and tc2 works on. A crane whose host stopped before
+// the service ever heard it cannot be put out of service: its whole reach stays held.
+TEST(SiteRun, AnOperatorPutsAStoppedCraneOutOfServiceAndTheOthersWorkOn) {
+  auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  site.cranes.resize(2);
+  const StackConfig config = load_site_crane_config(site);
+  const auto shared = random_site_jobs(site, config, 2, 5, SiteJobDraw{1.0, true});
+  SiteRunOptions options = in_mode(SiteMode::coordinated);
+  options.host_stops = {HostStop{0, 1.0}};
+  const SiteOutcome held = run_site(site, config, shared, options);
+  options.host_stops[0].out_of_service_after = 5.0;
+  const SiteOutcome o = run_site(site, config, shared, options);
+  EXPECT_TRUE(o.completed);
+  EXPECT_TRUE(std::isnan(held.cranes[0].out_of_service_at));
+  EXPECT_NEAR(o.cranes[0].out_of_service_at, 6.0, 1e-6);
+  EXPECT_GT(o.cranes[1].jobs_done, held.cranes[1].jobs_done);
+  EXPECT_GE(o.min_distance, site.margins.stop) << o.closest;
+  EXPECT_GE(held.min_distance, site.margins.stop) << held.closest;
+  std::printf("tc1's host stopped at 1 s: tc2 did %d jobs of 2 with its whole reach held, %d with tc1 out of service "
+              "at %.2f s (stuck: %d); min distance %.3f m (%s)\n", held.cranes[1].jobs_done, o.cranes[1].jobs_done,
+              o.cranes[0].out_of_service_at, o.cranes[1].stuck ? 1 : 0, o.min_distance, o.closest.c_str());
+
+  options.host_stops = {HostStop{0, 0.0, 5.0}};
+  const SiteOutcome never_heard = run_site(site, config, shared, options);
+  EXPECT_TRUE(std::isnan(never_heard.cranes[0].out_of_service_at));
+  EXPECT_TRUE(never_heard.cranes[1].stuck);
+  EXPECT_EQ(never_heard.cranes[1].jobs_done, 0);
+
+  options.host_stops = {HostStop{0, 1.0, 0.0}};
+  EXPECT_THROW((void)run_site(site, config, shared, options), std::invalid_argument);
+}
+
 // A host stopped among the network faults (seeded, as `crane_site demo --faults 2 --degraded 3
 // --stopped-hosts 1`): the stop margin kept, no crane braked by its guard, the stopped crane at
 // rest within its brakes' time, and every other crane done or stuck waiting for its reach.

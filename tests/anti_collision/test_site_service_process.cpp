@@ -1,7 +1,7 @@
 // The site service as a process on DDS (services/anti_collision/node/site_service_node.cpp): this
 // test's participant plays the three cranes of the shipped site on the site's topics and checks
-// what the process answers: a grant over DDS, its heartbeat, a silent crane's whole reach, a
-// malformed report refused without harm, and a service killed with -9 and started again (a new
+// what the process answers: a grant over DDS, its heartbeat, a silent crane's whole reach, the
+// site operator's word that a silent crane is out of service, a malformed report refused without harm, and a service killed with -9 and started again (a new
 // epoch, a crane still moving held at its whole reach until it reports at rest). ctest runs it in
 // a private network namespace; the participants are bound to loopback.
 #include <gtest/gtest.h>
@@ -250,6 +250,28 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNoth
   // again at rest and holds its rest box.
   tc3_reports = false;
   ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[2] == SiteStatus::HOLDING_WHOLE_REACH; }));
+  // The site operator's word (crane_site_status --out-of-service, rt/site/command): refused for
+  // tc2, which reports; taken for the silent tc3, which the service then holds where it stood.
+  {
+    std::string out;
+    const std::string domain = "--domain " + std::to_string(kDomain);
+    EXPECT_EQ(run_status(site, tick, domain + " --wait 1.5 --out-of-service tc2", out), 3) << out;
+    EXPECT_NE(out.find("did not put tc2 out of service within 1.5 s"), std::string::npos) << out;
+    EXPECT_EQ(run_status(site, tick, domain + " --wait 1 --out-of-service tc9", out), 2) << out;
+    EXPECT_NE(out.find("--out-of-service tc9: no such crane"), std::string::npos) << out;
+    EXPECT_EQ(run_status(site, tick, domain + " --wait 10 --out-of-service tc3", out), 0) << out;
+    EXPECT_NE(out.find("tc3      out_of_service"), std::string::npos) << out;
+    EXPECT_NE(out.find("tc3 is out of service"), std::string::npos) << out;
+    ASSERT_TRUE(site.run_until(5.0, tick, [&] {
+      return site.status()->holding[2] == SiteStatus::HOLDING_OUT_OF_SERVICE;
+    }));
+    site.run_for(0.5, tick);  // still silent: held so
+    EXPECT_EQ(site.status()->holding[2], SiteStatus::HOLDING_OUT_OF_SERVICE);
+    std::ifstream log(site.dir() / "site_service_1.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("operator: tc2 not put out of service: site service: tc2 was heard"), std::string::npos) << text;
+    EXPECT_NE(text.find("operator: tc3 out of service"), std::string::npos) << text;
+  }
   tc3_reports = true;
   ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[2] == SiteStatus::HOLDING_REST; }));
 

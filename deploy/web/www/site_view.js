@@ -103,7 +103,8 @@
       ctx.fillStyle = c.state === "silent" ? "#888" : colour;
       ctx.fillRect(bx - 4, by - 4, 8, 8);
       ctx.font = "12px sans-serif";
-      ctx.fillText(c.name + (c.waiting ? " (waits)" : c.holding === "whole_reach" ? " (whole reach)" : ""), bx + 6, by - 6);
+      ctx.fillText(c.name + (c.waiting ? " (waits)" : c.holding === "whole_reach" ? " (whole reach)" :
+                   c.holding === "out_of_service" ? " (out of service)" : ""), bx + 6, by - 6);
       drawn.cranes.push(entry);
     });
     state.drawn = drawn;

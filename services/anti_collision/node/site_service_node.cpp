@@ -2,8 +2,9 @@
 // anti-collision service on the site's own DDS domain (the site file's domain_id unless --domain).
 // It reads every crane's reports (rt/site/report), runs anti_collision::SiteService (the protocol
 // of site_service.hpp and the rules of site_arbiter.hpp), writes each instruction
-// (rt/site/instruction) and, at 10 Hz, its heartbeat and what it holds (rt/site/status). It only
-// translates and wires: every rule is in the core.
+// (rt/site/instruction) and, at 10 Hz, its heartbeat and what it holds (rt/site/status). It reads
+// the site operator's words (rt/site/command: a silent crane out of service) and logs what came of
+// each. It only translates and wires: every rule is in the core.
 //
 // One thread, paced at kCycle: take the reports, step the core, write. A report that cannot be read
 // or that the core refuses is logged (the first of each crane, then every 100th) and counted in the
@@ -71,6 +72,7 @@ int main(int argc, char** argv) {
     auto reports = participant->make_recording_reader<tp::SiteReport>(&wakeup, 256);
     auto instructions = participant->make_writer<tp::SiteInstruction>();
     auto status_writer = participant->make_writer<tp::SiteStatus>();
+    auto commands = participant->make_recording_reader<tp::SiteCommand>(&wakeup, 16);
     spdlog::info("site service for '{}' ({} cranes) on domain {}, {} mode, epoch {}", layout.name, layout.cranes.size(),
                  options.domain_id, mode_name, service.epoch());
 
@@ -81,6 +83,7 @@ int main(int argc, char** argv) {
     std::uint64_t status_seq = 0;
     std::uint64_t unreadable = 0;  // reports refused before the core (a count beyond the arrays, a code)
     tp::msgs::SiteReport_ dds_report;
+    tp::msgs::SiteCommand_ dds_command;
     for (std::uint64_t cycle = 0; !runtime::stop_requested(); ++cycle) {
       const double now = seconds_since(start);
       while (reports->take_next(dds_report)) {
@@ -96,6 +99,23 @@ int main(int argc, char** argv) {
         if (why.empty()) continue;
         const std::size_t slot = std::min<std::size_t>(message.crane, layout.cranes.size());
         if (refused[slot]++ % 100 == 0) spdlog::warn("{} ({} refused from this sender)", why, refused[slot]);
+      }
+      while (commands->take_next(dds_command)) {
+        protocol::SiteCommand command;
+        protocol::from_dds(dds_command, command);
+        const std::string crane = command.crane < layout.cranes.size() ? layout.cranes[command.crane].name
+                                                                       : std::to_string(command.crane);
+        if (command.command != protocol::SiteCommand::COMMAND_OUT_OF_SERVICE) {
+          spdlog::warn("operator command {} for crane {}: unknown code {}", command.header.seq, crane,
+                       static_cast<unsigned>(command.command));
+          continue;
+        }
+        const std::string why = service.out_of_service(command.crane, now);
+        if (why.empty()) {
+          spdlog::info("operator: {} out of service, held where it stood when it went silent", crane);
+        } else {
+          spdlog::warn("operator: {} not put out of service: {}", crane, why);
+        }
       }
       for (const ac::SiteOrder& order : service.step(now)) {
         protocol::SiteInstruction message;

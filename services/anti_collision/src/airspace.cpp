@@ -133,6 +133,15 @@ Airspace path_airspace(std::span<const Pose> waypoints, const PathAllowance& all
   return out;
 }
 
+Airspace out_of_service_airspace(const Airspace& held, const PathAllowance& allowance) noexcept {
+  Airspace out = held;
+  for (std::size_t i = 0; i < out.count; ++i) {
+    JointBox& box = out.boxes[i];
+    box.swing_radius = std::max(box.swing_radius, box.cable_high * std::sin(allowance.travel_swing));
+  }
+  return out;
+}
+
 Airspace whole_reach(const SiteCrane& c, const PathAllowance& allowance) noexcept {
   Airspace out;
   JointBox& box = out.boxes[0];

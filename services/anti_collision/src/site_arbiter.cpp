@@ -13,6 +13,7 @@ const char* to_string(Holding holding) noexcept {
     case Holding::path: return "path";
     case Holding::yield: return "yield";
     case Holding::whole_reach: return "whole_reach";
+    case Holding::out_of_service: return "out_of_service";
   }
   return "?";
 }
@@ -30,6 +31,7 @@ bool SiteArbiter::clear(std::size_t i, const Airspace& a, std::size_t j, const A
 void SiteArbiter::rest(std::size_t crane, const Pose& pose) {
   CraneState& c = cranes_.at(crane);
   c.holding = Holding::rest;
+  c.held_when_lost.reset();
   c.pose = pose;
   c.held = rest_airspace(pose, layout_.paths);
   c.held_shared = false;
@@ -78,9 +80,31 @@ void SiteArbiter::withdraw(std::size_t crane) { cranes_.at(crane).request.reset(
 
 void SiteArbiter::lost(std::size_t crane) {
   CraneState& c = cranes_.at(crane);
+  if (c.holding == Holding::out_of_service) {
+    c.held_when_lost.reset();  // it moved: where it stood says nothing any more
+  } else if (c.holding != Holding::whole_reach) {
+    c.held_when_lost = c.held;
+  }
   c.holding = Holding::whole_reach;
   c.held = whole_reach(layout_.cranes[crane], layout_.paths);
   c.held_shared = true;
+}
+
+void SiteArbiter::out_of_service(std::size_t crane) {
+  CraneState& c = cranes_.at(crane);
+  const std::string& name = layout_.cranes[crane].name;
+  if (c.holding != Holding::whole_reach) {
+    throw std::logic_error("site arbiter: crane " + name + " holds " + to_string(c.holding) +
+                           ": only a silent crane (whole_reach) can be put out of service");
+  }
+  if (!c.held_when_lost) {
+    throw std::logic_error("site arbiter: crane " + name +
+                           " went silent before this service knew where it was: its whole reach stays held");
+  }
+  c.holding = Holding::out_of_service;
+  c.held = out_of_service_airspace(*c.held_when_lost, layout_.paths);
+  c.held_shared = shared(crane, c.held);
+  c.request.reset();
 }
 
 bool SiteArbiter::ranks_before(std::size_t i, std::size_t j) const {
@@ -161,7 +185,8 @@ std::vector<Instruction> SiteArbiter::decide() {
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       const CraneState& c = cranes_[j];
-      const bool travels_shared = c.held_shared && c.holding != Holding::rest;
+      // Serialized: in shared airspace and not at rest (a crane out of service stands braked).
+      const bool travels_shared = c.held_shared && c.holding != Holding::rest && c.holding != Holding::out_of_service;
       if (!clear(i, r.airspace, j, c.held) || (mode_ == ArbiterMode::serialized && r.shared && travels_shared)) {
         waits.push_back(j);
       }

@@ -123,6 +123,7 @@ std::uint8_t holding_code(Holding holding) noexcept {
     case Holding::path: return SiteStatus::HOLDING_PATH;
     case Holding::yield: return SiteStatus::HOLDING_YIELD;
     case Holding::whole_reach: return SiteStatus::HOLDING_WHOLE_REACH;
+    case Holding::out_of_service: return SiteStatus::HOLDING_OUT_OF_SERVICE;
   }
   return SiteStatus::HOLDING_WHOLE_REACH;
 }

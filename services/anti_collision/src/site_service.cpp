@@ -1,7 +1,9 @@
 #include "crane/anti_collision/site_service.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace crane::anti_collision {
@@ -71,6 +73,15 @@ std::string SiteService::report(const CraneReport& r, double time) {
     case Holding::whole_reach:
       if (!r.moving) rest();
       break;
+    case Holding::out_of_service:
+      if (r.moving) {
+        ++moves_without_grant_;
+        arbiter_.lost(r.crane);
+      } else {
+        rest();  // it is back
+      }
+      dirty_ = true;
+      break;
     case Holding::rest:
       if (r.moving) {
         ++moves_without_grant_;
@@ -109,10 +120,33 @@ std::string SiteService::report(const CraneReport& r, double time) {
   return "";
 }
 
+std::string SiteService::out_of_service(std::size_t crane, double time) {
+  if (crane >= links_.size()) {
+    return "site service: crane " + std::to_string(crane) + " is not on the site (" + std::to_string(links_.size()) +
+           " cranes)";
+  }
+  const std::string& name = arbiter_.layout().cranes[crane].name;
+  if (heard(crane, time)) {
+    char ago[32];
+    std::snprintf(ago, sizeof ago, "%.2f", time - links_[crane].last_heard);
+    return "site service: " + name + " was heard " + ago + " s ago: a crane that reports is not out of service";
+  }
+  if (arbiter_.holding(crane) == Holding::out_of_service) return "";
+  if (arbiter_.holding(crane) != Holding::whole_reach) arbiter_.lost(crane);  // silent: as step() would
+  try {
+    arbiter_.out_of_service(crane);
+  } catch (const std::logic_error& error) {
+    return error.what();
+  }
+  links_[crane].pending_id = 0;
+  dirty_ = true;
+  return "";
+}
+
 std::vector<SiteOrder> SiteService::step(double time) {
   for (std::size_t i = 0; i < links_.size(); ++i) {
     if (heard(i, time)) continue;
-    if (arbiter_.holding(i) != Holding::whole_reach) {
+    if (arbiter_.holding(i) != Holding::whole_reach && arbiter_.holding(i) != Holding::out_of_service) {
       arbiter_.lost(i);
       dirty_ = true;
     }

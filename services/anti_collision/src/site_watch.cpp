@@ -78,6 +78,10 @@ Airspace SiteWatch::held(std::size_t i) const {
       return path_airspace(c.read->waypoints, layout_.paths);
     }
     case protocol::SiteStatus::HOLDING_WHOLE_REACH: return whole_reach(layout_.cranes[i], layout_.paths);
+    case protocol::SiteStatus::HOLDING_OUT_OF_SERVICE:  // where its last report put it, braked
+      return out_of_service_airspace(c.read->moving ? path_airspace(c.read->waypoints, layout_.paths)
+                                                    : rest_airspace(c.read->waypoints.front(), layout_.paths),
+                                     layout_.paths);
     default: return {};
   }
 }

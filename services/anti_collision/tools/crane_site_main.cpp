@@ -19,7 +19,8 @@
 //       --faults K injects K random link faults in each coordinated set (stack::random_link_faults)
 //       and prints the reaction times; --degraded D, D random degraded links (delay and loss,
 //       stack::random_degraded_links); --stopped-hosts H, H cranes' hosts stopped for good
-//       (stack::random_host_stops); --shared-points P draws jobs that share fewer points.
+//       (stack::random_host_stops), put out of service by the site operator S s after the stop with
+//       --out-of-service-after S; --shared-points P draws jobs that share fewer points.
 //
 //   crane_site jobs --site FILE [--jobs J] [--seed S] --out DIR
 //       the demo's seeded job set S (the same jobs `demo --sets 1 --seed S` runs) written as one job
@@ -39,6 +40,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <string>
@@ -124,6 +126,7 @@ struct DemoFaults {
   int lost{0};
   int degraded{0};
   int stopped_hosts{0};
+  double out_of_service_after{std::numeric_limits<double>::infinity()};  // [s]
 };
 
 struct SetResult {
@@ -157,6 +160,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         const auto slow = random_degraded_links(site, degraded, seed + static_cast<std::uint64_t>(s));
         options.faults.insert(options.faults.end(), slow.begin(), slow.end());
         options.host_stops = random_host_stops(site, injected.stopped_hosts, seed + static_cast<std::uint64_t>(s));
+        for (HostStop& h : options.host_stops) h.out_of_service_after = injected.out_of_service_after;
         options.loss_seed = seed + static_cast<std::uint64_t>(s);
         r.coordinated = run_site(site, config, set, options);
         options.faults.clear();
@@ -293,7 +297,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   }
   if (injected.stopped_hosts > 0) {
     std::vector<double> rest;
-    int stopped = 0, stuck = 0, left = 0, total = 0, stopped_left = 0;
+    int stopped = 0, stuck = 0, left = 0, total = 0, stopped_left = 0, put_out = 0;
     for (const SetResult& r : results) {
       stopped += r.coordinated.stopped_hosts;
       for (std::size_t i = 0; i < r.coordinated.cranes.size(); ++i) {
@@ -301,6 +305,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         total += jobs;
         if (!std::isnan(c.host_stopped_at)) {
           stopped_left += jobs - c.jobs_done;
+          put_out += std::isnan(c.out_of_service_at) ? 0 : 1;
           if (!std::isnan(c.rest_after_host_stop)) rest.push_back(c.rest_after_host_stop);
           continue;
         }
@@ -314,6 +319,11 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 injected.stopped_hosts, stopped, rest.size(), 1e3 * crane::stack::nearest_rank_quantile(rest, 0.0),
                 1e3 * crane::stack::nearest_rank_quantile(rest, 0.5), 1e3 * crane::stack::nearest_rank_quantile(rest, 1.0),
                 stopped_left, total, left, stuck, crane::stack::kStuckWait);
+    if (std::isfinite(injected.out_of_service_after)) {
+      std::printf("  out of service: the site operator's word %.0f s after each stop; %d of the %d stopped cranes put "
+                  "out of service (the others: their service restarted since, or the run ended first)\n",
+                  injected.out_of_service_after, put_out, stopped);
+    }
   }
   int guard_emergency = 0, guard_soft = 0;
   std::string guard_first;
@@ -400,6 +410,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 20));
   demo_command->add_option("--stopped-hosts", injected.stopped_hosts, "cranes' hosts stopped for good in each coordinated set")
       ->check(CLI::Range(0, 20));
+  demo_command
+      ->add_option("--out-of-service-after", injected.out_of_service_after,
+                   "seconds after a host's stop when the site operator puts its crane out of service (default: never)")
+      ->check(CLI::Range(0.01, 3600.0));
   crane::stack::SiteJobDraw draw;
   CLI::Option* shared_option =
       demo_command

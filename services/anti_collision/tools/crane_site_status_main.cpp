@@ -8,8 +8,15 @@
 // reported pose, the load as its swing envelope; each report pairs with the other crane's latest).
 // --json FILE writes the same figures.
 //
-// Exit status: 0 when a status was heard; 1 when none within --wait ("no site service heard on
-// domain 10 within 2 s"); 2 for a bad site file or option.
+// --out-of-service CRANE (deploy/crane site out-of-service): the site operator's word that CRANE,
+// silent (its host stopped, say), stands braked where it was when it went silent
+// (rt/site/command, COMMAND_OUT_OF_SERVICE; the operator's identity on a secured site). It is
+// written every 0.5 s until the status shows HOLDING_OUT_OF_SERVICE for the crane, or --wait ends;
+// the service logs why it refused (the crane reports, or the service never knew where it was).
+//
+// Exit status: 0 when a status was heard (and, with --out-of-service, the crane is out of
+// service); 1 when none within --wait ("no site service heard on domain 10 within 2 s"); 2 for a
+// bad site file or option; 3 when the service did not put the crane out of service within --wait.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -17,7 +24,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "crane/anti_collision/site_watch.hpp"
@@ -55,10 +65,21 @@ int main(int argc, char** argv) {
   app.add_option("--wait", wait, "seconds to listen (SIGINT ends it sooner)")->check(CLI::Range(0.1, 86400.0));
   std::string json_path;
   app.add_option("--json", json_path, "the figures as JSON");
+  std::string out_of_service;
+  app.add_option("--out-of-service", out_of_service,
+                 "the operator's word: this silent crane stands braked where it went silent (the service then "
+                 "holds that instead of its whole reach)");
   CLI11_PARSE(app, argc, argv);
   anti_collision::SiteLayout layout;
+  std::optional<std::size_t> target;
   try {
     layout = anti_collision::load_site_layout(site_path);
+    if (!out_of_service.empty()) {
+      for (std::size_t i = 0; i < layout.cranes.size(); ++i) {
+        if (layout.cranes[i].name == out_of_service) target = i;
+      }
+      if (!target) throw std::invalid_argument("--out-of-service " + out_of_service + ": no such crane in " + site_path);
+    }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_site_status: %s\n", error.what());
     return 2;
@@ -66,7 +87,8 @@ int main(int argc, char** argv) {
   try {
     runtime::configure_logging(options.log_level, "crane_site_status");
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(layout.domain_id);
-    if (options.identity.empty()) options.identity = "monitor";  // a read-only tool: the monitor role
+    // A read-only tool: the monitor role; the operator's when it writes a command.
+    if (options.identity.empty()) options.identity = target ? "operator" : "monitor";
     auto participant = runtime::make_participant(options, "crane_site_status");
     transport::Wakeup wakeup;
     runtime::install_stop_handlers(&wakeup);
@@ -74,6 +96,15 @@ int main(int argc, char** argv) {
     auto report_reader = participant->make_recording_reader<tp::SiteReport>(&wakeup, 256);
     const std::size_t n = layout.cranes.size();
     anti_collision::SiteWatch watch(layout);
+    std::unique_ptr<transport::Writer<tp::SiteCommand>> command_writer;
+    if (target) command_writer = participant->make_writer<tp::SiteCommand>();
+    const auto applied = [&] {
+      const auto& status = watch.last_status();
+      return target && status && *target < status->holding.size() &&
+             status->holding[*target] == SiteStatus::HOLDING_OUT_OF_SERVICE;
+    };
+    auto next_command = Clock::now();
+    const auto command_seq = static_cast<std::uint64_t>(runtime::now_nanoseconds());  // new for each run
     const auto start = Clock::now();
     const auto until = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait));
     const auto take = [&] {
@@ -93,7 +124,19 @@ int main(int argc, char** argv) {
     };
     while (Clock::now() < until && !runtime::stop_requested()) {
       take();
-      wakeup.wait_until(until);
+      if (target && applied()) break;
+      if (command_writer && Clock::now() >= next_command) {
+        protocol::SiteCommand command;
+        command.header.seq = command_seq;
+        command.crane = static_cast<std::uint8_t>(*target);
+        command.command = protocol::SiteCommand::COMMAND_OUT_OF_SERVICE;
+        tp::msgs::SiteCommand_ out;
+        protocol::to_dds(command, out);
+        out.header().stamp(runtime::now_stamp());
+        command_writer->write(out);
+        next_command += std::chrono::milliseconds(500);
+      }
+      wakeup.wait_until(target ? std::min(until, next_command) : until);
     }
     take();
     const auto& last = watch.last_status();
@@ -153,6 +196,14 @@ int main(int argc, char** argv) {
     out["unresolved"] = last->unresolved;
     out["reports_rejected"] = last->reports_rejected;
     if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << '\n';
+    if (target) {
+      if (!applied()) {
+        std::fprintf(stderr, "the site service did not put %s out of service within %g s (its log says why: a crane "
+                     "that reports, or one it never knew the place of)\n", out_of_service.c_str(), wait);
+        return 3;
+      }
+      std::printf("%s is out of service: the service holds where it stood when it went silent\n", out_of_service.c_str());
+    }
     return 0;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "crane_site_status: %s\n", error.what());

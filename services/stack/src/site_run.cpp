@@ -32,6 +32,7 @@ struct Crane {
   std::unique_ptr<ac::CraneSiteLink> link;
   bool braked{false};  // its guard braked it (it left its grant): it stays braked
   std::uint64_t stop_cycle{std::numeric_limits<std::uint64_t>::max()};  // its host gone from this cycle on
+  double out_of_service_after{std::numeric_limits<double>::infinity()};  // [s] the operator's word, after the stop
   double stuck_since{std::numeric_limits<double>::quiet_NaN()};  // [s] waiting for a stopped crane since
   CraneOutcome outcome;
   [[nodiscard]] bool host_stopped(std::uint64_t k) const noexcept { return k >= stop_cycle; }
@@ -99,7 +100,11 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   const auto limit = static_cast<std::uint64_t>(std::llround(options.time_limit / dt));
   std::vector<Crane> cranes(n);
   for (const HostStop& h : options.host_stops) {
-    cranes[h.crane].stop_cycle = std::min(cranes[h.crane].stop_cycle, static_cast<std::uint64_t>(std::llround(h.time / dt)));
+    const auto cycle = static_cast<std::uint64_t>(std::llround(h.time / dt));
+    if (cycle < cranes[h.crane].stop_cycle) {
+      cranes[h.crane].stop_cycle = cycle;
+      cranes[h.crane].out_of_service_after = h.out_of_service_after;
+    }
   }
   double faults_end = 0.0;  // [s] the last link fault over
   for (const LinkFault& f : options.faults) faults_end = std::max(faults_end, f.start + f.duration);
@@ -181,6 +186,20 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
           out.waited_for[static_cast<std::size_t>(cranes[j].link->activity())] += share;
         }
       }
+    }
+    // The site operator's word: a stopped crane out of service, given each cycle of kWordWindow
+    // until the service takes it.
+    bool word_to_come = false;  // a word not yet given, or being given
+    for (std::size_t i = 0; i < n; ++i) {
+      Crane& c = cranes[i];
+      const double from = static_cast<double>(c.stop_cycle) * dt + c.out_of_service_after;
+      if (!c.host_stopped(k) || !std::isnan(c.outcome.out_of_service_at) || !std::isfinite(from) ||
+          t >= from + kWordWindow) {
+        continue;
+      }
+      word_to_come = true;
+      if (service_down || t < from - 1e-9) continue;
+      if (service->out_of_service(i, t).empty()) c.outcome.out_of_service_at = t;
     }
     // The reports of the last cycle's state, then the service's rules and its instructions.
     if (!service_down) {
@@ -345,7 +364,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       }
     }
     if (std::all_of(cranes.begin(), cranes.end(), [&](const Crane& c) {
-          const bool stuck = c.stuck_since <= t - kStuckWait && t >= faults_end;
+          const bool stuck = c.stuck_since <= t - kStuckWait && t >= faults_end && !word_to_come;
           const bool stopped_at_rest = c.host_stopped(k) && !std::isnan(c.outcome.rest_after_host_stop);
           return c.link->phase() == ac::CraneSiteLink::Phase::done || c.braked || stopped_at_rest || stuck;
         })) {
@@ -418,10 +437,13 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
     }
   }
   for (const HostStop& h : options.host_stops) {
-    if (h.crane >= site.cranes.size() || !(h.time >= 0.0 && h.time <= options.time_limit)) {
+    if (h.crane >= site.cranes.size() || !(h.time >= 0.0 && h.time <= options.time_limit) ||
+        !(h.out_of_service_after > 0.0)) {
       throw std::invalid_argument("site run: a host stop of crane " + std::to_string(h.crane) + " (in [0, " +
                                   std::to_string(site.cranes.size()) + ")) at " + std::to_string(h.time) +
-                                  " s (in [0, time_limit " + std::to_string(options.time_limit) + "]) is out of range");
+                                  " s (in [0, time_limit " + std::to_string(options.time_limit) +
+                                  "]), out of service after " + std::to_string(h.out_of_service_after) +
+                                  " s (> 0), is out of range");
     }
   }
   if (options.mode != SiteMode::solo) return run_together(site, config, jobs, options);
@@ -441,7 +463,7 @@ SiteOutcome run_site(const ac::SiteLayout& site, const StackConfig& config, cons
       own.faults.push_back(f);
     }
     for (HostStop h : options.host_stops) {
-      if (h.crane == i) own.host_stops.push_back({0, h.time});
+      if (h.crane == i) own.host_stops.push_back({0, h.time, h.out_of_service_after});
     }
     const SiteOutcome one = run_together(alone, config, {jobs[i]}, own);
     out.cranes.push_back(one.cranes[0]);

@@ -39,6 +39,8 @@ CRANE_TOPIC(OperatorSpeed, OperatorSpeed_, "rt/crane/operator/speed", QosKind::c
 CRANE_TOPIC(SiteReport, SiteReport_, "rt/site/report", QosKind::command);
 CRANE_TOPIC(SiteInstruction, SiteInstruction_, "rt/site/instruction", QosKind::command);
 CRANE_TOPIC(SiteStatus, SiteStatus_, "rt/site/status", QosKind::command);
+// The site operator's word to the site service (crane_site_status --out-of-service).
+CRANE_TOPIC(SiteCommand, SiteCommand_, "rt/site/command", QosKind::command);
 
 #undef CRANE_TOPIC
 
@@ -66,6 +68,7 @@ void for_each_site_topic(F&& f) {
   f.template operator()<SiteReport>();
   f.template operator()<SiteInstruction>();
   f.template operator()<SiteStatus>();
+  f.template operator()<SiteCommand>();
 }
 
 }  // namespace crane::transport::topics

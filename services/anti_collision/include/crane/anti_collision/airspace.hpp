@@ -63,6 +63,11 @@ struct Airspace {
 /// What a crane that stops reporting holds (issue 34, item 4).
 [[nodiscard]] Airspace whole_reach(const SiteCrane& crane, const PathAllowance& allowance) noexcept;
 
+/// What a crane out of service holds (SiteArbiter::out_of_service): `held`, the airspace it held
+/// when it went silent, with each box's swing widened to the travel swing of its longest cable (a
+/// braked load swings as wide as a travelling one; the crane's supervisor brakes beyond it).
+[[nodiscard]] Airspace out_of_service_airspace(const Airspace& held, const PathAllowance& allowance) noexcept;
+
 /// Closest distance [m] between two cranes' airspaces (>= 0; +infinity when either is empty), and
 /// the parts it is between (Part::cable stands for what hangs from the trolley, the load included).
 [[nodiscard]] PairDistance airspace_distance(const SiteCrane& first, const Airspace& a, const SiteCrane& second,

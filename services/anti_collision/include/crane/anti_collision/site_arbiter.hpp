@@ -4,7 +4,8 @@
 // lockstep site simulation and the tests drive it the same way.
 //
 // Each crane holds an airspace at all times: at rest, the box of its pose (rest); moving, the
-// path it was granted (airspace.hpp); when it stops reporting, its whole reach (lost). A crane at
+// path it was granted (airspace.hpp); when it stops reporting, its whole reach (lost), until an
+// operator confirms it braked where it stood (out_of_service: what it held then). A crane at
 // rest asks for the path of its next leg (request). decide() grants a request when the path keeps
 // at least margins.slow_down from every other crane's held airspace, so that a granted crane never
 // meets another crane's slow-down margin while it keeps to its path (the site's warning and
@@ -55,8 +56,8 @@ struct Instruction {
   std::vector<Pose> waypoints;  // go: the path requested; yield: where the crane is, then its yield pose
 };
 
-enum class Holding : std::uint8_t { rest, path, yield, whole_reach };
-/// "rest", "path", "yield", "whole_reach".
+enum class Holding : std::uint8_t { rest, path, yield, whole_reach, out_of_service };
+/// "rest", "path", "yield", "whole_reach", "out_of_service".
 [[nodiscard]] const char* to_string(Holding holding) noexcept;
 
 class SiteArbiter {
@@ -81,8 +82,17 @@ class SiteArbiter {
   void progress(std::size_t crane, const std::vector<Pose>& remaining);
   /// Crane `crane` withdraws its pending request (nothing left to do).
   void withdraw(std::size_t crane);
-  /// Crane `crane` stopped reporting: it holds its whole reach until its next rest().
+  /// Crane `crane` stopped reporting, or moved without a grant: it holds its whole reach until its
+  /// next rest() (or out_of_service(), when it went silent from a rest or a path; a crane out of
+  /// service that moves cannot be put out of service again before it rests).
   void lost(std::size_t crane);
+  /// An operator confirms that crane `crane`, silent (lost), stands braked where it was when it went
+  /// silent (its host stopped, say): until its next rest() it holds what it held then, with the
+  /// swing of a braked load (out_of_service_airspace), instead of its whole reach. Its pending
+  /// request is dropped. std::logic_error, naming the crane, when it is not lost, or when it went
+  /// silent before this arbiter knew where it was (it was never at rest or on a path here: a
+  /// restarted service); std::out_of_range for a crane index not on the site.
+  void out_of_service(std::size_t crane);
 
   /// Grants and yields, by the rules of the header; each crane at most one instruction. The
   /// instructed cranes hold the path or the yield from now on.
@@ -112,6 +122,7 @@ class SiteArbiter {
   struct CraneState {
     Holding holding{Holding::whole_reach};
     Airspace held;
+    std::optional<Airspace> held_when_lost;  // what it held when it went silent (none: unknown)
     Pose pose;            // at rest: where; else the last rest pose
     bool held_shared{false};
     std::optional<Request> request;

@@ -15,6 +15,8 @@
 //       moving -> keeps the whole reach until the crane rests (a crane that lost its link stops);
 //   rest: at rest -> the pose's box (moved with the crane when it crept more than kRestTolerance
 //       on an axis since the box was taken); moving -> the whole reach (moving without a grant);
+//   out of service (an operator's word, out_of_service()): at rest -> the pose's box (it is
+//       back); moving -> the whole reach (moving without a grant);
 //   path or yield: before the crane has carried out that instruction, nothing (it holds the
 //       path already); after, moving -> the rest of the path (SiteArbiter::progress, when it
 //       has come further along it: another waypoint reached, or a point of the segment under way
@@ -79,6 +81,13 @@ class SiteService {
   /// At `time` [s]: the silent cranes lost, the rules, the instructions to send (new ones and those
   /// to send again).
   [[nodiscard]] std::vector<SiteOrder> step(double time);
+  /// An operator's word at `time` [s] (rt/site/command, COMMAND_OUT_OF_SERVICE): crane `crane`,
+  /// silent, stands braked where it was when it went silent; the service holds that
+  /// (SiteArbiter::out_of_service) instead of its whole reach, until the crane reports at rest.
+  /// Returns "" when applied (or already so), else why not: an unknown crane, a crane heard within
+  /// link_deadline ("tc2 was heard 0.12 s ago: a crane that reports is not out of service"), or
+  /// one this service never knew the place of (it restarted since). Never throws.
+  [[nodiscard]] std::string out_of_service(std::size_t crane, double time);
 
   [[nodiscard]] const SiteArbiter& arbiter() const noexcept { return arbiter_; }
   [[nodiscard]] std::uint32_t epoch() const noexcept { return epoch_; }

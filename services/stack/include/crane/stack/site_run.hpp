@@ -80,9 +80,16 @@ inline constexpr std::size_t kSiteService = static_cast<std::size_t>(-1);
 /// 30 ms on the lab crane; on a real crane, the drives' own watchdog or the spring-applied brakes of
 /// the power cut, taken to act as fast); it reports nothing, so the site service holds its whole
 /// reach once link_deadline has passed, for good.
+/// With `out_of_service_after`, the site operator, having seen the crane braked, puts it out of
+/// service that long after the stop (SiteService::out_of_service, as `crane_site_status
+/// --out-of-service` over DDS): the service then holds where it stood instead of its whole reach.
+/// [s] How long the operator's word is given, each cycle, before it counts as refused (the service
+/// down, or one that never knew the crane's place).
+inline constexpr double kWordWindow = 1.0;
 struct HostStop {
   std::size_t crane{0};
   double time{0.0};  // [s] >= 0
+  double out_of_service_after{std::numeric_limits<double>::infinity()};  // [s] > 0 (infinity: never)
 };
 /// [s] How long a crane waits at rest for a stopped crane's reach (or for cranes that wait for it)
 /// before its run counts as over: the hosts' rule (`deploy/crane site run`, docs/site.md).
@@ -126,6 +133,9 @@ struct CraneOutcome {
   // [s] From its host's stop to its plant at rest (trolley and slew under 0.01 m/s and rad/s, the
   // hoist under 0.01 m/s; NaN: not at rest by the run's end, or no stop).
   double rest_after_host_stop{std::numeric_limits<double>::quiet_NaN()};
+  // [s] When the site service put it out of service on the operator's word (NaN: never; the word
+  // is given each cycle for kWordWindow until the service takes it).
+  double out_of_service_at{std::numeric_limits<double>::quiet_NaN()};
   bool stuck{false};  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
 };
 
@@ -186,8 +196,8 @@ struct SiteOutcome {
 
 /// Runs `jobs` (one list per crane of `site`, in its order) on `site`, every crane with `config`
 /// (its stack, load_site_crane_config; the site file gives where it stands and its shape). With a
-/// host stopped, the run ends once every other crane has done its jobs or is stuck (kStuckWait)
-/// and every link fault is over. Solo runs (SiteMode::solo) keep each crane's own faults and host
+/// host stopped, the run ends once every other crane has done its jobs or is stuck (kStuckWait),
+/// every link fault is over and every operator's word has been given (kWordWindow). Solo runs (SiteMode::solo) keep each crane's own faults and host
 /// stops and those of the site service. Throws std::invalid_argument for a fault or a host stop
 /// out of range (naming it), besides the errors above.
 [[nodiscard]] SiteOutcome run_site(const anti_collision::SiteLayout& site, const StackConfig& config,
