@@ -30,6 +30,17 @@ SiteRunOptions in_mode(SiteMode mode) {
 
 const std::string kSource = CRANE_SOURCE_DIR;
 
+// Coordinated, with seed's 2 lost links and 3 degraded links (as `crane_site demo --faults 2
+// --degraded 3`).
+SiteRunOptions with_network_faults(const crane::anti_collision::SiteLayout& site, std::uint64_t seed) {
+  SiteRunOptions options = in_mode(SiteMode::coordinated);
+  options.faults = random_link_faults(site, 2, seed);
+  const auto slow = random_degraded_links(site, 3, seed);
+  options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+  options.loss_seed = seed;
+  return options;
+}
+
 TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   const StackConfig config = load_site_crane_config(site);
@@ -252,11 +263,8 @@ TEST(SiteRun, DegradedAndLostLinksTogetherKeepTheStopMargin) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   const StackConfig config = load_site_crane_config(site);
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    SiteRunOptions options = in_mode(SiteMode::coordinated);
-    options.faults = random_link_faults(site, 2, seed);
+    SiteRunOptions options = with_network_faults(site, seed);
     const auto slow = random_degraded_links(site, 3, seed);
-    options.faults.insert(options.faults.end(), slow.begin(), slow.end());
-    options.loss_seed = seed;
     for (const LinkFault& f : slow) {
       EXPECT_TRUE(f.degraded());
       EXPECT_LE(f.delay, 0.2);
@@ -375,16 +383,12 @@ TEST(SiteRun, AStoppedHostAmongTheNetworkFaultsKeepsTheStopMargin) {
   const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   const StackConfig config = load_site_crane_config(site);
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    SiteRunOptions options = in_mode(SiteMode::coordinated);
-    options.faults = random_link_faults(site, 2, seed);
-    const auto slow = random_degraded_links(site, 3, seed);
-    options.faults.insert(options.faults.end(), slow.begin(), slow.end());
+    SiteRunOptions options = with_network_faults(site, seed);
     options.host_stops = random_host_stops(site, 1, seed);
     ASSERT_EQ(options.host_stops.size(), 1u);
     EXPECT_LT(options.host_stops[0].crane, site.cranes.size());
     EXPECT_GE(options.host_stops[0].time, 0.0);
     EXPECT_LE(options.host_stops[0].time, 80.0);
-    options.loss_seed = seed;
     const SiteOutcome o = run_site(site, config, random_site_jobs(site, config, 2, seed), options);
     EXPECT_TRUE(o.completed) << "seed " << seed << ": " << o.guard_first;
     EXPECT_GE(o.min_distance, site.margins.stop) << "seed " << seed << ": " << o.closest;
