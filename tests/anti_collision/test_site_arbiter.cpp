@@ -274,29 +274,42 @@ TEST(SiteArbiter, ALostCraneHoldsItsWholeReach) {
 
 // An operator's word that a silent crane stands braked where it went silent (out_of_service): A,
 // lost from its rest pose with its jib away (heading -1.5 rad), no longer holds its whole reach but
-// its rest box, the swing widened to the travel swing of its cable (0.2 sin 0.3 m, by hand), so B
-// may lower its load at (1, 0). A crane lost on its path holds the rest of that path. Refused: a
-// crane that is not silent, one never known (a restarted arbiter), and one out of service that
-// moved (it forgets where it stood).
+// its rest box, with the swing of its load braked from its last reported motion (at rest, but it
+// may have sped up for report_age 0.1 s at the soft decelerations of 0.5 m/s^2 and rad/s^2: 0.05
+// m/s and rad/s; the brakes, 3 times as hard, then stop it 0.1 s later: by hand, the sheave at
+// radius 0.5 + 0.05 x 0.1 + 0.05^2 / 3 moves at hypot(0.05, r x 0.05), and the load keeps that
+// speed over the pendulum's frequency sqrt(g / 0.2)). So B may lower its load at (1, 0). A crane
+// lost on its path holds the rest of that path, the braked swing at each box's longest cable.
+// Refused: a crane that is not silent, one never known (a restarted arbiter), one out of service
+// that moved (it forgets where it stood), and a non-finite motion.
 TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
-  SiteLayout layout = two_towers();
-  layout.paths.travel_swing = 0.3;
+  const SiteLayout layout = two_towers();
   SiteArbiter arbiter(layout, ArbiterMode::coordinated);
-  EXPECT_THROW(arbiter.out_of_service(0), std::logic_error);  // never known: its whole reach stays
+  CraneMotion still;
+  still.slew = -1.5;
+  still.trolley = 0.5;
+  still.cable_length = 0.2;
+  EXPECT_THROW(arbiter.out_of_service(0, still, 0.1), std::logic_error);  // never known: its whole reach stays
   arbiter.rest(0, {-1.5, 0.5, 0.2});
-  EXPECT_THROW(arbiter.out_of_service(0), std::logic_error);  // it reports
+  EXPECT_THROW(arbiter.out_of_service(0, still, 0.1), std::logic_error);  // it reports
   arbiter.rest(1, {kPi, 1.0, 0.2});
   arbiter.lost(0);
   arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
   EXPECT_TRUE(arbiter.decide().empty());
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
-  arbiter.out_of_service(0);
+  CraneMotion nan = still;
+  nan.swing_in_plane = std::nan("");
+  EXPECT_THROW(arbiter.out_of_service(0, nan, 0.1), std::invalid_argument);
+  EXPECT_THROW(arbiter.out_of_service(0, still, -0.1), std::invalid_argument);
+  EXPECT_EQ(arbiter.holding(0), Holding::whole_reach);
+  arbiter.out_of_service(0, still, 0.1);
   EXPECT_EQ(arbiter.holding(0), Holding::out_of_service);
   EXPECT_STREQ(to_string(Holding::out_of_service), "out_of_service");
   ASSERT_EQ(arbiter.held(0).count, 1u);
   EXPECT_DOUBLE_EQ(arbiter.held(0).boxes[0].slew_low, -1.5);
-  EXPECT_DOUBLE_EQ(arbiter.held(0).boxes[0].swing_radius, 0.2 * std::sin(0.3));
-  EXPECT_DOUBLE_EQ(rest_airspace({-1.5, 0.5, 0.2}, layout.paths).boxes[0].swing_radius, 0.0);  // hoist_swing 0
+  const double radius = 0.5 + 0.05 * 0.1 + 0.05 * 0.05 / (2.0 * 1.5);
+  const double by_hand = std::hypot(0.05, radius * 0.05) * std::sqrt(0.2 / 9.80665);
+  EXPECT_NEAR(arbiter.held(0).boxes[0].swing_radius, by_hand, 1e-12);
   const auto orders = arbiter.decide();
   ASSERT_EQ(orders.size(), 1u);
   EXPECT_EQ(orders[0].crane, 1u);
@@ -304,7 +317,8 @@ TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
   arbiter.rest(0, {-1.5, 0.5, 0.2});
   EXPECT_EQ(arbiter.holding(0), Holding::rest);
 
-  // Lost on its path: the rest of the path, widened.
+  // Lost on its path, slewing at 0.3 rad/s: the rest of the path; the swing wider on the box
+  // whose cable reaches 1.0 m than on the one at 0.2 m, and wider than from rest.
   SiteArbiter moving(layout, ArbiterMode::coordinated);
   moving.rest(0, {-1.5, 0.5, 0.2});
   moving.rest(1, {kPi - 1.5, 0.5, 0.2});
@@ -312,15 +326,18 @@ TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
   moving.request(0, path, 0.0);
   ASSERT_EQ(moving.decide().size(), 1u);
   moving.lost(0);
-  moving.out_of_service(0);
+  CraneMotion slewing = still;
+  slewing.slew_rate = 0.3;
+  moving.out_of_service(0, slewing, 0.1);
   ASSERT_EQ(moving.held(0).count, 2u);
-  EXPECT_DOUBLE_EQ(moving.held(0).boxes[1].swing_radius, 1.0 * std::sin(0.3));
+  EXPECT_GT(moving.held(0).boxes[0].swing_radius, by_hand);
+  EXPECT_GT(moving.held(0).boxes[1].swing_radius, moving.held(0).boxes[0].swing_radius);
   // Moving without a grant while out of service: its whole reach, and it cannot be put out of
   // service again before it rests.
   moving.lost(0);
   EXPECT_EQ(moving.holding(0), Holding::whole_reach);
-  EXPECT_THROW(moving.out_of_service(0), std::logic_error);
-  EXPECT_THROW(moving.out_of_service(5), std::out_of_range);
+  EXPECT_THROW(moving.out_of_service(0, slewing, 0.1), std::logic_error);
+  EXPECT_THROW(moving.out_of_service(5, slewing, 0.1), std::out_of_range);
 }
 
 // A crane that reports reaching a waypoint holds only the rest of its path: B's load hangs low at
@@ -886,7 +903,10 @@ TEST(SiteService, MalformedReportsAreRefused) {
             "site service: a report refused: request_count = 1 is out of range: must be in [2, 9] with request_id 3");
   EXPECT_NE(service.report(at_rest(0, a_rest, 3, {a_rest, {0.0, INFINITY, 0.2}}), 0.0).find("request[1]"),
             std::string::npos);
-  EXPECT_EQ(service.reports_rejected(), 6u);
+  CraneReport nan_motion = at_rest(0, a_rest);
+  nan_motion.motion.swing_out_of_plane_rate = std::nan("");
+  EXPECT_NE(service.report(nan_motion, 0.0).find("the measured motion (slew 0 rad"), std::string::npos);
+  EXPECT_EQ(service.reports_rejected(), 7u);
   EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
   EXPECT_FALSE(service.heard(0, 0.0));
   EXPECT_THROW(SiteService(two_towers(), ArbiterMode::coordinated, 0), std::invalid_argument);

@@ -40,7 +40,6 @@ using Clock = std::chrono::steady_clock;
 using Status = protocol::SupervisorStatus;
 
 constexpr auto kCycle = std::chrono::milliseconds(10);
-constexpr double kReportPeriod = 0.1;  // [s] 10 Hz, and on every change
 
 void write_summary(const std::string& path, const std::string& name, const ac::CraneSiteLink& link) {
   if (path.empty()) return;
@@ -198,15 +197,14 @@ int main(int argc, char** argv) {
       if (!changed && now < next_report) continue;
       if (const auto report = link.report()) {
         protocol::SiteReport message{};
-        ac::to_message(*report, message);
-        ac::set_motion(ac::motion_of(*estimate), message);
+        ac::to_message(*report, message);  // its measured motion too, from the estimate of its last step
         message.header.seq = ++report_seq;
         tp::msgs::SiteReport_ out;
         protocol::to_dds(message, out);
         out.header().stamp(runtime::now_stamp());
         reports->write(out);
       }
-      next_report = now + kReportPeriod;
+      next_report = now + ac::kReportPeriod;
     }
     write_summary(summary_path, crane_name, link);
     spdlog::info("site link stopping: {} of {} jobs done", link.jobs_done(), link.jobs());

@@ -133,11 +133,21 @@ Airspace path_airspace(std::span<const Pose> waypoints, const PathAllowance& all
   return out;
 }
 
-Airspace out_of_service_airspace(const Airspace& held, const PathAllowance& allowance) noexcept {
+Airspace out_of_service_airspace(const SiteCrane& crane, const Airspace& held, const CraneMotion& last,
+                                 double report_age) noexcept {
+  const auto faster = [&](double speed, double deceleration) {
+    return speed + (speed < 0.0 ? -1.0 : 1.0) * deceleration * report_age;
+  };
+  CraneMotion braked = last;
+  braked.trolley_velocity = faster(last.trolley_velocity, crane.stopping.trolley_deceleration);
+  braked.slew_rate = faster(last.slew_rate, crane.stopping.slew_deceleration);
+  braked.cable_rate = 0.0;  // the box's longest cable is taken below
   Airspace out = held;
   for (std::size_t i = 0; i < out.count; ++i) {
     JointBox& box = out.boxes[i];
-    box.swing_radius = std::max(box.swing_radius, box.cable_high * std::sin(allowance.travel_swing));
+    braked.cable_length = box.cable_high;
+    braked.trolley = box.trolley_high;  // the largest radius: the sheave's fastest
+    box.swing_radius = stopping_travel(crane, braked, StopKind::emergency).swing_radius;
   }
   return out;
 }

@@ -264,6 +264,7 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
                                               const protocol::Reference& reference, bool braked) {
   if (phase_ == Phase::braked) return std::nullopt;
   pose_ = pose_of(estimate);
+  motion_ = motion_of(estimate);
   stepped_ = true;
   if (braked) {
     phase_ = Phase::braked;
@@ -450,6 +451,7 @@ std::optional<CraneReport> CraneSiteLink::report() const {
   } else {
     r.waypoints = {pose_};
   }
+  r.motion = motion_;
   r.instruction_epoch = carried_epoch_;
   r.instruction_seq = carried_seq_;
   if (phase_ == Phase::asking) {

@@ -90,8 +90,12 @@ void SiteArbiter::lost(std::size_t crane) {
   c.held_shared = true;
 }
 
-void SiteArbiter::out_of_service(std::size_t crane) {
+void SiteArbiter::out_of_service(std::size_t crane, const CraneMotion& last, double report_age) {
   CraneState& c = cranes_.at(crane);
+  if (!is_finite(last) || !(report_age >= 0.0) || !std::isfinite(report_age)) {
+    throw std::invalid_argument("site arbiter: crane " + layout_.cranes[crane].name +
+                                "'s last motion or report age is not finite (or the age is negative)");
+  }
   const std::string& name = layout_.cranes[crane].name;
   if (c.holding != Holding::whole_reach) {
     throw std::logic_error("site arbiter: crane " + name + " holds " + to_string(c.holding) +
@@ -102,7 +106,7 @@ void SiteArbiter::out_of_service(std::size_t crane) {
                            " went silent before this service knew where it was: its whole reach stays held");
   }
   c.holding = Holding::out_of_service;
-  c.held = out_of_service_airspace(*c.held_when_lost, layout_.paths);
+  c.held = out_of_service_airspace(layout_.cranes[crane], *c.held_when_lost, last, report_age);
   c.held_shared = shared(crane, c.held);
   c.request.reset();
 }

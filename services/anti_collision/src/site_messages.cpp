@@ -44,6 +44,7 @@ std::string from_message(const SiteReport& m, CraneReport& r) {
   }
   r.crane = m.crane;
   r.moving = m.state == SiteReport::STATE_MOVING;
+  r.motion = motion_of(m);
   r.waypoints = read_poses(m.waypoint_count, m.waypoint_slew, m.waypoint_trolley, m.waypoint_cable_length);
   r.instruction_epoch = m.instruction_epoch;
   r.instruction_seq = m.instruction_seq;
@@ -90,6 +91,7 @@ void to_message(const CraneReport& r, SiteReport& m) noexcept {
   m.request_id = r.request_id;
   m.request_count = r.request_id != 0 ? write_poses(r.request, m.request_slew, m.request_trolley, m.request_cable_length)
                                       : std::uint8_t{0};
+  set_motion(r.motion, m);
 }
 
 void to_message(const SiteOrder& o, std::uint32_t epoch, SiteInstruction& m) noexcept {

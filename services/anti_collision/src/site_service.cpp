@@ -51,6 +51,15 @@ std::string SiteService::report(const CraneReport& r, double time) {
   } else {
     why = bad_waypoint(r.waypoints, "waypoint");
     if (why.empty() && r.request_id != 0) why = bad_waypoint(r.request, "request");
+    if (why.empty() && !is_finite(r.motion)) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "the measured motion (slew %g rad, %g rad/s; trolley %g m, %g m/s; cable %g m; swing %g, %g rad) is "
+                    "not finite or its cable length is not > 0",
+                    r.motion.slew, r.motion.slew_rate, r.motion.trolley, r.motion.trolley_velocity, r.motion.cable_length,
+                    r.motion.swing_in_plane, r.motion.swing_out_of_plane);
+      why = text;
+    }
   }
   if (!why.empty()) {
     ++rejected_;
@@ -59,6 +68,7 @@ std::string SiteService::report(const CraneReport& r, double time) {
 
   Link& link = links_[r.crane];
   link.last_heard = time;
+  link.motion = r.motion;
   if (!link.carried_out && r.instruction_epoch == epoch_ && r.instruction_seq >= link.last_order.seq) {
     link.carried_out = true;
   }
@@ -134,7 +144,7 @@ std::string SiteService::out_of_service(std::size_t crane, double time) {
   if (arbiter_.holding(crane) == Holding::out_of_service) return "";
   if (arbiter_.holding(crane) != Holding::whole_reach) arbiter_.lost(crane);  // silent: as step() would
   try {
-    arbiter_.out_of_service(crane);
+    arbiter_.out_of_service(crane, links_[crane].motion, kReportPeriod);
   } catch (const std::logic_error& error) {
     return error.what();
   }

@@ -79,9 +79,10 @@ Airspace SiteWatch::held(std::size_t i) const {
     }
     case protocol::SiteStatus::HOLDING_WHOLE_REACH: return whole_reach(layout_.cranes[i], layout_.paths);
     case protocol::SiteStatus::HOLDING_OUT_OF_SERVICE:  // where its last report put it, braked
-      return out_of_service_airspace(c.read->moving ? path_airspace(c.read->waypoints, layout_.paths)
+      return out_of_service_airspace(layout_.cranes[i],
+                                     c.read->moving ? path_airspace(c.read->waypoints, layout_.paths)
                                                     : rest_airspace(c.read->waypoints.front(), layout_.paths),
-                                     layout_.paths);
+                                     c.read->motion, kReportPeriod);
     default: return {};
   }
 }

@@ -64,9 +64,14 @@ struct Airspace {
 [[nodiscard]] Airspace whole_reach(const SiteCrane& crane, const PathAllowance& allowance) noexcept;
 
 /// What a crane out of service holds (SiteArbiter::out_of_service): `held`, the airspace it held
-/// when it went silent, with each box's swing widened to the travel swing of its longest cable (a
-/// braked load swings as wide as a travelling one; the crane's supervisor brakes beyond it).
-[[nodiscard]] Airspace out_of_service_airspace(const Airspace& held, const PathAllowance& allowance) noexcept;
+/// when it went silent (it stands braked in it), each box's swing radius [m] that of an emergency
+/// stop (crane_geometry.hpp's stopping_travel, StopKind::emergency: the measured swing's amplitude
+/// plus the sheave's speed over the pendulum's frequency) from `last`, its last reported motion,
+/// taken at the box's longest cable (the widest), with its trolley and slew speeds first raised
+/// by `report_age` [s] of its soft stop's deceleration (it may have sped up since that report).
+/// Non-finite `last` gives non-finite radii: callers check it first (is_finite).
+[[nodiscard]] Airspace out_of_service_airspace(const SiteCrane& crane, const Airspace& held, const CraneMotion& last,
+                                               double report_age) noexcept;
 
 /// Closest distance [m] between two cranes' airspaces (>= 0; +infinity when either is empty), and
 /// the parts it is between (Part::cable stands for what hangs from the trolley, the load included).

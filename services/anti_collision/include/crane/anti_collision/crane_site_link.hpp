@@ -235,6 +235,7 @@ class CraneSiteLink {
   std::uint32_t request_id_{0};      // the leg asked for (0: none)
   std::uint32_t requests_{0};        // requests made
   bool stepped_{false};
+  CraneMotion motion_{};  // measured, at its last step (its reports carry it)
   std::vector<Pose> request_;
   Pose pose_{};                      // the measured pose (the last step's)
   std::uint32_t carried_epoch_{0};

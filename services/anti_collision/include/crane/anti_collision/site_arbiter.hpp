@@ -88,11 +88,13 @@ class SiteArbiter {
   void lost(std::size_t crane);
   /// An operator confirms that crane `crane`, silent (lost), stands braked where it was when it went
   /// silent (its host stopped, say): until its next rest() it holds what it held then, with the
-  /// swing of a braked load (out_of_service_airspace), instead of its whole reach. Its pending
-  /// request is dropped. std::logic_error, naming the crane, when it is not lost, or when it went
-  /// silent before this arbiter knew where it was (it was never at rest or on a path here: a
-  /// restarted service); std::out_of_range for a crane index not on the site.
-  void out_of_service(std::size_t crane);
+  /// swing of its load braked from `last`, its last reported motion, up to `report_age` [s] old
+  /// (out_of_service_airspace), instead of its whole reach. Its pending request is dropped.
+  /// std::logic_error, naming the crane, when it is not lost, or when it went silent before this
+  /// arbiter knew where it was (it was never at rest or on a path here: a restarted service);
+  /// std::invalid_argument for a non-finite `last` or a negative `report_age`; std::out_of_range
+  /// for a crane index not on the site.
+  void out_of_service(std::size_t crane, const CraneMotion& last, double report_age);
 
   /// Grants and yields, by the rules of the header; each crane at most one instruction. The
   /// instructed cranes hold the path or the yield from now on.

@@ -29,7 +29,8 @@
 // has not carried out is sent again every kResendPeriod.
 //
 // Errors: report() refuses a malformed report (an unknown crane, a waypoint count out of range, a
-// non-finite or non-positive cable length, a request of fewer than 2 waypoints) with a message
+// non-finite or non-positive cable length, a request of fewer than 2 waypoints, a non-finite
+// measured motion) with a message
 // naming the field and the value, counts it and changes nothing; it never throws. The constructor
 // throws common::ConfigError for an invalid layout (validate()).
 
@@ -46,10 +47,14 @@
 
 namespace crane::anti_collision {
 
+/// [s] How often a crane reports when nothing changes (its site link: 10 Hz, and on every change).
+inline constexpr double kReportPeriod = 0.1;
+
 /// One crane's report, in the core's terms (rt/site/report).
 struct CraneReport {
   std::size_t crane{0};                 // index in the site file
   bool moving{false};                   // false: at rest at waypoints[0]
+  CraneMotion motion{};                 // measured, at the report (the views; a silent crane's braked swing)
   std::vector<Pose> waypoints;          // 1 to Airspace::kMaxBoxes + 1 (see the header)
   std::uint32_t instruction_epoch{0};   // the last instruction carried out: its service's epoch
   std::uint64_t instruction_seq{0};     // and its seq (0, 0: none)
@@ -82,8 +87,9 @@ class SiteService {
   /// to send again).
   [[nodiscard]] std::vector<SiteOrder> step(double time);
   /// An operator's word at `time` [s] (rt/site/command, COMMAND_OUT_OF_SERVICE): crane `crane`,
-  /// silent, stands braked where it was when it went silent; the service holds that
-  /// (SiteArbiter::out_of_service) instead of its whole reach, until the crane reports at rest.
+  /// silent, stands braked where it was when it went silent; the service holds that, with the
+  /// swing of its load braked from its last report's motion (SiteArbiter::out_of_service, the
+  /// report up to kReportPeriod old), instead of its whole reach, until the crane reports at rest.
   /// Returns "" when applied (or already so), else why not: an unknown crane, a crane heard within
   /// link_deadline ("tc2 was heard 0.12 s ago: a crane that reports is not out of service"), or
   /// one this service never knew the place of (it restarted since). Never throws.
@@ -108,6 +114,7 @@ class SiteService {
     double last_sent{0.0};
     Pose rest_pose{};                // where its rest box was taken
     std::vector<Pose> progressed;    // the rest of its path at its last progress taken (empty: none yet)
+    CraneMotion motion{};            // measured, at its last report
   };
 
   SiteArbiter arbiter_;
