@@ -176,6 +176,12 @@ site)
     && rogue_rc=0 || rogue_rc=$?
   echo "site_service as monitor: exit $rogue_rc: $(grep -m1 -i "writer" "$W/rogue_service.log" || tail -1 "$W/rogue_service.log")"
   check "a site service with the monitor's identity cannot write instructions" grep -qi "cannot create a writer" "$W/rogue_service.log"
+  # The site operator's word (rt/site/command) is the operator's: with the monitor's identity,
+  # crane_site_status --out-of-service cannot create its command writer (exit 2).
+  timeout 30 "$BIN/crane_site_status" --site "$SITE" --security "$MATERIAL" --identity monitor --wait 1 \
+    --out-of-service tc2 > "$W/monitor_command.log" 2>&1 && monitor_command_rc=0 || monitor_command_rc=$?
+  echo "crane_site_status --out-of-service as monitor: exit $monitor_command_rc: $(grep -m1 -i "writer" "$W/monitor_command.log" || tail -1 "$W/monitor_command.log")"
+  check "the monitor cannot write the site operator's command" grep -qi "cannot create a writer" "$W/monitor_command.log"
   # 2. The service and tc1's stack (its supervisor's guard, its site link), each its own identity;
   # tc2 at rest where its jobs start, its reports played with the site link's identity (the site's
   # crane reports: tests/web/site_reports_writer), so that the service may grant tc1 its first leg.
