@@ -77,7 +77,8 @@ if [ "${CRANE_SITE_NETNS:-}" != 1 ]; then
     --until-done "$UNTIL" ${SECURITY:+--security "$SECURITY"} ${FAULTS[@]+$(printf -- '--fault %s ' "${FAULTS[@]}")}
 fi
 
-declare -A HOLDER ADDRESS PIDS DELAYERS  # DELAYERS: crane_packet_delay of a delay fault
+declare -A HOLDER ADDRESS PIDS DELAYERS WORDS  # DELAYERS: crane_packet_delay of a delay fault; WORDS: the
+                                               # operator's crane_site_status --out-of-service
 NAMES=()
 MONITOR=
 cleanup() {
@@ -86,6 +87,7 @@ cleanup() {
   for pid in "${PIDS[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
   for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
   for pid in "${DELAYERS[@]}"; do kill -TERM "$pid" 2>/dev/null; wait "$pid" 2>/dev/null || true; done
+  for pid in "${WORDS[@]}"; do kill -TERM "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; done
   for pid in "${HOLDER[@]}"; do kill "$pid" 2>/dev/null || true; done
 }
 trap cleanup EXIT
@@ -242,11 +244,15 @@ apply_fault() {  # index, spec, phase (on|off)
         ip link set "v-$host" down
         wait "${PIDS[$host]}" 2>/dev/null || true
       fi ;;
-    out-of-service)
+    out-of-service)  # in the background for up to 10 s: the other faults keep their times
       if [ "$phase" = on ]; then
-        local rc=0
         "$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --out-of-service "$host" --wait 10 \
-          > "$OUT/out_of_service_$host.txt" 2>&1 || rc=$?
+          > "$OUT/out_of_service_$host.txt" 2>&1 &
+        WORDS[$i]=$!
+      else
+        local rc=0
+        wait "${WORDS[$i]}" || rc=$?
+        unset "WORDS[$i]"
         echo "$host $rc" >> "$OUT/out_of_service.txt"
       fi ;;
     kill-service)
@@ -267,7 +273,8 @@ fault_times() {  # the spec's start and end, in whole seconds after ready
   case $kind in
     partition) echo "$b $((b + c))" ;;
     kill-service) echo "$a $((a + b))" ;;
-    stop-host | out-of-service) echo "$b $b" ;;
+    stop-host) echo "$b $b" ;;
+    out-of-service) echo "$b $((b + 11))" ;;  # crane_site_status --wait 10, and its ending
     *) echo "$c $((c + d))" ;;
   esac
 }
