@@ -43,7 +43,9 @@
 #                                                     --out-of-service from the office, the operator's
 #                                                     identity); the service then holds where it stood
 #                                                     instead of its whole reach; the run fails when
-#                                                     the service does not take it within 10 s
+#                                                     the service does not take it within 45 s (a
+#                                                     partition of 30 s and a restart of 10 s may
+#                                                     keep the word from the service)
 #                   HOST is a crane's name or "site" (the service's host). With a host stopped, the
 #                   run ends once the faults are over and every other crane has done its jobs or has
 #                   waited at rest for 15 s (for the stopped crane's reach); it is safe when no crane
@@ -148,8 +150,9 @@ first_config=$(awk 'NR == 1 { print $3 }' "$OUT/jobs/hosts.txt")
   > "$OUT/crane_web.log" 2>&1 &
 PIDS[crane_web]=$!
 make_host site 2
-start_service() {
-  spawn site "$OUT/site_service.log" "$BIN/site_service" --site "$SITE" "${NET[@]}"
+rm -f "$OUT/site_service_memory.json" "$OUT/site_service_memory.json.bad"  # a new site run: no memory of an old one
+start_service() {  # its memory file (where each crane stood) outlives a kill-service fault
+  spawn site "$OUT/site_service.log" "$BIN/site_service" --site "$SITE" "${NET[@]}" --memory "$OUT/site_service_memory.json"
   PIDS[site_service]=$!
 }
 start_service
@@ -244,9 +247,9 @@ apply_fault() {  # index, spec, phase (on|off)
         ip link set "v-$host" down
         wait "${PIDS[$host]}" 2>/dev/null || true
       fi ;;
-    out-of-service)  # in the background for up to 10 s: the other faults keep their times
+    out-of-service)  # in the background for up to 45 s: the other faults keep their times
       if [ "$phase" = on ]; then
-        "$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --out-of-service "$host" --wait 10 \
+        "$BIN/crane_site_status" --site "$SITE" "${NET[@]}" --out-of-service "$host" --wait 45 \
           > "$OUT/out_of_service_$host.txt" 2>&1 &
         WORDS[$i]=$!
       else
@@ -274,7 +277,7 @@ fault_times() {  # the spec's start and end, in whole seconds after ready
     partition) echo "$b $((b + c))" ;;
     kill-service) echo "$a $((a + b))" ;;
     stop-host) echo "$b $b" ;;
-    out-of-service) echo "$b $((b + 11))" ;;  # crane_site_status --wait 10, and its ending
+    out-of-service) echo "$b $((b + 46))" ;;  # crane_site_status --wait 45, and its ending (or sooner: the word taken)
     *) echo "$c $((c + d))" ;;
   esac
 }
@@ -305,7 +308,8 @@ while :; do
       FAULT_DONE[$i]=on
       [[ ${FAULTS[$i]} == kill-service:* ]] && FAULT_DONE[service_down]=1
       apply_fault "$i" "${FAULTS[$i]}" on
-    elif [ "${FAULT_DONE[$i]:-}" = on ] && later "$to"; then
+    elif [ "${FAULT_DONE[$i]:-}" = on ] && { later "$to" ||
+           { [[ ${FAULTS[$i]} == out-of-service:* ]] && ! kill -0 "${WORDS[$i]}" 2>/dev/null; }; }; then
       FAULT_DONE[$i]=off
       apply_fault "$i" "${FAULTS[$i]}" off
       [[ ${FAULTS[$i]} == kill-service:* ]] && FAULT_DONE[service_down]=0

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/grant_guard.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/anti_collision/site_memory.hpp"
 #include "crane/anti_collision/site_messages.hpp"
 #include "crane/anti_collision/site_service.hpp"
 #include "crane/common/validation.hpp"
@@ -854,8 +856,196 @@ TEST(SiteService, AnOperatorPutsASilentCraneOutOfService) {
   SiteService restarted(s, ArbiterMode::coordinated, 4);
   (void)restarted.step(1.0);
   EXPECT_EQ(restarted.out_of_service(0, 1.0),
-            "site arbiter: crane a went silent before this service knew where it was: its whole reach stays held");
+            "site arbiter: crane a went silent where this service did not know it stood (never heard at rest or on a grant, with no "
+            "memory of it, or it moved without a grant): its whole reach stays held");
   EXPECT_EQ(restarted.arbiter().holding(0), Holding::whole_reach);
+}
+
+void expect_same_airspace(const Airspace& a, const Airspace& b) {
+  ASSERT_EQ(a.count, b.count);
+  for (std::size_t k = 0; k < a.count; ++k) {
+    const JointBox& x = a.boxes[k];
+    const JointBox& y = b.boxes[k];
+    EXPECT_EQ(x.slew_low, y.slew_low) << k;
+    EXPECT_EQ(x.slew_high, y.slew_high) << k;
+    EXPECT_EQ(x.trolley_low, y.trolley_low) << k;
+    EXPECT_EQ(x.trolley_high, y.trolley_high) << k;
+    EXPECT_EQ(x.cable_low, y.cable_low) << k;
+    EXPECT_EQ(x.cable_high, y.cable_high) << k;
+    EXPECT_EQ(x.swing_radius, y.swing_radius) << k;
+  }
+}
+
+// The service's memory across its own restart (SiteService::memory and recall; site_service
+// --memory, site_memory.hpp): A rests (its load swinging 0.03 rad), B lowers on its grant; both go
+// silent and the service restarts. Without the memory the operator's word is refused for both; with
+// it, A is held in its rest box braked from its remembered motion, exactly as the service before
+// would have held it, and B on its path as it was held (travel and hoist allowances): the memory's
+// motion may be older than B's stop. Nothing is granted on a memory; the memory reads back from its
+// file to the bit; a crane out of service stays so; a crane heard moving from a remembered rest
+// forgets it; bad memories are refused whole, the crane and the box named.
+TEST(SiteService, ARestartedServiceRecallsWhereASilentCraneStood) {
+  SiteLayout s = two_towers();
+  s.link_deadline = 0.3;
+  SiteService before(s, ArbiterMode::coordinated, 3);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  CraneReport a = at_rest(0, a_rest);
+  a.motion = {-1.5, 0.0, 0.5, 0.0, 0.2, 0.0, 0.03, 0.0, 0.0, 0.0};
+  ASSERT_EQ(before.report(a, 0.0), "");
+  const std::vector<Pose> b_path{{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}};
+  ASSERT_EQ(before.report(at_rest(1, b_path[0], 6, b_path), 0.0), "");
+  const std::vector<SiteOrder> go = before.step(0.0);
+  ASSERT_EQ(go.size(), 1u);  // B lowers
+  CraneReport b;
+  b.crane = 1;
+  b.moving = true;
+  b.waypoints = b_path;
+  b.instruction_epoch = 3;
+  b.instruction_seq = go[0].seq;
+  b.motion = {kPi, 0.0, 1.0, 0.0, 0.4, 0.2, 0.0, 0.0, 0.0, 0.0};
+  ASSERT_EQ(before.report(b, 0.05), "");
+  ASSERT_EQ(before.arbiter().holding(1), Holding::path);
+  const Airspace b_held = before.arbiter().held(1);
+  SiteService reference = before;  // the word, given to the service before its restart
+  ASSERT_EQ(reference.out_of_service(0, 0.4), "");
+
+  const SiteMemory memory = before.memory();
+  const std::string text = memory_to_json(memory, s);
+  const SiteMemory read = memory_from_json(text, s, "memory.json");
+  EXPECT_EQ(memory_to_json(read, s), text);
+  ASSERT_TRUE(read[0].place && read[1].place);
+  EXPECT_FALSE(read[0].place->moving);
+  EXPECT_TRUE(read[1].place->moving);
+  expect_same_airspace(read[1].place->airspace, b_held);
+  EXPECT_EQ(read[0].motion.swing_in_plane, 0.03);
+
+  SiteService without(s, ArbiterMode::coordinated, 4);
+  EXPECT_EQ(without.out_of_service(0, 1.0),
+            "site arbiter: crane a went silent where this service did not know it stood (never heard at rest or on a grant, with no "
+            "memory of it, or it moved without a grant): its whole reach stays held");
+  EXPECT_EQ(without.out_of_service(1, 1.0),
+            "site arbiter: crane b went silent where this service did not know it stood (never heard at rest or on a grant, with no "
+            "memory of it, or it moved without a grant): its whole reach stays held");
+
+  SiteService after(s, ArbiterMode::coordinated, 4);
+  ASSERT_EQ(after.recall(read), "");
+  EXPECT_TRUE(after.step(1.0).empty());
+  EXPECT_EQ(after.arbiter().holding(0), Holding::whole_reach);  // nothing granted on a memory
+  EXPECT_EQ(after.arbiter().holding(1), Holding::whole_reach);
+  ASSERT_EQ(after.out_of_service(0, 1.0), "");
+  expect_same_airspace(after.arbiter().held(0), reference.arbiter().held(0));
+  EXPECT_GT(after.arbiter().held(0).boxes[0].swing_radius, 0.2 * std::sin(0.03));  // braked from its swing
+  ASSERT_EQ(after.out_of_service(1, 1.0), "");
+  expect_same_airspace(after.arbiter().held(1), b_held);
+
+  // Out of service before the restart: so again at once after it.
+  SiteService again(s, ArbiterMode::coordinated, 5);
+  ASSERT_EQ(again.recall(reference.memory()), "");
+  EXPECT_EQ(again.arbiter().holding(0), Holding::out_of_service);
+  expect_same_airspace(again.arbiter().held(0), reference.arbiter().held(0));
+
+  // Heard moving from a remembered rest: a move without a grant, the place forgotten. From a
+  // remembered path: it may be finishing it, the place kept.
+  SiteService moved(s, ArbiterMode::coordinated, 6);
+  ASSERT_EQ(moved.recall(read), "");
+  CraneReport a_moving = a;
+  a_moving.moving = true;
+  a_moving.waypoints = {a_rest, {-1.0, 0.5, 0.2}};
+  ASSERT_EQ(moved.report(a_moving, 1.0), "");
+  b.instruction_seq = 0;  // an instruction of the service before: not this one's
+  ASSERT_EQ(moved.report(b, 1.0), "");
+  (void)moved.step(1.5);
+  EXPECT_EQ(moved.out_of_service(0, 1.5),
+            "site arbiter: crane a went silent where this service did not know it stood (never heard at rest or on a grant, with no "
+            "memory of it, or it moved without a grant): its whole reach stays held");
+  EXPECT_EQ(moved.out_of_service(1, 1.5), "");
+
+  // At rest, then moving without a grant, then silent: where it stood says nothing any more.
+  SiteService rogue(s, ArbiterMode::coordinated, 9);
+  ASSERT_EQ(rogue.report(a, 0.0), "");
+  ASSERT_EQ(rogue.report(a_moving, 0.1), "");
+  EXPECT_EQ(rogue.moves_without_grant(), 1u);
+  (void)rogue.step(0.5);
+  EXPECT_NE(rogue.out_of_service(0, 0.5).find("its whole reach stays held"), std::string::npos);
+  EXPECT_EQ(rogue.arbiter().holding(0), Holding::whole_reach);
+
+  // Refused whole: heard already, another site's size, a bad box (crane a's place not recalled).
+  SiteService heard(s, ArbiterMode::coordinated, 7);
+  ASSERT_EQ(heard.report(a, 1.0), "");
+  EXPECT_EQ(heard.recall(read), "site service: crane a was heard already: a memory is recalled only at the start");
+  SiteService bad(s, ArbiterMode::coordinated, 8);
+  EXPECT_EQ(bad.recall(SiteMemory(3)), "site service: the memory has 3 cranes, the site 2");
+  SiteMemory broken = read;
+  broken[1].place->airspace.boxes[0].cable_low = std::nan("");
+  EXPECT_EQ(bad.recall(broken).rfind("site service: the memory refused: site arbiter: crane b's recalled box 0 (slew", 0),
+            0u)
+      << bad.recall(broken);
+  broken[1].place->airspace.boxes[0].cable_low = 3.0;  // above its high end
+  EXPECT_NE(bad.recall(broken).find("crane b's recalled box 0"), std::string::npos);
+  broken[1].place->airspace.count = 0;
+  EXPECT_EQ(bad.recall(broken),
+            "site service: the memory refused: site arbiter: crane b's recalled place has 0 boxes: must be in [1, 8]");
+  broken = read;
+  broken[0].place.reset();
+  broken[0].out_of_service = true;
+  EXPECT_EQ(bad.recall(broken),
+            "site service: the memory refused: site arbiter: crane a is out of service in the memory but has no place");
+  (void)bad.step(2.0);
+  EXPECT_NE(bad.out_of_service(0, 2.0), "");  // nothing recalled
+  EXPECT_NE(bad.out_of_service(1, 2.0), "");
+}
+
+// The memory's file (site_memory.hpp): written whole and read back; a missing file is no memory;
+// a bad one is refused with the field and the value named.
+TEST(SiteMemory, TheFileIsReadBackOrRefusedWithTheFieldNamed) {
+  const SiteLayout s = two_towers();
+  SiteMemory memory(2);
+  memory[0].place = SiteArbiter::Place{rest_airspace({0.1, 0.7, 0.3}, s.paths), false};
+  memory[0].motion.slew_rate = 1.0 / 3.0;
+  const std::string text = memory_to_json(memory, s);
+  const std::string path = ::testing::TempDir() + "site_memory_test.json";
+  std::remove(path.c_str());
+  EXPECT_FALSE(read_memory_file(path, s).has_value());
+  write_memory_file(path, text);
+  const auto back = read_memory_file(path, s);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(memory_to_json(*back, s), text);
+  EXPECT_EQ((*back)[0].motion.slew_rate, 1.0 / 3.0);
+  EXPECT_FALSE((*back)[1].place.has_value());
+  EXPECT_THROW(write_memory_file("/nonexistent-dir/memory.json", text), std::runtime_error);
+  EXPECT_THROW((void)memory_to_json(SiteMemory(1), s), std::invalid_argument);
+
+  const auto refused = [&](std::string changed, const std::string& from, const std::string& to) {
+    const auto at = changed.find(from);
+    if (at == std::string::npos) return "'" + from + "' not in the file";
+    changed.replace(at, from.size(), to);
+    try {
+      (void)memory_from_json(changed, s, "m.json");
+    } catch (const crane::common::ConfigError& error) {
+      return std::string(error.what());
+    }
+    return std::string("not refused");
+  };
+  EXPECT_EQ(refused("[]", "[]", "[1]"), "m.json: the file is not an object");
+  EXPECT_EQ(refused(text, "\"cranes\"", "x").substr(0, 30), "m.json: the file is not JSON: ");
+  // A number beyond a double is nlohmann's out_of_range, not its parse_error (found by fuzz.site_memory).
+  EXPECT_EQ(refused(text, "\"trolley\": 0.5", "\"trolley\": 1e99999").substr(0, 30), "m.json: the file is not JSON: ");
+  EXPECT_EQ(refused(text, "memory 1", "memory 2"),
+            "m.json: format = \"crane site service memory 2\": must be \"crane site service memory 1\"");
+  EXPECT_EQ(refused(text, "\"site\": \"" + s.name + "\"", "\"site\": \"other\""),
+            "m.json: site = \"other\": the site file is '" + s.name + "'");
+  EXPECT_EQ(refused(text, "\"name\": \"b\"", "\"name\": \"c\""),
+            "m.json: cranes[1].name = \"c\": the site file's crane 1 is 'b'");
+  EXPECT_EQ(refused(text, "\"moving\": false", "\"moving\": 0"), "m.json: cranes[0].place.moving = 0 is not true or false");
+  EXPECT_EQ(refused(text, "\"slew_rate\"", "\"slew_speed\""), "m.json: cranes[0].motion.slew_rate is missing");
+  EXPECT_EQ(refused(text, "\"trolley\": 0.5", "\"trolley\": \"x\""),
+            "m.json: cranes[0].motion.trolley = \"x\" is not a number");
+  // A box of 6 numbers: its first number and the comma after it taken out.
+  const std::size_t open = text.find('[', text.find('[', text.find("\"boxes\"")) + 1);
+  const std::size_t comma = text.find(',', open);
+  EXPECT_EQ(refused(text, text.substr(open, comma + 1 - open), "["), "m.json: cranes[0].place.boxes[0] has 6 numbers: must be 7");
+  EXPECT_EQ(refused(text, "\"place\": null", "\"place\": {\"moving\": true, \"boxes\": []}"),
+            "m.json: cranes[1].place.boxes has 0 boxes: must be 1 to 8");
 }
 
 // A crane that moves while the service holds only its rest box has no grant: its whole reach is

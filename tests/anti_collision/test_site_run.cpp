@@ -345,7 +345,8 @@ TEST(SiteRun, AStoppedHostsCraneHoldsItsWholeReachForGood) {
 // The site operator's word (HostStop::out_of_service_after, as `crane_site_status --out-of-service`):
 // tc1's host stops 1 s in and the operator puts it out of service 5 s later; the service then holds
 // where tc1 stood instead of its whole reach, and tc2 works on. A crane whose host stopped before
-// the service ever heard it cannot be put out of service: its whole reach stays held.
+// the service ever heard it cannot be put out of service: its whole reach stays held; one whose
+// host stopped while the service was down can, from the restarted service's memory.
 TEST(SiteRun, AnOperatorPutsAStoppedCraneOutOfServiceAndTheOthersWorkOn) {
   auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   site.cranes.resize(2);
@@ -371,6 +372,20 @@ TEST(SiteRun, AnOperatorPutsAStoppedCraneOutOfServiceAndTheOthersWorkOn) {
   EXPECT_TRUE(std::isnan(never_heard.cranes[0].out_of_service_at));
   EXPECT_TRUE(never_heard.cranes[1].stuck);
   EXPECT_EQ(never_heard.cranes[1].jobs_done, 0);
+
+  // The service killed at 0.5 s and restarted at 2.5 s; tc1's host stops at 1 s, while it is down,
+  // so the service after never hears tc1. Its memory (site_service --memory) knows where tc1 stood
+  // when the service before last heard it, and the word is taken.
+  options.host_stops = {HostStop{0, 1.0, 5.0}};
+  options.faults = {LinkFault{kSiteService, 0.5, 2.0}};
+  const SiteOutcome restarted = run_site(site, config, shared, options);
+  EXPECT_TRUE(restarted.completed);
+  EXPECT_NEAR(restarted.cranes[0].out_of_service_at, 6.0, 1e-6);
+  EXPECT_GT(restarted.cranes[1].jobs_done, held.cranes[1].jobs_done);
+  EXPECT_GE(restarted.min_distance, site.margins.stop) << restarted.closest;
+  std::printf("with the service down 0.5-2.5 s: tc1 out of service at %.2f s, tc2 did %d jobs; min distance %.3f m\n",
+              restarted.cranes[0].out_of_service_at, restarted.cranes[1].jobs_done, restarted.min_distance);
+  options.faults.clear();
 
   options.host_stops = {HostStop{0, 1.0, 0.0}};
   EXPECT_THROW((void)run_site(site, config, shared, options), std::invalid_argument);

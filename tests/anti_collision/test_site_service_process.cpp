@@ -68,11 +68,12 @@ class SiteProcess {
     crane::launch::ProcessSpec spec;
     spec.name = "site_service";
     spec.executable = kBin + "/site_service";
-    spec.arguments = {"--site", kSite, "--domain", std::to_string(kDomain)};
+    spec.arguments = {"--site", kSite, "--domain", std::to_string(kDomain), "--memory", memory().string()};
     spec.log_path = (dir_ / ("site_service_" + std::to_string(++starts_) + ".log")).string();
     pid_ = group_.start(spec);
     return pid_;
   }
+  [[nodiscard]] std::filesystem::path memory() const { return dir_ / "memory.json"; }
   void kill_hard() {
     ::kill(pid_, SIGKILL);
     for (int i = 0; i < 200 && !group_.poll(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -189,7 +190,7 @@ ac::CraneReport at_rest(std::size_t crane, const ac::Pose& pose) {
   return r;
 }
 
-TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNothing) {
+TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingOnlyItsMemory) {
   SiteProcess site;
   // tc1 asks to turn its jib 0.3 rad further from the others, hook up: clear of everything held.
   const std::vector<ac::Pose> leg{kRest[0], {kPi - 0.3, 0.5, 0.2}};
@@ -294,15 +295,52 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingNoth
               1e3 * site.largest_status_gap());
 
   // kill -9 and start again: another epoch; tc1, still reporting moving, is held at its whole
-  // reach until it reports at rest.
+  // reach until it reports at rest. tc3 went silent before the kill: the new service never hears
+  // it, but its memory file (--memory) knows where tc3 stood, and takes the operator's word.
+  tc3_reports = false;
+  site.run_for(0.5, tick);
   site.kill_hard();
+  ASSERT_TRUE(std::filesystem::exists(site.memory()));
   site.start();
-  ASSERT_TRUE(site.run_until(20.0, tick, [&] { return site.status()->epoch != epoch; })) << "see " << site.dir();
+  ASSERT_TRUE(site.run_until(20.0, tick, [&] { return site.status() && site.status()->epoch != epoch; }))
+      << "see " << site.dir();
   site.run_for(0.5, tick);
   EXPECT_EQ(site.status()->holding[0], SiteStatus::HOLDING_WHOLE_REACH);
   EXPECT_EQ(site.status()->holding[1], SiteStatus::HOLDING_REST);
+  EXPECT_EQ(site.status()->holding[2], SiteStatus::HOLDING_WHOLE_REACH);  // nothing granted on a memory
+  const std::string domain = "--domain " + std::to_string(kDomain);
+  {
+    std::string out;
+    EXPECT_EQ(run_status(site, tick, domain + " --wait 10 --out-of-service tc3", out), 0) << out;
+    std::ifstream log(site.dir() / "site_service_2.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("recalled where the cranes stood from"), std::string::npos) << text;
+    EXPECT_NE(text.find("operator: tc3 out of service"), std::string::npos) << text;
+  }
   tc1 = at_rest(0, leg.back());
   ASSERT_TRUE(site.run_until(5.0, tick, [&] { return site.status()->holding[0] == SiteStatus::HOLDING_REST; }));
+
+  // A memory file that cannot be read: logged, kept as .bad, the service starts knowing nothing,
+  // and the word for tc3 is refused.
+  const std::uint32_t second = site.status()->epoch;
+  site.kill_hard();
+  std::ofstream(site.memory()) << "{\"format\": \"crane site service memory 1\", \"cranes\": [";
+  site.start();
+  ASSERT_TRUE(site.run_until(20.0, tick, [&] { return site.status() && site.status()->epoch != second; }))
+      << "see " << site.dir();
+  {
+    std::string out;
+    EXPECT_EQ(run_status(site, tick, domain + " --wait 1.5 --out-of-service tc3", out), 3) << out;
+    std::ifstream log(site.dir() / "site_service_3.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("memory.json: the file is not JSON"), std::string::npos) << text;
+    EXPECT_NE(text.find("not recalled, kept as"), std::string::npos) << text;
+    EXPECT_NE(text.find("operator: tc3 not put out of service: site arbiter: crane tc3 went silent where this service "
+                        "did not know it stood"),
+              std::string::npos)
+        << text;
+    EXPECT_TRUE(std::filesystem::exists(site.memory().string() + ".bad"));
+  }
 }
 
 }  // namespace

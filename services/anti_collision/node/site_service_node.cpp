@@ -10,10 +10,20 @@
 // or that the core refuses is logged (the first of each crane, then every 100th) and counted in the
 // status; the service goes on. Its epoch (SiteInstruction_.epoch) is drawn at start, so that a
 // restarted service is told from the one before. SIGINT/SIGTERM stop it.
+//
+// With --memory FILE it remembers, across a crash or a kill, where each crane stood
+// (site_memory.hpp, SiteService::memory): it writes the file whenever that changes, before the
+// instructions of the same step leave, and at least every kMemoryRefresh; it recalls it at its
+// start (SiteService::recall) unless the file is older than --memory-max-age (a site stopped for
+// longer may have had its cranes moved by hand). A file that cannot be read or recalled, or is too
+// old, is logged, kept as FILE.bad, and the service starts with no memory; a write that fails is
+// logged and the service goes on (the memory serves only the operator's word).
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -21,6 +31,7 @@
 #include <vector>
 
 #include "crane/anti_collision/site_file.hpp"
+#include "crane/anti_collision/site_memory.hpp"
 #include "crane/anti_collision/site_messages.hpp"
 #include "crane/protocol/dds.hpp"
 #include "crane/runtime/node_runtime.hpp"
@@ -33,6 +44,7 @@ namespace tp = transport::topics;
 
 constexpr auto kCycle = std::chrono::milliseconds(10);
 constexpr int kStatusEvery = 10;  // cycles: 10 Hz
+constexpr double kMemoryRefresh = 1.0;  // [s] the memory file is written at least this often
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -57,6 +69,13 @@ int main(int argc, char** argv) {
   std::string mode_name = "coordinated";
   app.add_option("--mode", mode_name, "coordinated | serialized (one crane at a time in shared airspace)")
       ->check(CLI::IsMember({"coordinated", "serialized"}));
+  std::string memory_path;
+  app.add_option("--memory", memory_path,
+                 "a file to remember where each crane stood across a restart (the operator's word for a crane "
+                 "that went silent before it)");
+  double memory_max_age = 300.0;
+  app.add_option("--memory-max-age", memory_max_age, "[s] a memory file older than this is not recalled")
+      ->check(CLI::Range(0.0, 86400.0));
   CLI11_PARSE(app, argc, argv);
   try {
     runtime::configure_logging(options.log_level, "site_service");
@@ -64,6 +83,33 @@ int main(int argc, char** argv) {
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(layout.domain_id);
     const ac::ArbiterMode mode = mode_name == "serialized" ? ac::ArbiterMode::serialized : ac::ArbiterMode::coordinated;
     ac::SiteService service(layout, mode, draw_epoch());
+    std::string memory_written;  // the file's text as last written
+    if (!memory_path.empty()) {
+      std::string why;
+      try {
+        std::error_code error;
+        const auto written = std::filesystem::last_write_time(memory_path, error);
+        const double age = error ? 0.0
+                                 : std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - written)
+                                       .count();
+        if (age > memory_max_age) {
+          why = memory_path + " was written " + std::to_string(static_cast<long long>(age)) +
+                " s ago: older than --memory-max-age " + std::to_string(static_cast<long long>(memory_max_age)) + " s";
+        } else if (const auto memory = ac::read_memory_file(memory_path, layout)) {
+          why = service.recall(*memory);
+          if (why.empty()) spdlog::info("recalled where the cranes stood from {}", memory_path);
+        }
+      } catch (const std::exception& error) {
+        why = error.what();
+      }
+      if (!why.empty()) {
+        const std::string kept = memory_path + ".bad";
+        std::rename(memory_path.c_str(), kept.c_str());
+        spdlog::error("{}: not recalled, kept as {}; starting with no memory", why, kept);
+      }
+    }
+    std::uint64_t memory_failures = 0;
+    double memory_written_at = -kMemoryRefresh;
 
     auto participant = runtime::make_participant(options, "site_service");
     transport::Wakeup wakeup;
@@ -117,7 +163,20 @@ int main(int argc, char** argv) {
           spdlog::warn("operator: {} not put out of service: {}", crane, why);
         }
       }
-      for (const ac::SiteOrder& order : service.step(now)) {
+      const std::vector<ac::SiteOrder> orders = service.step(now);
+      if (!memory_path.empty()) {  // before the orders leave: every grant carried out is remembered
+        std::string text = ac::memory_to_json(service.memory(), layout);
+        if (text != memory_written || now - memory_written_at >= kMemoryRefresh) {
+          try {
+            ac::write_memory_file(memory_path, text);
+            memory_written = std::move(text);
+            memory_written_at = now;
+          } catch (const std::exception& error) {
+            if (memory_failures++ % 100 == 0) spdlog::error("{} ({} failed writes)", error.what(), memory_failures);
+          }
+        }
+      }
+      for (const ac::SiteOrder& order : orders) {
         protocol::SiteInstruction message;
         ac::to_message(order, service.epoch(), message);
         tp::msgs::SiteInstruction_ out;

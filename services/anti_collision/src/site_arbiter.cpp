@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <utility>
 
@@ -78,21 +79,22 @@ void SiteArbiter::request(std::size_t crane, std::vector<Pose> waypoints, double
 
 void SiteArbiter::withdraw(std::size_t crane) { cranes_.at(crane).request.reset(); }
 
-void SiteArbiter::lost(std::size_t crane) {
+void SiteArbiter::lost(std::size_t crane, bool moved) {
   CraneState& c = cranes_.at(crane);
-  if (c.holding == Holding::out_of_service) {
+  if (moved || c.holding == Holding::out_of_service) {
     c.held_when_lost.reset();  // it moved: where it stood says nothing any more
   } else if (c.holding != Holding::whole_reach) {
     c.held_when_lost = c.held;
+    c.lost_moving = c.holding == Holding::path || c.holding == Holding::yield;
   }
   c.holding = Holding::whole_reach;
   c.held = whole_reach(layout_.cranes[crane], layout_.paths);
   c.held_shared = true;
 }
 
-void SiteArbiter::out_of_service(std::size_t crane, const CraneMotion& last, double report_age) {
+void SiteArbiter::out_of_service(std::size_t crane, const std::optional<CraneMotion>& last, double report_age) {
   CraneState& c = cranes_.at(crane);
-  if (!is_finite(last) || !(report_age >= 0.0) || !std::isfinite(report_age)) {
+  if ((last && !is_finite(*last)) || !(report_age >= 0.0) || !std::isfinite(report_age)) {
     throw std::invalid_argument("site arbiter: crane " + layout_.cranes[crane].name +
                                 "'s last motion or report age is not finite (or the age is negative)");
   }
@@ -103,12 +105,58 @@ void SiteArbiter::out_of_service(std::size_t crane, const CraneMotion& last, dou
   }
   if (!c.held_when_lost) {
     throw std::logic_error("site arbiter: crane " + name +
-                           " went silent before this service knew where it was: its whole reach stays held");
+                           " went silent where this service did not know it stood (never heard at rest or on a grant, "
+                           "with no memory of it, or it moved without a grant): its whole reach stays held");
   }
   c.holding = Holding::out_of_service;
-  c.held = out_of_service_airspace(layout_.cranes[crane], *c.held_when_lost, last, report_age);
+  c.held = last ? out_of_service_airspace(layout_.cranes[crane], *c.held_when_lost, *last, report_age) : *c.held_when_lost;
   c.held_shared = shared(crane, c.held);
   c.request.reset();
+}
+
+std::optional<SiteArbiter::Place> SiteArbiter::place(std::size_t crane) const {
+  const CraneState& c = cranes_.at(crane);
+  switch (c.holding) {
+    case Holding::rest: return Place{c.held, false};
+    case Holding::path:
+    case Holding::yield: return Place{c.held, true};
+    case Holding::whole_reach:
+    case Holding::out_of_service: break;
+  }
+  if (!c.held_when_lost) return std::nullopt;
+  return Place{*c.held_when_lost, c.lost_moving};
+}
+
+void SiteArbiter::recall(std::size_t crane, const Place& place) {
+  CraneState& c = cranes_.at(crane);
+  const std::string& name = layout_.cranes[crane].name;
+  if (c.holding != Holding::whole_reach || c.held_when_lost) {
+    throw std::logic_error("site arbiter: crane " + name + " holds " + to_string(c.holding) +
+                           (c.held_when_lost ? " and is known where it went silent" : "") +
+                           ": only a crane this service never knew the place of can be recalled");
+  }
+  const Airspace& a = place.airspace;
+  if (a.count == 0 || a.count > Airspace::kMaxBoxes) {
+    throw std::invalid_argument("site arbiter: crane " + name + "'s recalled place has " + std::to_string(a.count) +
+                                " boxes: must be in [1, " + std::to_string(Airspace::kMaxBoxes) + "]");
+  }
+  for (std::size_t k = 0; k < a.count; ++k) {
+    const JointBox& b = a.boxes[k];
+    const bool finite = std::isfinite(b.slew_low) && std::isfinite(b.slew_high) && std::isfinite(b.trolley_low) &&
+                        std::isfinite(b.trolley_high) && std::isfinite(b.cable_low) && std::isfinite(b.cable_high) &&
+                        std::isfinite(b.swing_radius);
+    if (!finite || b.slew_low > b.slew_high || b.trolley_low > b.trolley_high || b.cable_low > b.cable_high ||
+        !(b.cable_low > 0.0) || b.swing_radius < 0.0) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "'s recalled box %zu (slew [%g, %g] rad, trolley [%g, %g] m, cable [%g, %g] m, swing %g m) is not "
+                    "finite, has a low end above its high end, a cable length <= 0 or a negative swing",
+                    k, b.slew_low, b.slew_high, b.trolley_low, b.trolley_high, b.cable_low, b.cable_high, b.swing_radius);
+      throw std::invalid_argument("site arbiter: crane " + name + text);
+    }
+  }
+  c.held_when_lost = a;
+  c.lost_moving = place.moving;
 }
 
 bool SiteArbiter::ranks_before(std::size_t i, std::size_t j) const {

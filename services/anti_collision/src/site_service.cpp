@@ -69,6 +69,7 @@ std::string SiteService::report(const CraneReport& r, double time) {
   Link& link = links_[r.crane];
   link.last_heard = time;
   link.motion = r.motion;
+  link.motion_trusted = true;
   if (!link.carried_out && r.instruction_epoch == epoch_ && r.instruction_seq >= link.last_order.seq) {
     link.carried_out = true;
   }
@@ -81,12 +82,16 @@ std::string SiteService::report(const CraneReport& r, double time) {
   };
   switch (arbiter_.holding(r.crane)) {
     case Holding::whole_reach:
-      if (!r.moving) rest();
+      if (!r.moving) {
+        rest();
+      } else if (const auto place = arbiter_.place(r.crane); place && !place->moving) {
+        arbiter_.lost(r.crane, true);  // it moves, but stood at rest when last known: it had no grant
+      }
       break;
     case Holding::out_of_service:
       if (r.moving) {
         ++moves_without_grant_;
-        arbiter_.lost(r.crane);
+        arbiter_.lost(r.crane, true);
       } else {
         rest();  // it is back
       }
@@ -95,7 +100,7 @@ std::string SiteService::report(const CraneReport& r, double time) {
     case Holding::rest:
       if (r.moving) {
         ++moves_without_grant_;
-        arbiter_.lost(r.crane);
+        arbiter_.lost(r.crane, true);
         dirty_ = true;
       } else if (std::abs(here.slew - link.rest_pose.slew) > kRestTolerance ||
                  std::abs(here.trolley - link.rest_pose.trolley) > kRestTolerance ||
@@ -144,11 +149,61 @@ std::string SiteService::out_of_service(std::size_t crane, double time) {
   if (arbiter_.holding(crane) == Holding::out_of_service) return "";
   if (arbiter_.holding(crane) != Holding::whole_reach) arbiter_.lost(crane);  // silent: as step() would
   try {
-    arbiter_.out_of_service(crane, links_[crane].motion, kReportPeriod);
+    const Link& link = links_[crane];
+    arbiter_.out_of_service(crane, link.motion_trusted ? std::optional<CraneMotion>(link.motion) : std::nullopt,
+                            kReportPeriod);
   } catch (const std::logic_error& error) {
     return error.what();
   }
   links_[crane].pending_id = 0;
+  dirty_ = true;
+  return "";
+}
+
+SiteMemory SiteService::memory() const {
+  SiteMemory out(links_.size());
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    out[i].place = arbiter_.place(i);
+    out[i].motion = links_[i].motion;
+    out[i].out_of_service = arbiter_.holding(i) == Holding::out_of_service;
+  }
+  return out;
+}
+
+std::string SiteService::recall(const SiteMemory& memory) {
+  if (memory.size() != links_.size()) {
+    return "site service: the memory has " + std::to_string(memory.size()) + " cranes, the site " +
+           std::to_string(links_.size());
+  }
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (std::isfinite(links_[i].last_heard)) {
+      return "site service: crane " + arbiter_.layout().cranes[i].name +
+             " was heard already: a memory is recalled only at the start";
+    }
+  }
+  SiteArbiter arbiter = arbiter_;  // all or nothing
+  std::vector<Link> links = links_;
+  try {
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      const CraneMemory& m = memory[i];
+      if (!m.place) {
+        if (m.out_of_service) {
+          throw std::invalid_argument("site arbiter: crane " + arbiter.layout().cranes[i].name +
+                                      " is out of service in the memory but has no place");
+        }
+        continue;
+      }
+      arbiter.recall(i, *m.place);
+      links[i].motion = m.motion;
+      // Moving when last known: the motion of the memory may be older than the crane's stop.
+      links[i].motion_trusted = !m.place->moving || m.out_of_service;
+      if (m.out_of_service) arbiter.out_of_service(i, m.motion, kReportPeriod);
+    }
+  } catch (const std::exception& error) {
+    return std::string("site service: the memory refused: ") + error.what();
+  }
+  arbiter_ = std::move(arbiter);
+  links_ = std::move(links);
   dirty_ = true;
   return "";
 }

@@ -227,6 +227,13 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         }
         std::fprintf(stderr, "\n");
       }
+      for (const auto& c : o->cranes) {
+        if (c.out_of_service_refused.empty()) continue;
+        std::fprintf(stderr, "set seed %llu, %s: %s not put out of service: %s\n",
+                     static_cast<unsigned long long>(seed + (&r - results.data())),
+                     o == &r.coordinated ? "coordinated" : o == &r.serialized ? "serialized" : "solo", c.name.c_str(),
+                     c.out_of_service_refused.c_str());
+      }
     }
     min_distance.push_back(r.coordinated.min_distance);
     serial_min.push_back(r.serialized.min_distance);
@@ -297,7 +304,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   }
   if (injected.stopped_hosts > 0) {
     std::vector<double> rest;
-    int stopped = 0, stuck = 0, left = 0, total = 0, stopped_left = 0, put_out = 0;
+    int stopped = 0, stuck = 0, left = 0, total = 0, stopped_left = 0, put_out = 0, refused = 0;
     for (const SetResult& r : results) {
       stopped += r.coordinated.stopped_hosts;
       for (std::size_t i = 0; i < r.coordinated.cranes.size(); ++i) {
@@ -306,6 +313,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         if (!std::isnan(c.host_stopped_at)) {
           stopped_left += jobs - c.jobs_done;
           put_out += std::isnan(c.out_of_service_at) ? 0 : 1;
+          refused += c.out_of_service_refused.empty() ? 0 : 1;
           if (!std::isnan(c.rest_after_host_stop)) rest.push_back(c.rest_after_host_stop);
           continue;
         }
@@ -321,8 +329,10 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 stopped_left, total, left, stuck, crane::stack::kStuckWait);
     if (std::isfinite(injected.out_of_service_after)) {
       std::printf("  out of service: the site operator's word %.0f s after each stop; %d of the %d stopped cranes put "
-                  "out of service (the others: their service restarted since, or the run ended first)\n",
-                  injected.out_of_service_after, put_out, stopped);
+                  "out of service, %d refused (stderr says why), %d not given (the run ended first, or the service was "
+                  "down for the word's %.0f s)\n",
+                  injected.out_of_service_after, put_out, stopped, refused, stopped - put_out - refused,
+                  crane::stack::kWordWindow);
     }
   }
   int guard_emergency = 0, guard_soft = 0;

@@ -135,13 +135,17 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   for (; k < limit; ++k) {
     const double t = static_cast<double>(k) * dt;
     // The links: a crane whose link is down neither reports nor hears; a killed service hears and
-    // sends nothing, and restarts with no memory (another epoch).
+    // sends nothing, and restarts (another epoch) with its memory file only (site_service
+    // --memory): where each crane stood, used by nothing but the operator's word.
     const auto active = [&](const LinkFault& f) { return t >= f.start && t < f.start + f.duration; };
     const bool service_down = std::any_of(options.faults.begin(), options.faults.end(), [&](const LinkFault& f) {
       return f.crane == kSiteService && !f.degraded() && active(f);
     });
     if (service_was_down && !service_down) {
+      const ac::SiteMemory memory = service->memory();  // as written before the kill (write-ahead)
       service = std::make_unique<ac::SiteService>(site, arbiter_mode, draw_epoch(++restarts));
+      const std::string why = service->recall(memory);
+      if (!why.empty()) throw std::logic_error("site run: " + why);
     }
     service_was_down = service_down;
     std::vector<bool> up(n);
@@ -199,7 +203,8 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
       }
       word_to_come = true;
       if (service_down || t < from - 1e-9) continue;
-      if (service->out_of_service(i, t).empty()) c.outcome.out_of_service_at = t;
+      c.outcome.out_of_service_refused = service->out_of_service(i, t);
+      if (c.outcome.out_of_service_refused.empty()) c.outcome.out_of_service_at = t;
     }
     // The reports of the last cycle's state, then the service's rules and its instructions.
     if (!service_down) {

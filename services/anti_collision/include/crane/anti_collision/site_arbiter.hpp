@@ -82,19 +82,41 @@ class SiteArbiter {
   void progress(std::size_t crane, const std::vector<Pose>& remaining);
   /// Crane `crane` withdraws its pending request (nothing left to do).
   void withdraw(std::size_t crane);
-  /// Crane `crane` stopped reporting, or moved without a grant: it holds its whole reach until its
-  /// next rest() (or out_of_service(), when it went silent from a rest or a path; a crane out of
-  /// service that moves cannot be put out of service again before it rests).
-  void lost(std::size_t crane);
+  /// Crane `crane` stopped reporting (`moved` false), or moved without a grant (`moved` true): it
+  /// holds its whole reach until its next rest() (or out_of_service(), when it went silent from a
+  /// rest or a path; a crane that moved without a grant, out of service or not, cannot be put out
+  /// of service before it rests: where it stood says nothing any more).
+  void lost(std::size_t crane, bool moved = false);
   /// An operator confirms that crane `crane`, silent (lost), stands braked where it was when it went
   /// silent (its host stopped, say): until its next rest() it holds what it held then, with the
   /// swing of its load braked from `last`, its last reported motion, up to `report_age` [s] old
   /// (out_of_service_airspace), instead of its whole reach. Its pending request is dropped.
-  /// std::logic_error, naming the crane, when it is not lost, or when it went silent before this
-  /// arbiter knew where it was (it was never at rest or on a path here: a restarted service);
+  /// std::logic_error, naming the crane, when it is not lost, or when this arbiter does not know
+  /// where it stood (never at rest or on a path here and not recalled: a restarted service with no
+  /// memory of it; or it moved without a grant);
   /// std::invalid_argument for a non-finite `last` or a negative `report_age`; std::out_of_range
   /// for a crane index not on the site.
-  void out_of_service(std::size_t crane, const CraneMotion& last, double report_age);
+  /// With `last` none, the motion is not known (a crane a restarted service recalls on a path,
+  /// recall(): it may have been moving at any speed its grant allows when it stopped): it holds what
+  /// it held then as it was held, each box with its own swing allowance.
+  void out_of_service(std::size_t crane, const std::optional<CraneMotion>& last, double report_age);
+
+  /// Where crane `crane` stands for this arbiter: what it holds at rest, on a path or a yield, or
+  /// what it held when it went silent (lost or out of service); none when it never knew (its whole
+  /// reach since the start). `moving`: that place is a path or a yield, not a rest box.
+  struct Place {
+    Airspace airspace;
+    bool moving{false};
+  };
+  [[nodiscard]] std::optional<Place> place(std::size_t crane) const;
+  /// A restarted service's memory (site_memory.hpp): crane `crane`, never heard by this arbiter,
+  /// stood in `place` when the service before it last knew (SiteService::recall). It still holds its
+  /// whole reach; the place is what out_of_service() then holds. std::logic_error, naming the crane,
+  /// when this arbiter already knows where it is (it rested or was lost here); std::invalid_argument
+  /// for a place of no box, more than Airspace::kMaxBoxes, or a box with a non-finite field, a low end
+  /// above its high end, a cable length <= 0 or a negative swing radius; std::out_of_range for a crane
+  /// index not on the site.
+  void recall(std::size_t crane, const Place& place);
 
   /// Grants and yields, by the rules of the header; each crane at most one instruction. The
   /// instructed cranes hold the path or the yield from now on.
@@ -125,6 +147,7 @@ class SiteArbiter {
     Holding holding{Holding::whole_reach};
     Airspace held;
     std::optional<Airspace> held_when_lost;  // what it held when it went silent (none: unknown)
+    bool lost_moving{false};                 // held_when_lost is a path or a yield
     Pose pose;            // at rest: where; else the last rest pose
     bool held_shared{false};
     std::optional<Request> request;

@@ -37,6 +37,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,18 @@ struct CraneReport {
   std::uint32_t request_id{0};          // 0: no request
   std::vector<Pose> request;            // request_id != 0: 2 to Airspace::kMaxBoxes + 1, from where it rests
 };
+
+/// What a site service remembers of a crane across its own restart (docs/site.md, "The service's
+/// memory"): where the crane stood (SiteArbiter::place: at rest, on a path or a yield, or what it
+/// held when it went silent), its last reported motion and whether an operator put it out of
+/// service. Only a silent crane's place is ever used, by the operator's word (out_of_service()).
+struct CraneMemory {
+  std::optional<SiteArbiter::Place> place;  // none: the service never knew
+  CraneMotion motion{};                     // its last reported motion
+  bool out_of_service{false};
+};
+/// Per crane, in the site file's order (site_memory.hpp reads and writes it as a file).
+using SiteMemory = std::vector<CraneMemory>;
 
 /// One instruction to send (rt/site/instruction).
 struct SiteOrder {
@@ -95,6 +108,22 @@ class SiteService {
   /// one this service never knew the place of (it restarted since). Never throws.
   [[nodiscard]] std::string out_of_service(std::size_t crane, double time);
 
+  /// What this service would need to remember across a restart (CraneMemory). The site_service
+  /// process writes it whenever it changes, before the instructions of the same step leave, so that
+  /// every grant a crane may be carrying out is in it.
+  [[nodiscard]] SiteMemory memory() const;
+  /// A restarted service, before it hears any report, recalls what the one before it remembered
+  /// (`memory`, one entry per crane). Each crane still holds its whole reach, and nothing is granted
+  /// on a memory; a silent crane's remembered place is what an operator's word then holds
+  /// (out_of_service()): its rest box with its load's swing braked from the remembered motion; a
+  /// path or yield as it was held (the crane may have been moving at any speed its grant allows
+  /// when it stopped, after the memory's motion); a crane out of service in the memory is out of
+  /// service again at once. A crane heard moving whose remembered place is a rest box forgets it (a
+  /// move without a grant). Returns "" when recalled, else why not, recalling nothing: a memory of
+  /// another number of cranes, a crane heard already, a place SiteArbiter::recall refuses (the crane
+  /// and the box named). Never throws beyond std::bad_alloc.
+  [[nodiscard]] std::string recall(const SiteMemory& memory);
+
   [[nodiscard]] const SiteArbiter& arbiter() const noexcept { return arbiter_; }
   [[nodiscard]] std::uint32_t epoch() const noexcept { return epoch_; }
   [[nodiscard]] std::uint64_t reports_rejected() const noexcept { return rejected_; }
@@ -115,6 +144,7 @@ class SiteService {
     Pose rest_pose{};                // where its rest box was taken
     std::vector<Pose> progressed;    // the rest of its path at its last progress taken (empty: none yet)
     CraneMotion motion{};            // measured, at its last report
+    bool motion_trusted{true};       // false: recalled on a path (the memory's motion may be older than its stop)
   };
 
   SiteArbiter arbiter_;

@@ -20,8 +20,9 @@
 //
 // A lost link (SiteRunOptions::faults): the crane's reports, the instructions to it and the
 // heartbeat are dropped, and so are those on their way; a killed site service hears and sends
-// nothing and restarts with no memory (another epoch), and what was on its way to or from it is
-// lost. A degraded link delivers them late, in order (LinkFault). A stopped host (HostStop) takes its
+// nothing and restarts (another epoch) knowing only what its memory file said (SiteService::memory
+// at the kill, recall: where each crane stood, for the operator's word), and what was on its way
+// to or from it is lost. A degraded link delivers them late, in order (LinkFault). A stopped host (HostStop) takes its
 // crane's stack and link away for good; its plant runs on, braked by its actuation gate. What the crane and the service
 // then do is their cores' (crane_site_link.hpp, site_service.hpp). The guard's rules 1-3 brake a crane that leaves its grant (it then stays
 // braked and stops reporting, so the service holds its whole reach); its swing rule is counted,
@@ -56,8 +57,8 @@ enum class SiteMode : std::uint8_t {
 
 /// A fault between the cranes and the site service, from `start` for `duration` [s]. With `delay`
 /// and `loss` both 0: crane `crane`'s link lost (both ways), or, with crane == kSiteService, the
-/// site service killed and restarted with no memory (every link down meanwhile; the new service
-/// holds every crane's whole reach until it reports). Otherwise the link is degraded, the crane's
+/// site service killed and restarted with only its memory file (every link down meanwhile; the new
+/// service holds every crane's whole reach until it reports). Otherwise the link is degraded, the crane's
 /// (every crane's with kSiteService: the service's host): each message sent on it either way
 /// arrives `delay` late, and with probability `loss` one kResendDelay later still (the site's
 /// topics are reliable: a lost sample is sent again), in the order sent.
@@ -136,6 +137,9 @@ struct CraneOutcome {
   // [s] When the site service put it out of service on the operator's word (NaN: never; the word
   // is given each cycle for kWordWindow until the service takes it).
   double out_of_service_at{std::numeric_limits<double>::quiet_NaN()};
+  // Why the service did not take the word, its last answer ("": taken, never given, or given
+  // only while the service was down).
+  std::string out_of_service_refused;
   bool stuck{false};  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
 };
 
