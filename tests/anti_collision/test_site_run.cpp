@@ -76,6 +76,52 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
   EXPECT_LT(coordinated_total, serialized_total);
 }
 
+// The bound of any order of grants (schedule_bound.hpp) from the solo runs' timelines: each
+// crane's timeline ends where its last job was done (to a cycle), every pair's bound lies between
+// the longer of the two alone and both one after the other, waiting only at rest never beats
+// waiting anywhere, and the site's order (the coordinated run) is no faster than either. Seeds
+// 1-2: the conflicts the jobs force cost time even in the best order.
+TEST(SiteRun, TheBoundOfAnyOrderOfGrantsLiesBetweenTheCranesAloneAndTheSite) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_site_crane_config(site);
+  const double dt = config.facts.sample_period;
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    const auto jobs = random_site_jobs(site, config, 2, seed);
+    const SiteOutcome solo = run_site(site, config, jobs, in_mode(SiteMode::solo));
+    const SiteOutcome coordinated = run_site(site, config, jobs, in_mode(SiteMode::coordinated));
+    ASSERT_TRUE(solo.completed && coordinated.completed);
+    std::int64_t longest = 0;
+    for (const CraneOutcome& c : solo.cranes) {
+      ASSERT_FALSE(c.timeline.steps.empty()) << c.name;
+      EXPECT_NEAR(static_cast<double>(c.timeline.cycles()) * dt, c.finish_time, 2.0 * dt) << c.name;
+      for (const auto& step : c.timeline.steps) EXPECT_GE(step.uses.count, 1u);
+      longest = std::max(longest, c.timeline.cycles());
+    }
+    std::int64_t site_bound = 0;
+    for (std::size_t i = 0; i < site.cranes.size(); ++i) {
+      for (std::size_t j = i + 1; j < site.cranes.size(); ++j) {
+        const auto& a = solo.cranes[i].timeline;
+        const auto& b = solo.cranes[j].timeline;
+        const std::int64_t pair = crane::anti_collision::two_crane_bound(site, i, a, j, b);
+        EXPECT_GE(pair, std::max(a.cycles(), b.cycles()));
+        EXPECT_LE(pair, a.cycles() + b.cycles());
+        EXPECT_EQ(crane::anti_collision::two_crane_bound(site, j, b, i, a), pair) << "the same plane, turned";
+        // Waiting only at rest between legs (the site's whole legs): never shorter.
+        const std::int64_t at_rest =
+            crane::anti_collision::two_crane_bound(site, i, a, j, b, crane::anti_collision::WaitRule::at_rest);
+        ASSERT_GE(at_rest, pair) << "seed " << seed;
+        EXPECT_GE(coordinated.total_time, static_cast<double>(at_rest) * dt) << "seed " << seed;
+        site_bound = std::max(site_bound, pair);
+      }
+    }
+    EXPECT_GT(site_bound, longest) << "seed " << seed << ": the jobs' conflicts cost time in any order";
+    EXPECT_GE(coordinated.total_time, static_cast<double>(site_bound) * dt) << "seed " << seed;
+    std::printf("seed %llu: alone %.2f s, the bound of any order %.2f s, the site %.2f s\n",
+                static_cast<unsigned long long>(seed), static_cast<double>(longest) * dt,
+                static_cast<double>(site_bound) * dt, coordinated.total_time);
+  }
+}
+
 // The job draw: with SiteJobDraw{1, true} every point lies within another crane's reach, with
 // {0, true} every point is clear of the other cranes' jibs, each checked here from the site file's
 // bases, jibs and margins and the planner's travel (as site_run.hpp defines them); the default draw

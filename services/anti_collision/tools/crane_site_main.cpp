@@ -47,6 +47,7 @@
 
 #include "crane/anti_collision/crane_geometry.hpp"
 #include "crane/anti_collision/crane_site_link.hpp"
+#include "crane/anti_collision/schedule_bound.hpp"
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/common/validation.hpp"
 #include "crane/stack/maneuver_metrics.hpp"
@@ -131,11 +132,14 @@ struct DemoFaults {
 
 struct SetResult {
   crane::stack::SiteOutcome coordinated, serialized, solo;
+  // [s] --bound: the largest of its pairs' bounds, waiting anywhere and only at rest (NaN: none
+  // computed, or at rest a pair with no order: each in the other's way)
+  double bound{std::numeric_limits<double>::quiet_NaN()}, bound_at_rest{std::numeric_limits<double>::quiet_NaN()};
   std::string error;
 };
 
 int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, const DemoFaults& injected,
-         const crane::stack::SiteJobDraw& draw) {
+         const crane::stack::SiteJobDraw& draw, bool bound) {
   const int faults = injected.lost;
   const int degraded = injected.degraded;
   using namespace crane::stack;
@@ -169,6 +173,24 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         r.serialized = run_site(site, config, set, options);
         options.mode = SiteMode::solo;
         r.solo = run_site(site, config, set, options);
+        // The bound of any order of grants: each pair's, from the cranes' solo timelines.
+        if (bound && r.solo.completed) {
+          using crane::anti_collision::WaitRule;
+          const auto site_bound = [&](WaitRule rule) {
+            double worst = 0.0;
+            for (std::size_t i = 0; i < site.cranes.size(); ++i) {
+              for (std::size_t j = i + 1; j < site.cranes.size(); ++j) {
+                const std::int64_t pair = crane::anti_collision::two_crane_bound(
+                    site, i, r.solo.cranes[i].timeline, j, r.solo.cranes[j].timeline, rule);
+                if (pair < 0) return std::numeric_limits<double>::quiet_NaN();
+                worst = std::max(worst, config.facts.sample_period * static_cast<double>(pair));
+              }
+            }
+            return worst;
+          };
+          r.bound = site_bound(WaitRule::anywhere);
+          r.bound_at_rest = site_bound(WaitRule::at_rest);
+        }
       } catch (const std::exception& error) {
         r.error = error.what();
       }
@@ -202,7 +224,9 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
                 o->min_distance, o->closest.c_str());
   }
 
-  std::vector<double> min_distance, serial_min, vs_serialized, vs_solo;
+  std::vector<double> min_distance, serial_min, vs_serialized, vs_solo, bound_vs_solo, vs_bound, rest_vs_solo,
+      vs_rest;
+  int no_rest_order = 0;
   int failed = 0, incomplete = 0, faulted = 0;
   std::uint64_t unresolved = 0;
   int yields = 0;
@@ -242,6 +266,16 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     if (r.coordinated.completed && r.serialized.completed && r.solo.completed && r.coordinated.stopped_hosts == 0) {
       vs_serialized.push_back(r.coordinated.total_time / r.serialized.total_time);
       vs_solo.push_back(r.coordinated.total_time / r.solo.total_time);
+      if (!std::isnan(r.bound)) {
+        bound_vs_solo.push_back(r.bound / r.solo.total_time);
+        vs_bound.push_back(r.coordinated.total_time / r.bound);
+        if (std::isnan(r.bound_at_rest)) {
+          ++no_rest_order;
+        } else {
+          rest_vs_solo.push_back(r.bound_at_rest / r.solo.total_time);
+          vs_rest.push_back(r.coordinated.total_time / r.bound_at_rest);
+        }
+      }
     }
     unresolved += r.coordinated.unresolved + r.serialized.unresolved;
     for (const auto& c : r.coordinated.cranes) yields += c.yields, waiting += c.waiting_time;
@@ -259,6 +293,24 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
               crane::stack::nearest_rank_quantile(vs_serialized, 1.0), crane::stack::nearest_rank_quantile(vs_serialized, 0.0));
   std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", crane::stack::nearest_rank_quantile(vs_solo, 0.5),
               crane::stack::nearest_rank_quantile(vs_solo, 1.0), crane::stack::nearest_rank_quantile(vs_solo, 0.0));
+  const auto print_bound = [](const char* what, const std::vector<double>& vs_solo_of, const std::vector<double>& of) {
+    using crane::stack::nearest_rank_quantile;
+    std::printf("  %s: bound / solo median %.3f  worst %.3f  best %.3f; coordinated / bound median %.3f  worst %.3f  "
+                "best %.3f  (%zu sets)\n",
+                what, nearest_rank_quantile(vs_solo_of, 0.5), nearest_rank_quantile(vs_solo_of, 1.0),
+                nearest_rank_quantile(vs_solo_of, 0.0), nearest_rank_quantile(of, 0.5), nearest_rank_quantile(of, 1.0),
+                nearest_rank_quantile(of, 0.0), of.size());
+  };
+  if (!vs_bound.empty()) {
+    std::printf("  the bound of any order of grants (--bound: each pair of cranes on Akers' plane, from their solo "
+                "runs; docs/site.md):\n");
+    print_bound("waiting anywhere (any order, any cut of the legs)", bound_vs_solo, vs_bound);
+    print_bound("waiting at rest between legs (the site's whole legs)", rest_vs_solo, vs_rest);
+    if (no_rest_order > 0) {
+      std::printf("  (%d sets with no order at rest: two cranes in each other's way, which the site resolves by a "
+                  "yield)\n", no_rest_order);
+    }
+  }
   int slow = 0, stops = 0, emergency = 0;
   for (const SetResult& r : results) {
     slow += r.coordinated.watch_slow_downs, stops += r.coordinated.watch_stops, emergency += r.coordinated.watch_emergency_stops;
@@ -431,6 +483,9 @@ int main(int argc, char** argv) {
                        "probability that a pick or place point lies within another crane's reach, the others then "
                        "clear of every other crane's jib (default: 0.7, the others anywhere: the jobs of docs/site.md)")
           ->check(CLI::Range(0.0, 1.0));
+  bool bound = false;
+  demo_command->add_flag("--bound", bound,
+                         "also the bound of any order of grants, from the solo runs (about 1 s a set more)");
   std::string out;
   CLI::App* jobs_command = app.add_subcommand("jobs", "a seeded job set written as one job file per crane (site_link --jobs)");
   jobs_command->add_option("--site", site_path, "the site file")->required();
@@ -442,7 +497,7 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    return demo(site_path, sets, jobs, seed, threads, injected, draw);
+    return demo(site_path, sets, jobs, seed, threads, injected, draw, bound);
   }
   return 1;
 }

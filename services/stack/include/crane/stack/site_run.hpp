@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "crane/anti_collision/crane_site_link.hpp"
+#include "crane/anti_collision/schedule_bound.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
 #include "crane/stack/stack_config.hpp"
 
@@ -140,7 +141,12 @@ struct CraneOutcome {
   // Why the service did not take the word, its last answer ("": taken, never given, or given
   // only while the service was down).
   std::string out_of_service_refused;
-  bool stuck{false};  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
+  bool stuck{false};
+  // Its work interval by interval until its last job was done (schedule_bound.hpp): each change of
+  // what it held, as its own reports say (moving: the segment from the point it has passed to the
+  // waypoint it goes to; at rest or dwelling: the box where it stands). In a solo run, the input of
+  // the bound of any order of grants (two_crane_bound).
+  anti_collision::Timeline timeline;  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
 };
 
 struct SiteOutcome {

@@ -1,0 +1,81 @@
+#pragma once
+// How fast two cranes could do their jobs on one site at best, under the site's own rules
+// (issue 34's throughput figure; docs/site.md, "How far from the best order"): a lower bound of
+// any order of grants, against which the site service's order is measured.
+//
+// Each crane's work is taken as it ran alone (its Timeline: the intervals of its solo run, each
+// with the airspace it used, the box of a path segment or of its rest), and the two are laid out
+// on one plane, the first crane's progress along x, the second's along y (Akers' geometric method
+// for two jobs: S. B. Akers, "A graphical approach to production scheduling problems", Operations
+// Research 4, 1956; P. Brucker, "Scheduling Algorithms", 5th ed., section 6.4.2). A schedule is a
+// monotone path from (0, 0) to (T_a, T_b): diagonally both cranes progress, along x only the first
+// (the second waits), along y only the second; its length is the site's time. Forbidden is the
+// interior of every cell (interval k of a, interval l of b) whose airspaces do not keep
+// margins.slow_down (SiteArbiter::clear's rule: such grants are never held together); its edges are
+// open (a crane waits at the end of an interval holding nothing). The shortest path is searched
+// over the lattice of whole cycles, on which every interval ends (the lockstep's 10 ms): exact for
+// the cycle-stepped site, T_a x T_b cells (about 0.3 s for two cranes' 90 s). Akers' shortcut, the
+// diagonal until a forbidden cell and then around it, is not exact on these planes, whose forbidden
+// cells touch (an edge between two of them is open): on seeded random planes it came out longer
+// than the lattice (the first: 15 cycles against 14; session 31), so it is not used.
+//
+// What it leaves out makes it lower than any real schedule, so it is a bound: a crane that has done
+// its jobs stands nowhere (a real one must be told to yield); the third crane of a site is not
+// there (the site's bound is the largest of its pairs'); a crane's intervals hold what its own
+// reports say while it is in them (the rest of its leg from the point it has passed is held, the
+// interval's part of it counted); each interval lasts as long as alone (a run's settling varies
+// by a few seconds). Where a crane waits (WaitRule): anywhere, holding only the interval it is in
+// and at an interval's end nothing, the bound of any order and any cut of the legs into grants;
+// or only at rest between legs, holding its rest box, the bound of the site's protocol, which
+// grants a leg whole. It is the bound of the rules' geometry (the grants' boxes, margins and
+// allowances), not of the cranes' physics.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "crane/anti_collision/airspace.hpp"
+#include "crane/anti_collision/site_layout.hpp"
+
+namespace crane::anti_collision {
+
+/// One interval of a crane's work: from the end of the one before (from cycle 0 for the first) to
+/// `end_cycle`, it uses `uses` (a path segment's box, or its rest box).
+struct TimelineStep {
+  std::int64_t end_cycle{0};  // [cycles] > the step before's
+  Airspace uses;
+  bool rest{false};  // at rest between legs (WaitRule::at_rest: where it may wait)
+};
+
+/// Where a crane may wait for the other.
+enum class WaitRule : std::uint8_t {
+  anywhere,  // inside any interval, holding it; at an interval's end, holding nothing
+  at_rest,   // only in its rest intervals, holding them: the site's protocol, which grants a leg whole
+};
+
+/// A crane's work, interval by interval, as it ran alone.
+struct Timeline {
+  std::vector<TimelineStep> steps;
+  [[nodiscard]] std::int64_t cycles() const noexcept { return steps.empty() ? 0 : steps.back().end_cycle; }
+};
+
+/// The shortest time [cycles] in which crane `first` doing `a` and crane `second` doing `b` can both
+/// be done under the header's rules, each waiting as `rule` says: at least max(a.cycles(),
+/// b.cycles()); with WaitRule::anywhere at most their sum (one after the other is a path). -1 when
+/// no path exists (WaitRule::at_rest: each stands in the other's way where it may wait, which the
+/// site resolves by a yield, not modelled). std::invalid_argument for a crane index not on
+/// `layout`, the same crane twice, or a step that does not end after the one before.
+[[nodiscard]] std::int64_t two_crane_bound(const SiteLayout& layout, std::size_t first, const Timeline& a,
+                                           std::size_t second, const Timeline& b,
+                                           WaitRule rule = WaitRule::anywhere);
+
+namespace internal {
+/// The same search on a plane given directly: the first crane's interval ends x (x[0] = 0, rising),
+/// the second's y, and forbidden[k * (y.size() - 1) + l] for the cell of intervals k and l;
+/// rest_x, rest_y empty for WaitRule::anywhere, else per interval whether it is a rest interval.
+[[nodiscard]] std::int64_t two_crane_bound(const std::vector<std::int64_t>& x, const std::vector<std::int64_t>& y,
+                                           const std::vector<char>& forbidden, const std::vector<char>& rest_x = {},
+                                           const std::vector<char>& rest_y = {});
+}  // namespace internal
+
+}  // namespace crane::anti_collision
