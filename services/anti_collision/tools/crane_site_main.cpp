@@ -485,7 +485,7 @@ int main(int argc, char** argv) {
           ->check(CLI::Range(0.0, 1.0));
   bool bound = false;
   demo_command->add_flag("--bound", bound,
-                         "also the bound of any order of grants, from the solo runs (about 1 s a set more)");
+                         "also the bound of any order of grants, from the solo runs (about 2 s a set more)");
   std::string out;
   CLI::App* jobs_command = app.add_subcommand("jobs", "a seeded job set written as one job file per crane (site_link --jobs)");
   jobs_command->add_option("--site", site_path, "the site file")->required();
