@@ -885,6 +885,12 @@ TEST(SiteService, ARestartedServiceRecallsWhereASilentCraneStood) {
   const std::string text = memory_to_json(memory, s);
   const SiteMemory read = memory_from_json(text, s, "memory.json");
   EXPECT_EQ(memory_to_json(read, s), text);
+  EXPECT_TRUE(same_memory(read, memory));
+  EXPECT_FALSE(same_memory(read, reference.memory()));  // a out of service there
+  SiteMemory moved_a = read;
+  moved_a[0].motion.swing_in_plane = 0.031;
+  EXPECT_FALSE(same_memory(read, moved_a));
+  EXPECT_FALSE(same_memory(read, SiteMemory(2)));
   ASSERT_TRUE(read[0].place && read[1].place);
   EXPECT_FALSE(read[0].place->moving);
   EXPECT_TRUE(read[1].place->moving);

@@ -74,6 +74,11 @@ class SiteProcess {
     return pid_;
   }
   [[nodiscard]] std::filesystem::path memory() const { return dir_ / "memory.json"; }
+  /// The log of the process's `start`-th start (1 for the first).
+  [[nodiscard]] std::string log(int start) const {
+    std::ifstream in(dir_ / ("site_service_" + std::to_string(start) + ".log"));
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
   void kill_hard() {
     ::kill(pid_, SIGKILL);
     for (int i = 0; i < 200 && !group_.poll(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -268,8 +273,7 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingOnly
     }));
     site.run_for(0.5, tick);  // still silent: held so
     EXPECT_EQ(site.status()->holding[2], SiteStatus::HOLDING_OUT_OF_SERVICE);
-    std::ifstream log(site.dir() / "site_service_1.log");
-    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    const std::string text = site.log(1);
     EXPECT_NE(text.find("operator: tc2 not put out of service: site service: tc2 was heard"), std::string::npos) << text;
     EXPECT_NE(text.find("operator: tc3 out of service"), std::string::npos) << text;
   }
@@ -312,8 +316,7 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingOnly
   {
     std::string out;
     EXPECT_EQ(run_status(site, tick, domain + " --wait 10 --out-of-service tc3", out), 0) << out;
-    std::ifstream log(site.dir() / "site_service_2.log");
-    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    const std::string text = site.log(2);
     EXPECT_NE(text.find("recalled where the cranes stood from"), std::string::npos) << text;
     EXPECT_NE(text.find("operator: tc3 out of service"), std::string::npos) << text;
   }
@@ -331,8 +334,7 @@ TEST(SiteServiceProcess, GrantsOverDdsHoldsSilentCranesAndStartsAgainKnowingOnly
   {
     std::string out;
     EXPECT_EQ(run_status(site, tick, domain + " --wait 1.5 --out-of-service tc3", out), 3) << out;
-    std::ifstream log(site.dir() / "site_service_3.log");
-    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    const std::string text = site.log(3);
     EXPECT_NE(text.find("memory.json: the file is not JSON"), std::string::npos) << text;
     EXPECT_NE(text.find("not recalled, kept as"), std::string::npos) << text;
     EXPECT_NE(text.find("operator: tc3 not put out of service: site arbiter: crane tc3 went silent where this service "

@@ -17,7 +17,10 @@
 // start (SiteService::recall) unless the file is older than --memory-max-age (a site stopped for
 // longer may have had its cranes moved by hand). A file that cannot be read or recalled, or is too
 // old, is logged, kept as FILE.bad, and the service starts with no memory; a write that fails is
-// logged and the service goes on (the memory serves only the operator's word).
+// logged and the service goes on (the memory serves only the operator's word). Each cycle compares
+// the memory (a vector of one small entry per crane) with the one written; the JSON and the write
+// (with its fdatasync: 0.25 ms mean, 0.5 ms worst of 200 on this machine's ext4) happen only on a
+// change, a few times a second, and once a second.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -83,7 +86,7 @@ int main(int argc, char** argv) {
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(layout.domain_id);
     const ac::ArbiterMode mode = mode_name == "serialized" ? ac::ArbiterMode::serialized : ac::ArbiterMode::coordinated;
     ac::SiteService service(layout, mode, draw_epoch());
-    std::string memory_written;  // the file's text as last written
+    ac::SiteMemory memory_written;  // as last written to the file
     if (!memory_path.empty()) {
       std::string why;
       try {
@@ -165,11 +168,11 @@ int main(int argc, char** argv) {
       }
       const std::vector<ac::SiteOrder> orders = service.step(now);
       if (!memory_path.empty()) {  // before the orders leave: every grant carried out is remembered
-        std::string text = ac::memory_to_json(service.memory(), layout);
-        if (text != memory_written || now - memory_written_at >= kMemoryRefresh) {
+        ac::SiteMemory memory = service.memory();
+        if (!ac::same_memory(memory, memory_written) || now - memory_written_at >= kMemoryRefresh) {
           try {
-            ac::write_memory_file(memory_path, text);
-            memory_written = std::move(text);
+            ac::write_memory_file(memory_path, ac::memory_to_json(memory, layout));
+            memory_written = std::move(memory);
             memory_written_at = now;
           } catch (const std::exception& error) {
             if (memory_failures++ % 100 == 0) spdlog::error("{} ({} failed writes)", error.what(), memory_failures);

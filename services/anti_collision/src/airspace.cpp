@@ -152,6 +152,11 @@ Airspace out_of_service_airspace(const SiteCrane& crane, const Airspace& held, c
   return out;
 }
 
+bool same_airspace(const Airspace& a, const Airspace& b) noexcept {
+  return a.count == b.count && a.count <= Airspace::kMaxBoxes &&
+         std::equal(a.boxes.begin(), a.boxes.begin() + static_cast<std::ptrdiff_t>(a.count), b.boxes.begin());
+}
+
 Airspace whole_reach(const SiteCrane& c, const PathAllowance& allowance) noexcept {
   Airspace out;
   JointBox& box = out.boxes[0];

@@ -160,6 +160,21 @@ std::string SiteService::out_of_service(std::size_t crane, double time) {
   return "";
 }
 
+bool same_memory(const SiteMemory& a, const SiteMemory& b) noexcept {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const CraneMemory& p = a[i];
+    const CraneMemory& q = b[i];
+    if (p.out_of_service != q.out_of_service || !(p.motion == q.motion) || p.place.has_value() != q.place.has_value()) {
+      return false;
+    }
+    if (p.place && (p.place->moving != q.place->moving || !same_airspace(p.place->airspace, q.place->airspace))) {
+      return false;
+    }
+  }
+  return true;
+}
+
 SiteMemory SiteService::memory() const {
   SiteMemory out(links_.size());
   for (std::size_t i = 0; i < links_.size(); ++i) {

@@ -40,20 +40,6 @@ struct Crane {
 
 std::uint32_t draw_epoch(std::uint32_t restarts) { return 7001u + 7919u * restarts; }
 
-bool same(const ac::Airspace& a, const ac::Airspace& b) {
-  if (a.count != b.count) return false;
-  for (std::size_t i = 0; i < a.count; ++i) {
-    const ac::JointBox& p = a.boxes[i];
-    const ac::JointBox& q = b.boxes[i];
-    if (p.slew_low != q.slew_low || p.slew_high != q.slew_high || p.trolley_low != q.trolley_low ||
-        p.trolley_high != q.trolley_high || p.cable_low != q.cable_low || p.cable_high != q.cable_high ||
-        p.swing_radius != q.swing_radius) {
-      return false;
-    }
-  }
-  return true;
-}
-
 // CraneOutcome::timeline, after the crane's step of cycle k: a new interval whenever what its
 // report holds changes, none once its jobs are done.
 void record_timeline(Crane& c, std::uint64_t k, const ac::PathAllowance& paths) {
@@ -66,7 +52,7 @@ void record_timeline(Crane& c, std::uint64_t k, const ac::PathAllowance& paths) 
   std::vector<ac::TimelineStep>& steps = c.outcome.timeline.steps;
   const auto end = static_cast<std::int64_t>(k) + 1;  // it holds `uses` over cycle k (the first from 0)
   const bool rest = !report->moving;
-  if (!steps.empty() && steps.back().rest == rest && same(steps.back().uses, uses)) {
+  if (!steps.empty() && steps.back().rest == rest && ac::same_airspace(steps.back().uses, uses)) {
     steps.back().end_cycle = end;
   } else {
     steps.push_back({end, uses, rest});

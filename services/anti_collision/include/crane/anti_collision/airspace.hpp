@@ -43,6 +43,7 @@ struct JointBox {
   double trolley_low{0.0}, trolley_high{0.0};  // [m]
   double cable_low{0.0}, cable_high{0.0};      // [m]
   double swing_radius{0.0};                    // [m] horizontal, about the sheave's vertical
+  bool operator==(const JointBox&) const = default;
 };
 
 struct Airspace {
@@ -50,6 +51,9 @@ struct Airspace {
   std::array<JointBox, kMaxBoxes> boxes{};
   std::size_t count{0};  // boxes used; 0: no airspace
 };
+
+/// True when `a` and `b` have the same boxes in use (count and every field, exactly).
+[[nodiscard]] bool same_airspace(const Airspace& a, const Airspace& b) noexcept;
 
 /// At rest at `pose`: one box, the pose itself, with the hoist swing allowance.
 [[nodiscard]] Airspace rest_airspace(const Pose& pose, const PathAllowance& allowance) noexcept;

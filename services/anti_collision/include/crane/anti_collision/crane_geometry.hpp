@@ -85,6 +85,7 @@ struct CraneMotion {
   double swing_out_of_plane{0.0};       // [rad] theta, across the jib
   double swing_in_plane_rate{0.0};      // [rad/s]
   double swing_out_of_plane_rate{0.0};  // [rad/s]
+  bool operator==(const CraneMotion&) const = default;
 };
 
 enum class StopKind : std::uint8_t {

@@ -74,6 +74,9 @@ struct CraneMemory {
 };
 /// Per crane, in the site file's order (site_memory.hpp reads and writes it as a file).
 using SiteMemory = std::vector<CraneMemory>;
+/// True when `a` and `b` remember the same, exactly (what site_service compares each cycle before
+/// it writes its memory file).
+[[nodiscard]] bool same_memory(const SiteMemory& a, const SiteMemory& b) noexcept;
 
 /// One instruction to send (rt/site/instruction).
 struct SiteOrder {
@@ -105,7 +108,8 @@ class SiteService {
   /// report up to kReportPeriod old), instead of its whole reach, until the crane reports at rest.
   /// Returns "" when applied (or already so), else why not: an unknown crane, a crane heard within
   /// link_deadline ("tc2 was heard 0.12 s ago: a crane that reports is not out of service"), or
-  /// one this service never knew the place of (it restarted since). Never throws.
+  /// one whose place this service does not know (it restarted since with no memory of it, recall();
+  /// or the crane moved without a grant). Never throws.
   [[nodiscard]] std::string out_of_service(std::size_t crane, double time);
 
   /// What this service would need to remember across a restart (CraneMemory). The site_service

@@ -141,12 +141,12 @@ struct CraneOutcome {
   // Why the service did not take the word, its last answer ("": taken, never given, or given
   // only while the service was down).
   std::string out_of_service_refused;
-  bool stuck{false};
+  bool stuck{false};  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
   // Its work interval by interval until its last job was done (schedule_bound.hpp): each change of
-  // what it held, as its own reports say (moving: the segment from the point it has passed to the
-  // waypoint it goes to; at rest or dwelling: the box where it stands). In a solo run, the input of
+  // what it held, as its own reports say (moving, dwelling too: the segment from the point it has
+  // passed to the waypoint ahead; at rest: the box where it stands). In a solo run, the input of
   // the bound of any order of grants (two_crane_bound).
-  anti_collision::Timeline timeline;  // it ended waiting, for kStuckWait, for a stopped crane (or for one that waits for it)
+  anti_collision::Timeline timeline;
 };
 
 struct SiteOutcome {
