@@ -28,6 +28,7 @@ using namespace crane::anti_collision;
 using crane::anti_collision::test_sites::two_towers;
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kNow = 5.0;  // [s] the time of a decision, after every request of these tests
 
 // A's jib along +x (its chord 2.5..2.58 m, half width 0.03) under B's load hanging at x = 1.0
 // (B's slew pi, trolley 1.0), at cable 2.0 (load centre 1.0 m, bottom 0.95): in plan the load's
@@ -127,19 +128,19 @@ TEST(SiteArbiter, AClearRequestIsGrantedAndAConflictingOneWaits) {
   arbiter.rest(1, {kPi - 1.5, 0.5, 0.2});
   // B lowers its load at x = 1.0 on A's jib line: A's jib is turned away, so B goes.
   arbiter.request(1, {{kPi - 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
-  auto decided = arbiter.decide();
+  auto decided = arbiter.decide(kNow);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 1u);
   EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
   EXPECT_EQ(arbiter.holding(1), Holding::path);
   // A now asks to turn its jib to heading 0, under B's load: it waits for B.
   arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 2.0);
-  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_TRUE(arbiter.decide(kNow).empty());
   ASSERT_EQ(arbiter.waits_for(0).size(), 1u);
   EXPECT_EQ(arbiter.waits_for(0)[0], 1u);
   // B hoists up and rests there: its load 0.17 m above A's jib, beyond slow_down (0.15): A goes.
   arbiter.rest(1, {kPi, 1.0, 0.2});
-  decided = arbiter.decide();
+  decided = arbiter.decide(kNow);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 0u);
 }
@@ -156,7 +157,7 @@ TEST(SiteArbiter, PriorityThenFirstCome) {
     arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
     arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);  // first
     arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 0.5, 0.2}}, 2.0);
-    const auto decided = arbiter.decide();
+    const auto decided = arbiter.decide(kNow);
     ASSERT_EQ(decided.size(), 1u);
     EXPECT_EQ(decided[0].crane, b_priority ? 1u : 0u);
     EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
@@ -171,7 +172,7 @@ TEST(SiteArbiter, TheLowerCraneYieldsItsJibToTheHigherCranesCable) {
   arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
   arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);  // A's jib to heading 0
   arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 2.0);  // B's load down on it
-  const auto decided = arbiter.decide();
+  const auto decided = arbiter.decide(kNow);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 1u);
   EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
@@ -189,7 +190,7 @@ TEST(SiteArbiter, TwoCranesThatWaitForEachOtherAreResolvedByAYield) {
   // (2 - cos 0.5, -sin 0.5) = (1.12, -0.48) in plan; A's trolley 0.5 does not reach it, its jib does).
   arbiter.request(1, {{kPi + 0.5, 1.0, 2.0}, {kPi, 1.0, 2.0}}, 1.0);
   arbiter.request(0, {{0.0, 0.5, 0.2}, {-0.6, 0.5, 0.2}}, 2.0);
-  const auto decided = arbiter.decide();
+  const auto decided = arbiter.decide(kNow);
   EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
   ASSERT_EQ(decided.size(), 1u);
@@ -204,11 +205,116 @@ TEST(SiteArbiter, TwoCranesThatWaitForEachOtherAreResolvedByAYield) {
   // A rests at its yield pose: B goes; A asks again from there and waits for B.
   arbiter.rest(0, yielded);
   arbiter.request(0, {yielded, {-0.6, 0.5, 0.2}}, 3.0);
-  auto next = arbiter.decide();
+  auto next = arbiter.decide(kNow);
   ASSERT_EQ(next.size(), 1u);
   EXPECT_EQ(next[0].crane, 1u);
   EXPECT_EQ(next[0].kind, Instruction::Kind::go);
   EXPECT_EQ(arbiter.unresolved(), 0u);
+}
+
+// Rule 0, no starving. A third crane C (jib 3.5 m) at (1, -2), its jib at heading +y at slew 0.
+// B lowers its load at (1, 0) and hoists it again: A's request, to slew its jib from -y to +x
+// over (1, 0), waits for B. C asks later to lower its load at P = (0.5, -0.9), which A's jib
+// sweeps over (|P| = 1.03 < 1.4) but which meets nothing held: 0.42 m in plan from A's jib at
+// -y, 1.03 from B's cable, 1.75 - 1.35 - 0.05 = 0.35 from B's whole reach. Once A has waited
+// max_wait (40 s), C's later request waits for A's instead of taking the place A must pass; and
+// A, starving, no longer gives its jib way to C's cable (rule 2), which would make it yield.
+TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
+  SiteLayout site = two_towers();
+  SiteCrane c = site.cranes[1];
+  c.name = "c";
+  c.base = {1.0, -2.0};
+  c.slew_zero_heading = kPi / 2.0;
+  c.jib_height = 3.5;
+  c.hook_height_min = 1.5;
+  c.hook_height_max = 3.3;
+  c.domain_id = 13;
+  site.cranes.push_back(c);
+  // A fourth crane E at (4.2, 0), jib 3.5 m: its whole reach (x >= 2.75) meets B's jib turned to
+  // +x (it reaches 3.4 at 3.0-3.08 m, under E's loads) and nothing of A's or C's.
+  SiteCrane e = c;
+  e.name = "e";
+  e.base = {4.2, 0.0};
+  e.slew_zero_heading = 0.0;
+  e.domain_id = 14;
+  site.cranes.push_back(e);
+  site.max_wait = 40.0;
+  const double c_slew = std::atan2(1.1, -0.5) - kPi / 2.0;  // from (1, -2) to P: (-0.5, 1.1)
+  const double c_trolley = std::hypot(0.5, 1.1);
+  const auto waiting_site = [&](const SiteLayout& layout) {
+    SiteArbiter arbiter(layout, ArbiterMode::coordinated);
+    arbiter.rest(0, {-kPi / 2.0, 0.5, 0.2});
+    arbiter.rest(1, {kPi, 1.0, 0.2});
+    arbiter.rest(2, {c_slew, c_trolley, 0.2});
+    arbiter.rest(3, {0.0, 0.5, 0.2});
+    arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}, {kPi, 1.0, 0.2}}, 0.0);
+    EXPECT_EQ(arbiter.decide(0.5).size(), 1u);  // B goes
+    arbiter.request(0, {{-kPi / 2.0, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);
+    arbiter.request(2, {{c_slew, c_trolley, 0.2}, {c_slew, c_trolley, 2.0}}, 2.0);
+    return arbiter;
+  };
+  SiteArbiter arbiter = waiting_site(site);
+
+  // Before A has waited 40 s, C goes: first come among the requests that can go.
+  SiteArbiter before = arbiter;
+  auto decided = before.decide(40.9);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 2u);
+  EXPECT_EQ(before.waits_for(0), std::vector<std::size_t>{1u});
+
+  // From then on C waits for A, which waits for B; B rests hook up, A goes, C waits for A's path.
+  SiteArbiter after = arbiter;
+  EXPECT_TRUE(after.decide(41.0).empty());
+  EXPECT_EQ(after.waits_for(0), std::vector<std::size_t>{1u});
+  EXPECT_EQ(after.waits_for(2), std::vector<std::size_t>{0u});
+  after.rest(1, {kPi, 1.0, 0.2});
+  decided = after.decide(42.5);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 0u);
+  EXPECT_EQ(after.waits_for(2), std::vector<std::size_t>{0u});
+  EXPECT_EQ(after.holding(0), Holding::path);
+  EXPECT_EQ(after.yields() + after.unresolved(), 0u);
+
+  // With no limit (max_wait 0), C goes at 41 s as before.
+  SiteLayout no_limit = site;
+  no_limit.max_wait = 0.0;
+  SiteArbiter unlimited = waiting_site(no_limit);
+  decided = unlimited.decide(41.0);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 2u);
+
+  // A starving request reserves its path only while it waits for cranes that will move. Kept
+  // waiting by a silent crane (its whole reach), it reserves nothing: B may never come back, and
+  // C's leg meets nothing B can hold.
+  SiteArbiter silent = arbiter;
+  silent.lost(1);
+  decided = silent.decide(41.0);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 2u);
+  EXPECT_EQ(silent.waits_for(0), std::vector<std::size_t>{1u});
+  // B resting idle with its load lowered in A's way will move: it is told to yield, and C still
+  // waits for A.
+  SiteArbiter resting = arbiter;
+  resting.rest(1, {kPi, 1.0, 2.0});
+  decided = resting.decide(41.0);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 1u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
+  EXPECT_EQ(resting.waits_for(2), std::vector<std::size_t>{0u});
+  // But when B, resting there, asks to turn its jib to +x and waits for E, silent, B may never
+  // move either (in turn): C goes.
+  SiteArbiter chain = arbiter;
+  chain.rest(1, {kPi, 1.0, 2.0});
+  chain.request(1, {{kPi, 1.0, 2.0}, {kPi, 1.0, 0.2}, {0.0, 1.0, 0.2}}, 3.0);
+  chain.lost(3);
+  decided = chain.decide(41.0);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 2u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
+  EXPECT_EQ(chain.waits_for(1), std::vector<std::size_t>{3u});
+  EXPECT_EQ(chain.waits_for(0), std::vector<std::size_t>{1u});
+
+  EXPECT_THROW((void)arbiter.decide(std::nan("")), std::invalid_argument);
 }
 
 // An idle crane in the way (no request of its own) is told to yield as well.
@@ -217,7 +323,7 @@ TEST(SiteArbiter, AnIdleCraneInTheWayYields) {
   arbiter.rest(0, {0.0, 0.5, 0.2});
   arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
   arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
-  const auto decided = arbiter.decide();
+  const auto decided = arbiter.decide(kNow);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 0u);
   EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
@@ -232,18 +338,18 @@ TEST(SiteArbiter, ALostCraneHoldsItsWholeReach) {
   EXPECT_EQ(arbiter.holding(0), Holding::whole_reach);
   arbiter.rest(1, {kPi + 1.5, 0.5, 0.2});
   arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
-  EXPECT_TRUE(arbiter.decide().empty());  // A never reported
+  EXPECT_TRUE(arbiter.decide(kNow).empty());  // A never reported
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
   arbiter.request(1, {{kPi + 1.5, 0.5, 0.2}, {kPi, 1.0, 0.2}}, 1.5);  // hook up only
-  ASSERT_EQ(arbiter.decide().size(), 1u);
+  ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
   arbiter.rest(1, {kPi, 1.0, 0.2});
   arbiter.rest(0, {-1.5, 0.5, 0.2});
   arbiter.lost(0);
   arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 2.0);
-  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_TRUE(arbiter.decide(kNow).empty());
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
   arbiter.rest(0, {-1.5, 0.5, 0.2});  // A reports again, its jib away
-  ASSERT_EQ(arbiter.decide().size(), 1u);
+  ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
 }
 
 // An operator's word that a silent crane stands braked where it went silent (out_of_service): A,
@@ -269,7 +375,7 @@ TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
   arbiter.rest(1, {kPi, 1.0, 0.2});
   arbiter.lost(0);
   arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}}, 1.0);
-  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_TRUE(arbiter.decide(kNow).empty());
   EXPECT_EQ(arbiter.waits_for(1), std::vector<std::size_t>{0u});
   CraneMotion nan = still;
   nan.swing_in_plane = std::nan("");
@@ -284,7 +390,7 @@ TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
   const double radius = 0.5 + 0.05 * 0.1 + 0.05 * 0.05 / (2.0 * 1.5);
   const double by_hand = std::hypot(0.05, radius * 0.05) * std::sqrt(0.2 / 9.80665);
   EXPECT_NEAR(arbiter.held(0).boxes[0].swing_radius, by_hand, 1e-12);
-  const auto orders = arbiter.decide();
+  const auto orders = arbiter.decide(kNow);
   ASSERT_EQ(orders.size(), 1u);
   EXPECT_EQ(orders[0].crane, 1u);
   // It comes back at rest.
@@ -298,7 +404,7 @@ TEST(SiteArbiter, AnOperatorPutsASilentCraneOutOfServiceWhereItStood) {
   moving.rest(1, {kPi - 1.5, 0.5, 0.2});
   const std::vector<Pose> path{{-1.5, 0.5, 0.2}, {-1.0, 0.5, 0.2}, {-1.0, 0.5, 1.0}};
   moving.request(0, path, 0.0);
-  ASSERT_EQ(moving.decide().size(), 1u);
+  ASSERT_EQ(moving.decide(kNow).size(), 1u);
   moving.lost(0);
   CraneMotion slewing = still;
   slewing.slew_rate = 0.3;
@@ -323,13 +429,13 @@ TEST(SiteArbiter, ProgressFreesThePathBehind) {
   arbiter.rest(1, {kPi, 1.0, 1.5});
   const std::vector<Pose> path{{kPi, 1.0, 1.5}, {kPi, 1.0, 0.2}, {kPi - 1.5, 1.0, 0.2}, {kPi - 1.5, 1.0, 1.5}};
   arbiter.request(1, path, 1.0);
-  ASSERT_EQ(arbiter.decide().size(), 1u);
+  ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
   // A's jib to heading 0 meets B's load where B's path starts.
   arbiter.request(0, {{-1.5, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 2.0);
-  EXPECT_TRUE(arbiter.decide().empty());
+  EXPECT_TRUE(arbiter.decide(kNow).empty());
   EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
   arbiter.progress(1, {path.begin() + 2, path.end()});  // B hoisted up and travelled
-  ASSERT_EQ(arbiter.decide().size(), 1u);
+  ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
   EXPECT_THROW(arbiter.progress(0, {}), std::invalid_argument);
   SiteArbiter idle(two_towers(), ArbiterMode::coordinated);
   idle.rest(0, {0.0, 0.5, 0.2});
@@ -347,7 +453,7 @@ TEST(SiteArbiter, SerializedModeLetsOneCraneAtATimeIntoSharedAirspace) {
     // and neither jib turns over the other's load.
     arbiter.request(0, {{-1.5, 0.5, 0.2}, {-0.6, 1.2, 0.2}, {-0.6, 1.2, 1.5}}, 1.0);
     arbiter.request(1, {{kPi - 1.5, 0.5, 0.2}, {kPi - 0.6, 1.2, 0.2}, {kPi - 0.6, 1.2, 1.5}}, 2.0);
-    EXPECT_EQ(arbiter.decide().size(), mode == ArbiterMode::coordinated ? 2u : 1u);
+    EXPECT_EQ(arbiter.decide(kNow).size(), mode == ArbiterMode::coordinated ? 2u : 1u);
   }
 }
 

@@ -63,6 +63,7 @@ TEST(SiteLayout, ShippedSiteLoads) {
             (std::filesystem::path(kSitePath).parent_path() / "lab_tower_crane.yaml").lexically_normal());
   ASSERT_EQ(site.zones.size(), 1u);
   EXPECT_TRUE(site.zones[0].fixed);
+  EXPECT_DOUBLE_EQ(site.max_wait, 20.0);
   EXPECT_EQ(find_crane(site, "tc3"), 2);
   EXPECT_EQ(find_crane(site, "tc9"), -1);
   // The jibs overlap in plan view (bases 2 m apart, each reaching 1.4 m + its radius).
@@ -87,6 +88,8 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.48 is out of range: must be in [0.5, 2.45]");
   EXPECT_EQ(refusal(edited("travel_swing: 0.6", "travel_swing: 2")),
             "site.yaml: site.paths.travel_swing = 2 is out of range: must be in [0, 1.5]");
+  EXPECT_EQ(refusal(edited("max_wait: 20", "max_wait: -1")),
+            "site.yaml: site.max_wait = -1 is out of range: must be in [0, 3600]");
   EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: -3.5")),
             "site.yaml: site.cranes[0] (tc1).slew_min = -3 is out of range: must be < slew_max = -3.5");
   EXPECT_EQ(refusal(edited("kind: tower", "kind: gantry")),

@@ -159,7 +159,16 @@ void SiteArbiter::recall(std::size_t crane, const Place& place) {
   c.lost_moving = place.moving;
 }
 
+bool SiteArbiter::starving(std::size_t i) const noexcept {
+  const auto& r = cranes_[i].request;
+  return r && layout_.max_wait > 0.0 && decided_at_ >= r->time + layout_.max_wait;
+}
+
 bool SiteArbiter::ranks_before(std::size_t i, std::size_t j) const {
+  const bool si = starving(i);
+  const bool sj = starving(j);
+  if (si != sj) return si;
+  if (si && cranes_[i].request->time != cranes_[j].request->time) return cranes_[i].request->time < cranes_[j].request->time;
   const int pi = layout_.cranes[i].priority;
   const int pj = layout_.cranes[j].priority;
   if (pi != pj) return pi > pj;
@@ -219,7 +228,9 @@ std::optional<std::vector<Pose>> SiteArbiter::yield_path(std::size_t v, const st
   return std::nullopt;
 }
 
-std::vector<Instruction> SiteArbiter::decide() {
+std::vector<Instruction> SiteArbiter::decide(double time) {
+  if (!std::isfinite(time)) throw std::invalid_argument("site arbiter: a decision time is not finite");
+  decided_at_ = time;
   const std::size_t n = cranes_.size();
   std::vector<Instruction> out;
   std::vector<std::size_t> order;
@@ -245,15 +256,57 @@ std::vector<Instruction> SiteArbiter::decide() {
     }
     return waits;
   };
+  // Rule 0. The cranes that may never move: silent or out of service, and, in turn, those at rest
+  // whose request waits for one of them.
+  std::vector<bool> stalled(n, false);
+  if (std::any_of(order.begin(), order.end(), [this](std::size_t i) { return starving(i); })) {
+    std::vector<std::vector<std::size_t>> asking(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      stalled[i] = cranes_[i].holding == Holding::whole_reach || cranes_[i].holding == Holding::out_of_service;
+    }
+    for (const std::size_t i : order) asking[i] = blockers(i);
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const std::size_t i : order) {
+        if (stalled[i] || std::none_of(asking[i].begin(), asking[i].end(), [&](std::size_t j) { return stalled[j]; })) {
+          continue;
+        }
+        stalled[i] = true;
+        grew = true;
+      }
+    }
+  }
+  // The starving request ranked before `position` whose path i's request meets and that still
+  // waits, for no crane that may never move. Every starving request ranks before the others, so
+  // they are decided by then.
+  const auto reserved = [&](std::size_t i, std::size_t position) -> std::optional<std::size_t> {
+    for (std::size_t earlier = 0; earlier < position; ++earlier) {
+      const std::size_t k = order[earlier];
+      if (k == i || instructed[k] || !starving(k) ||
+          clear(i, cranes_[i].request->airspace, k, cranes_[k].request->airspace)) {
+        continue;
+      }
+      const auto& kept = cranes_[k].waits_for;
+      if (std::none_of(kept.begin(), kept.end(), [&](std::size_t j) { return stalled[j]; })) return k;
+    }
+    return std::nullopt;
+  };
   for (std::size_t position = 0; position < order.size(); ++position) {
     const std::size_t i = order[position];
     std::vector<std::size_t> waits = blockers(i);
     for (const std::size_t j : waits) blocks[i][j] = true;
     if (waits.empty()) {
-      // Rule 2: a later request of a higher crane whose cable meets this jib, and that could go now.
+      if (const auto k = reserved(i, position)) {
+        waits.push_back(*k);
+        blocks[i][*k] = true;
+      }
+    }
+    if (waits.empty() && !starving(i)) {
+      // Rule 2: a later request of a higher crane whose cable meets this jib, and that could go now
+      // (rule 0 before it: a starving request gives way to none).
       for (std::size_t later = position + 1; later < order.size() && waits.empty(); ++later) {
         const std::size_t k = order[later];
-        if (yields_jib_to(i, k) && blockers(k).empty()) waits.push_back(k);
+        if (yields_jib_to(i, k) && blockers(k).empty() && !reserved(k, later)) waits.push_back(k);
       }
     }
     cranes_[i].waits_for = waits;

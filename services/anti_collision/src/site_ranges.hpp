@@ -25,6 +25,7 @@ inline constexpr Range kBrakeFactor{1.0, 100.0};
 inline constexpr Range kDelayPeriods{0.0, 3.0};  // [swing periods] as the supervisor's zone_stop_delay_periods
 inline constexpr Range kMargin{1.0e-3, 100.0};
 inline constexpr Range kDeadline{1.0e-3, 10.0};
+inline constexpr Range kMaxWait{0.0, 3600.0};  // [s] 0: no limit
 inline constexpr Range kOvershoot{0.0, 10.0};
 inline constexpr Range kSwingAllowance{0.0, 1.5};
 inline constexpr int kMaxDomain = 232;  // the DDS port mapping's largest domain id

@@ -239,7 +239,7 @@ std::vector<SiteOrder> SiteService::step(double time) {
   std::vector<SiteOrder> out;
   // The rules decide on what the service holds and is asked: only when that changed.
   std::vector<Instruction> decided;
-  if (dirty_) decided = arbiter_.decide();
+  if (dirty_) decided = arbiter_.decide(time);
   dirty_ = false;
   for (Instruction& instruction : decided) {
     Link& link = links_[instruction.crane];

@@ -93,9 +93,9 @@ int check(const std::string& path) {
     return 2;
   }
   std::printf("site '%s' on domain %d: %zu cranes, %zu fixed zones; margins warning %.3f, slow_down %.3f, stop %.3f m; "
-              "link deadline %.3f s\n\n",
+              "link deadline %.3f s; max wait %.1f s\n\n",
               site.name.c_str(), site.domain_id, site.cranes.size(), site.zones.size(), site.margins.warning,
-              site.margins.slow_down, site.margins.stop, site.link_deadline);
+              site.margins.slow_down, site.margins.stop, site.link_deadline, site.max_wait);
   std::printf("%-8s %-8s %9s %8s %-8s %12s %14s %20s\n", "crane", "other", "apart_m", "overlap", "higher",
               "clearance_m", "cable_vs_jib", "worst_static_m");
   for (std::size_t i = 0; i < site.cranes.size(); ++i) {

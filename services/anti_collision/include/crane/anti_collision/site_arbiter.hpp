@@ -1,7 +1,8 @@
 #pragma once
 // The site service's rules (issue 34, item 3; docs/site.md, "Grants"): which crane may use which
-// airspace next. A core with no clock, no DDS and no threads: the site service process, the
-// lockstep site simulation and the tests drive it the same way.
+// airspace next. A core with no clock of its own (request() and decide() are given their time),
+// no DDS and no threads: the site service process, the lockstep site simulation and the tests
+// drive it the same way.
 //
 // Each crane holds an airspace at all times: at rest, the box of its pose (rest); moving, the
 // path it was granted (airspace.hpp); when it stops reporting, its whole reach (lost), until an
@@ -12,6 +13,12 @@
 // slow-down layer, crane_geometry.hpp's classify, is for cranes that leave their paths).
 //
 // Who goes first, when requests compete (the rules of real sites, in this order):
+//   0. no starving: a request that has waited `max_wait` of the site file (when it is not 0) goes
+//      before every other, the oldest first, and it reserves its path: a later-ranked request that
+//      could go but meets it waits for it (in waits_for, and so in the rules against deadlock
+//      below), unless it waits for a crane that may never move: silent, out of service, or, in
+//      turn, at rest with a request that waits for such a crane (the reservation would stop the
+//      others for nothing). A starving request gives its jib way to no cable (rule 2);
 //   1. the higher `priority` of the site file;
 //   2. the lower crane yields its jib to the higher crane's cable: when the closest parts of two
 //      pending paths are the lower crane's jib or counter-jib and the higher crane's cable or load,
@@ -32,6 +39,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -118,15 +126,20 @@ class SiteArbiter {
   /// index not on the site.
   void recall(std::size_t crane, const Place& place);
 
-  /// Grants and yields, by the rules of the header; each crane at most one instruction. The
-  /// instructed cranes hold the path or the yield from now on.
-  [[nodiscard]] std::vector<Instruction> decide();
+  /// Grants and yields at `time` [s] (the clock of request()), by the rules of the header; each
+  /// crane at most one instruction. The instructed cranes hold the path or the yield from now on.
+  /// std::invalid_argument for a non-finite time. A request starving (rule 0) changes no outcome
+  /// by itself (what could go was granted at the decision before): the caller decides again only
+  /// when what the cranes hold or ask changed.
+  [[nodiscard]] std::vector<Instruction> decide(double time);
+
 
   [[nodiscard]] std::size_t size() const noexcept { return cranes_.size(); }
   [[nodiscard]] Holding holding(std::size_t crane) const { return cranes_.at(crane).holding; }
   [[nodiscard]] const Airspace& held(std::size_t crane) const { return cranes_.at(crane).held; }
   [[nodiscard]] bool pending(std::size_t crane) const { return cranes_.at(crane).request.has_value(); }
-  /// The cranes whose held airspace the pending request meets (as of the last decide()).
+  /// The cranes whose held airspace the pending request meets, or whose starving request it meets
+  /// (rule 0), as of the last decide().
   [[nodiscard]] const std::vector<std::size_t>& waits_for(std::size_t crane) const { return cranes_.at(crane).waits_for; }
   /// Yields told so far, and the times decide() found a blocked crane no yield could free.
   [[nodiscard]] std::uint64_t yields() const noexcept { return yields_; }
@@ -154,7 +167,8 @@ class SiteArbiter {
     std::vector<std::size_t> waits_for;
   };
 
-  [[nodiscard]] bool ranks_before(std::size_t i, std::size_t j) const;  // rules 1, 3, 4
+  [[nodiscard]] bool starving(std::size_t i) const noexcept;  // rule 0, at decided_at_
+  [[nodiscard]] bool ranks_before(std::size_t i, std::size_t j) const;  // rules 0, 1, 3, 4
   [[nodiscard]] bool yields_jib_to(std::size_t i, std::size_t j) const;  // rule 2: i's request gives way to j's
   [[nodiscard]] bool shared(std::size_t i, const Airspace& a) const;
   [[nodiscard]] std::optional<std::vector<Pose>> yield_path(std::size_t victim, const std::vector<std::size_t>& waiting) const;
@@ -164,6 +178,7 @@ class SiteArbiter {
   std::vector<CraneState> cranes_;
   std::uint64_t yields_{0};
   std::uint64_t unresolved_{0};
+  double decided_at_{-std::numeric_limits<double>::infinity()};  // [s] the last decide()'s time
 };
 
 }  // namespace crane::anti_collision

@@ -97,6 +97,8 @@ struct SiteLayout {
                                       // link: rt/site/*), in [0, 232], unlike every crane's
   double link_deadline{0.3};          // [s] a crane hears nothing from the site service this long: it stops
                                       // moving into shared airspace (the supervisor's rule)
+  double max_wait{0.0};               // [s] a request that has waited this long goes before every later one
+                                      // (the site service's rule 0, site_arbiter.hpp); 0: no limit
   PathAllowance paths;
 
   static constexpr std::size_t kMaxCranes = 20;
