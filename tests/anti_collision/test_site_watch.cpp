@@ -66,6 +66,12 @@ TEST(SiteWatch, TheDistanceBetweenTwoReportedCranesByHand) {
   EXPECT_NEAR(watch.closest(), 0.16, 1e-4);
   EXPECT_EQ(watch.closest_parts(), "tc1.jib-tc2.load");
   EXPECT_DOUBLE_EQ(watch.closest_time(), 2.0);
+  // The reports it paired: tc1's of 1 s, tc2's of 2 s, one second apart.
+  ASSERT_EQ(watch.closest_reports().size(), 2u);
+  EXPECT_EQ(watch.closest_reports()[0].crane, 0u);
+  EXPECT_EQ(watch.closest_reports()[1].crane, 1u);
+  EXPECT_DOUBLE_EQ(watch.closest_reports()[1].slew, 0.0);
+  EXPECT_DOUBLE_EQ(watch.closest_apart(), 1.0);
   EXPECT_EQ(watch.cranes()[1].reports, 2u);
   EXPECT_DOUBLE_EQ(watch.cranes()[1].first_heard, 2.0);
   EXPECT_DOUBLE_EQ(watch.cranes()[1].heard, 3.0);

@@ -35,6 +35,8 @@ bool SiteWatch::report(const protocol::SiteReport& message, double time) {
       closest_parts_ = layout_.cranes[i].name + "." + to_string(d.first) + "-" + layout_.cranes[k].name + "." +
                        to_string(d.second);
       closest_time_ = time;
+      closest_reports_ = {*cranes_[i].report, *cranes_[k].report};
+      closest_apart_ = time - cranes_[j].heard;
     }
   }
   return true;

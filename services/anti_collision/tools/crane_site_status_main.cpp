@@ -191,6 +191,28 @@ int main(int argc, char** argv) {
                   watch.closest_parts().c_str(), watch.closest_time(), layout.margins.stop);
       out["min_distance_m"] = watch.closest();
       out["closest"] = watch.closest_parts() + " at " + std::to_string(watch.closest_time()) + " s";
+      // What the two cranes reported then: a late report pairs two moments.
+      std::string context;
+      for (const auto& report : watch.closest_reports()) {
+        const double swing = std::hypot(report.swing_in_plane, report.swing_out_of_plane);
+        char text[224];
+        std::snprintf(text, sizeof text,
+                      "%s%s %s: slew %.3f rad at %.3f rad/s, trolley %.3f m at %.3f m/s, cable %.3f m, swing %.3f rad",
+                      context.empty() ? "" : "; ", layout.cranes.at(report.crane).name.c_str(),
+                      report.state == protocol::SiteReport::STATE_MOVING ? "moving" : "at rest", report.slew,
+                      report.slew_rate, report.trolley, report.trolley_velocity, report.cable_length, swing);
+        context += text;
+        out["closest_reports"].push_back({{"crane", layout.cranes.at(report.crane).name},
+                                          {"moving", report.state == protocol::SiteReport::STATE_MOVING},
+                                          {"slew_rad", report.slew},
+                                          {"slew_rate_rad_s", report.slew_rate},
+                                          {"trolley_m", report.trolley},
+                                          {"trolley_velocity_m_s", report.trolley_velocity},
+                                          {"cable_length_m", report.cable_length},
+                                          {"swing_rad", swing}});
+      }
+      std::printf("  then: %s; the older report heard %.3f s before\n", context.c_str(), watch.closest_apart());
+      out["closest_reports_apart_s"] = watch.closest_apart();
     }
     out["yields"] = last->yields;
     out["unresolved"] = last->unresolved;

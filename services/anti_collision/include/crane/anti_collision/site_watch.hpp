@@ -66,6 +66,11 @@ class SiteWatch {
   [[nodiscard]] double closest() const noexcept { return closest_; }
   [[nodiscard]] const std::string& closest_parts() const noexcept { return closest_parts_; }
   [[nodiscard]] double closest_time() const noexcept { return closest_time_; }
+  /// At the closest distance, the two reports it paired (the first and the second crane of
+  /// closest_parts()), and how long before closest_time() [s] the older of them was heard: the two
+  /// poses are of moments about that far apart. Empty before two cranes reported.
+  [[nodiscard]] const std::vector<protocol::SiteReport>& closest_reports() const noexcept { return closest_reports_; }
+  [[nodiscard]] double closest_apart() const noexcept { return closest_apart_; }
 
   /// The airspace the service holds for crane `i` as its last report and the service's status say
   /// (HOLDING_REST: its rest pose; PATH or YIELD: the last instruction's path until its report
@@ -84,6 +89,8 @@ class SiteWatch {
   double closest_{std::numeric_limits<double>::infinity()};
   std::string closest_parts_;
   double closest_time_{0.0};
+  std::vector<protocol::SiteReport> closest_reports_;
+  double closest_apart_{0.0};
 };
 
 /// The plan-view outline of what hangs from the trolley anywhere in `box` of `crane` (site frame
