@@ -128,9 +128,9 @@ class SiteArbiter {
 
   /// Grants and yields at `time` [s] (the clock of request()), by the rules of the header; each
   /// crane at most one instruction. The instructed cranes hold the path or the yield from now on.
-  /// std::invalid_argument for a non-finite time. A request starving (rule 0) changes no outcome
-  /// by itself (what could go was granted at the decision before): the caller decides again only
-  /// when what the cranes hold or ask changed.
+  /// std::invalid_argument for a non-finite time. A request that starts starving (rule 0) grants
+  /// nothing by itself (what could go was granted at the decision before; it only reorders and
+  /// holds back): the caller decides again only when what the cranes hold or ask changed.
   [[nodiscard]] std::vector<Instruction> decide(double time);
 
 
