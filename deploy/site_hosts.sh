@@ -376,8 +376,9 @@ try:
           % (len(names) + 1, run_time, "%.3f m, %s" % (d, status["closest"]) if d is not None else "none", stop))
     if d is None or d < stop: problems.append("closest distance %s below the stop margin %.3f m" % (d, stop))
     for r in status.get("closest_reports", []):
-        print("       then %s %s: slew %.3f rad/s, trolley %.3f m/s, swing %.3f rad" % (
-            r["crane"], "moving" if r["moving"] else "at rest", r["slew_rate_rad_s"], r["trolley_velocity_m_s"], r["swing_rad"]))
+        print("       then %s %s: slew %.3f rad/s, trolley %.3f m/s, swing %.3f rad (envelope %.3f m)" % (
+            r["crane"], "moving" if r["moving"] else "at rest", r["slew_rate_rad_s"], r["trolley_velocity_m_s"], r["swing_rad"],
+            r["swing_envelope_m"]))
     if "closest_reports_apart_s" in status:
         print("       the older of the two reports heard %.3f s before" % status["closest_reports_apart_s"])
 except (OSError, ValueError):

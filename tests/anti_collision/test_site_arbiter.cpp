@@ -138,6 +138,10 @@ TEST(SiteArbiter, AClearRequestIsGrantedAndAConflictingOneWaits) {
   EXPECT_TRUE(arbiter.decide(kNow).empty());
   ASSERT_EQ(arbiter.waits_for(0).size(), 1u);
   EXPECT_EQ(arbiter.waits_for(0)[0], 1u);
+  EXPECT_EQ(arbiter.wait_reason(0), WaitReason::held);
+  EXPECT_EQ(arbiter.wait_reason(1), WaitReason::none);
+  EXPECT_EQ(arbiter.requested_at(0), 2.0);
+  EXPECT_EQ(arbiter.requested_at(1), std::nullopt);  // granted: none pending
   // B hoists up and rests there: its load 0.17 m above A's jib, beyond slow_down (0.15): A goes.
   arbiter.rest(1, {kPi, 1.0, 0.2});
   decided = arbiter.decide(kNow);
@@ -176,6 +180,7 @@ TEST(SiteArbiter, TheLowerCraneYieldsItsJibToTheHigherCranesCable) {
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 1u);
   EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
+  EXPECT_EQ(arbiter.wait_reason(0), WaitReason::higher_cable);
 }
 
 // The deadlock: A rests with its jib under the place where B must lower, B rests with its load
@@ -261,17 +266,21 @@ TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 2u);
   EXPECT_EQ(before.waits_for(0), std::vector<std::size_t>{1u});
+  EXPECT_EQ(before.wait_reason(0), WaitReason::held);
 
   // From then on C waits for A, which waits for B; B rests hook up, A goes, C waits for A's path.
   SiteArbiter after = arbiter;
   EXPECT_TRUE(after.decide(41.0).empty());
   EXPECT_EQ(after.waits_for(0), std::vector<std::size_t>{1u});
   EXPECT_EQ(after.waits_for(2), std::vector<std::size_t>{0u});
+  EXPECT_EQ(after.wait_reason(0), WaitReason::held);
+  EXPECT_EQ(after.wait_reason(2), WaitReason::starving);  // A's path, reserved, and not C's rule 2
   after.rest(1, {kPi, 1.0, 0.2});
   decided = after.decide(42.5);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 0u);
   EXPECT_EQ(after.waits_for(2), std::vector<std::size_t>{0u});
+  EXPECT_EQ(after.wait_reason(2), WaitReason::held);  // now what A holds
   EXPECT_EQ(after.holding(0), Holding::path);
   EXPECT_EQ(after.yields() + after.unresolved(), 0u);
 
@@ -917,7 +926,7 @@ TEST(SiteService, AnOperatorPutsASilentCraneOutOfService) {
   (void)service.step(0.4);
   EXPECT_EQ(service.arbiter().holding(0), Holding::out_of_service);  // step does not take it back
   crane::protocol::SiteStatus status;
-  to_message(service, status);
+  to_message(service, 0.4, status);
   EXPECT_EQ(status.holding[0], crane::protocol::SiteStatus::HOLDING_OUT_OF_SERVICE);
   ASSERT_EQ(service.report(at_rest(0, a_rest), 0.5), "");
   EXPECT_EQ(service.arbiter().holding(0), Holding::rest);
@@ -937,6 +946,38 @@ TEST(SiteService, AnOperatorPutsASilentCraneOutOfService) {
             "site arbiter: crane a went silent where this service did not know it stood (never heard at rest or on a grant, with no "
             "memory of it, or it moved without a grant): its whole reach stays held");
   EXPECT_EQ(restarted.arbiter().holding(0), Holding::whole_reach);
+}
+
+// The status (rt/site/status) says who waits for whom, why and since when: B lowers on its grant,
+// A's later request to turn its jib under B's load waits for what B holds, asked at 0.5 s and
+// reported again since (the same request: its time stays). The IDL's WAIT_* names are the
+// arbiter's.
+TEST(SiteService, TheStatusSaysWhoWaitsForWhomWhyAndForHowLong) {
+  SiteService service(two_towers(), ArbiterMode::coordinated, 3);
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  const Pose b_rest{kPi - 1.5, 0.5, 0.2};
+  const CraneReport b = at_rest(1, b_rest, 1, {b_rest, {kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}});
+  ASSERT_EQ(service.report(at_rest(0, a_rest), 0.0), "");
+  ASSERT_EQ(service.report(b, 0.0), "");
+  ASSERT_EQ(service.step(0.0).size(), 1u);  // B goes
+  const CraneReport a = at_rest(0, a_rest, 7, {a_rest, {0.0, 0.5, 0.2}});
+  ASSERT_EQ(service.report(a, 0.5), "");
+  EXPECT_TRUE(service.step(0.5).empty());
+  ASSERT_EQ(service.report(a, 2.0), "");
+  (void)service.step(2.0);
+  crane::protocol::SiteStatus status;
+  to_message(service, 2.5, status);
+  using crane::protocol::SiteStatus;
+  EXPECT_TRUE(status.pending[0]);
+  EXPECT_EQ(status.waits_for[0], 1u << 1);
+  EXPECT_EQ(status.wait_reason[0], SiteStatus::WAIT_HELD);
+  EXPECT_DOUBLE_EQ(status.waited[0], 2.0);
+  EXPECT_FALSE(status.pending[1]);
+  EXPECT_EQ(status.wait_reason[1], SiteStatus::WAIT_NONE);
+  EXPECT_EQ(status.waited[1], 0.0);
+  for (const WaitReason reason : {WaitReason::none, WaitReason::held, WaitReason::starving, WaitReason::higher_cable}) {
+    EXPECT_EQ(crane::protocol::code_name(SiteStatus::kCodes, "WAIT", wait_code(reason)), to_string(reason));
+  }
 }
 
 void expect_same_airspace(const Airspace& a, const Airspace& b) {

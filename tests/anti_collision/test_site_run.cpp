@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -68,6 +69,11 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
         counted += w;
       }
       EXPECT_NEAR(counted, waiting, 1e-9 * waiting + 1e-9) << "seed " << seed;
+      // And by why the service had them wait (SiteArbiter::wait_reason): the same sum, part of it
+      // for what other cranes hold.
+      const double why = std::accumulate(o->waited_why.begin(), o->waited_why.end(), 0.0);
+      EXPECT_NEAR(why, waiting, 1e-9 * waiting + 1e-9) << "seed " << seed;
+      EXPECT_GT(o->waited_why[static_cast<std::size_t>(crane::anti_collision::WaitReason::held)], 0.0) << "seed " << seed;
       EXPECT_GT(waiting, 0.0) << "seed " << seed << ": the jobs force conflicts";
     }
     coordinated_total += coordinated.total_time;

@@ -3,7 +3,8 @@
 //   1. the view: every crane of the site reported, the site service heard, one pair per two cranes;
 //   2. each pair's distance equals what crane_site_status (another process on the site's domain)
 //      prints for it, and is no more than this file's own bound from the parts the view gives:
-//      the closest of points sampled along each two capsules' axes, less both radii;
+//      the closest of points sampled along each two capsules' axes, less both radii; who waits
+//      for whom, why and since when, as crane_site_status says it (the writer's tc1 waits);
 //   3. the site's scene for Foxglove's 3D panel, as Foxglove's own client (@foxglove/ws-protocol)
 //      receives it: a JSON foxglove.SceneUpdate with an entity per crane whose load sphere is where
 //      the view's load is, a line loop per box the view holds and asks for, and a text per pair
@@ -96,6 +97,26 @@ async function main() {
     console.log(`[ figure ] ${name}: ${p.distance.toFixed(4)} m (${p.parts.join("-")}), crane_site_status ` +
                 `${theirs.distance_m.toFixed(4)} m, sampled parts ${bound.toFixed(4)} m, band ${p.band}`);
   }
+  // Who waits, why and since when: a reason exactly when it waits for a crane, a time exactly when
+  // its request is pending, the same as crane_site_status's (a later status: the writer's cranes
+  // stand still, so the waits stay; the time only grows).
+  const waiting = view.cranes.filter((c) => c.waits_for.length > 0);
+  if (waiting.length === 0) problems.push("no crane waits in the view: the writer's tc1 asks for a leg through the others");
+  for (const c of view.cranes) {
+    const theirs = status.cranes.find((q) => q.name === c.name);
+    if ((c.waits_for.length > 0) !== (c.wait_reason !== null)) problems.push(`${c.name}: waits for [${c.waits_for}], reason ${c.wait_reason}`);
+    if (c.waiting !== (c.waited_s !== null) || (c.waited_s !== null && !(c.waited_s >= 0))) {
+      problems.push(`${c.name}: waiting ${c.waiting}, waited ${c.waited_s} s`);
+    }
+    if (!theirs) { problems.push(`crane_site_status has no crane ${c.name}`); continue; }
+    if ((c.wait_reason || "-") !== theirs.why || (c.waits_for.join(",") || "-") !== theirs.waits_for) {
+      problems.push(`${c.name}: the view's wait for [${c.waits_for}] (${c.wait_reason}), crane_site_status's ${theirs.waits_for} (${theirs.why})`);
+    }
+    if (c.waited_s !== null && !(theirs.waited_s >= c.waited_s)) {
+      problems.push(`${c.name}: waited ${c.waited_s} s in the view, ${theirs.waited_s} s in crane_site_status's later status`);
+    }
+  }
+  console.log(`[ figure ] site page waits: ${waiting.map((c) => `${c.name} for ${c.waits_for} (${c.wait_reason}, ${c.waited_s.toFixed(1)} s)`).join("; ")}`);
 
   // 3. The scene, as Foxglove's client gets it (the view fetched again right after: the cranes
   // stand still, so both describe the same site).

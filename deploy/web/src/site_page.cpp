@@ -118,6 +118,12 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
       if ((status->waits_for[i] & (std::uint32_t{1} << j)) != 0) waits.push_back(layout.cranes[j].name);
     }
     crane["waits_for"] = waits;
+    // Why (a WAIT_* name: held, starving, higher_cable) and how long its request has waited [s].
+    crane["wait_reason"] = listed && !waits.empty()
+                               ? json(std::string(protocol::code_name(protocol::SiteStatus::kCodes, "WAIT",
+                                                                      status->wait_reason[i])))
+                               : json(nullptr);
+    crane["waited_s"] = listed && status->pending[i] ? json(status->waited[i]) : json(nullptr);
     crane["instruction"] = !seen.order                                        ? json(nullptr)
                            : seen.order->kind == ac::Instruction::Kind::go ? json("go")
                                                                             : json("yield");

@@ -127,7 +127,9 @@
         "warning " + view.margins.warning + " m, slow down " + view.margins.slow_down + " m, stop " + view.margins.stop + " m";
     document.getElementById("closest").textContent = view.closest
         ? "closest " + fixed(view.closest.distance, 3) + " m (" + view.closest.parts + " at " + fixed(view.closest.at, 1) + " s)" : "";
-    const waits = view.cranes.filter((c) => c.waits_for.length > 0).map((c) => c.name + " waits for " + c.waits_for.join(", "));
+    const waits = view.cranes.filter((c) => c.waits_for.length > 0).map((c) =>
+        c.name + " waits for " + c.waits_for.join(", ") + " (" + c.wait_reason +
+        (c.waited_s !== null ? ", " + fixed(c.waited_s, 0) + " s" : "") + ")");
     document.getElementById("waits").textContent = waits.join("; ");
     const rows = [["", "crane", "state", "holding", "request", "instruction", "slew [deg]", "trolley [m]", "cable [m]", "heard [s ago]"]];
     view.cranes.forEach((c, i) => {

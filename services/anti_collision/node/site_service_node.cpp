@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
       }
       if (cycle % kStatusEvery == 0) {
         protocol::SiteStatus message;
-        ac::to_message(service, message);
+        ac::to_message(service, now, message);
         message.reports_rejected += unreadable;
         message.header.seq = ++status_seq;
         tp::msgs::SiteStatus_ out;

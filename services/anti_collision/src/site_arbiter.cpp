@@ -19,6 +19,16 @@ const char* to_string(Holding holding) noexcept {
   return "?";
 }
 
+const char* to_string(WaitReason reason) noexcept {
+  switch (reason) {
+    case WaitReason::none: return "none";
+    case WaitReason::held: return "held";
+    case WaitReason::starving: return "starving";
+    case WaitReason::higher_cable: return "higher_cable";
+  }
+  return "?";
+}
+
 SiteArbiter::SiteArbiter(SiteLayout layout, ArbiterMode mode) : layout_(std::move(layout)), mode_(mode) {
   validate(layout_);
   cranes_.resize(layout_.cranes.size());
@@ -236,6 +246,7 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < n; ++i) {
     cranes_[i].waits_for.clear();
+    cranes_[i].wait_reason = WaitReason::none;
     if (cranes_[i].request && cranes_[i].holding == Holding::rest) order.push_back(i);
   }
   std::sort(order.begin(), order.end(), [this](std::size_t a, std::size_t b) { return ranks_before(a, b); });
@@ -294,11 +305,13 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
   for (std::size_t position = 0; position < order.size(); ++position) {
     const std::size_t i = order[position];
     std::vector<std::size_t> waits = blockers(i);
+    WaitReason why = WaitReason::held;
     for (const std::size_t j : waits) blocks[i][j] = true;
     if (waits.empty()) {
       if (const auto k = reserved(i, position)) {
         waits.push_back(*k);
         blocks[i][*k] = true;
+        why = WaitReason::starving;
       }
     }
     if (waits.empty() && !starving(i)) {
@@ -308,9 +321,13 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
         const std::size_t k = order[later];
         if (yields_jib_to(i, k) && blockers(k).empty() && !reserved(k, later)) waits.push_back(k);
       }
+      why = WaitReason::higher_cable;
     }
     cranes_[i].waits_for = waits;
-    if (!waits.empty()) continue;
+    if (!waits.empty()) {
+      cranes_[i].wait_reason = why;
+      continue;
+    }
     CraneState& c = cranes_[i];
     c.holding = Holding::path;
     c.held = c.request->airspace;

@@ -130,7 +130,17 @@ std::uint8_t holding_code(Holding holding) noexcept {
   return SiteStatus::HOLDING_WHOLE_REACH;
 }
 
-void to_message(const SiteService& service, SiteStatus& m) noexcept {
+std::uint8_t wait_code(WaitReason reason) noexcept {
+  switch (reason) {
+    case WaitReason::none: return SiteStatus::WAIT_NONE;
+    case WaitReason::held: return SiteStatus::WAIT_HELD;
+    case WaitReason::starving: return SiteStatus::WAIT_STARVING;
+    case WaitReason::higher_cable: return SiteStatus::WAIT_HIGHER_CABLE;
+  }
+  return SiteStatus::WAIT_NONE;
+}
+
+void to_message(const SiteService& service, double time, SiteStatus& m) noexcept {
   static_assert(SiteLayout::kMaxCranes == SiteStatus::MAX_CRANES, "the IDL's MAX_CRANES is the site's kMaxCranes");
   static_assert(Airspace::kMaxBoxes + 1 == SiteReport::MAX_WAYPOINTS, "the IDL's MAX_WAYPOINTS is kMaxBoxes + 1");
   const SiteArbiter& a = service.arbiter();
@@ -139,10 +149,14 @@ void to_message(const SiteService& service, SiteStatus& m) noexcept {
   m.holding.fill(SiteStatus::HOLDING_WHOLE_REACH);
   m.pending.fill(false);
   m.waits_for.fill(0);
+  m.wait_reason.fill(SiteStatus::WAIT_NONE);
+  m.waited.fill(0.0);
   for (std::size_t i = 0; i < a.size() && i < m.holding.size(); ++i) {
     m.holding[i] = holding_code(a.holding(i));
     m.pending[i] = a.pending(i);
     for (const std::size_t j : a.waits_for(i)) m.waits_for[i] |= std::uint32_t{1} << j;
+    m.wait_reason[i] = wait_code(a.wait_reason(i));
+    if (const auto since = a.requested_at(i)) m.waited[i] = std::max(0.0, time - *since);
   }
   m.yields = a.yields();
   m.unresolved = a.unresolved();

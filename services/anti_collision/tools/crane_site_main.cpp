@@ -417,6 +417,22 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     if (waited_for_stopped > 0.0) std::printf(", a stopped host %.1f", 100.0 * waited_for_stopped / asked);
     std::printf("\n");
   }
+  // Why the service had them wait (SiteOutcome::waited_why): the rules' own share of the waiting.
+  std::array<double, kWaitReasonCount> waited_why{};
+  for (const SetResult& r : results) {
+    if (!r.error.empty()) continue;
+    for (std::size_t w = 0; w < waited_why.size(); ++w) waited_why[w] += r.coordinated.waited_why[w];
+  }
+  const double asked_why = std::accumulate(waited_why.begin(), waited_why.end(), 0.0);
+  if (asked_why > 0.0) {
+    std::printf("  coordinated waits, by why [%% of %.0f crane-seconds]: its path meets what they hold %.1f, "
+                "a starving request's path (rule 0) %.1f, its jib gives way to a higher cable (rule 2) %.1f, "
+                "no crane %.1f\n",
+                asked_why, 100.0 * waited_why[static_cast<std::size_t>(WaitReason::held)] / asked_why,
+                100.0 * waited_why[static_cast<std::size_t>(WaitReason::starving)] / asked_why,
+                100.0 * waited_why[static_cast<std::size_t>(WaitReason::higher_cable)] / asked_why,
+                100.0 * waited_why[static_cast<std::size_t>(WaitReason::none)] / asked_why);
+  }
   const bool safe = !min_distance.empty() && crane::stack::nearest_rank_quantile(min_distance, 0.0) >= site.margins.stop;
   return failed == 0 && incomplete == 0 && faulted == 0 && safe ? 0 : 1;
 }

@@ -2,7 +2,8 @@
 // are, from any host on the site's domain (docs/site.md, "The site service on DDS"). Listens to
 // rt/site/status and rt/site/report for --wait seconds (or until SIGINT/SIGTERM) and prints the
 // last status: one row per crane of the site file (what the service holds for it, whether a
-// request waits and for which cranes, what the crane last reported: at rest or moving, its pose),
+// request waits, for which cranes, why (held, starving, higher_cable: SiteStatus_'s WAIT_*) and for how
+// long, what the crane last reported: at rest or moving, its pose),
 // then the service's counters, then the distance between every two cranes that reported: at their
 // last reports and the smallest over the listening time (the parts of crane_geometry.hpp at each
 // reported pose, the load as its swing envelope; each report pairs with the other crane's latest).
@@ -30,6 +31,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "crane/anti_collision/crane_geometry.hpp"
+#include "crane/anti_collision/site_messages.hpp"
 #include "crane/anti_collision/site_watch.hpp"
 #include "crane/anti_collision/site_file.hpp"
 #include "crane/protocol/dds.hpp"
@@ -152,8 +155,8 @@ int main(int argc, char** argv) {
                   last->crane_count, layout.cranes.size());
     }
     nlohmann::json out{{"epoch", last->epoch}, {"cranes", nlohmann::json::array()}, {"pairs", nlohmann::json::array()}};
-    std::printf("%-8s %-12s %-8s %-10s %-9s %s\n", "crane", "holding", "request", "waits_for", "reported",
-                "slew_deg trolley_m cable_m");
+    std::printf("%-8s %-12s %-8s %-10s %-12s %-8s %-9s %s\n", "crane", "holding", "request", "waits_for", "why",
+                "waited_s", "reported", "slew_deg trolley_m cable_m");
     for (std::size_t i = 0; i < n && i < last->holding.size(); ++i) {
       const std::string holding(protocol::code_name(SiteStatus::kCodes, "HOLDING", last->holding[i]));
       const auto& report = cranes[i].report;
@@ -165,10 +168,18 @@ int main(int argc, char** argv) {
         std::snprintf(pose, sizeof pose, "%8.1f %9.3f %7.3f", report->slew * 180.0 / 3.14159265358979323846,
                       report->trolley, report->cable_length);
       }
-      std::printf("%-8s %-12s %-8s %-10s %-9s %s\n", layout.cranes[i].name.c_str(), holding.c_str(),
-                  last->pending[i] ? "waiting" : "-", waits_for(layout, last->waits_for[i]).c_str(), state.c_str(), pose);
+      // Why it waits for them (a WAIT_* name) and how long its request has waited.
+      const std::string why = last->waits_for[i] == 0
+                                  ? "-"
+                                  : std::string(protocol::code_name(SiteStatus::kCodes, "WAIT", last->wait_reason[i]));
+      char waited[32] = "-";
+      if (last->pending[i]) std::snprintf(waited, sizeof waited, "%.1f", last->waited[i]);
+      std::printf("%-8s %-12s %-8s %-10s %-12s %-8s %-9s %s\n", layout.cranes[i].name.c_str(), holding.c_str(),
+                  last->pending[i] ? "waiting" : "-", waits_for(layout, last->waits_for[i]).c_str(), why.c_str(), waited,
+                  state.c_str(), pose);
       nlohmann::json row{{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
-                         {"state", state}};
+                         {"state", state}, {"waits_for", waits_for(layout, last->waits_for[i])}, {"why", why}};
+      if (last->pending[i]) row["waited_s"] = last->waited[i];
       if (cranes[i].reports > 0) {  // [s] since the tool started: the rate is reports over the span
         row["first_report_s"] = cranes[i].first_heard;
         row["last_report_s"] = cranes[i].heard;
@@ -195,12 +206,19 @@ int main(int argc, char** argv) {
       std::string context;
       for (const auto& report : watch.closest_reports()) {
         const double swing = std::hypot(report.swing_in_plane, report.swing_out_of_plane);
-        char text[224];
+        // The load's swing envelope the distance used (crane_geometry.hpp: L sin A, A the amplitude
+        // of the swing with its rate), in every direction of the load's capsule.
+        const double envelope = anti_collision::stopping_travel(layout.cranes.at(report.crane),
+                                                                anti_collision::motion_of(report),
+                                                                anti_collision::StopKind::none)
+                                    .swing_radius;
+        char text[256];
         std::snprintf(text, sizeof text,
-                      "%s%s %s: slew %.3f rad at %.3f rad/s, trolley %.3f m at %.3f m/s, cable %.3f m, swing %.3f rad",
+                      "%s%s %s: slew %.3f rad at %.3f rad/s, trolley %.3f m at %.3f m/s, cable %.3f m, swing %.3f rad "
+                      "(envelope %.3f m)",
                       context.empty() ? "" : "; ", layout.cranes.at(report.crane).name.c_str(),
                       report.state == protocol::SiteReport::STATE_MOVING ? "moving" : "at rest", report.slew,
-                      report.slew_rate, report.trolley, report.trolley_velocity, report.cable_length, swing);
+                      report.slew_rate, report.trolley, report.trolley_velocity, report.cable_length, swing, envelope);
         context += text;
         out["closest_reports"].push_back({{"crane", layout.cranes.at(report.crane).name},
                                           {"moving", report.state == protocol::SiteReport::STATE_MOVING},
@@ -209,7 +227,8 @@ int main(int argc, char** argv) {
                                           {"trolley_m", report.trolley},
                                           {"trolley_velocity_m_s", report.trolley_velocity},
                                           {"cable_length_m", report.cable_length},
-                                          {"swing_rad", swing}});
+                                          {"swing_rad", swing},
+                                          {"swing_envelope_m", envelope}});
       }
       std::printf("  then: %s; the older report heard %.3f s before\n", context.c_str(), watch.closest_apart());
       out["closest_reports_apart_s"] = watch.closest_apart();

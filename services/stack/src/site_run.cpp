@@ -197,6 +197,8 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     for (std::size_t i = 0; k > 0 && i < n; ++i) {
       if (cranes[i].host_stopped(k) || cranes[i].link->phase() != ac::CraneSiteLink::Phase::asking) continue;
       const std::vector<std::size_t>& blockers = service->arbiter().waits_for(i);
+      const ac::WaitReason why = service_down ? ac::WaitReason::none : service->arbiter().wait_reason(i);
+      out.waited_why[static_cast<std::size_t>(why)] += dt;
       if (service_down || blockers.empty()) {
         out.waited_for_none += dt;
         continue;

@@ -68,6 +68,15 @@ enum class Holding : std::uint8_t { rest, path, yield, whole_reach, out_of_servi
 /// "rest", "path", "yield", "whole_reach", "out_of_service".
 [[nodiscard]] const char* to_string(Holding holding) noexcept;
 
+/// Why a pending request waits for the cranes of waits_for (the rules of the header): none (it
+/// does not wait, or it is not decided yet); held: its path meets what they hold (serialized: or
+/// they travel in shared airspace); starving: rule 0, it meets the path a starving request of
+/// theirs reserves; higher_cable: rule 2, it gives its jib way to a higher crane's cable.
+enum class WaitReason : std::uint8_t { none, held, starving, higher_cable };
+inline constexpr std::size_t kWaitReasonCount = 4;
+/// "none", "held", "starving", "higher_cable".
+[[nodiscard]] const char* to_string(WaitReason reason) noexcept;
+
 class SiteArbiter {
  public:
   static constexpr double kYieldSlewStep = 0.5236;  // [rad] (30 deg)
@@ -141,6 +150,13 @@ class SiteArbiter {
   /// The cranes whose held airspace the pending request meets, or whose starving request it meets
   /// (rule 0), as of the last decide().
   [[nodiscard]] const std::vector<std::size_t>& waits_for(std::size_t crane) const { return cranes_.at(crane).waits_for; }
+  /// Why, as of the last decide(): none when waits_for is empty.
+  [[nodiscard]] WaitReason wait_reason(std::size_t crane) const { return cranes_.at(crane).wait_reason; }
+  /// The time [s] (request()'s clock) of crane `crane`'s pending request; none when none is pending.
+  [[nodiscard]] std::optional<double> requested_at(std::size_t crane) const {
+    const auto& r = cranes_.at(crane).request;
+    return r ? std::optional<double>(r->time) : std::nullopt;
+  }
   /// Yields told so far, and the times decide() found a blocked crane no yield could free.
   [[nodiscard]] std::uint64_t yields() const noexcept { return yields_; }
   [[nodiscard]] std::uint64_t unresolved() const noexcept { return unresolved_; }
@@ -165,6 +181,7 @@ class SiteArbiter {
     bool held_shared{false};
     std::optional<Request> request;
     std::vector<std::size_t> waits_for;
+    WaitReason wait_reason{WaitReason::none};
   };
 
   [[nodiscard]] bool starving(std::size_t i) const noexcept;  // rule 0, at decided_at_

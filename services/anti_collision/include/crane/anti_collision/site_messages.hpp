@@ -32,9 +32,13 @@ void to_message(const SiteOrder& order, std::uint32_t epoch, protocol::SiteInstr
 /// `message` read into `order`. "" when read, else why not.
 [[nodiscard]] std::string from_message(const protocol::SiteInstruction& message, SiteOrder& order);
 
-/// What `service` holds, its counters and its epoch written into `message` (header untouched).
-void to_message(const SiteService& service, protocol::SiteStatus& message) noexcept;
+/// What `service` holds, who waits for whom and why, its counters and its epoch written into
+/// `message` (header untouched); `time` [s], the service's clock (step()'s), gives each pending
+/// request's `waited`.
+void to_message(const SiteService& service, double time, protocol::SiteStatus& message) noexcept;
 /// The IDL's HOLDING_* code of `holding`.
 [[nodiscard]] std::uint8_t holding_code(Holding holding) noexcept;
+/// The IDL's WAIT_* code of `reason`.
+[[nodiscard]] std::uint8_t wait_code(WaitReason reason) noexcept;
 
 }  // namespace crane::anti_collision

@@ -161,6 +161,10 @@ struct SiteOutcome {
   std::array<double, anti_collision::CraneSiteLink::kActivityCount> waited_for{};
   double waited_for_none{0.0};
   double waited_for_stopped_host{0.0};
+  // The same crane-seconds asking (a stopped host's too), by why the service's last decision had the
+  // crane wait (SiteArbiter::wait_reason; index: WaitReason; none: it waited for no crane, or the
+  // service was down). On a fault-free run they add up to the cranes' waiting_time too.
+  std::array<double, anti_collision::kWaitReasonCount> waited_why{};
   // Every job done within the time limit (no crane braked by its guard), but those a stopped host
   // left undone: its crane's, and those of the cranes stuck waiting for its reach.
   bool completed{false};
