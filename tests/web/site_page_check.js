@@ -154,6 +154,9 @@ async function main() {
     if (loops !== c.held.length + c.requested.length) {
       problems.push(`scene: ${c.name} has ${loops} line loops, the view ${c.held.length} held + ${c.requested.length} requested boxes`);
     }
+    const label = (e.texts[0] || { text: "" }).text;
+    const waits = c.waits_for.length > 0 ? `waits for ${c.waits_for.join(", ")} (${c.wait_reason}, ` : null;
+    if (waits !== null && !label.includes(waits)) problems.push(`scene: ${c.name}'s text '${label}' does not say '${waits}...'`);
   }
   const texts = (scene.entities.find((x) => x.id === "site/distances") || { texts: [] }).texts.map((t) => t.text);
   for (const p of now.pairs) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "crane/anti_collision/site_messages.hpp"
 #include "crane/protocol/messages.hpp"
@@ -70,6 +71,15 @@ const char* band(double distance, const ac::Margins& m) noexcept {
   return ac::to_string(ac::classify(distance, std::numeric_limits<double>::infinity(), m));
 }
 
+// The names of the cranes crane `i`'s request waits for, as the service's last status says.
+std::vector<std::string> waits_for(const ac::SiteLayout& layout, const protocol::SiteStatus& status, std::size_t i) {
+  std::vector<std::string> names;
+  for (std::size_t j = 0; i < status.crane_count && i < status.waits_for.size() && j < layout.cranes.size() && j < 32; ++j) {
+    if ((status.waits_for[i] & (std::uint32_t{1} << j)) != 0) names.push_back(layout.cranes[j].name);
+  }
+  return names;
+}
+
 }  // namespace
 
 json site_page_json(const ac::SiteWatch& watch, double time) {
@@ -113,10 +123,7 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
                                                                       status->holding[i])))
                               : json(nullptr);
     crane["waiting"] = listed && status->pending[i];
-    json waits = json::array();
-    for (std::size_t j = 0; listed && j < layout.cranes.size() && j < 32; ++j) {
-      if ((status->waits_for[i] & (std::uint32_t{1} << j)) != 0) waits.push_back(layout.cranes[j].name);
-    }
+    const json waits = listed ? json(waits_for(layout, *status, i)) : json::array();
     crane["waits_for"] = waits;
     // Why (a WAIT_* name: held, starving, higher_cable) and how long its request has waited [s].
     crane["wait_reason"] = listed && !waits.empty()
@@ -208,7 +215,19 @@ json site_scene_json(const ac::SiteWatch& watch, std::int64_t stamp_ns) {
     }
     if (status && i < status->holding.size() && i < status->crane_count) {
       label += ", holds " + std::string(protocol::code_name(protocol::SiteStatus::kCodes, "HOLDING", status->holding[i]));
-      if (status->pending[i]) label += ", waits";
+      if (status->pending[i]) {
+        // "waits for tc2 (held, 4 s)", as the site page's line says it.
+        const auto names = waits_for(layout, *status, i);
+        std::string who;
+        for (const auto& name : names) who += (who.empty() ? "" : ", ") + name;
+        char waited[32];
+        std::snprintf(waited, sizeof waited, "%.0f s", status->waited[i]);
+        label += names.empty() ? ", waits (" + std::string(waited) + ")"
+                               : ", waits for " + who + " (" +
+                                     std::string(protocol::code_name(protocol::SiteStatus::kCodes, "WAIT",
+                                                                     status->wait_reason[i])) +
+                                     ", " + waited + ")";
+      }
     }
     for (auto& l : loops(c, watch.held(i), c.jib_height, 0.02, colour(rgb, 0.9))) e["lines"].push_back(std::move(l));
     for (auto& l : loops(c, watch.requested(i), c.jib_height + 0.05, 0.01, colour(rgb, 0.4))) e["lines"].push_back(std::move(l));

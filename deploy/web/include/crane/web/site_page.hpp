@@ -32,7 +32,8 @@
 // ("crane/tc1": the mast a cylinder, jib and counter-jib a line list as thick as their capsules,
 // the cable a line, the load a sphere of its swing envelope, what the service holds a line loop
 // at the jib's height per box, what it asks for a thinner one 5 cm above, a text with the name,
-// state and holding) and one with the pairs' distances ("site/distances": a text per pair over
+// state and holding, and while its request waits, for whom, why and how long: "tc1 at rest,
+// holds rest, waits for tc2 (held, 3 s)") and one with the pairs' distances ("site/distances": a text per pair over
 // the middle of the two masts, coloured by its band) and the fixed zones ("site/zones": a line
 // loop each on the ground). Entities are replaced by id at each update (lifetime 0).
 
