@@ -56,6 +56,41 @@ TEST(Airspace, RestPosesByHand) {
   EXPECT_NEAR(dswing, std::sin(0.3) - 0.03 - 0.05 - 2.0 * std::sin(0.05), 1e-9);
 }
 
+// The allowances of a box by hand: a segment in which the slew or the trolley travels gets the
+// tracking allowance on either side of both intervals (and the overshoot past its goals); one in
+// which neither travels (only the hoist moves) and a rest box get the hold allowance.
+TEST(Airspace, TheTrackingAllowanceWhereAnAxisTravelsTheHoldAllowanceWhereNone) {
+  SiteLayout s = two_towers();
+  s.paths = {.trolley_overshoot = 0.07, .slew_overshoot = 0.05, .travel_swing = 0.6, .hoist_swing = 0.05,
+             .trolley_tracking = 0.04, .slew_tracking = 0.07, .trolley_hold = 0.01, .slew_hold = 0.02};
+  // Hook up at (0.3 rad, 0.8 m), travel to (0.9 rad, 0.6 m), lower to 1.5 m of cable.
+  const std::vector<Pose> path{{0.3, 0.8, 0.2}, {0.9, 0.6, 0.2}, {0.9, 0.6, 1.5}};
+  const Airspace a = path_airspace(path, s.paths);
+  ASSERT_EQ(a.count, 2u);
+  const JointBox& travel = a.boxes[0];
+  EXPECT_NEAR(travel.slew_low, 0.3 - 0.07, 1e-15);
+  EXPECT_NEAR(travel.slew_high, 0.9 + 0.05 + 0.07, 1e-15);
+  EXPECT_NEAR(travel.trolley_low, 0.6 - 0.07 - 0.04, 1e-15);
+  EXPECT_NEAR(travel.trolley_high, 0.8 + 0.04, 1e-15);
+  EXPECT_NEAR(travel.swing_radius, 0.2 * std::sin(0.6), 1e-15);
+  const JointBox& lower = a.boxes[1];
+  EXPECT_NEAR(lower.slew_low, 0.9 - 0.02, 1e-15);
+  EXPECT_NEAR(lower.slew_high, 0.9 + 0.02, 1e-15);
+  EXPECT_NEAR(lower.trolley_low, 0.6 - 0.01, 1e-15);
+  EXPECT_NEAR(lower.trolley_high, 0.6 + 0.01, 1e-15);
+  EXPECT_NEAR(lower.cable_high, 1.5, 1e-15);
+  EXPECT_NEAR(lower.swing_radius, 1.5 * std::sin(0.05), 1e-15);
+  const Airspace at_rest = rest_airspace({0.9, 0.6, 1.5}, s.paths);
+  const JointBox& rest = at_rest.boxes[0];
+  EXPECT_NEAR(rest.slew_high - rest.slew_low, 2 * 0.02, 1e-15);
+  EXPECT_NEAR(rest.trolley_high - rest.trolley_low, 2 * 0.01, 1e-15);
+  // A slew alone travels: the trolley still gets the tracking allowance (pulled outward).
+  const Airspace slewing = path_airspace(std::vector<Pose>{{0.3, 0.8, 0.2}, {0.9, 0.8, 0.2}}, s.paths);
+  const JointBox& slew_only = slewing.boxes[0];
+  EXPECT_NEAR(slew_only.trolley_low, 0.8 - 0.04, 1e-15);
+  EXPECT_NEAR(slew_only.trolley_high, 0.8 + 0.04, 1e-15);
+}
+
 // A slewing path sweeps every heading between its ends: A turning from -1 to +1 rad passes under
 // B's lowered load at heading 0; the samples' padding keeps the swept jib inside the airspace at
 // every heading, checked against 2000 seeded random headings of the path.
@@ -93,7 +128,8 @@ TEST(Airspace, ThePruningGivesTheSameAnswerAsEveryPair) {
   for (int i = 0; i < 400; ++i) {
     SiteLayout s = two_towers(in(2.0, 4.0));
     s.paths = {.trolley_overshoot = in(0.0, 0.1), .slew_overshoot = in(0.0, 0.1), .travel_swing = in(0.0, 0.6),
-               .hoist_swing = in(0.0, 0.05), .trolley_tracking = in(0.0, 0.05), .slew_tracking = in(0.0, 0.05)};
+               .hoist_swing = in(0.0, 0.05), .trolley_tracking = in(0.0, 0.05), .slew_tracking = in(0.0, 0.05),
+               .trolley_hold = in(0.0, 0.05), .slew_hold = in(0.0, 0.05)};
     for (auto& c : s.cranes) {
       c.base = {in(-2.0, 2.0), in(-2.0, 2.0)};
       c.jib_length = in(0.8, 2.0);

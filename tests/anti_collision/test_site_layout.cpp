@@ -64,6 +64,8 @@ TEST(SiteLayout, ShippedSiteLoads) {
   ASSERT_EQ(site.zones.size(), 1u);
   EXPECT_TRUE(site.zones[0].fixed);
   EXPECT_DOUBLE_EQ(site.max_wait, 20.0);
+  EXPECT_DOUBLE_EQ(site.paths.trolley_hold, 0.01);
+  EXPECT_DOUBLE_EQ(site.paths.slew_hold, 0.02);
   EXPECT_EQ(find_crane(site, "tc3"), 2);
   EXPECT_EQ(find_crane(site, "tc9"), -1);
   // The jibs overlap in plan view (bases 2 m apart, each reaching 1.4 m + its radius).
@@ -88,6 +90,8 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: site.cranes[0] (tc1).hook_height_max = 2.48 is out of range: must be in [0.5, 2.45]");
   EXPECT_EQ(refusal(edited("travel_swing: 0.6", "travel_swing: 2")),
             "site.yaml: site.paths.travel_swing = 2 is out of range: must be in [0, 1.5]");
+  EXPECT_EQ(refusal(edited("slew_hold: 0.02", "slew_hold: -0.02")),
+            "site.yaml: site.paths.slew_hold = -0.02 is out of range: must be in [0, 10]");
   EXPECT_EQ(refusal(edited("max_wait: 20", "max_wait: -1")),
             "site.yaml: site.max_wait = -1 is out of range: must be in [0, 3600]");
   EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: -3.5")),

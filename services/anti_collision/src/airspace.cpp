@@ -104,11 +104,13 @@ JointBox box_of(const Pose& from, const Pose& to, const PathAllowance& allowance
   if (to.slew < from.slew) box.slew_low -= allowance.slew_overshoot;
   if (to.trolley > from.trolley) box.trolley_high += allowance.trolley_overshoot;
   if (to.trolley < from.trolley) box.trolley_low = std::max(0.0, box.trolley_low - allowance.trolley_overshoot);
-  // The tracking allowance on either side.
-  box.slew_low -= allowance.slew_tracking;
-  box.slew_high += allowance.slew_tracking;
-  box.trolley_low = std::max(0.0, box.trolley_low - allowance.trolley_tracking);
-  box.trolley_high += allowance.trolley_tracking;
+  // The tracking allowance on either side: the travel's, or where the trolley and the slew hold.
+  const double slew_tracking = travels ? allowance.slew_tracking : allowance.slew_hold;
+  const double trolley_tracking = travels ? allowance.trolley_tracking : allowance.trolley_hold;
+  box.slew_low -= slew_tracking;
+  box.slew_high += slew_tracking;
+  box.trolley_low = std::max(0.0, box.trolley_low - trolley_tracking);
+  box.trolley_high += trolley_tracking;
   box.cable_low = std::min(from.cable_length, to.cable_length);
   box.cable_high = std::max(from.cable_length, to.cable_length);
   box.swing_radius = box.cable_high * std::sin(travels ? allowance.travel_swing : allowance.hoist_swing);

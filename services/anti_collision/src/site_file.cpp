@@ -125,6 +125,8 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.paths.hoist_swing = paths.number("hoist_swing", kSwingAllowance.lower, kSwingAllowance.upper);
     layout.paths.trolley_tracking = paths.number("trolley_tracking", kOvershoot.lower, kOvershoot.upper);
     layout.paths.slew_tracking = paths.number("slew_tracking", kOvershoot.lower, kOvershoot.upper);
+    layout.paths.trolley_hold = paths.number("trolley_hold", kOvershoot.lower, kOvershoot.upper);
+    layout.paths.slew_hold = paths.number("slew_hold", kOvershoot.lower, kOvershoot.upper);
     paths.finish();
     for (auto& z : s.list("zones")) layout.zones.push_back(config::read_zone(z));
     // Each crane's planner block and the config's name as the site file gives it: checked against the

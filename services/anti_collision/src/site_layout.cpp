@@ -56,6 +56,8 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_in_range(prefix + ".paths.hoist_swing", layout.paths.hoist_swing, kSwingAllowance.lower, kSwingAllowance.upper);
   require_in_range(prefix + ".paths.trolley_tracking", layout.paths.trolley_tracking, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.slew_tracking", layout.paths.slew_tracking, kOvershoot.lower, kOvershoot.upper);
+  require_in_range(prefix + ".paths.trolley_hold", layout.paths.trolley_hold, kOvershoot.lower, kOvershoot.upper);
+  require_in_range(prefix + ".paths.slew_hold", layout.paths.slew_hold, kOvershoot.lower, kOvershoot.upper);
 
   std::set<std::string> names;
   if (layout.domain_id < 0 || layout.domain_id > kMaxDomain) {

@@ -6,9 +6,11 @@
 // interval [m] and a cable-length interval [m], with the load's swing (a horizontal radius [m]
 // about the sheave's vertical). A path through waypoints is one box per segment, widened by the
 // tracking controller's overshoot past each goal and by the tracking allowance on either side of
-// its slew and trolley intervals; the swing is the site's travel allowance (the
-// crane's supervisor brakes beyond it) while the trolley or the slew moves, and its hoist
-// allowance while only the hoist does. At rest a crane holds the box of its pose.
+// its slew and trolley intervals (PathAllowance's *_tracking while the trolley or the slew
+// travels in the segment, *_hold while neither does); the swing is the site's travel allowance
+// (the crane's supervisor brakes beyond it) while the trolley or the slew moves, and its hoist
+// allowance while only the hoist does. At rest a crane holds the box of its pose (with the hold
+// allowance).
 //
 // Geometry: each part of a crane at one slew angle is a slab, a segment in plan view swept by a
 // disc, times a height interval (every part of a tower crane is one: the jib and counter-jib

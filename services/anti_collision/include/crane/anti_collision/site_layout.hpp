@@ -82,10 +82,16 @@ struct PathAllowance {
   double slew_overshoot{0.05};     // [rad] past a slew goal
   double travel_swing{0.6};        // [rad] swing while the trolley or the slew moves (the supervisor's max_swing)
   double hoist_swing{0.05};        // [rad] swing while only the hoist moves (the residual of the travel)
-  // How far the drives' tracking strays from the plan, on either side of every box: the trolley
-  // pulled outward while the jib slews, a stop from the slew's speed (measured: docs/site.md).
+  // How far the drives' tracking strays from the plan, on either side of every box in which the
+  // slew or the trolley travels: the trolley pulled outward while the jib slews, a stop from the
+  // slew's speed (measured: docs/site.md, "The crane's own guard").
   double trolley_tracking{0.0};    // [m]
   double slew_tracking{0.0};       // [rad]
+  // The same on either side of a box in which neither travels (only the hoist moves, or the crane
+  // rests): how far from the plan the travel before left the trolley and the slew, settled, and
+  // how far they creep while the hoist moves (measured: docs/site.md, "Holding an axis").
+  double trolley_hold{0.0};        // [m]
+  double slew_hold{0.0};           // [rad]
 };
 
 struct SiteLayout {
