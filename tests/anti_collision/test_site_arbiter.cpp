@@ -1006,6 +1006,9 @@ TEST(SiteService, TheStatusSaysWhoWaitsForWhomWhyAndForHowLong) {
   using crane::protocol::SiteStatus;
   EXPECT_TRUE(status.pending[0]);
   EXPECT_EQ(status.waits_for[0], 1u << 1);
+  EXPECT_EQ(waits_for_names(service.arbiter().layout(), status, 0), std::vector<std::string>{"b"});
+  EXPECT_TRUE(waits_for_names(service.arbiter().layout(), status, 1).empty());
+  EXPECT_TRUE(waits_for_names(service.arbiter().layout(), status, 5).empty());  // beyond crane_count
   EXPECT_EQ(status.wait_reason[0], SiteStatus::WAIT_HELD);
   EXPECT_DOUBLE_EQ(status.waited[0], 2.0);
   EXPECT_FALSE(status.pending[1]);

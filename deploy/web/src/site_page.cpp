@@ -71,15 +71,6 @@ const char* band(double distance, const ac::Margins& m) noexcept {
   return ac::to_string(ac::classify(distance, std::numeric_limits<double>::infinity(), m));
 }
 
-// The names of the cranes crane `i`'s request waits for, as the service's last status says.
-std::vector<std::string> waits_for(const ac::SiteLayout& layout, const protocol::SiteStatus& status, std::size_t i) {
-  std::vector<std::string> names;
-  for (std::size_t j = 0; i < status.crane_count && i < status.waits_for.size() && j < layout.cranes.size() && j < 32; ++j) {
-    if ((status.waits_for[i] & (std::uint32_t{1} << j)) != 0) names.push_back(layout.cranes[j].name);
-  }
-  return names;
-}
-
 }  // namespace
 
 json site_page_json(const ac::SiteWatch& watch, double time) {
@@ -123,7 +114,7 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
                                                                       status->holding[i])))
                               : json(nullptr);
     crane["waiting"] = listed && status->pending[i];
-    const json waits = listed ? json(waits_for(layout, *status, i)) : json::array();
+    const json waits = listed ? json(ac::waits_for_names(layout, *status, i)) : json::array();
     crane["waits_for"] = waits;
     // Why (a WAIT_* name: held, starving, higher_cable) and how long its request has waited [s].
     crane["wait_reason"] = listed && !waits.empty()
@@ -217,7 +208,7 @@ json site_scene_json(const ac::SiteWatch& watch, std::int64_t stamp_ns) {
       label += ", holds " + std::string(protocol::code_name(protocol::SiteStatus::kCodes, "HOLDING", status->holding[i]));
       if (status->pending[i]) {
         // "waits for tc2 (held, 4 s)", as the site page's line says it.
-        const auto names = waits_for(layout, *status, i);
+        const auto names = ac::waits_for_names(layout, *status, i);
         std::string who;
         for (const auto& name : names) who += (who.empty() ? "" : ", ") + name;
         char waited[32];

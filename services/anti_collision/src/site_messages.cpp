@@ -140,6 +140,15 @@ std::uint8_t wait_code(WaitReason reason) noexcept {
   return SiteStatus::WAIT_NONE;
 }
 
+std::vector<std::string> waits_for_names(const SiteLayout& layout, const SiteStatus& status, std::size_t crane) {
+  std::vector<std::string> names;
+  if (crane >= status.crane_count || crane >= status.waits_for.size()) return names;
+  for (std::size_t j = 0; j < layout.cranes.size() && j < 32; ++j) {
+    if ((status.waits_for[crane] & (std::uint32_t{1} << j)) != 0) names.push_back(layout.cranes[j].name);
+  }
+  return names;
+}
+
 void to_message(const SiteService& service, double time, SiteStatus& m) noexcept {
   static_assert(SiteLayout::kMaxCranes == SiteStatus::MAX_CRANES, "the IDL's MAX_CRANES is the site's kMaxCranes");
   static_assert(Airspace::kMaxBoxes + 1 == SiteReport::MAX_WAYPOINTS, "the IDL's MAX_WAYPOINTS is kMaxBoxes + 1");

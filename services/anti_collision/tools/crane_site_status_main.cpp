@@ -45,12 +45,10 @@ namespace tp = transport::topics;
 using Clock = std::chrono::steady_clock;
 using protocol::SiteStatus;
 
-std::string waits_for(const anti_collision::SiteLayout& layout, std::uint32_t bits) {
+// "tc1,tc3", or "-" for none.
+std::string waits_for(const anti_collision::SiteLayout& layout, const SiteStatus& status, std::size_t crane) {
   std::string out;
-  for (std::size_t j = 0; j < layout.cranes.size() && j < 32; ++j) {
-    if ((bits & (std::uint32_t{1} << j)) == 0) continue;
-    out += (out.empty() ? "" : ",") + layout.cranes[j].name;
-  }
+  for (const auto& name : anti_collision::waits_for_names(layout, status, crane)) out += (out.empty() ? "" : ",") + name;
   return out.empty() ? "-" : out;
 }
 
@@ -175,10 +173,10 @@ int main(int argc, char** argv) {
       char waited[32] = "-";
       if (last->pending[i]) std::snprintf(waited, sizeof waited, "%.1f", last->waited[i]);
       std::printf("%-8s %-12s %-8s %-10s %-12s %-8s %-9s %s\n", layout.cranes[i].name.c_str(), holding.c_str(),
-                  last->pending[i] ? "waiting" : "-", waits_for(layout, last->waits_for[i]).c_str(), why.c_str(), waited,
+                  last->pending[i] ? "waiting" : "-", waits_for(layout, *last, i).c_str(), why.c_str(), waited,
                   state.c_str(), pose);
       nlohmann::json row{{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
-                         {"state", state}, {"waits_for", waits_for(layout, last->waits_for[i])}, {"why", why}};
+                         {"state", state}, {"waits_for", waits_for(layout, *last, i)}, {"why", why}};
       if (last->pending[i]) row["waited_s"] = last->waited[i];
       if (cranes[i].reports > 0) {  // [s] since the tool started: the rate is reports over the span
         row["first_report_s"] = cranes[i].first_heard;

@@ -142,7 +142,6 @@ class SiteArbiter {
   /// holds back): the caller decides again only when what the cranes hold or ask changed.
   [[nodiscard]] std::vector<Instruction> decide(double time);
 
-
   [[nodiscard]] std::size_t size() const noexcept { return cranes_.size(); }
   [[nodiscard]] Holding holding(std::size_t crane) const { return cranes_.at(crane).holding; }
   [[nodiscard]] const Airspace& held(std::size_t crane) const { return cranes_.at(crane).held; }

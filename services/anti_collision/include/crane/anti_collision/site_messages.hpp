@@ -8,8 +8,10 @@
 // its arrays, an unknown code), naming the field and the value; they never throw. Whatever else a
 // report may get wrong (non-finite values, counts below their minimum) SiteService::report refuses.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "crane/anti_collision/site_service.hpp"
 #include "crane/protocol/messages.hpp"
@@ -40,5 +42,9 @@ void to_message(const SiteService& service, double time, protocol::SiteStatus& m
 [[nodiscard]] std::uint8_t holding_code(Holding holding) noexcept;
 /// The IDL's WAIT_* code of `reason`.
 [[nodiscard]] std::uint8_t wait_code(WaitReason reason) noexcept;
+/// The names (`layout`'s) of the cranes crane `crane`'s request waits for, as `status` says
+/// (its waits_for bits); empty for a crane beyond the status's crane_count.
+[[nodiscard]] std::vector<std::string> waits_for_names(const SiteLayout& layout, const protocol::SiteStatus& status,
+                                                       std::size_t crane);
 
 }  // namespace crane::anti_collision
