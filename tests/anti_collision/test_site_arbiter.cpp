@@ -47,13 +47,13 @@ TEST(Airspace, RestPosesByHand) {
   // 0.29552 - 0.03 - 0.05 = 0.21552, heights overlapping.
   const double d = airspace_distance(s.cranes[0], a, s.cranes[1], rest_airspace({kPi + 0.3, 1.0, 2.0}, s.paths)).distance;
   EXPECT_NEAR(d, std::sin(0.3) - 0.03 - 0.05, 1e-9);
-  // Its swing allowance widens the load: 0.05 rad at cable 2 m is 2 sin(0.05) = 0.09996 m.
+  // Its swing allowance widens the load by its radius, 0.1 m, whatever the cable.
   SiteLayout swinging = two_towers();
-  swinging.paths.hoist_swing = 0.05;
+  swinging.paths.hoist_swing_radius = 0.1;
   const double dswing = airspace_distance(swinging.cranes[0], rest_airspace({0.0, 0.5, 0.2}, swinging.paths),
                                           swinging.cranes[1], rest_airspace({kPi + 0.3, 1.0, 2.0}, swinging.paths))
                             .distance;
-  EXPECT_NEAR(dswing, std::sin(0.3) - 0.03 - 0.05 - 2.0 * std::sin(0.05), 1e-9);
+  EXPECT_NEAR(dswing, std::sin(0.3) - 0.03 - 0.05 - 0.1, 1e-9);
 }
 
 // The allowances of a box by hand: a segment in which the slew or the trolley travels gets the
@@ -61,7 +61,7 @@ TEST(Airspace, RestPosesByHand) {
 // which neither travels (only the hoist moves) and a rest box get the hold allowance.
 TEST(Airspace, TheTrackingAllowanceWhereAnAxisTravelsTheHoldAllowanceWhereNone) {
   SiteLayout s = two_towers();
-  s.paths = {.trolley_overshoot = 0.07, .slew_overshoot = 0.05, .travel_swing = 0.6, .hoist_swing = 0.05,
+  s.paths = {.trolley_overshoot = 0.07, .slew_overshoot = 0.05, .travel_swing = 0.6, .hoist_swing_radius = 0.03,
              .trolley_tracking = 0.04, .slew_tracking = 0.07, .trolley_hold = 0.01, .slew_hold = 0.02};
   // Hook up at (0.3 rad, 0.8 m), travel to (0.9 rad, 0.6 m), lower to 1.5 m of cable.
   const std::vector<Pose> path{{0.3, 0.8, 0.2}, {0.9, 0.6, 0.2}, {0.9, 0.6, 1.5}};
@@ -79,11 +79,12 @@ TEST(Airspace, TheTrackingAllowanceWhereAnAxisTravelsTheHoldAllowanceWhereNone) 
   EXPECT_NEAR(lower.trolley_low, 0.6 - 0.01, 1e-15);
   EXPECT_NEAR(lower.trolley_high, 0.6 + 0.01, 1e-15);
   EXPECT_NEAR(lower.cable_high, 1.5, 1e-15);
-  EXPECT_NEAR(lower.swing_radius, 1.5 * std::sin(0.05), 1e-15);
+  EXPECT_NEAR(lower.swing_radius, 0.03, 1e-15);  // a radius: the same at 1.5 m of cable as at rest hook up
   const Airspace at_rest = rest_airspace({0.9, 0.6, 1.5}, s.paths);
   const JointBox& rest = at_rest.boxes[0];
   EXPECT_NEAR(rest.slew_high - rest.slew_low, 2 * 0.02, 1e-15);
   EXPECT_NEAR(rest.trolley_high - rest.trolley_low, 2 * 0.01, 1e-15);
+  EXPECT_NEAR(rest.swing_radius, 0.03, 1e-15);
   // A slew alone travels: the trolley still gets the tracking allowance (pulled outward).
   const Airspace slewing = path_airspace(std::vector<Pose>{{0.3, 0.8, 0.2}, {0.9, 0.8, 0.2}}, s.paths);
   const JointBox& slew_only = slewing.boxes[0];
@@ -128,7 +129,7 @@ TEST(Airspace, ThePruningGivesTheSameAnswerAsEveryPair) {
   for (int i = 0; i < 400; ++i) {
     SiteLayout s = two_towers(in(2.0, 4.0));
     s.paths = {.trolley_overshoot = in(0.0, 0.1), .slew_overshoot = in(0.0, 0.1), .travel_swing = in(0.0, 0.6),
-               .hoist_swing = in(0.0, 0.05), .trolley_tracking = in(0.0, 0.05), .slew_tracking = in(0.0, 0.05),
+               .hoist_swing_radius = in(0.0, 0.05), .trolley_tracking = in(0.0, 0.05), .slew_tracking = in(0.0, 0.05),
                .trolley_hold = in(0.0, 0.05), .slew_hold = in(0.0, 0.05)};
     for (auto& c : s.cranes) {
       c.base = {in(-2.0, 2.0), in(-2.0, 2.0)};

@@ -66,6 +66,7 @@ TEST(SiteLayout, ShippedSiteLoads) {
   EXPECT_DOUBLE_EQ(site.max_wait, 20.0);
   EXPECT_DOUBLE_EQ(site.paths.trolley_hold, 0.01);
   EXPECT_DOUBLE_EQ(site.paths.slew_hold, 0.02);
+  EXPECT_DOUBLE_EQ(site.paths.hoist_swing_radius, 0.025);
   EXPECT_EQ(find_crane(site, "tc3"), 2);
   EXPECT_EQ(find_crane(site, "tc9"), -1);
   // The jibs overlap in plan view (bases 2 m apart, each reaching 1.4 m + its radius).
@@ -92,6 +93,11 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: site.paths.travel_swing = 2 is out of range: must be in [0, 1.5]");
   EXPECT_EQ(refusal(edited("slew_hold: 0.02", "slew_hold: -0.02")),
             "site.yaml: site.paths.slew_hold = -0.02 is out of range: must be in [0, 10]");
+  EXPECT_EQ(refusal(edited("hoist_swing_radius: 0.025", "hoist_swing_radius: -1")),
+            "site.yaml: site.paths.hoist_swing_radius = -1 is out of range: must be in [0, 10]");
+  // A site file of before session 34 gave the hoist's swing as an angle: refused, not misread as metres.
+  EXPECT_EQ(refusal(edited("hoist_swing_radius: 0.025", "hoist_swing: 0.05")),
+            "site.yaml: missing field site.paths.hoist_swing_radius");
   EXPECT_EQ(refusal(edited("max_wait: 20", "max_wait: -1")),
             "site.yaml: site.max_wait = -1 is out of range: must be in [0, 3600]");
   EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: -3.5")),

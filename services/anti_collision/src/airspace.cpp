@@ -113,7 +113,7 @@ JointBox box_of(const Pose& from, const Pose& to, const PathAllowance& allowance
   box.trolley_high += trolley_tracking;
   box.cable_low = std::min(from.cable_length, to.cable_length);
   box.cable_high = std::max(from.cable_length, to.cable_length);
-  box.swing_radius = box.cable_high * std::sin(travels ? allowance.travel_swing : allowance.hoist_swing);
+  box.swing_radius = travels ? box.cable_high * std::sin(allowance.travel_swing) : allowance.hoist_swing_radius;
   return box;
 }
 

@@ -122,7 +122,7 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.paths.trolley_overshoot = paths.number("trolley_overshoot", kOvershoot.lower, kOvershoot.upper);
     layout.paths.slew_overshoot = paths.number("slew_overshoot", kOvershoot.lower, kOvershoot.upper);
     layout.paths.travel_swing = paths.number("travel_swing", kSwingAllowance.lower, kSwingAllowance.upper);
-    layout.paths.hoist_swing = paths.number("hoist_swing", kSwingAllowance.lower, kSwingAllowance.upper);
+    layout.paths.hoist_swing_radius = paths.number("hoist_swing_radius", kOvershoot.lower, kOvershoot.upper);
     layout.paths.trolley_tracking = paths.number("trolley_tracking", kOvershoot.lower, kOvershoot.upper);
     layout.paths.slew_tracking = paths.number("slew_tracking", kOvershoot.lower, kOvershoot.upper);
     layout.paths.trolley_hold = paths.number("trolley_hold", kOvershoot.lower, kOvershoot.upper);

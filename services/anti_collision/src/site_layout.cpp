@@ -53,7 +53,7 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_in_range(prefix + ".paths.trolley_overshoot", layout.paths.trolley_overshoot, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.slew_overshoot", layout.paths.slew_overshoot, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.travel_swing", layout.paths.travel_swing, kSwingAllowance.lower, kSwingAllowance.upper);
-  require_in_range(prefix + ".paths.hoist_swing", layout.paths.hoist_swing, kSwingAllowance.lower, kSwingAllowance.upper);
+  require_in_range(prefix + ".paths.hoist_swing_radius", layout.paths.hoist_swing_radius, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.trolley_tracking", layout.paths.trolley_tracking, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.slew_tracking", layout.paths.slew_tracking, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.trolley_hold", layout.paths.trolley_hold, kOvershoot.lower, kOvershoot.upper);

@@ -81,7 +81,10 @@ struct PathAllowance {
   double trolley_overshoot{0.07};  // [m] past a trolley goal (the delayed-feedback law's, measured)
   double slew_overshoot{0.05};     // [rad] past a slew goal
   double travel_swing{0.6};        // [rad] swing while the trolley or the slew moves (the supervisor's max_swing)
-  double hoist_swing{0.05};        // [rad] swing while only the hoist moves (the residual of the travel)
+  // [m] the load's swing, as a radius at the hook, while neither the trolley nor the slew moves (the
+  // residual of the travel, which the anti-swing law damps as the hoist moves: measured, docs/site.md,
+  // "The swing while hoisting"). A radius, not an angle: it does not grow with the cable.
+  double hoist_swing_radius{0.025};
   // How far the drives' tracking strays from the plan, on either side of every box in which the
   // slew or the trolley travels: the trolley pulled outward while the jib slews, a stop from the
   // slew's speed (measured: docs/site.md, "The crane's own guard").
