@@ -55,6 +55,11 @@ TEST(SiteRun, SeededJobSetsKeepTheStopMarginAndBeatTheSerializedBaseline) {
       EXPECT_TRUE(o->completed) << "seed " << seed;
       EXPECT_EQ(o->unresolved, 0u) << "seed " << seed;
       EXPECT_GE(o->min_distance, site.margins.stop) << "seed " << seed << ": " << o->closest;
+      // Healthy cranes keep to their grants, swing included: no guard braked one (rules 1-3), and
+      // none saw its load swing wider than the box allows (rule 5: the travel's swing, and the
+      // hoist's swing radius where only the hoist moves; docs/site.md, "The swing while hoisting").
+      EXPECT_EQ(o->guard_emergency_stops, 0) << "seed " << seed << ": " << o->guard_first;
+      EXPECT_EQ(o->guard_soft_stops, 0) << "seed " << seed << ": " << o->guard_first;
       double waiting = 0.0;
       for (const CraneOutcome& c : o->cranes) {
         EXPECT_EQ(c.jobs_done, 2) << c.name << ", seed " << seed;
