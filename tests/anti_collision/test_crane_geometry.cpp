@@ -1,9 +1,10 @@
 // The anti-collision geometry (anti_collision/crane_geometry.hpp) against hand-computed geometry:
 // segments in analytic positions, jibs of two cranes at different heights, a cable against a
-// lower crane's jib, two loads, the stopping travel of a shaped and of an emergency stop; against
-// an independent computation: the segment distance minimised by brute force on seeded random
-// segments, and the stopping envelope against the crane's parts at densely sampled intermediate
-// poses of the same stop; and the margins' actions at their boundaries.
+// lower crane's jib, two loads, a swinging load over a lower jib and risen toward a jib above, the
+// stopping travel of a shaped and of an emergency stop; against an independent computation: the
+// segment distance and the upright cylinders' minimised by brute force on seeded random shapes,
+// and the stopping envelope against the crane's parts at densely sampled intermediate poses of the
+// same stop, the load on its pendulum's sphere; and the margins' actions at their boundaries.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -85,6 +86,72 @@ TEST(SegmentDistance, SeededRandomSegmentsAgreeWithBruteForce) {
   }
 }
 
+// The upright cylinder (flat ends) against a minimisation that shares nothing with the code's:
+// for each of 401 points along a capsule's segment, the closest point of the solid cylinder by
+// projection (the plan offset clamped to the radius, the height to the cylinder's), then the
+// minimum; for two cylinders, 401 points up the first's axis, each widened by its radius toward
+// the second's axis. Segments of every kind: slanted, horizontal, vertical, points.
+TEST(SegmentDistance, UprightCylindersAgreeWithBruteForce) {
+  std::mt19937 rng(35);
+  std::uniform_real_distribution<double> coordinate(-5.0, 5.0);
+  std::uniform_real_distribution<double> size(0.0, 2.0);
+  const auto random_point = [&] { return Vector3(coordinate(rng), coordinate(rng), coordinate(rng)); };
+  const auto closest_in = [](const Vector3& p, const Capsule& u) {
+    const Vector3 axis(u.a.x(), u.a.y(), 0.0);
+    Vector3 plan(p.x() - axis.x(), p.y() - axis.y(), 0.0);
+    if (plan.norm() > u.radius) plan *= u.radius / plan.norm();
+    return Vector3(axis.x() + plan.x(), axis.y() + plan.y(),
+                   std::clamp(p.z(), std::min(u.a.z(), u.b.z()), std::max(u.a.z(), u.b.z())));
+  };
+  constexpr int kPoints = 401;
+  int overlapping = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vector3 c = random_point();
+    const Capsule u{c, Vector3(c.x(), c.y(), c.z() + 3.0 * size(rng)), size(rng), true};
+    Vector3 p0 = random_point(), p1 = random_point();
+    if (trial % 5 == 1) p1.z() = p0.z();                   // horizontal, as a jib
+    if (trial % 5 == 2) p1 = Vector3(p0.x(), p0.y(), p1.z());  // vertical, as a mast
+    if (trial % 5 == 3) p1 = p0;                           // a point
+    const Capsule k{p0, p1, size(rng)};
+    const double exact = capsule_distance(k, u);
+    ASSERT_DOUBLE_EQ(exact, capsule_distance(u, k)) << "trial " << trial;
+    double brute = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < kPoints; ++i) {
+      const Vector3 p = p0 + (p1 - p0) * (static_cast<double>(i) / (kPoints - 1));
+      brute = std::min(brute, (p - closest_in(p, u)).norm());
+    }
+    const double step = (p1 - p0).norm() / (kPoints - 1);
+    if (brute < 1e-12) {  // the segment enters the cylinder: an overlap, negative
+      ++overlapping;
+      ASSERT_LT(exact, 0.0) << "trial " << trial;
+      continue;
+    }
+    ASSERT_GE(brute - k.radius, exact - 1e-9) << "trial " << trial;
+    ASSERT_LE(brute - k.radius, exact + step / 2.0 + 1e-9) << "trial " << trial;
+  }
+  EXPECT_GT(overlapping, 0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vector3 c = random_point(), d = random_point();
+    const Capsule u{c, Vector3(c.x(), c.y(), c.z() + 3.0 * size(rng)), size(rng), true};
+    const Capsule v{d, Vector3(d.x(), d.y(), d.z() + 3.0 * size(rng)), size(rng), true};
+    const double exact = capsule_distance(u, v);
+    double brute = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < kPoints; ++i) {
+      Vector3 p = u.a + (u.b - u.a) * (static_cast<double>(i) / (kPoints - 1));
+      Vector3 toward(v.a.x() - p.x(), v.a.y() - p.y(), 0.0);
+      if (toward.norm() > 0.0) p += toward * (std::min(u.radius, toward.norm()) / toward.norm());
+      brute = std::min(brute, (p - closest_in(p, v)).norm());
+    }
+    if (brute < 1e-12) {
+      ASSERT_LE(exact, 1e-9) << "trial " << trial;
+      continue;
+    }
+    const double step = (u.b - u.a).norm() / (kPoints - 1);
+    ASSERT_GE(brute, exact - 1e-9) << "trial " << trial;
+    ASSERT_LE(brute, exact + step / 2.0 + 1e-9) << "trial " << trial;
+  }
+}
+
 // Two cranes 60 m apart, jibs crossing at right angles in plan view, jibs at 40 m and 48 m: the
 // jib capsules' axes are 8 m apart vertically (both chords + depth/2), less both radii (1 m each).
 TEST(CraneGeometry, JibsAtDifferentHeights) {
@@ -140,6 +207,59 @@ TEST(CraneGeometry, LoadAgainstLoad) {
   EXPECT_NEAR(d.distance, 14.0 - (1.0 + swing_a) - 1.0, 1e-9);
   EXPECT_EQ(d.first, Part::load);
   EXPECT_EQ(d.second, Part::load);
+}
+
+// A higher crane's load swinging over a lower crane's jib: the pendulum's load never comes lower
+// than the cable's length, so its envelope widens it sideways only. The high crane's sheave at
+// (30, 0, 48) over the low jib's axis, a cable of 4 m swinging 0.3 rad (an envelope of
+// 4 sin(0.3) = 1.18 m): the load's lowest point 48 - 4 - 1 = 43 m, the low jib's capsule's top
+// 40.8 + 1 = 41.8 m: 1.2 m, what the load hanging still would keep. (The capsule of sessions
+// before 35, its sphere-swept end reaching the envelope below the load too, said 0.018 m.)
+TEST(CraneGeometry, ALoadSwingingOverALowerJibKeepsItsHeight) {
+  const SiteCrane low = tower(0.0, 0.0, 40.0);
+  const SiteCrane high = tower(30.0, -30.0, 48.0, kPi / 2.0);  // jib along +y: x = 30
+  CraneMotion a;
+  a.trolley = 10.0;
+  a.cable_length = 5.0;
+  CraneMotion b;
+  b.trolley = 30.0;  // sheave at (30, 0, 48)
+  b.cable_length = 4.0;
+  b.swing_out_of_plane = 0.3;
+  const auto d = distance(envelope(low, a, StopKind::none), envelope(high, b, StopKind::none));
+  EXPECT_NEAR(d.distance, 43.0 - 41.8, 1e-9);
+  EXPECT_EQ(d.first, Part::jib);
+  EXPECT_EQ(d.second, Part::load);
+  // The envelope widens it sideways: the load's part is 1 + 4 sin(0.3) m wide about the sheave.
+  const Capsule load = envelope(high, b, StopKind::none).samples[0][static_cast<std::size_t>(Part::load)];
+  EXPECT_TRUE(load.upright);
+  EXPECT_NEAR(load.radius, 1.0 + 4.0 * std::sin(0.3), 1e-12);
+  EXPECT_NEAR(std::min(load.a.z(), load.b.z()), 43.0, 1e-12);
+}
+
+// A load swung sideways rises: on a cable of 9 m under a jib at 44 m, swinging asin(0.6) (an
+// envelope of 5.4 m), its centre can come up to sqrt(81 - 29.16) = 7.2 m below the sheave, its
+// top to 44 - 7.2 + 1 = 37.8 m. A lower crane's jib (rails at 38 m: its capsule's axis at 38.8 m,
+// radius 1 m) passes 7.2 m from the sheave's vertical in plan, 0.8 m outside the load's envelope
+// (6.4 m): hypot(0.8, 38.8 - 37.8) - 1 = 0.281 m. The cable (5.4 m wide, from 35 m up to the
+// sheave) is 7.2 - 5.4 - 1 = 0.8 m away in plan; a load whose top did not rise (36 m) would be
+// hypot(0.8, 2.8) - 1 = 1.91 m away.
+TEST(CraneGeometry, ALoadSwungSidewaysRisesTowardAJibAbove) {
+  const SiteCrane swinging = tower(0.0, 0.0, 44.0);
+  const SiteCrane lower = tower(27.2, -30.0, 38.0, kPi / 2.0);  // jib along +y: x = 27.2
+  CraneMotion a;
+  a.trolley = 20.0;  // sheave at (20, 0, 44)
+  a.cable_length = 9.0;
+  a.swing_in_plane = std::asin(0.6);
+  CraneMotion b;
+  b.trolley = 45.0;  // its own sheave at (27.2, 15): far from the other
+  b.cable_length = 1.0;
+  const auto d = distance(envelope(swinging, a, StopKind::none), envelope(lower, b, StopKind::none));
+  EXPECT_NEAR(d.distance, std::hypot(0.8, 1.0) - 1.0, 1e-9);
+  EXPECT_EQ(d.first, Part::load);
+  EXPECT_EQ(d.second, Part::jib);
+  const auto parts = envelope(swinging, a, StopKind::none).samples[0];
+  const Capsule& jib = envelope(lower, b, StopKind::none).samples[0][static_cast<std::size_t>(Part::jib)];
+  EXPECT_NEAR(capsule_distance(parts[static_cast<std::size_t>(Part::cable)], jib), 0.8, 1e-9);
 }
 
 // The stopping travel by hand: trolley at 0.5 m/s, 0.5 m/s^2, reaction 0.1 s, ZV shaped (mean
@@ -207,21 +327,29 @@ TEST(CraneGeometry, StoppingEnvelopeContainsSeededRandomStops) {
       pose.slew_rate = pose.trolley_velocity = 0.0;
       auto parts = envelope(moving, pose, StopKind::none);
       for (auto& capsule : parts.samples[0]) capsule.radius = 0.0;
-      // The structure at its true size; the load anywhere in its swing envelope, sampled on a ring.
+      // The structure at its true size; the cable and the load as they hang (the sheave the top of
+      // the cable's cylinder), then swung anywhere in the envelope, sampled on two rings, the load
+      // on the pendulum's sphere about the sheave.
       parts.samples[0][static_cast<std::size_t>(Part::jib)].radius = jib_radius(moving);
       parts.samples[0][static_cast<std::size_t>(Part::counter_jib)].radius = jib_radius(moving);
       parts.samples[0][static_cast<std::size_t>(Part::mast)].radius = mast_radius(moving);
-      parts.samples[0][static_cast<std::size_t>(Part::load)].radius = moving.load_radius;
-      actual = std::min(actual, distance(parts, probe_env).distance);
-      for (int k = 0; k < 8; ++k) {
-        auto swung = parts;
-        const double a = 2.0 * kPi * k / 8.0;
-        const Vector3 offset(travel.swing_radius * std::cos(a), travel.swing_radius * std::sin(a), 0.0);
-        auto& load = swung.samples[0][static_cast<std::size_t>(Part::load)];
-        load.a += offset;
-        load.b += offset;
-        swung.samples[0][static_cast<std::size_t>(Part::cable)].b += offset;
-        actual = std::min(actual, distance(swung, probe_env).distance);
+      const Capsule column = parts.samples[0][static_cast<std::size_t>(Part::cable)];
+      const Vector3 sheave = column.a.z() > column.b.z() ? column.a : column.b;
+      const auto hang = [&](const Vector3& offset) {
+        auto hung = parts;
+        const double depth = std::sqrt(m.cable_length * m.cable_length - offset.squaredNorm());
+        const Vector3 centre = sheave + offset - Vector3(0.0, 0.0, depth);
+        hung.samples[0][static_cast<std::size_t>(Part::cable)] = {sheave, centre, 0.0};
+        hung.samples[0][static_cast<std::size_t>(Part::load)] = {centre, centre, moving.load_radius};
+        return hung;
+      };
+      actual = std::min(actual, distance(hang(Vector3::Zero()), probe_env).distance);
+      const double swing = std::min(travel.swing_radius, m.cable_length);
+      for (const double ring : {swing / 2.0, swing}) {
+        for (int k = 0; k < 8; ++k) {
+          const double a = 2.0 * kPi * k / 8.0;
+          actual = std::min(actual, distance(hang(Vector3(ring * std::cos(a), ring * std::sin(a), 0.0)), probe_env).distance);
+        }
       }
     }
     ASSERT_LE(claimed, actual + 1e-9) << "trial " << trial;

@@ -3,12 +3,13 @@
 //   1. the view: every crane of the site reported, the site service heard, one pair per two cranes;
 //   2. each pair's distance equals what crane_site_status (another process on the site's domain)
 //      prints for it, and is no more than this file's own bound from the parts the view gives:
-//      the closest of points sampled along each two capsules' axes, less both radii; who waits
-//      for whom, why and since when, as crane_site_status says it (the writer's tc1 waits);
+//      the closest of points sampled along each two capsules' axes (to an upright part's cylinder),
+//      less the radii; who waits for whom, why and since when, as crane_site_status says it (the
+//      writer's tc1 waits);
 //   3. the site's scene for Foxglove's 3D panel, as Foxglove's own client (@foxglove/ws-protocol)
-//      receives it: a JSON foxglove.SceneUpdate with an entity per crane whose load sphere is where
-//      the view's load is, a line loop per box the view holds and asks for, and a text per pair
-//      naming the view's distance;
+//      receives it: a JSON foxglove.SceneUpdate with an entity per crane whose load cylinder is
+//      the view's load envelope, a line loop per box the view holds and asks for, and a text per
+//      pair naming the view's distance;
 //   4. the page in Debian's chromium, headless (puppeteer-core): it drew every crane (its load's
 //      pixel in the crane's colour, not the background), the held and requested airspace the view
 //      has, a row per pair coloured by its band, the service's epoch; a screenshot.
@@ -43,16 +44,38 @@ const sub = (a, b) => a.map((v, i) => v - b[i]);
 const norm = (a) => Math.hypot(...a);
 
 // The smallest distance between points sampled along the two axes (an upper bound of the
-// segments' distance: the capsules' distance can only be smaller).
+// segments' distance: the capsules' distance can only be smaller), less both radii. An upright
+// part (the cable's and the load's envelope: a cylinder with flat ends) is taken as what it is:
+// each sampled point's distance to the solid cylinder, its plan distance to the axis less the
+// radius and its height outside the cylinder's, by Pythagoras.
+function toUpright(x, u) {
+  const plan = Math.hypot(x[0] - u.a[0], x[1] - u.a[1]) - u.radius;
+  const gap = Math.max(0, x[2] - Math.max(u.a[2], u.b[2]), Math.min(u.a[2], u.b[2]) - x[2]);
+  return gap > 0 ? Math.hypot(Math.max(0, plan), gap) : plan;
+}
 function sampledDistance(p, q) {
   let best = Infinity;
   const n = 200;
-  for (let i = 0; i <= n; ++i) {
-    const a = p.a.map((v, k) => v + (p.b[k] - v) * (i / n));
-    for (let j = 0; j <= n; ++j) {
-      const b = q.a.map((v, k) => v + (q.b[k] - v) * (j / n));
-      best = Math.min(best, norm(sub(a, b)));
+  const along = (s, i) => s.a.map((v, k) => v + (s.b[k] - v) * (i / n));
+  if (p.upright && q.upright) {
+    // Points of p's axis against q's cylinder, less p's radius: p's cylinder holds every point
+    // within its radius of the axis in plan, at the axis' heights.
+    for (let i = 0; i <= n; ++i) {
+      const x = along(p, i);
+      const plan = Math.hypot(x[0] - q.a[0], x[1] - q.a[1]) - q.radius - p.radius;
+      const gap = Math.max(0, x[2] - Math.max(q.a[2], q.b[2]), Math.min(q.a[2], q.b[2]) - x[2]);
+      best = Math.min(best, gap > 0 ? Math.hypot(Math.max(0, plan), gap) : plan);
     }
+    return best;
+  }
+  if (p.upright || q.upright) {
+    const [u, c] = p.upright ? [p, q] : [q, p];
+    for (let i = 0; i <= n; ++i) best = Math.min(best, toUpright(along(c, i), u));
+    return best - c.radius;
+  }
+  for (let i = 0; i <= n; ++i) {
+    const a = along(p, i);
+    for (let j = 0; j <= n; ++j) best = Math.min(best, norm(sub(a, along(q, j))));
   }
   return best - p.radius - q.radius;
 }
@@ -145,10 +168,14 @@ async function main() {
     const e = scene.entities.find((x) => x.id === "crane/" + c.name);
     if (!e) { problems.push(`scene: no entity for ${c.name}`); continue; }
     if (e.frame_id !== "site") problems.push(`scene: ${c.name} in frame ${e.frame_id}`);
+    // The load's envelope: an upright cylinder over the view's load part, as wide and as tall.
     const load = c.parts.find((p) => p.part === "load");
-    const sphere = e.spheres[0];
-    if (!sphere || Math.abs(sphere.pose.position.x - load.a[0]) > 1e-9 || Math.abs(sphere.pose.position.y - load.a[1]) > 1e-9) {
-      problems.push(`scene: ${c.name}'s load sphere ${JSON.stringify(sphere && sphere.pose.position)} is not the view's load ${load.a}`);
+    const cylinder = e.cylinders.find((y) => Math.abs(y.pose.position.x - load.a[0]) < 1e-9 &&
+                                             Math.abs(y.pose.position.y - load.a[1]) < 1e-9 &&
+                                             Math.abs(y.size.x - 2 * load.radius) < 1e-9);
+    if (!load.upright || !cylinder || Math.abs(cylinder.size.z - Math.abs(load.b[2] - load.a[2])) > 1e-9 ||
+        Math.abs(cylinder.pose.position.z - (load.a[2] + load.b[2]) / 2) > 1e-9) {
+      problems.push(`scene: ${c.name}'s load cylinder ${JSON.stringify(cylinder)} is not the view's load ${JSON.stringify(load)}`);
     }
     const loops = e.lines.filter((l) => l.type === 1).length;
     if (loops !== c.held.length + c.requested.length) {

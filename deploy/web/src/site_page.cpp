@@ -135,7 +135,8 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
         parts.push_back({{"part", ac::to_string(static_cast<ac::Part>(p))},
                          {"a", {k.a.x(), k.a.y(), k.a.z()}},
                          {"b", {k.b.x(), k.b.y(), k.b.z()}},
-                         {"radius", k.radius}});
+                         {"radius", k.radius},
+                         {"upright", k.upright}});
       }
     } else {
       crane["pose"] = nullptr;
@@ -196,10 +197,14 @@ json site_scene_json(const ac::SiteWatch& watch, std::int64_t stamp_ns) {
       }
       const ac::Capsule& cable = parts[static_cast<std::size_t>(ac::Part::cable)];
       e["lines"].push_back(line(kLineStrip, json::array({point(cable.a), point(cable.b)}), 0.01, colour(rgb, 1.0)));
+      // The load's envelope, an upright cylinder with flat ends (crane_geometry.hpp).
       const ac::Capsule& load = parts[static_cast<std::size_t>(ac::Part::load)];
       const double d = 2.0 * load.radius;
-      e["spheres"].push_back({{"pose", pose_at(load.a.x(), load.a.y(), load.a.z())}, {"size", vec3(d, d, d)},
-                              {"color", colour(rgb, 0.9)}});
+      e["cylinders"].push_back({{"pose", pose_at(load.a.x(), load.a.y(), (load.a.z() + load.b.z()) / 2.0)},
+                                {"size", vec3(d, d, std::abs(load.b.z() - load.a.z()))},
+                                {"bottom_scale", 1.0},
+                                {"top_scale", 1.0},
+                                {"color", colour(rgb, 0.9)}});
       label += seen.report->state == protocol::SiteReport::STATE_MOVING ? " moving" : " at rest";
     } else {
       label += " silent";

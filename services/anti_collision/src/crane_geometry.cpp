@@ -54,7 +54,80 @@ double segment_distance(const Vector3& p0, const Vector3& p1, const Vector3& q0,
   return ((p0 + s * d1) - (q0 + t * d2)).norm();
 }
 
+namespace {
+
+// The gap [m] between the height intervals [a0, a1] and [b0, b1] (either end first); 0 when they meet.
+double height_gap(double a0, double a1, double b0, double b1) noexcept {
+  return std::max({0.0, std::min(b0, b1) - std::max(a0, a1), std::min(a0, a1) - std::max(b0, b1)});
+}
+
+// The plan distance [m] from the point (px, py) to the plan segment [(x0, y0), (x1, y1)].
+double plan_distance(double px, double py, double x0, double y0, double x1, double y1) noexcept {
+  const double dx = x1 - x0;
+  const double dy = y1 - y0;
+  const double length2 = dx * dx + dy * dy;
+  const double t = length2 > 0.0 ? std::clamp(((px - x0) * dx + (py - y0) * dy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(px - (x0 + t * dx), py - (y0 + t * dy));
+}
+
+// Combines a plan distance less the radii (`plan`, negative inside) and a height gap: Pythagoras
+// apart, the plan's (negative: overlapping) where the heights meet.
+double combine(double plan, double gap) noexcept {
+  return gap > 0.0 ? std::hypot(std::max(0.0, plan), gap) : plan;
+}
+
+// The segment [p0, p1] (its radius not counted) against the upright cylinder `u`.
+double segment_upright_distance(const Vector3& p0, const Vector3& p1, const Capsule& u) noexcept {
+  const double cx = u.a.x();
+  const double cy = u.a.y();
+  constexpr double kFlat = 1e-12;  // [m] a segment this close to horizontal or vertical is one
+  if (std::abs(p1.z() - p0.z()) <= kFlat) {
+    return combine(plan_distance(cx, cy, p0.x(), p0.y(), p1.x(), p1.y()) - u.radius,
+                   height_gap(p0.z(), p0.z(), u.a.z(), u.b.z()));
+  }
+  if (std::hypot(p1.x() - p0.x(), p1.y() - p0.y()) <= kFlat) {
+    return combine(std::hypot(p0.x() - cx, p0.y() - cy) - u.radius, height_gap(p0.z(), p1.z(), u.a.z(), u.b.z()));
+  }
+  // Any other segment: the distance from a point moving along it to the solid cylinder (a convex
+  // set) is convex in the point's parameter, so golden-section search finds its minimum.
+  const auto at = [&](double t) {
+    const Vector3 p = p0 + t * (p1 - p0);
+    return combine(std::hypot(p.x() - cx, p.y() - cy) - u.radius, height_gap(p.z(), p.z(), u.a.z(), u.b.z()));
+  };
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  double lo = 0.0;
+  double hi = 1.0;
+  double x1 = hi - ratio * (hi - lo);
+  double x2 = lo + ratio * (hi - lo);
+  double f1 = at(x1);
+  double f2 = at(x2);
+  for (int k = 0; k < 80; ++k) {
+    if (f1 <= f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - ratio * (hi - lo);
+      f1 = at(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + ratio * (hi - lo);
+      f2 = at(x2);
+    }
+  }
+  return std::min({f1, f2, at(0.0), at(1.0)});
+}
+
+}  // namespace
+
 double capsule_distance(const Capsule& first, const Capsule& second) noexcept {
+  if (first.upright && second.upright) {
+    return combine(std::hypot(first.a.x() - second.a.x(), first.a.y() - second.a.y()) - first.radius - second.radius,
+                   height_gap(first.a.z(), first.b.z(), second.a.z(), second.b.z()));
+  }
+  if (second.upright) return segment_upright_distance(first.a, first.b, second) - first.radius;
+  if (first.upright) return segment_upright_distance(second.a, second.b, first) - second.radius;
   return segment_distance(first.a, first.b, second.a, second.b) - first.radius - second.radius;
 }
 
@@ -155,6 +228,10 @@ CraneEnvelope envelope(const SiteCrane& crane, const CraneMotion& m, StopKind ki
   const double chord = crane.jib_height + crane.jib_depth / 2.0;
   const double cable_short = std::min(m.cable_length, m.cable_length + stop.cable);
   const double cable_long = std::max(m.cable_length, m.cable_length + stop.cable);
+  // The load's centre, swung stop.swing_radius sideways on the shortest cable, is this far below
+  // the sheave (0 when the envelope is wider than the cable).
+  const double swung = std::min(stop.swing_radius, cable_short);
+  const double highest_load = std::sqrt(std::max(0.0, cable_short * cable_short - swung * swung));
   const Vector3 axis(crane.base[0], crane.base[1], chord);
   for (std::size_t i = 0; i < n; ++i) {
     const double f = n > 1 ? static_cast<double>(i) / steps : 0.0;
@@ -169,11 +246,11 @@ CraneEnvelope envelope(const SiteCrane& crane, const CraneMotion& m, StopKind ki
                                                    Vector3(crane.base[0], crane.base[1], crane.jib_height),
                                                    mast_radius(crane)};
     const Vector3 sheave(crane.base[0] + trolley * u.x(), crane.base[1] + trolley * u.y(), crane.jib_height);
-    parts[static_cast<std::size_t>(Part::cable)] = {sheave, sheave - Vector3(0.0, 0.0, cable_long),
-                                                    stop.swing_radius + pad};
-    parts[static_cast<std::size_t>(Part::load)] = {sheave - Vector3(0.0, 0.0, cable_short),
-                                                   sheave - Vector3(0.0, 0.0, cable_long),
-                                                   crane.load_radius + stop.swing_radius + pad};
+    parts[static_cast<std::size_t>(Part::cable)] = {sheave - Vector3(0.0, 0.0, cable_long), sheave,
+                                                    stop.swing_radius + pad, true};
+    parts[static_cast<std::size_t>(Part::load)] = {sheave - Vector3(0.0, 0.0, cable_long + crane.load_radius),
+                                                   sheave - Vector3(0.0, 0.0, highest_load - crane.load_radius),
+                                                   crane.load_radius + stop.swing_radius + pad, true};
   }
   return out;
 }

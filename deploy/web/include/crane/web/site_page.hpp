@@ -15,14 +15,15 @@
 //              "held" | "starving" | "higher_cable" (SiteStatus_'s WAIT_*), "waited_s": s (how long its
 //              request has waited) | null (none pending), "instruction": "go" | "yield" | null,
 //              "pose": null | {"slew": rad, "trolley": m, "cable_length": m},
-//              "parts": [{"part": "jib", "a": [x, y, z], "b": [x, y, z], "radius": m}, ...],
+//              "parts": [{"part": "jib", "a": [x, y, z], "b": [x, y, z], "radius": m,
+//                         "upright": bool}, ...],
 //              "held": [[[x, y], ...], ...], "requested": [[[x, y], ...], ...]}, ...],
 //  "pairs": [{"cranes": ["tc1", "tc2"], "distance": m, "parts": ["jib", "cable"],
 //             "band": "clear" | "warning" | "slow_down" | "stop"}, ...],
 //  "closest": null | {"distance": m, "parts": "tc1.jib-tc2.cable", "at": s}}
 //
-// parts: crane_geometry.hpp's capsules at the reported pose (the load as its measured swing
-// envelope); held, requested: one plan outline per box of the airspace (plan_outline), the held
+// parts: crane_geometry.hpp's shapes at the reported pose (capsules; upright: the upright
+// cylinder about [a, b] with flat ends, the cable and the load as their measured swing envelope); held, requested: one plan outline per box of the airspace (plan_outline), the held
 // one as SiteWatch::held says; band: the margin the distance is under, the site's rule
 // (anti_collision::classify) for cranes at rest ("emergency_stop" only for a NaN distance).
 
@@ -30,8 +31,8 @@
 // The same for Foxglove's 3D panel: site_scene_json, a foxglove.SceneUpdate (JSON encoding) on
 // crane_web's channel kSceneTopic, frame "site" (the site frame): one entity per crane
 // ("crane/tc1": the mast a cylinder, jib and counter-jib a line list as thick as their capsules,
-// the cable a line, the load a sphere of its swing envelope, what the service holds a line loop
-// at the jib's height per box, what it asks for a thinner one 5 cm above, a text with the name,
+// the cable a line, the load an upright cylinder of its swing envelope, what the service holds a
+// line loop at the jib's height per box, what it asks for a thinner one 5 cm above, a text with the name,
 // state and holding, and while its request waits, for whom, why and how long: "tc1 at rest,
 // holds rest, waits for tc2 (held, 3 s)") and one with the pairs' distances ("site/distances": a text per pair over
 // the middle of the two masts, coloured by its band) and the fixed zones ("site/zones": a line

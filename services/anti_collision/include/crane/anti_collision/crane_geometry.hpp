@@ -1,17 +1,26 @@
 #pragma once
-// The parts of a tower crane on a site as capsules, the space they may occupy until the crane is
+// The parts of a tower crane on a site as capsules and upright cylinders, the space they may occupy until the crane is
 // at rest after a stop, and the distance between two cranes: what the site's anti-collision rules
 // are made of (issue 34). Pure functions, noexcept, no allocation: the site service and each
 // crane's supervisor call them every cycle.
 //
-// Parts (site frame of site_layout.hpp, [m]); each is a capsule (a segment swept by a sphere), an
-// outer bound of the real part so that a distance computed here never exceeds the real one:
+// Parts (site frame of site_layout.hpp, [m]); each an outer bound of the real part, so that a
+// distance computed here never exceeds the real one. The structure's are capsules (a segment swept
+// by a sphere); what hangs from the trolley is an upright cylinder with flat ends about the
+// sheave's vertical (Capsule::upright), since a pendulum's swing widens it sideways and raises
+// the load, but never lowers it below the cable's length:
 //   jib          slew axis -> jib tip, at the jib's cross-section centre (jib_height + depth/2),
 //                radius = half the cross-section's diagonal (the capsule contains the jib box)
 //   counter_jib  slew axis -> tail, the same cross-section
 //   mast         ground -> jib_height on the slew axis, radius = half the square section's diagonal
-//   cable        the trolley's sheave -> the load, radius = the swing envelope (below)
-//   load         the load's centre over the stop's hoist travel, radius = load_radius + swing envelope
+//   cable        upright: the sheave down to the stop's longest cable, radius = the swing envelope s
+//                (below): a point of the cable at angle A from the vertical is at most L sin(A) from it
+//   load         upright: from the stop's longest cable less load_radius below the sheave up to
+//                sqrt(L_s^2 - s^2) less load_radius below it (L_s the stop's shortest cable: the
+//                load's centre swung s sideways on a cable of L_s rises to that), radius =
+//                load_radius + s. Before session 35 a capsule, whose sphere-swept ends put the swing
+//                envelope below the load too, where a pendulum's load never goes (docs/site.md,
+//                "The load's shape").
 //
 // The stopping envelope: every part over the motion from the current state to rest after a stop
 // decided now (StopKind), sampled along the slew and trolley travel and inflated by how far a
@@ -45,10 +54,14 @@ using Vector3 = Eigen::Vector3d;
 /// Standard gravity [m/s^2] of the site's swing envelopes.
 inline constexpr double kStandardGravity = 9.80665;
 
+/// A part's shape: the segment [a, b] swept by a sphere of `radius` (a capsule); or, when
+/// `upright`, the cylinder of `radius` about [a, b] with flat ends, a and b then on one vertical
+/// (the same x and y; capsule_distance reads x and y from a).
 struct Capsule {
   Vector3 a{Vector3::Zero()};  // [m] segment ends, site frame
   Vector3 b{Vector3::Zero()};
   double radius{0.0};          // [m] >= 0
+  bool upright{false};
 };
 
 /// Closest distance [m] between the segments [p0, p1] and [q0, q1] (either may be a point):
@@ -56,8 +69,14 @@ struct Capsule {
 [[nodiscard]] double segment_distance(const Vector3& p0, const Vector3& p1, const Vector3& q0,
                                       const Vector3& q1) noexcept;
 
-/// Distance [m] between the two capsules' surfaces: segment distance less both radii; negative
-/// when they overlap.
+/// Distance [m] between the two shapes' surfaces; negative when they overlap. Two capsules: the
+/// segment distance less both radii. An upright cylinder against a capsule: the distance from the
+/// capsule's segment to the solid cylinder, less the capsule's radius (exact for a horizontal or
+/// vertical segment, or a point; along any other segment the distance, convex there, minimised by
+/// golden-section search to about 1e-15 of the segment). Two upright cylinders: the plan distance
+/// of their axes less both radii, and the gap between their height intervals, combined by
+/// Pythagoras (exact). Overlapping, the plan distance less the radii where the heights overlap,
+/// else minus the capsule's radius.
 [[nodiscard]] double capsule_distance(const Capsule& first, const Capsule& second) noexcept;
 
 enum class Part : std::uint8_t { jib, counter_jib, mast, cable, load };
