@@ -137,6 +137,10 @@ class SiteLink {
     }
     return verdict;
   }
+  /// True when the guard has heard nothing from the site service for the link deadline at `time`
+  /// [s], or never: the status says so (WARNING_SITE_UNHEARD), and the crane's site link does not
+  /// start before it clears, so that no grant reaches the link that this guard has not heard.
+  [[nodiscard]] bool unheard(double time) const noexcept { return guard_.link_lost(time); }
 
  private:
   anti_collision::SiteLayout layout_;
@@ -402,7 +406,9 @@ int main(int argc, char** argv) {
         motion.swing_out_of_plane = sensors_plain.swing_out_of_plane;
         motion.swing_in_plane_rate = estimated ? last_estimate.swing_in_plane_rate() : 0.0;
         motion.swing_out_of_plane_rate = estimated ? last_estimate.swing_out_of_plane_rate() : 0.0;
-        cycle.site = site->check(motion, std::chrono::duration<double>(now - started).count());
+        const double site_time = std::chrono::duration<double>(now - started).count();
+        cycle.site = site->check(motion, site_time);
+        cycle.site_unheard = site->unheard(site_time);
       }
       // One operator command per cycle; a second one waits for the next cycle (nothing is dropped).
       if (!pending_command && commands->take_next(command)) pending_command = true;

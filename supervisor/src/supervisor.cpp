@@ -312,6 +312,7 @@ void Supervisor::step(const SupervisorInput& in, SupervisorOutput& out) noexcept
     // The site grant, checked by the crane's own guard on this motion (docs/site.md).
     if (in.site == SiteVerdict::emergency_stop) active |= kFaultSiteGrant;
     if (in.site == SiteVerdict::soft_stop) warnings |= kWarningSite;
+    if (in.site != SiteVerdict::off && in.site_unheard) warnings |= kWarningSiteUnheard;
     if (zones_enabled_ != 0 && load_valid) {
       ZoneState state;
       state.trolley = in.trolley_position;

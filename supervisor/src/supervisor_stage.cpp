@@ -99,6 +99,7 @@ void SupervisorStage::step(const SupervisorCycle& cycle, protocol::SupervisorSta
   in.actuator_writers = cycle.actuator_writers;
   in.nonfinite_seen = cycle.nonfinite_seen;
   in.site = cycle.site;
+  in.site_unheard = cycle.site_unheard;
   in.move_in_progress = cycle.reference != nullptr && cycle.reference->phase == protocol::Reference::PHASE_MOVING;
   command_handled_ = cycle.command != nullptr;
   if (command_handled_ && cycle.command->command >= protocol::SupervisorCommand::COMMAND_ARM &&

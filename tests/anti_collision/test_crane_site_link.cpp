@@ -543,6 +543,35 @@ TEST_F(Link, ABrakedCraneStopsReportingForGood) {
   EXPECT_FALSE(link_->report().has_value());
 }
 
+// The crane may start on the site once its supervisor says so, each condition by itself.
+TEST(CraneSiteLinkReady, OnlyAWholeArmedChainWhoseGuardHearsTheSiteService) {
+  using Status = crane::protocol::SupervisorStatus;
+  Status ready{};
+  ready.stages_alive = Status::STAGES_ALL;
+  ready.brakes_released = true;
+  ready.mode = Status::MODE_READY;
+  ready.warnings = Status::WARNING_SITE;  // another warning: no matter
+  EXPECT_TRUE(ready_for_site(ready));
+  Status s = ready;
+  s.mode = Status::MODE_OPERATING;
+  EXPECT_TRUE(ready_for_site(s));
+  s = ready;
+  s.warnings |= Status::WARNING_SITE_UNHEARD;
+  EXPECT_FALSE(ready_for_site(s)) << "its guard does not hear the site service";
+  s = ready;
+  s.stages_alive = Status::STAGES_ALL & ~Status::STAGE_TRACKING;
+  EXPECT_FALSE(ready_for_site(s));
+  s = ready;
+  s.brakes_released = false;
+  EXPECT_FALSE(ready_for_site(s));
+  s = ready;
+  s.latched_faults = Status::FAULT_SITE_GRANT;
+  EXPECT_FALSE(ready_for_site(s));
+  s = ready;
+  s.mode = Status::MODE_STANDBY;
+  EXPECT_FALSE(ready_for_site(s));
+}
+
 TEST(CraneSiteLinkJobs, JobsOutsideTheCranesRangesAreRefusedNamingTheField) {
   const SiteLayout layout = load_site_layout(kSite);
   const CraneLinkParams params;

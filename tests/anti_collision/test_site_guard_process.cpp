@@ -4,6 +4,8 @@
 // its instructions). Three moves of the trolley, outward along tc1's jib toward tc2 (shared
 // airspace):
 //   1. with no grant: the supervisor brakes the crane (FAULT_SITE_GRANT: nothing moves by default);
+//      its status says that its guard does not hear the service (WARNING_SITE_UNHEARD), cleared
+//      once the heartbeat runs;
 //   2. with a grant of that path and the heartbeat: the move ends, no site fault;
 //   3. granted back, the heartbeat stops early in the move: past the link deadline the supervisor warns
 //      (WARNING_SITE), the planner stops softly (REASON_SITE) inside the grant, and no brake.
@@ -236,6 +238,9 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
   SiteCrane crane;
   ASSERT_TRUE(crane.wait(40.0, [&] { return crane.ready(); })) << "stack not ready; see " << crane.dir();
   const double start = crane.trolley();
+  // No heartbeat yet: the status says the guard does not hear the site service (a site link would
+  // not start: ready_for_site).
+  EXPECT_NE(crane.status()->warnings & Status::WARNING_SITE_UNHEARD, 0u);
 
   // 1. No grant: the first motion brakes the crane.
   crane.move(0.6);
@@ -264,6 +269,8 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
   crane.reset();
   ASSERT_TRUE(crane.wait(10.0, [&] { return crane.ready() && crane.status()->latched_faults == 0; }))
       << "reset; see " << crane.dir();
+  ASSERT_TRUE(crane.wait(5.0, [&] { return (crane.status()->warnings & Status::WARNING_SITE_UNHEARD) == 0; }))
+      << "the heartbeat on, the guard still does not hear the service; see " << crane.dir();
   crane.move(0.6);
   ASSERT_TRUE(crane.wait(20.0, [&] {
     return crane.status()->mode == Status::MODE_READY && std::fabs(crane.trolley() - 0.6) < 0.02 &&
@@ -282,6 +289,7 @@ TEST(SiteGuardProcess, ACraneOnASiteMovesOnlyWithinItsGrantAndStopsWhenTheServic
   crane.heartbeat = false;
   ASSERT_TRUE(crane.wait(5.0, [&] { return (crane.warnings_seen() & Status::WARNING_SITE) != 0; }))
       << "no WARNING_SITE after the heartbeat stopped; see " << crane.dir();
+  EXPECT_NE(crane.warnings_seen() & Status::WARNING_SITE_UNHEARD, 0u);
   ASSERT_TRUE(crane.wait(10.0, [&] { return std::fabs(crane.status()->trolley_velocity) < 0.005; }));
   crane.run_for(1.0);
   const double rest = crane.trolley();

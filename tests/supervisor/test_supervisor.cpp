@@ -1021,6 +1021,28 @@ TEST(SupervisorLimits, TheSiteGuardsSoftStopIsAWarning) {
   EXPECT_EQ(step(supervisor, healthy).warnings & sv::kWarningSite, 0u);
 }
 
+// A site guard that does not hear the site service is a warning on a site only (the crane's site
+// link waits for it to clear before it starts: ready_for_site); it changes nothing else.
+TEST(SupervisorLimits, AGuardThatDoesNotHearTheSiteServiceIsAWarningOnASiteOnly) {
+  sv::Supervisor supervisor{sv::SupervisorParams{}};
+  auto healthy = healthy_input();
+  healthy.site = sv::SiteVerdict::proceed;
+  step(supervisor, healthy);
+  ASSERT_TRUE(step(supervisor, healthy).brakes_released);
+  EXPECT_EQ(step(supervisor, healthy).warnings & sv::kWarningSiteUnheard, 0u);
+  auto unheard = healthy;
+  unheard.site_unheard = true;
+  const auto out = step(supervisor, unheard);
+  EXPECT_NE(out.warnings & sv::kWarningSiteUnheard, 0u);
+  EXPECT_EQ(out.warnings & sv::kWarningSite, 0u);
+  EXPECT_EQ(out.active_faults, 0u);
+  EXPECT_TRUE(out.brakes_released);
+  auto off_site = unheard;
+  off_site.site = sv::SiteVerdict::off;
+  EXPECT_EQ(step(supervisor, off_site).warnings & sv::kWarningSiteUnheard, 0u) << "not on a site";
+  EXPECT_EQ(step(supervisor, healthy).warnings & sv::kWarningSiteUnheard, 0u);
+}
+
 TEST(SupervisorLimits, ArmAndResetAreRefusedWhileUnsafe) {
   sv::SupervisorParams params;
   params.arm_on_start = false;

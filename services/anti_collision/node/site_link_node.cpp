@@ -6,8 +6,9 @@
 // hears the service's instructions and heartbeat. Translation and wiring only: the crane's side of
 // the protocol is anti_collision::CraneSiteLink (crane_site_link.hpp).
 //
-// It starts once the crane is ready (every stage alive, brakes released, no latched fault, an
-// estimate heard); before that it reports nothing, so the service holds the crane's whole reach.
+// It starts once the crane is ready (an estimate heard, and ac::ready_for_site: every stage alive,
+// brakes released, no latched fault, its supervisor's guard hearing the site service); before that
+// it reports nothing, so the service holds the crane's whole reach.
 // A latched supervisor fault afterwards ends its reports and its goals for good (the service then
 // holds the crane's whole reach). --summary FILE gets its figures as JSON whenever a job is done
 // and at exit (written to FILE.tmp, then renamed). SIGINT/SIGTERM stop it.
@@ -165,9 +166,7 @@ int main(int argc, char** argv) {
         }
       }
       if (!ready) {
-        ready = estimate && status && status->stages_alive == Status::STAGES_ALL && status->brakes_released &&
-                status->latched_faults == 0 &&
-                (status->mode == Status::MODE_READY || status->mode == Status::MODE_OPERATING);
+        ready = estimate && status && ac::ready_for_site(*status);
         if (!ready) continue;
         spdlog::info("the crane is ready: reporting to the site service");
       }

@@ -133,6 +133,7 @@ enum Warning : std::uint32_t {
   kWarningZoneApproach = StatusCodes::WARNING_ZONE_APPROACH,        // the predicted stopping position is in a zone
   kWarningSite = StatusCodes::WARNING_SITE,                         // the site guard asks for a soft stop
   kWarningDrivesBraked = StatusCodes::WARNING_DRIVES_BRAKED,        // brakes on in ready/operating after the drives ran
+  kWarningSiteUnheard = StatusCodes::WARNING_SITE_UNHEARD,          // on a site: the guard does not hear the site service
 };
 
 /// What the crane's guard of its site grant (anti_collision::GrantGuard, docs/site.md) answered
@@ -296,6 +297,8 @@ struct SupervisorInput {
   std::uint8_t command_operating_mode{0};  // set_operating_mode: an OPERATION_* code (others refused)
   std::uint8_t command_zone{0};            // enable_zone / disable_zone: index in site.zones (others refused)
   SiteVerdict site{SiteVerdict::off};      // the site guard's answer for this cycle's motion
+  bool site_unheard{false};                // on a site (site not off): the guard has not heard the site service
+                                           // within its link deadline, or never (kWarningSiteUnheard)
 };
 
 struct SupervisorOutput {

@@ -39,6 +39,7 @@ struct SupervisorCycle {
   const protocol::SupervisorCommand* command{nullptr};  // at most one operator command per cycle
   bool realtime{false};  // wall-clock cycles: a hardware bridge's sample stamp is when it read the encoders
   SiteVerdict site{SiteVerdict::off};  // the site guard's answer on this cycle's motion (off: not on a site)
+  bool site_unheard{false};            // the site guard has not heard the site service within its link deadline
 };
 
 class SupervisorStage {

@@ -97,6 +97,16 @@ inline constexpr double kGoalResendPeriod = 1.0;
 /// Moves to one waypoint its planner may end short (aborted, rejected) before the link gives up.
 inline constexpr int kMoveAttempts = 3;
 
+/// True when the crane, as its supervisor's `status` says, may start working on the site: every
+/// stage alive, the brakes released, no latched fault, mode ready or operating, and its
+/// supervisor's guard hears the site service (no WARNING_SITE_UNHEARD). The last: the guard hears
+/// the service's instructions on a participant of its own; a link that started before that
+/// participant had found the service could take a grant the guard never heard, and the guard then
+/// brakes the crane's first move as a move without a grant (session 35, a host round's start:
+/// docs/site.md, "Each crane's site link"). The site_link process reports nothing before (the
+/// service holds the crane's whole reach).
+[[nodiscard]] bool ready_for_site(const protocol::SupervisorStatus& status) noexcept;
+
 class CraneSiteLink {
  public:
   enum class Phase : std::uint8_t {
