@@ -258,7 +258,7 @@ TEST(CraneGeometry, ALoadSwungSidewaysRisesTowardAJibAbove) {
   EXPECT_EQ(d.first, Part::load);
   EXPECT_EQ(d.second, Part::jib);
   const auto parts = envelope(swinging, a, StopKind::none).samples[0];
-  const Capsule& jib = envelope(lower, b, StopKind::none).samples[0][static_cast<std::size_t>(Part::jib)];
+  const Capsule jib = envelope(lower, b, StopKind::none).samples[0][static_cast<std::size_t>(Part::jib)];
   EXPECT_NEAR(capsule_distance(parts[static_cast<std::size_t>(Part::cable)], jib), 0.8, 1e-9);
 }
 
