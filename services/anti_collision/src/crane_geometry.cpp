@@ -61,15 +61,6 @@ double height_gap(double a0, double a1, double b0, double b1) noexcept {
   return std::max({0.0, std::min(b0, b1) - std::max(a0, a1), std::min(a0, a1) - std::max(b0, b1)});
 }
 
-// The plan distance [m] from the point (px, py) to the plan segment [(x0, y0), (x1, y1)].
-double plan_distance(double px, double py, double x0, double y0, double x1, double y1) noexcept {
-  const double dx = x1 - x0;
-  const double dy = y1 - y0;
-  const double length2 = dx * dx + dy * dy;
-  const double t = length2 > 0.0 ? std::clamp(((px - x0) * dx + (py - y0) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(px - (x0 + t * dx), py - (y0 + t * dy));
-}
-
 // Combines a plan distance less the radii (`plan`, negative inside) and a height gap: Pythagoras
 // apart, the plan's (negative: overlapping) where the heights meet.
 double combine(double plan, double gap) noexcept {
@@ -82,7 +73,9 @@ double segment_upright_distance(const Vector3& p0, const Vector3& p1, const Caps
   const double cy = u.a.y();
   constexpr double kFlat = 1e-12;  // [m] a segment this close to horizontal or vertical is one
   if (std::abs(p1.z() - p0.z()) <= kFlat) {
-    return combine(plan_distance(cx, cy, p0.x(), p0.y(), p1.x(), p1.y()) - u.radius,
+    // The plan distance: segment_distance with every point at height 0, the axis a point.
+    const Vector3 axis(cx, cy, 0.0);
+    return combine(segment_distance(axis, axis, Vector3(p0.x(), p0.y(), 0.0), Vector3(p1.x(), p1.y(), 0.0)) - u.radius,
                    height_gap(p0.z(), p0.z(), u.a.z(), u.b.z()));
   }
   if (std::hypot(p1.x() - p0.x(), p1.y() - p0.y()) <= kFlat) {

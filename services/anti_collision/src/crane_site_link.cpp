@@ -51,7 +51,8 @@ void check_point(const SiteCrane& c, const WorkPoint& w, std::size_t job, const 
 bool ready_for_site(const protocol::SupervisorStatus& s) noexcept {
   using Status = protocol::SupervisorStatus;
   return s.stages_alive == Status::STAGES_ALL && s.brakes_released && s.latched_faults == 0 &&
-         (s.mode == Status::MODE_READY || s.mode == Status::MODE_OPERATING) && (s.warnings & Status::WARNING_SITE_UNHEARD) == 0;
+         (s.mode == Status::MODE_READY || s.mode == Status::MODE_OPERATING) &&
+         (s.warnings & Status::WARNING_SITE_UNHEARD) == 0;
 }
 
 static_assert(kStopTrolley == protocol::MoveRequest::AXIS_TROLLEY && kStopSlew == protocol::MoveRequest::AXIS_SLEW &&

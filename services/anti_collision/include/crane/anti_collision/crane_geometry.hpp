@@ -1,8 +1,8 @@
 #pragma once
-// The parts of a tower crane on a site as capsules and upright cylinders, the space they may occupy until the crane is
-// at rest after a stop, and the distance between two cranes: what the site's anti-collision rules
-// are made of (issue 34). Pure functions, noexcept, no allocation: the site service and each
-// crane's supervisor call them every cycle.
+// The parts of a tower crane on a site as capsules and upright cylinders, the space they may
+// occupy until the crane is at rest after a stop, and the distance between two cranes: what the
+// site's anti-collision rules are made of (issue 34). Pure functions, noexcept, no allocation: the
+// site service and each crane's supervisor call them every cycle.
 //
 // Parts (site frame of site_layout.hpp, [m]); each an outer bound of the real part, so that a
 // distance computed here never exceeds the real one. The structure's are capsules (a segment swept
