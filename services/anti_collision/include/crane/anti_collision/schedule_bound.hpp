@@ -1,7 +1,8 @@
 #pragma once
 // How fast two cranes could do their jobs on one site at best, under the site's own rules
 // (issue 34's throughput figure; docs/site.md, "How far from the best order"): a lower bound of
-// any order of grants, against which the site service's order is measured.
+// any order of grants, against which the site service's order is measured. Below it, the other
+// end for every crane of a site at once: the best schedule a search finds (search_site_schedule).
 //
 // Each crane's work is taken as it ran alone (its Timeline: the intervals of its solo run, each
 // with the airspace it used, the box of a path segment or of its rest), and the two are laid out
@@ -32,6 +33,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "crane/anti_collision/airspace.hpp"
@@ -69,7 +71,63 @@ struct Timeline {
                                            std::size_t second, const Timeline& b,
                                            WaitRule rule = WaitRule::anywhere);
 
+/// An order of every crane's whole legs at once, found by search: the other end of the bound of the
+/// site's protocol (WaitRule::at_rest) on a site of more than two cranes, where two_crane_bound sees
+/// one pair at a time and the exact search, a lattice of one axis per crane, is too large (three
+/// cranes' 90 s: 10^12 points).
+///
+/// The model is two_crane_bound's at rest, for every crane at once: a crane runs each leg (the
+/// intervals between two rest intervals) without a stop, holding each interval while it is in it;
+/// it waits only inside a rest interval, holding its box; done, it holds nothing. No two cranes may
+/// hold, in the same cycle, intervals whose airspaces do not keep margins.slow_down. A schedule is
+/// the cycle each crane leaves each of its rest intervals.
+///
+/// The search is a serial schedule generation (R. Kolisch, "Serial and parallel resource-constrained
+/// project scheduling methods revisited", EJOR 90, 1996): the departures are placed one at a time,
+/// each at the earliest cycle at which the leg it starts, and the rest at its end, keep clear of
+/// everything placed so far, the other cranes taken to stay at rest where they stand until their
+/// own next departure is placed. The order of the departures is searched: earliest leg first,
+/// then `tries` random orders (seeded by `seed`) biased towards it, each improved by swapping
+/// neighbours. Under HoldRule::path the site is replayed cycle by cycle instead, each crane asking
+/// as soon as it has stood its rest interval's time and the requests that may go granted in an
+/// order of random keys per leg (the first try: the crane listed first goes first), every other try
+/// holding back a request whose leg meets a waiting request's ranked before it.
+/// Every schedule it returns keeps the rule, so the site's best order of whole legs takes at most
+/// `cycles`; the search is not exhaustive, so it may take less. It may find none where cranes can
+/// only pass each other by leaving together (each leg meeting the other's rest box after it has
+/// left): a departure is placed only when it keeps clear of the others standing where they are.
+/// What a crane holds while it moves, in search_site_schedule.
+enum class HoldRule : std::uint8_t {
+  timed,  // each interval while it is in it: a leg may start while its path still meets another's, as
+          // long as the two are never there in the same cycle (the bound's model; a service would need
+          // each leg's timing)
+  path,   // the site service's rule (SiteArbiter::decide): a crane leaves its rest only when its whole
+          // leg and the rest box at its end meet nothing another crane holds then, at rest its box,
+          // moving the rest of its leg (each interval not yet over) and the rest box at its end
+};
+
+struct SiteSchedule {
+  std::int64_t cycles{-1};  // [cycles] when the last crane is done; -1: no order found
+  // Per crane, the cycle it leaves each of its rest intervals, in order (empty: it has none).
+  std::vector<std::vector<std::int64_t>> departures;
+};
+
+/// The best schedule found for crane k doing timelines[k], k = 0 .. layout.cranes.size() - 1.
+/// std::invalid_argument when the timelines are not one per crane of `layout`, or a step does not
+/// end after the one before.
+[[nodiscard]] SiteSchedule search_site_schedule(const SiteLayout& layout, const std::vector<Timeline>& timelines,
+                                                std::uint64_t seed, int tries = 200,
+                                                HoldRule rule = HoldRule::timed);
+
 namespace internal {
+/// search_site_schedule on planes given directly: per crane its intervals' ends (ends[k][0] = 0,
+/// rising) and whether each is at rest; forbidden(i, k, j, l) whether interval k of crane i and
+/// interval l of crane j may not be held in one cycle (asked for i < j only).
+[[nodiscard]] SiteSchedule search_site_schedule(
+    const std::vector<std::vector<std::int64_t>>& ends, const std::vector<std::vector<char>>& rest,
+    const std::function<bool(std::size_t, std::size_t, std::size_t, std::size_t)>& forbidden, std::uint64_t seed,
+    int tries = 200, HoldRule rule = HoldRule::timed);
+
 /// The same search on a plane given directly: the first crane's interval ends x (x[0] = 0, rising),
 /// the second's y, and forbidden[k * (y.size() - 1) + l] for the cell of intervals k and l;
 /// rest_x, rest_y empty for WaitRule::anywhere, else per interval whether it is a rest interval.
