@@ -427,6 +427,12 @@ TEST(SiteScheduleSearch, RandomPlanesAgainstTheExactLattice) {
       EXPECT_EQ(path.cycles, -1) << "trial " << trial;
       continue;
     }
+    // The first order only (tries 0): the departures in the order of time, each as soon as it may.
+    const SiteSchedule first = search(ends, rest, cells, 0);
+    if (first.cycles >= 0) {
+      EXPECT_TRUE(keeps_the_rule(ends, rest, cells, first)) << "trial " << trial << ", the first order";
+      EXPECT_GE(first.cycles, std::max(best, found.cycles)) << "trial " << trial << ", the first order";
+    }
     if (path.cycles >= 0) {
       ++with_path[n];
       EXPECT_TRUE(keeps_the_rule(ends, rest, cells, path)) << "trial " << trial << ", the service's rule";

@@ -519,7 +519,7 @@ SiteSchedule search(const std::vector<std::vector<std::int64_t>>& ends, const st
     if (better(found)) best = found;
     // Neighbours of two cranes swapped, kept when no slower.
     std::int64_t here = found.cycles;
-    for (std::size_t swaps = 0; order.size() > 1 && swaps < 3 * order.size(); ++swaps) {
+    for (std::size_t swaps = 0; tries > 0 && order.size() > 1 && swaps < 3 * order.size(); ++swaps) {
       const std::size_t p = std::uniform_int_distribution<std::size_t>(0, order.size() - 2)(rng);
       if (order[p] == order[p + 1]) continue;
       std::swap(order[p], order[p + 1]);

@@ -92,6 +92,10 @@ struct Timeline {
 /// as soon as it has stood its rest interval's time and the requests that may go granted in an
 /// order of random keys per leg (the first try: the crane listed first goes first), every other try
 /// holding back a request whose leg meets a waiting request's ranked before it.
+/// With `tries` 0 it takes only the first order, as a service that knew the legs' timing, or
+/// followed its own rule, would grant them: the departures in the order of time, each as soon as
+/// it may (timed, the soonest departure first places them in the order of time: placing one never
+/// lets another leave sooner); under HoldRule::path the first replay.
 /// Every schedule it returns keeps the rule, so the site's best order of whole legs takes at most
 /// `cycles`; the search is not exhaustive, so it may take less. It may find none where cranes can
 /// only pass each other by leaving together (each leg meeting the other's rest box after it has
