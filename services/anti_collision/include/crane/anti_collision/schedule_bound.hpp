@@ -71,6 +71,16 @@ struct Timeline {
                                            std::size_t second, const Timeline& b,
                                            WaitRule rule = WaitRule::anywhere);
 
+/// What a crane holds while it moves, in search_site_schedule.
+enum class HoldRule : std::uint8_t {
+  timed,  // each interval while it is in it: a leg may start while its path still meets another's, as
+          // long as the two are never there in the same cycle (the bound's model; a service would need
+          // each leg's timing)
+  path,   // the site service's rule (SiteArbiter::decide): a crane leaves its rest only when its whole
+          // leg and the rest box at its end meet nothing another crane holds then, at rest its box,
+          // moving the rest of its leg (each interval not yet over) and the rest box at its end
+};
+
 /// An order of every crane's whole legs at once, found by search: the other end of the bound of the
 /// site's protocol (WaitRule::at_rest) on a site of more than two cranes, where two_crane_bound sees
 /// one pair at a time and the exact search, a lattice of one axis per crane, is too large (three
@@ -100,16 +110,6 @@ struct Timeline {
 /// `cycles`; the search is not exhaustive, so it may take less. It may find none where cranes can
 /// only pass each other by leaving together (each leg meeting the other's rest box after it has
 /// left): a departure is placed only when it keeps clear of the others standing where they are.
-/// What a crane holds while it moves, in search_site_schedule.
-enum class HoldRule : std::uint8_t {
-  timed,  // each interval while it is in it: a leg may start while its path still meets another's, as
-          // long as the two are never there in the same cycle (the bound's model; a service would need
-          // each leg's timing)
-  path,   // the site service's rule (SiteArbiter::decide): a crane leaves its rest only when its whole
-          // leg and the rest box at its end meet nothing another crane holds then, at rest its box,
-          // moving the rest of its leg (each interval not yet over) and the rest box at its end
-};
-
 struct SiteSchedule {
   std::int64_t cycles{-1};  // [cycles] when the last crane is done; -1: no order found
   // Per crane, the cycle it leaves each of its rest intervals, in order (empty: it has none).
