@@ -342,6 +342,33 @@ TEST(SiteScheduleSearch, TheServicesRuleWaitsForTheWholePathToClear) {
   EXPECT_TRUE(keeps_the_rule(ends, rest, cells, path));
 }
 
+// Leaving behind a moving crane (HoldRule::behind), by hand. a: at rest 1, then 10 cycles that meet
+// b's second interval and 1 clear; b: at rest 1, then 5 clear and 10 that meet a's first. Under the
+// service's rule b leaves when a's first interval is over, at 11: done at 26 (b first: a leaves at
+// 16, done at 27). Behind a, b leaves at 1, stands before its second interval from 6 to 11 and is
+// done at 21, the exact best at rest (b leaving at 6). a cannot go behind b: its first interval
+// meets what b holds. Nor can b go behind a when a comes to rest where b's second interval passes:
+// then one waits for the other, 27 cycles either way.
+TEST(SiteScheduleSearch, ALegLeavesBehindAMovingCraneAndWaitsBeforeWhatItHolds) {
+  const Ends ends{{0, 1, 11, 12}, {0, 1, 6, 16}};
+  const Rests rest{{1, 0, 0}, {1, 0, 0}};
+  Cells cells(2, std::vector<std::vector<char>>(2));
+  cells[0][1] = {0, 0, 0, 0, 0, 1, 0, 0, 0};  // a's first with b's second
+  cells[1][0] = {0, 0, 0, 0, 0, 0, 0, 1, 0};
+  EXPECT_EQ(search(ends, rest, cells, 20, HoldRule::path).cycles, 26);
+  EXPECT_EQ(exact_at_rest(ends, rest, cells), 21);
+  const SiteSchedule behind = search(ends, rest, cells, 20, HoldRule::behind);
+  EXPECT_EQ(behind.cycles, 21);
+  EXPECT_EQ(behind.departures[0], std::vector<std::int64_t>{1});
+  EXPECT_EQ(behind.departures[1], std::vector<std::int64_t>{1});
+  // Not behind a crane whose rest box at its end meets the leg: a rests after its first interval.
+  const Rests rests_after{{1, 0, 1}, {1, 0, 0}};
+  cells[0][1] = {0, 0, 0, 0, 0, 1, 0, 0, 1};  // ... and that rest box meets b's second too
+  cells[1][0] = {0, 0, 0, 0, 0, 0, 0, 1, 1};
+  EXPECT_EQ(search(ends, rests_after, cells, 20, HoldRule::behind).cycles, 27);  // one after the other
+  EXPECT_EQ(search(ends, rests_after, cells, 20, HoldRule::path).cycles, 27);
+}
+
 // Three cranes, each at rest 1 cycle, then a leg of 100 that meets each other's: one after the
 // other, 301 cycles; each pair alone needs 201, so the pairs' bound misses the third crane by 100.
 TEST(SiteScheduleSearch, ThreeCranesInEachOthersWayGoOneAfterTheOther) {
@@ -397,6 +424,8 @@ TEST(SiteScheduleSearch, RandomPlanesAgainstTheExactLattice) {
   std::int64_t over[4] = {0, 0, 0, 0}, total[4] = {0, 0, 0, 0};
   int with_path[4] = {0, 0, 0, 0};
   std::int64_t path_over[4] = {0, 0, 0, 0}, path_total[4] = {0, 0, 0, 0};
+  int with_behind[4] = {0, 0, 0, 0};
+  std::int64_t behind_over[4] = {0, 0, 0, 0}, behind_total[4] = {0, 0, 0, 0};
   for (int trial = 0; trial < 600; ++trial) {
     const std::size_t n = trial % 2 == 0 ? 2 : 3;
     Ends ends(n, {0});
@@ -422,6 +451,20 @@ TEST(SiteScheduleSearch, RandomPlanesAgainstTheExactLattice) {
     const SiteSchedule found = search(ends, rest, cells, 30);
     const std::int64_t best = exact_at_rest(ends, rest, cells);
     const SiteSchedule path = search(ends, rest, cells, 30, HoldRule::path);
+    // Behind a moving crane a leg may wait before an interval, as when waiting anywhere: never
+    // shorter than any pair's exact bound waiting anywhere, nor than the longest crane's work.
+    const SiteSchedule behind = search(ends, rest, cells, 30, HoldRule::behind);
+    if (behind.cycles >= 0) {
+      ++with_behind[n];
+      for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_GE(behind.cycles, ends[i].back()) << "trial " << trial << ", behind";
+        for (std::size_t j = i + 1; j < n; ++j) {
+          EXPECT_GE(behind.cycles, internal::two_crane_bound(ends[i], ends[j], cells[i][j], {}, {}))
+              << "trial " << trial << ", behind";
+        }
+      }
+      if (best >= 0) behind_over[n] += behind.cycles - best, behind_total[n] += best;
+    }
     if (best < 0) {
       EXPECT_EQ(found.cycles, -1) << "trial " << trial;
       EXPECT_EQ(path.cycles, -1) << "trial " << trial;
@@ -464,6 +507,9 @@ TEST(SiteScheduleSearch, RandomPlanesAgainstTheExactLattice) {
                 missed[n]);
     std::printf("%zu cranes, the service's rule: an order found in %d, %.2f %% over the best in all\n", n, with_path[n],
                 path_total[n] > 0 ? 100.0 * static_cast<double>(path_over[n]) / static_cast<double>(path_total[n]) : 0.0);
+    std::printf("%zu cranes, leaving behind a moving crane: an order found in %d, %+.2f %% of the best at rest\n", n,
+                with_behind[n],
+                behind_total[n] > 0 ? 100.0 * static_cast<double>(behind_over[n]) / static_cast<double>(behind_total[n]) : 0.0);
     EXPECT_GT(compared[n], 40) << "the comparison must have planes to compare";
   }
 }

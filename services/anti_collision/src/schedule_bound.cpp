@@ -320,14 +320,14 @@ class Decoder {
   std::vector<std::vector<std::int64_t>> departed_;
 };
 
-// HoldRule::path: the site service's rule replayed cycle by cycle in `keys`' order (per crane, per
-// departure; lower first), each crane asking as soon as it has stood its rest interval's time;
-// with `reserve`, a request that must wait also holds back the later-keyed ones whose leg meets
-// its own. false: at some point no crane moves and none may leave.
+// HoldRule::path and HoldRule::behind: the site service's rule replayed cycle by cycle in `keys`'
+// order (per crane, per departure; lower first), each crane asking as soon as it has stood its rest
+// interval's time; with `reserve`, a request that must wait also holds back the later-keyed ones
+// whose leg meets its own. false: at some point no crane moves and none may leave.
 class Replay {
  public:
-  Replay(const std::vector<Work>& work, const std::vector<std::vector<std::vector<char>>>& forbidden)
-      : work_(work), forbidden_(forbidden) {}
+  Replay(const std::vector<Work>& work, const std::vector<std::vector<std::vector<char>>>& forbidden, HoldRule rule)
+      : work_(work), forbidden_(forbidden), rule_(rule) {}
 
   bool run(const std::vector<std::vector<double>>& keys, bool reserve, SiteSchedule& out) {
     const std::size_t n = work_.size();
@@ -335,23 +335,40 @@ class Replay {
     out.departures.assign(n, {});
     for (std::size_t c = 0; c < n; ++c) {
       State& k = cranes_[c];
-      k.leg = &work_[c].first_leg;
       k.left = work_[c].stops.size();
-      k.then = work_[c].stops.empty() ? nullptr : &work_[c].stops[0];
-      k.end = work_[c].first_leg_length;
+      start(k, &work_[c].first_leg, work_[c].stops.empty() ? nullptr : &work_[c].stops[0], 0);
     }
     for (std::size_t c = 0; c < n; ++c) {  // the first legs go at cycle 0: clear of each other's
       for (std::size_t o = c + 1; o < n; ++o) {
-        if (meets(c, *cranes_[c].leg, cranes_[c].then, o, held(o, 0))) return false;
+        if (meets(c, *cranes_[c].leg, cranes_[c].then, o, held(o))) return false;
       }
     }
     std::int64_t t = 0;
     for (;;) {
+      // Each moving crane into its next interval: first those that left on a clear path, then those
+      // that left behind one (HoldRule::behind), each only when that interval meets nothing held.
+      for (const bool behind : {false, true}) {
+        for (std::size_t c = 0; c < n; ++c) {
+          State& k = cranes_[c];
+          if (k.leg == nullptr || k.behind != behind) continue;
+          while (k.cur + 1 < k.leg->size() && k.cur_end <= t) {
+            const LegStep& next = (*k.leg)[k.cur + 1];
+            if (behind && blocked(c, next.step)) {  // it waits where it is, one cycle
+              k.end += t + 1 - k.cur_end;
+              k.cur_end = t + 1;
+              break;
+            }
+            ++k.cur;
+            k.cur_end += next.to - next.from;
+          }
+        }
+      }
       // Legs that end now: at rest in the next rest interval, or done.
       for (std::size_t c = 0; c < n; ++c) {
         State& k = cranes_[c];
         if (k.leg != nullptr && k.end <= t) {
           k.leg = nullptr;
+          k.behind = false;
           if (k.then == nullptr) {
             k.done = true;
           } else {
@@ -384,8 +401,21 @@ class Replay {
         const Stop& stop = work_[c].stops[cranes_[c].stop];
         const Stop* then = cranes_[c].stop + 1 < work_[c].stops.size() ? &work_[c].stops[cranes_[c].stop + 1] : nullptr;
         bool clear = true;
+        bool behind = false;
         for (std::size_t o = 0; o < n && clear; ++o) {
-          if (o != c) clear = !meets(c, stop.leg, then, o, held(o, t));
+          if (o == c) continue;
+          const State& other = cranes_[o];
+          if (rule_ == HoldRule::behind && other.leg != nullptr && !other.behind && !stop.leg.empty()) {
+            // Behind a crane that left on a clear path: its rest box at the end, and whatever it
+            // holds against this leg's first interval and rest box at the end, stay out of the way.
+            const std::vector<std::size_t> h = held(o);
+            const std::vector<LegStep> first(stop.leg.begin(), stop.leg.begin() + 1);
+            clear = !meets(c, first, then, o, h) &&
+                    (other.then == nullptr || !meets(c, stop.leg, nullptr, o, {other.then->rest}));
+            behind = behind || (clear && meets(c, stop.leg, nullptr, o, h));
+          } else {
+            clear = !meets(c, stop.leg, then, o, held(o));
+          }
         }
         for (const std::size_t w : held_back) {
           if (!clear) break;
@@ -397,10 +427,8 @@ class Replay {
         if (clear) {
           State& k = cranes_[c];
           out.departures[c].push_back(t);
-          k.leg = &stop.leg;
-          k.then = then;
-          k.departed = t;
-          k.end = t + stop.leg_length;
+          start(k, &stop.leg, then, t);
+          k.behind = behind;
           --k.left;
           moved = true;
         } else if (reserve) {
@@ -413,9 +441,7 @@ class Replay {
         const State& k = cranes_[c];
         if (k.done) continue;
         if (k.leg != nullptr) {
-          for (const LegStep& l : *k.leg) {
-            if (k.departed + l.to > t) next = std::min(next, k.departed + l.to);
-          }
+          if (k.cur_end > t) next = std::min(next, k.cur_end);
           next = std::min(next, std::max(k.end, t + 1));
         } else {
           const std::int64_t ready = k.arrived + work_[c].stops[k.stop].length;
@@ -435,25 +461,42 @@ class Replay {
 
  private:
   struct State {
-    const std::vector<LegStep>* leg{nullptr};  // moving on it since `departed`; none: at rest or done
+    const std::vector<LegStep>* leg{nullptr};  // moving on it; none: at rest or done
     const Stop* then{nullptr};                 // the rest interval at its end (none: done after it)
-    std::int64_t departed{0}, end{0}, arrived{0};
+    std::size_t cur{0};                        // the interval of `leg` it is in, until cycle cur_end
+    std::int64_t cur_end{0}, end{0}, arrived{0};  // end: the cycle its leg ends, waits included
     std::size_t stop{0}, left{0};              // the rest interval it stands in; departures left
+    bool behind{false};                        // left behind a moving crane (HoldRule::behind)
     bool done{false};
   };
 
-  // What crane o holds at cycle t: at rest its box; moving the rest of its leg (each interval not
-  // yet over) and the rest box at its end; done nothing.
-  [[nodiscard]] std::vector<std::size_t> held(std::size_t o, std::int64_t t) const {
+  static void start(State& k, const std::vector<LegStep>* leg, const Stop* then, std::int64_t t) {
+    k.leg = leg;
+    k.then = then;
+    k.cur = 0;
+    k.cur_end = t + (leg->empty() ? 0 : leg->front().to - leg->front().from);
+    k.end = t + (leg->empty() ? 0 : leg->back().to);
+  }
+
+  // What crane o holds now: at rest its box; moving the rest of its leg (the interval it is in and
+  // those after it) and the rest box at its end; done nothing.
+  [[nodiscard]] std::vector<std::size_t> held(std::size_t o) const {
     const State& k = cranes_[o];
     if (k.done) return {};
     if (k.leg == nullptr) return {work_[o].stops[k.stop].rest};
     std::vector<std::size_t> h;
-    for (const LegStep& l : *k.leg) {
-      if (k.departed + l.to > t) h.push_back(l.step);
-    }
+    for (std::size_t l = k.cur; l < k.leg->size(); ++l) h.push_back((*k.leg)[l].step);
     if (k.then != nullptr) h.push_back(k.then->rest);
     return h;
+  }
+
+  // Whether interval `step` of crane c meets what another crane holds now.
+  [[nodiscard]] bool blocked(std::size_t c, std::size_t step) const {
+    const std::vector<LegStep> one{{0, 0, step}};
+    for (std::size_t o = 0; o < cranes_.size(); ++o) {
+      if (o != c && meets(c, one, nullptr, o, held(o))) return true;
+    }
+    return false;
   }
 
   [[nodiscard]] static std::vector<std::size_t> path(const std::vector<LegStep>& leg, const Stop* then) {
@@ -478,6 +521,7 @@ class Replay {
 
   const std::vector<Work>& work_;
   const std::vector<std::vector<std::vector<char>>>& forbidden_;
+  HoldRule rule_;
   std::vector<State> cranes_;
 };
 
@@ -486,8 +530,8 @@ SiteSchedule search(const std::vector<std::vector<std::int64_t>>& ends, const st
                     HoldRule rule) {
   std::vector<Work> work;
   for (std::size_t c = 0; c < ends.size(); ++c) work.push_back(parse_work(ends[c], rest[c]));
-  if (rule == HoldRule::path) {
-    Replay replay(work, forbidden);
+  if (rule == HoldRule::path || rule == HoldRule::behind) {
+    Replay replay(work, forbidden, rule);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     SiteSchedule best, found;

@@ -79,6 +79,12 @@ enum class HoldRule : std::uint8_t {
   path,   // the site service's rule (SiteArbiter::decide): a crane leaves its rest only when its whole
           // leg and the rest box at its end meet nothing another crane holds then, at rest its box,
           // moving the rest of its leg (each interval not yet over) and the rest box at its end
+  behind, // HoldRule::path, and a crane may also leave behind one that left on a clear path and has not
+          // arrived: its leg may meet what that one still holds of its leg (not the rest box at that
+          // one's end, nor with its first interval or its own rest box at the end), and it enters each
+          // interval only when the interval meets nothing held then, waiting before it where it is
+          // (a stop in the middle of a leg, taken to cost no time). Not the service's rule: what a
+          // grant "go, and wait before what it still holds" would be worth
 };
 
 /// An order of every crane's whole legs at once, found by search: the other end of the bound of the
@@ -98,15 +104,16 @@ enum class HoldRule : std::uint8_t {
 /// everything placed so far, the other cranes taken to stay at rest where they stand until their
 /// own next departure is placed. The order of the departures is searched: earliest leg first,
 /// then `tries` random orders (seeded by `seed`) biased towards it, each improved by swapping
-/// neighbours. Under HoldRule::path the site is replayed cycle by cycle instead, each crane asking
+/// neighbours. Under HoldRule::path and HoldRule::behind the site is replayed cycle by cycle instead, each crane asking
 /// as soon as it has stood its rest interval's time and the requests that may go granted in an
 /// order of random keys per leg (the first try: the crane listed first goes first), every other try
 /// holding back a request whose leg meets a waiting request's ranked before it.
 /// With `tries` 0 it takes only the first order, as a service that knew the legs' timing, or
 /// followed its own rule, would grant them: the departures in the order of time, each as soon as
 /// it may (timed, the soonest departure first places them in the order of time: placing one never
-/// lets another leave sooner); under HoldRule::path the first replay.
-/// Every schedule it returns keeps the rule, so the site's best order of whole legs takes at most
+/// lets another leave sooner); under HoldRule::path and HoldRule::behind the first replay.
+/// Every schedule it returns keeps the rule (behind: departures only; the waits inside a leg are not
+/// returned), so the site's best order of whole legs takes at most
 /// `cycles`; the search is not exhaustive, so it may take less. It may find none where cranes can
 /// only pass each other by leaving together (each leg meeting the other's rest box after it has
 /// left): a departure is placed only when it keeps clear of the others standing where they are.
