@@ -192,18 +192,24 @@ using Ends = std::vector<std::vector<std::int64_t>>;
 using Rests = std::vector<std::vector<char>>;
 using Cells = std::vector<std::vector<std::vector<char>>>;  // [i][j][k * steps_j + l], both ways
 
-// Each crane's interval per cycle of the schedule `departures` says (the rest intervals held until
-// their departure, the others as long as alone, nothing once done), -1 when done; empty if a
-// departure comes before the crane could leave.
+// Each crane's interval per cycle of the schedule `departures` and `waits` say (the rest intervals
+// held until their departure, the others as long as alone and the wait before the next, nothing once
+// done), -1 when done; empty if a departure comes before the crane could leave, or a wait is not
+// inside a leg (before an interval that follows a moving one) or is negative.
 std::vector<std::vector<int>> held_per_cycle(const Ends& ends, const Rests& rest, const SiteSchedule& s,
                                              std::int64_t horizon) {
   std::vector<std::vector<int>> held;
+  if (s.waits.size() != ends.size()) return {};
   for (std::size_t c = 0; c < ends.size(); ++c) {
+    if (s.waits[c].size() != rest[c].size()) return {};
     std::vector<int> h(static_cast<std::size_t>(horizon), -1);
     std::int64_t t = 0;
     std::size_t q = 0;
     for (std::size_t k = 0; k < rest[c].size(); ++k) {
+      const std::int64_t wait = s.waits[c][k];
+      if (wait < 0 || (wait > 0 && (k == 0 || rest[c][k] || rest[c][k - 1]))) return {};
       std::int64_t until = t + ends[c][k + 1] - ends[c][k];
+      if (k + 1 < rest[c].size()) until += s.waits[c][k + 1];  // waiting in k before k + 1
       if (rest[c][k]) {
         if (q >= s.departures[c].size() || s.departures[c][q] < until) return {};
         until = s.departures[c][q++];
@@ -222,7 +228,7 @@ std::vector<std::vector<int>> held_per_cycle(const Ends& ends, const Rests& rest
                                           const SiteSchedule& s) {
   const std::int64_t horizon = s.cycles + 1;
   const auto held = held_per_cycle(ends, rest, s, horizon);
-  if (held.empty()) return ::testing::AssertionFailure() << "a departure before its crane could leave";
+  if (held.empty()) return ::testing::AssertionFailure() << "a departure before its crane could leave, or a wait outside a leg";
   std::int64_t last = 0;
   for (std::size_t c = 0; c < held.size(); ++c) {
     for (std::int64_t t = 0; t < horizon; ++t) {
@@ -361,6 +367,9 @@ TEST(SiteScheduleSearch, ALegLeavesBehindAMovingCraneAndWaitsBeforeWhatItHolds) 
   EXPECT_EQ(behind.cycles, 21);
   EXPECT_EQ(behind.departures[0], std::vector<std::int64_t>{1});
   EXPECT_EQ(behind.departures[1], std::vector<std::int64_t>{1});
+  EXPECT_EQ(behind.waits[1], (std::vector<std::int64_t>{0, 0, 5}));  // before its second interval, 6 to 11
+  EXPECT_EQ(behind.waits[0], (std::vector<std::int64_t>{0, 0, 0}));
+  EXPECT_TRUE(keeps_the_rule(ends, rest, cells, behind));
   // Not behind a crane whose rest box at its end meets the leg: a rests after its first interval.
   const Rests rests_after{{1, 0, 1}, {1, 0, 0}};
   cells[0][1] = {0, 0, 0, 0, 0, 1, 0, 0, 1};  // ... and that rest box meets b's second too
@@ -456,6 +465,7 @@ TEST(SiteScheduleSearch, RandomPlanesAgainstTheExactLattice) {
     const SiteSchedule behind = search(ends, rest, cells, 30, HoldRule::behind);
     if (behind.cycles >= 0) {
       ++with_behind[n];
+      EXPECT_TRUE(keeps_the_rule(ends, rest, cells, behind)) << "trial " << trial << ", behind";
       for (std::size_t i = 0; i < n; ++i) {
         EXPECT_GE(behind.cycles, ends[i].back()) << "trial " << trial << ", behind";
         for (std::size_t j = i + 1; j < n; ++j) {

@@ -310,6 +310,8 @@ class Decoder {
     out.cycles = 0;
     for (const std::int64_t d : done_) out.cycles = std::max(out.cycles, d);
     out.departures = departed_;
+    out.waits.clear();
+    for (const Work& w : work_) out.waits.emplace_back(w.steps, 0);  // a leg runs without a stop
   }
 
   const std::vector<Work>& work_;
@@ -333,7 +335,9 @@ class Replay {
     const std::size_t n = work_.size();
     cranes_.assign(n, {});
     out.departures.assign(n, {});
+    out.waits.clear();
     for (std::size_t c = 0; c < n; ++c) {
+      out.waits.emplace_back(work_[c].steps, 0);
       State& k = cranes_[c];
       k.left = work_[c].stops.size();
       start(k, &work_[c].first_leg, work_[c].stops.empty() ? nullptr : &work_[c].stops[0], 0);
@@ -354,6 +358,7 @@ class Replay {
           while (k.cur + 1 < k.leg->size() && k.cur_end <= t) {
             const LegStep& next = (*k.leg)[k.cur + 1];
             if (behind && blocked(c, next.step)) {  // it waits where it is, one cycle
+              out.waits[c][next.step] += t + 1 - k.cur_end;
               k.end += t + 1 - k.cur_end;
               k.cur_end = t + 1;
               break;

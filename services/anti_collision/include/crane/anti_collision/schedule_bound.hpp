@@ -112,8 +112,7 @@ enum class HoldRule : std::uint8_t {
 /// followed its own rule, would grant them: the departures in the order of time, each as soon as
 /// it may (timed, the soonest departure first places them in the order of time: placing one never
 /// lets another leave sooner); under HoldRule::path and HoldRule::behind the first replay.
-/// Every schedule it returns keeps the rule (behind: departures only; the waits inside a leg are not
-/// returned), so the site's best order of whole legs takes at most
+/// Every schedule it returns keeps the rule, so the site's best order of whole legs takes at most
 /// `cycles`; the search is not exhaustive, so it may take less. It may find none where cranes can
 /// only pass each other by leaving together (each leg meeting the other's rest box after it has
 /// left): a departure is placed only when it keeps clear of the others standing where they are.
@@ -121,6 +120,10 @@ struct SiteSchedule {
   std::int64_t cycles{-1};  // [cycles] when the last crane is done; -1: no order found
   // Per crane, the cycle it leaves each of its rest intervals, in order (empty: it has none).
   std::vector<std::vector<std::int64_t>> departures;
+  // Per crane, per interval of its timeline, the cycles [cycles] it waited inside its leg just before
+  // entering that interval, in the one before it (HoldRule::behind; 0 under the other rules). With
+  // the departures, where every crane is in every cycle.
+  std::vector<std::vector<std::int64_t>> waits;
 };
 
 /// The best schedule found for crane k doing timelines[k], k = 0 .. layout.cranes.size() - 1.
