@@ -274,6 +274,84 @@ TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
   EXPECT_EQ(link_->unsettled_moves(), 0);
 }
 
+// Left behind a moving crane (site_arbiter.hpp): a go for the first waypoints of its leg only. The
+// crane moves to the last of them and asks there, with a new request, for the rest of the leg from
+// that waypoint (not from its measured pose: a hair of slew would make the hoist's segment a
+// travel's). A go for the old request is not taken; the dwell at the work height comes once,
+// whether the part granted ends before it or at it.
+TEST_F(Link, AGoForTheFirstWaypointsOfItsLegMovesThereAndAsksForTheRest) {
+  (void)step();
+  SiteOrder part = go(1);
+  const std::uint32_t first_request = part.request_id;
+  part.waypoints.resize(2);  // the travel to above the pick only
+  ASSERT_TRUE(link_->instruction(part, kEpoch, t_));
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->trolley_target, 0.9);
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 0.2);
+  arrive(*g);
+  estimate_.slew_angle = 0.004;  // it rests a hair off the waypoint
+  EXPECT_FALSE(next_goal(0.5).has_value()) << "no move past the part granted";
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  auto r = link_->report();
+  EXPECT_FALSE(r->moving);
+  expect_pose(r->waypoints[0], 0.004, 0.9, 0.2);
+  EXPECT_NE(r->request_id, first_request) << "a new request";
+  ASSERT_EQ(r->request.size(), 3u);
+  expect_pose(r->request[0], 0.0, 0.9, 0.2);
+  expect_pose(r->request[1], 0.0, 0.9, 1.5);
+  expect_pose(r->request[2], 0.0, 0.9, 0.2);
+  SiteOrder old = go(2);
+  old.request_id = first_request;
+  EXPECT_FALSE(link_->instruction(old, kEpoch, t_)) << "a go for the request it was granted part of";
+  // The rest: lower, dwell 1 s, hoist up; then it asks for the place, the job not yet done.
+  ASSERT_TRUE(link_->instruction(go(3), kEpoch, t_));
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 1.5);
+  arrive(*g);
+  const double lowered = t_;
+  g = next_goal(2.0);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(t_ - lowered, 1.0, 0.02) << "the dwell at the work height";
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 0.2);
+  arrive(*g);
+  EXPECT_FALSE(next_goal(0.05).has_value());
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  r = link_->report();
+  ASSERT_EQ(r->request.size(), 4u) << "the place's whole leg";
+  expect_pose(r->request[2], -1.5, 0.5, 1.2);
+  EXPECT_EQ(link_->jobs_done(), 0);
+
+  // The place granted up to its work height: the dwell there, then it asks for the hoist up, and
+  // the go for it starts the hoist at once (no second dwell); the job is done when it settles.
+  part = go(4);
+  part.waypoints.resize(3);
+  ASSERT_TRUE(link_->instruction(part, kEpoch, t_));
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 1.2);
+  arrive(*g);
+  const double placed = t_;
+  EXPECT_FALSE(next_goal(0.9).has_value()) << "dwelling";
+  for (int k = 0; k < 20 && link_->phase() != CraneSiteLink::Phase::asking; ++k) (void)step();
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  EXPECT_NEAR(t_ - placed, 1.0, 0.05);
+  r = link_->report();
+  ASSERT_EQ(r->request.size(), 2u);
+  expect_pose(r->request[1], -1.5, 0.5, 0.2);
+  ASSERT_TRUE(link_->instruction(go(5), kEpoch, t_));
+  g = step();
+  ASSERT_TRUE(g.has_value()) << "the hoist up at once";
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 0.2);
+  arrive(*g);
+  (void)step();
+  EXPECT_EQ(link_->jobs_done(), 1);
+}
+
 // What the crane is doing, as the site's waits are counted by it: the segment under way (the one
 // about to start once it has settled at a waypoint), the dwell, a yield (a lost-link stop:
 // ALostLinkInSharedAirspaceStopsSoftlyThenTheCraneAsksAgain).

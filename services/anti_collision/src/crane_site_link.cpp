@@ -180,9 +180,14 @@ bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, dou
   guard_.heard(time);
   if (epoch == carried_epoch_ && order.seq <= carried_seq_) return false;  // sent again, or older
   const bool go = order.kind == Instruction::Kind::go;
-  if (go ? (phase_ != Phase::asking || order.request_id != request_id_)
+  if (go ? (phase_ != Phase::asking || order.request_id != request_id_ || order.waypoints.size() > request_.size())
          : (phase_ != Phase::asking && phase_ != Phase::done && phase_ != Phase::aborted)) {
     return false;
+  }
+  rest_of_leg_.clear();
+  path_from_ = request_from_;
+  if (go && order.waypoints.size() < request_.size()) {  // the first waypoints only: the rest asked at the last
+    rest_of_leg_.assign(request_.begin() + static_cast<std::ptrdiff_t>(order.waypoints.size() - 1), request_.end());
   }
   yielding_ = !go;
   if (yielding_) ++yields_;
@@ -237,9 +242,25 @@ void CraneSiteLink::rest_at(const Pose& here, double time) {
   path.push_back({w.slew, w.trolley, w.cable_length});
   path.push_back({w.slew, w.trolley, up});
   request_ = std::move(path);
+  request_from_ = 0;
+  leg_waypoints_ = request_.size();
+  rest_of_leg_.clear();
   request_id_ = ++requests_;  // a new id: a new request
   phase_ = Phase::asking;
   asked_at_ = time;
+}
+
+void CraneSiteLink::ask_rest_of_leg(double time) {
+  guard_.grant(rest_airspace(pose_, layout_.paths), time);
+  // From the waypoint it rests at, not its measured pose: a hair of slew between the two would make
+  // the next segment, the hoist's, a travel's, held with the travel swing.
+  request_ = rest_of_leg_;
+  request_from_ = path_from_ + path_.size() - 1;
+  rest_of_leg_.clear();
+  request_id_ = ++requests_;
+  phase_ = Phase::asking;
+  asked_at_ = time;
+  changed_ = true;
 }
 
 Request CraneSiteLink::disobey(const Pose& to, const Pose& here) {
@@ -337,8 +358,16 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
   }
 
   if (phase_ == Phase::dwelling && time >= dwell_until_ - 1e-9) {
-    phase_ = Phase::moving;
-    start_next_ = true;
+    if (waypoint_ + 1 < path_.size()) {
+      phase_ = Phase::moving;
+      start_next_ = true;
+    } else if (!link_lost_) {  // the end of the part of its leg it was granted
+      ask_rest_of_leg(time);
+    } else {
+      rest_of_leg_.clear();
+      phase_ = Phase::resting;
+      changed_ = true;
+    }
   }
   if (phase_ == Phase::moving && start_next_) {
     start_next_ = false;
@@ -425,12 +454,23 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
   const bool timed_out = time - *arrived_at_ >= params_.settle_timeout - 1e-9;
   if (!settled(estimate, params_.gravity) && !timed_out) return goal;
   if (timed_out) ++unsettled_moves_;
-  if (waypoint_ + 1 < path_.size()) {
-    if (!yielding_ && waypoint_ + 2 == path_.size()) {  // at the work height
+  const bool work_height = !yielding_ && path_from_ + waypoint_ + 2 == leg_waypoints_;
+  if (waypoint_ + 1 < path_.size() || (work_height && !rest_of_leg_.empty())) {
+    if (work_height) {
       phase_ = Phase::dwelling;
       dwell_until_ = time + params_.dwell;
     } else {
       start_next_ = true;
+    }
+    return goal;
+  }
+  if (!yielding_ && !rest_of_leg_.empty()) {  // the end of the part of its leg it was granted
+    if (!link_lost_) {
+      ask_rest_of_leg(time);
+    } else {
+      rest_of_leg_.clear();  // it asks for the whole leg when the link is back
+      phase_ = Phase::resting;
+      changed_ = true;
     }
     return goal;
   }

@@ -10,7 +10,10 @@
 // travel (slew and trolley), lower to the work height, hold `dwell` (hooking or unhooking), hoist
 // up. The crane asks for the whole leg (its report's request, from where it rests) and starts it
 // only when the service's go for that request arrives; a yield it obeys at once (hook up, through
-// the waypoints it is given; it asks again afterwards). It moves waypoint by waypoint: the goal to
+// the waypoints it is given; it asks again afterwards). A go may grant the first waypoints of the
+// leg only (the service's leaving behind a moving crane, site_arbiter.hpp): the crane moves to the
+// last of them, and there, at rest (after the dwell, if that is the work height), asks for the
+// rest of the leg; a crane that halts or yields before asks for the whole leg again. It moves waypoint by waypoint: the goal to
 // the next waypoint (COMMAND_MOVE, every axis named, the trapezoid profile) once the reference of
 // the goal before has arrived and the crane has settled (trolley and slew under 0.01 m/s and
 // rad/s, hoist under 0.01 m/s, swing amplitude under 0.5 deg) or `settle_timeout` after the
@@ -215,6 +218,9 @@ class CraneSiteLink {
   /// under way it has reported passing (passed_, when it is not the segment's start), to the end.
   [[nodiscard]] std::vector<Pose> rest_of_path() const;
   void rest_at(const Pose& here, double time);
+  /// Left behind a moving crane, at the end of the part of its leg it was granted: it asks for the
+  /// rest of the leg from where it rests.
+  void ask_rest_of_leg(double time);
 
   SiteLayout layout_;
   std::size_t crane_;
@@ -247,6 +253,11 @@ class CraneSiteLink {
   bool stepped_{false};
   CraneMotion motion_{};  // measured, at its last step (its reports carry it)
   std::vector<Pose> request_;
+  std::size_t request_from_{0};      // the waypoint of its leg request_[0] is (0: a whole leg asked from rest)
+  std::size_t path_from_{0};         // the same for path_[0]
+  std::size_t leg_waypoints_{0};     // its leg's waypoints, as first asked
+  std::vector<Pose> rest_of_leg_;    // granted part of its leg (left behind a moving crane): the rest, from
+                                     // path_.back(); empty: the whole leg was granted
   Pose pose_{};                      // the measured pose (the last step's)
   std::uint32_t carried_epoch_{0};
   std::uint64_t carried_seq_{0};

@@ -108,6 +108,8 @@ struct SiteLayout {
                                       // moving into shared airspace (the supervisor's rule)
   double max_wait{0.0};               // [s] a request that has waited this long goes before every later one
                                       // (the site service's rule 0, site_arbiter.hpp); 0: no limit
+  bool leave_behind{false};           // a leg may leave behind a moving crane and wait at a waypoint before
+                                      // what it still holds (site_arbiter.hpp, "Leaving behind")
   PathAllowance paths;
 
   static constexpr std::size_t kMaxCranes = 20;
