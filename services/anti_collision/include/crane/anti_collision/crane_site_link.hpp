@@ -13,11 +13,11 @@
 // the waypoints it is given; it asks again afterwards). A go may grant the first waypoints of the
 // leg only (the service's leaving behind a moving crane, site_arbiter.hpp): the crane moves to the
 // last of them, and there, at rest (after the dwell, if that is the work height), asks for the
-// rest of the leg; a crane that halts or yields before asks for the whole leg again. It moves waypoint by waypoint: the goal to
-// the next waypoint (COMMAND_MOVE, every axis named, the trapezoid profile) once the reference of
-// the goal before has arrived and the crane has settled (trolley and slew under 0.01 m/s and
-// rad/s, hoist under 0.01 m/s, swing amplitude under 0.5 deg) or `settle_timeout` after the
-// reference arrived. A goal the planner has not answered (move_status(): its MoveStatus_) is sent
+// rest of the leg from that waypoint; a crane that halts or yields before asks for the whole leg
+// again. It moves waypoint by waypoint: the goal to the next waypoint (COMMAND_MOVE, every axis
+// named, the trapezoid profile) once the reference of the goal before has arrived and the crane
+// has settled (trolley and slew under 0.01 m/s and rad/s, hoist under 0.01 m/s, swing amplitude
+// under 0.5 deg) or `settle_timeout` after the reference arrived. A goal the planner has not answered (move_status(): its MoveStatus_) is sent
 // again every kGoalResendPeriod.
 //
 // A move its planner ends short (MoveStatus_ RESULT_ABORTED: the supervisor's soft stop for swing,
@@ -219,7 +219,7 @@ class CraneSiteLink {
   [[nodiscard]] std::vector<Pose> rest_of_path() const;
   void rest_at(const Pose& here, double time);
   /// Left behind a moving crane, at the end of the part of its leg it was granted: it asks for the
-  /// rest of the leg from where it rests.
+  /// rest of the leg from that waypoint (not its measured pose, a hair off it).
   void ask_rest_of_leg(double time);
 
   SiteLayout layout_;
