@@ -17,8 +17,8 @@
 // again. It moves waypoint by waypoint: the goal to the next waypoint (COMMAND_MOVE, every axis
 // named, the trapezoid profile) once the reference of the goal before has arrived and the crane
 // has settled (trolley and slew under 0.01 m/s and rad/s, hoist under 0.01 m/s, swing amplitude
-// under 0.5 deg) or `settle_timeout` after the reference arrived. A goal the planner has not answered (move_status(): its MoveStatus_) is sent
-// again every kGoalResendPeriod.
+// under 0.5 deg) or `settle_timeout` after the reference arrived. A goal the planner has not
+// answered (move_status(): its MoveStatus_) is sent again every kGoalResendPeriod.
 //
 // A move its planner ends short (MoveStatus_ RESULT_ABORTED: the supervisor's soft stop for swing,
 // a speed or zone limit approached, its site guard; or RESULT_REJECTED) leaves the crane inside its
