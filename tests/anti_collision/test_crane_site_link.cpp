@@ -274,7 +274,7 @@ TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
   EXPECT_EQ(link_->unsettled_moves(), 0);
 }
 
-// Left behind a moving crane (site_arbiter.hpp): a go for the first waypoints of its leg only. The
+// A part of a leg (site_arbiter.hpp): a go for the first waypoints of its leg only. The
 // crane moves to the last of them and asks there, with a new request, for the rest of the leg from
 // that waypoint (not from its measured pose: a hair of slew would make the hoist's segment a
 // travel's). A go for the old request is not taken; the dwell at the work height comes once,

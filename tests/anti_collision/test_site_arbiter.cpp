@@ -488,62 +488,63 @@ TEST(SiteArbiter, ProgressFreesThePathBehind) {
   EXPECT_THROW(idle.progress(0, {{0.0, 0.5, 0.2}}), std::logic_error);
 }
 
-// Leaving behind a moving crane (the site file's leave_behind). B, its load low over A's jib line
-// at x = 1.0 (heading 0 of A), hoists up and slews away, hook up: its cable meets A's jib at
-// heading 0 only while it hoists there; its load at 0.2 m of cable passes 0.17 m above A's jib.
-// A turns its jib from heading -1.5 through 0 to 0.5: its first segment (to -0.5) and its rest at
-// 0.5 keep clear of B, its second segment meets B's hoist. A goes to -0.5 and holds its whole path;
-// at rest there it asks for the rest, which waits for B and ranks from A's first ask; once B has
-// hoisted, it goes. Without leave_behind, A waits at -1.5. And when B stops short of its path's end
-// (rests mid-hoist), A holds its path no more: what it waits for may never clear.
-TEST(SiteArbiter, ALegLeavesBehindAMovingCraneAndWaitsAtAWaypointBeforeWhatItHolds) {
+// A part of a leg (the site file's part_of_leg). B, its load low over A's jib line at x = 1.0
+// (heading 0 of A), hoists up and slews away, hook up: its cable meets A's jib at heading 0 only
+// while it hoists there; its load at 0.2 m of cable passes 0.17 m above A's jib. A turns its jib
+// from heading -1.5 through 0 to 0.5: its first segment (to -0.5) and its rest at -0.5 keep clear
+// of B, its second segment meets B's hoist. A goes to -0.5, holding that part only; at rest there
+// it asks for the rest, a new request, which waits for B; once B has hoisted, it goes. Without
+// part_of_leg, A waits at -1.5. The same when B will rest in A's way (B's leg reversed: at rest
+// there with nothing to do, B then yields), and when B stands there at rest; A waits whole when its
+// first segment meets B, or when B is silent.
+TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) {
   const std::vector<Pose> b_path{{kPi, 1.0, 1.5}, {kPi, 1.0, 0.2}, {kPi - 1.5, 1.0, 0.2}};
+  const std::vector<Pose> b_back(b_path.rbegin(), b_path.rend());
   const std::vector<Pose> a_path{{-1.5, 0.5, 0.2}, {-0.5, 0.5, 0.2}, {0.5, 0.5, 0.2}};
   SiteLayout site = two_towers();
-  const auto started = [&](bool leave_behind) {
-    site.leave_behind = leave_behind;
+  const auto started = [&](bool part_of_leg, const std::vector<Pose>& b) {
+    site.part_of_leg = part_of_leg;
     SiteArbiter arbiter(site, ArbiterMode::coordinated);
     arbiter.rest(0, a_path.front());
-    arbiter.rest(1, b_path.front());
-    arbiter.request(1, b_path, 1.0);
+    arbiter.rest(1, b.front());
+    arbiter.request(1, b, 1.0);
     EXPECT_EQ(arbiter.decide(kNow).size(), 1u);
     arbiter.request(0, a_path, 2.0);
     return arbiter;
   };
   {
-    SiteArbiter arbiter = started(false);
+    SiteArbiter arbiter = started(false, b_path);
     EXPECT_TRUE(arbiter.decide(kNow).empty());
     EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
   }
-  SiteArbiter arbiter = started(true);
-  // The geometry as the header says.
-  const auto distance = [&](const std::vector<Pose>& a, const std::vector<Pose>& b) {
-    return airspace_distance(site.cranes[0], path_airspace(a, site.paths), site.cranes[1], path_airspace(b, site.paths))
-        .distance;
+  // The geometry as the test's comment says.
+  const auto distance = [&](const Airspace& a, const Airspace& b) {
+    return airspace_distance(site.cranes[0], a, site.cranes[1], b).distance;
   };
-  ASSERT_GE(distance({a_path[0], a_path[1]}, b_path), site.margins.slow_down);
-  ASSERT_GE(distance({a_path[2]}, b_path), site.margins.slow_down);
-  ASSERT_GE(distance(a_path, {b_path[2]}), site.margins.slow_down);
-  ASSERT_GE(distance(a_path, {b_path[1], b_path[2]}), site.margins.slow_down);
-  ASSERT_LT(distance({a_path[1], a_path[2]}, {b_path[0], b_path[1]}), site.margins.slow_down);
+  const auto path = [&](const std::vector<Pose>& p) { return path_airspace(p, site.paths); };
+  const Airspace a_wait = rest_airspace(a_path[1], site.paths);
+  ASSERT_GE(distance(path({a_path[0], a_path[1]}), path(b_path)), site.margins.slow_down);
+  ASSERT_GE(distance(a_wait, path(b_path)), site.margins.slow_down);
+  ASSERT_LT(distance(path({a_path[1], a_path[2]}), path({b_path[0], b_path[1]})), site.margins.slow_down);
+  const Airspace b_low = rest_airspace(b_path[0], site.paths);
+  ASSERT_GE(distance(path({a_path[0], a_path[1]}), b_low), site.margins.slow_down);
+  ASSERT_GE(distance(a_wait, b_low), site.margins.slow_down);
+  ASSERT_LT(distance(path(a_path), b_low), site.margins.slow_down);
 
+  SiteArbiter arbiter = started(true, b_path);
   auto decided = arbiter.decide(kNow);
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].crane, 0u);
   EXPECT_EQ(decided[0].kind, Instruction::Kind::go);
   ASSERT_EQ(decided[0].waypoints.size(), 2u) << "up to the waypoint before the segment that meets B";
   EXPECT_DOUBLE_EQ(decided[0].waypoints[1].slew, -0.5);
-  EXPECT_TRUE(same_airspace(arbiter.held(0), path_airspace(a_path, site.paths))) << "its whole path held";
-  // Half way to its waypoint, it reports the rest of what it was granted; it holds the rest of its leg.
-  const Pose half_way{-1.0, 0.5, 0.2};
-  arbiter.progress(0, {half_way, a_path[1]});
-  EXPECT_TRUE(same_airspace(arbiter.held(0), path_airspace(std::vector<Pose>{half_way, a_path[1], a_path[2]}, site.paths)));
-  // At rest there (a hair off), it asks for the rest: it waits for B, ranked from its first ask.
+  EXPECT_TRUE(same_airspace(arbiter.held(0), path({a_path[0], a_path[1]}))) << "that part only";
+  // At rest there (a hair off), it asks for the rest: a new request, which waits for B.
   arbiter.rest(0, {-0.501, 0.5, 0.2});
-  EXPECT_EQ(arbiter.held(0).count, 2u) << "its rest box and the rest of its leg";
+  EXPECT_TRUE(same_airspace(arbiter.held(0), rest_airspace({-0.501, 0.5, 0.2}, site.paths)));
   arbiter.request(0, {a_path[1], a_path[2]}, 9.0);
-  EXPECT_EQ(arbiter.requested_at(0), 2.0);
-  EXPECT_TRUE(arbiter.decide(10.0).empty());
+  EXPECT_EQ(arbiter.requested_at(0), 9.0);
+  EXPECT_TRUE(arbiter.decide(10.0).empty()) << "its first segment meets B's hoist: it waits whole";
   EXPECT_EQ(arbiter.waits_for(0), std::vector<std::size_t>{1u});
   arbiter.progress(1, {b_path[1], b_path[2]});  // B hoisted up
   decided = arbiter.decide(10.0);
@@ -551,18 +552,33 @@ TEST(SiteArbiter, ALegLeavesBehindAMovingCraneAndWaitsAtAWaypointBeforeWhatItHol
   EXPECT_EQ(decided[0].crane, 0u);
   EXPECT_EQ(decided[0].waypoints.size(), 2u) << "the rest, whole";
 
-  // B stops short (it rests mid-hoist): A, at its waypoint, holds its rest box only.
-  SiteArbiter stopped = started(true);
-  ASSERT_EQ(stopped.decide(kNow).size(), 1u);
-  stopped.rest(0, a_path[1]);
-  EXPECT_EQ(stopped.held(0).count, 2u);
-  stopped.rest(1, {kPi, 1.0, 1.0});
-  EXPECT_TRUE(same_airspace(stopped.held(0), rest_airspace(a_path[1], site.paths)));
-  // And a crane lost ahead: the same.
-  SiteArbiter lost = started(true);
-  ASSERT_EQ(lost.decide(kNow).size(), 1u);
-  lost.lost(1);
-  EXPECT_TRUE(same_airspace(lost.held(0), path_airspace(std::vector<Pose>{a_path[0], a_path[1]}, site.paths)));
+  // B will rest in A's way: A still goes to -0.5, and waits there until B leaves.
+  SiteArbiter in_the_way = started(true, b_back);
+  decided = in_the_way.decide(kNow);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].waypoints.size(), 2u);
+  in_the_way.rest(0, a_path[1]);
+  in_the_way.rest(1, b_back.back());
+  in_the_way.request(0, {a_path[1], a_path[2]}, 12.0);
+  decided = in_the_way.decide(12.0);
+  EXPECT_EQ(in_the_way.waits_for(0), std::vector<std::size_t>{1u});
+  ASSERT_EQ(decided.size(), 1u) << "B, with nothing to do, yields";
+  EXPECT_EQ(decided[0].crane, 1u);
+  EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
+  // B at rest there from the start: the same.
+  site.part_of_leg = true;
+  SiteArbiter at_rest(site, ArbiterMode::coordinated);
+  at_rest.rest(0, a_path.front());
+  at_rest.rest(1, b_path.front());
+  at_rest.request(0, a_path, 2.0);
+  decided = at_rest.decide(kNow);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].waypoints.size(), 2u);
+  // B silent (its whole reach held): A waits whole.
+  SiteArbiter silent(site, ArbiterMode::coordinated);
+  silent.rest(0, a_path.front());
+  silent.request(0, a_path, 2.0);
+  EXPECT_TRUE(silent.decide(kNow).empty());
 }
 
 // The serialized baseline: two requests in shared airspace that keep apart geometrically still go

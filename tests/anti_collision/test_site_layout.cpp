@@ -64,7 +64,7 @@ TEST(SiteLayout, ShippedSiteLoads) {
   ASSERT_EQ(site.zones.size(), 1u);
   EXPECT_TRUE(site.zones[0].fixed);
   EXPECT_DOUBLE_EQ(site.max_wait, 20.0);
-  EXPECT_TRUE(site.leave_behind);
+  EXPECT_TRUE(site.part_of_leg);
   EXPECT_DOUBLE_EQ(site.paths.trolley_hold, 0.01);
   EXPECT_DOUBLE_EQ(site.paths.slew_hold, 0.02);
   EXPECT_DOUBLE_EQ(site.paths.hoist_swing_radius, 0.025);
@@ -101,9 +101,9 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
             "site.yaml: missing field site.paths.hoist_swing_radius");
   EXPECT_EQ(refusal(edited("max_wait: 20", "max_wait: -1")),
             "site.yaml: site.max_wait = -1 is out of range: must be in [0, 3600]");
-  EXPECT_EQ(refusal(edited("leave_behind: true", "leave_behind: often")),
-            "site.yaml: site.leave_behind = 'often' is not a boolean (true or false)");
-  EXPECT_EQ(refusal(edited("leave_behind: true", "leave_behnd: true")), "site.yaml: missing field site.leave_behind");
+  EXPECT_EQ(refusal(edited("part_of_leg: true", "part_of_leg: often")),
+            "site.yaml: site.part_of_leg = 'often' is not a boolean (true or false)");
+  EXPECT_EQ(refusal(edited("part_of_leg: true", "part_of_leg_: true")), "site.yaml: missing field site.part_of_leg");
   EXPECT_EQ(refusal(edited("slew_max: 3.0", "slew_max: -3.5")),
             "site.yaml: site.cranes[0] (tc1).slew_min = -3 is out of range: must be < slew_max = -3.5");
   EXPECT_EQ(refusal(edited("kind: tower", "kind: gantry")),

@@ -39,51 +39,14 @@ bool SiteArbiter::clear(std::size_t i, const Airspace& a, std::size_t j, const A
   return airspace_distance(layout_.cranes[i], a, layout_.cranes[j], b).distance >= layout_.margins.slow_down;
 }
 
-void SiteArbiter::release_behind(std::size_t ahead) {
-  for (CraneState& c : cranes_) {
-    if (c.continuation.empty() ||
-        std::find(c.behind_of.begin(), c.behind_of.end(), ahead) == c.behind_of.end()) {
-      continue;
-    }
-    // Its held airspace ends with the rest of its leg's boxes (progress, rest): drop them.
-    const std::size_t rest_of_leg = c.continuation.size() - 1;
-    if ((c.holding == Holding::path || c.holding == Holding::rest) && c.held.count > rest_of_leg) {
-      c.held.count -= rest_of_leg;
-    }
-    c.continuation.clear();
-    c.behind_of.clear();
-  }
-}
-
 void SiteArbiter::rest(std::size_t crane, const Pose& pose) {
   CraneState& c = cranes_.at(crane);
-  if (c.holding == Holding::path && c.path_end &&
-      (std::abs(pose.slew - c.path_end->slew) > kAtWaypoint || std::abs(pose.trolley - c.path_end->trolley) > kAtWaypoint ||
-       std::abs(pose.cable_length - c.path_end->cable_length) > kAtWaypoint)) {
-    release_behind(crane);  // short of its path's end
-  }
   c.holding = Holding::rest;
   c.held_when_lost.reset();
   c.pose = pose;
   c.held = rest_airspace(pose, layout_.paths);
   c.held_shared = false;
   c.path_end.reset();
-  if (!c.continuation.empty()) {
-    const Pose& at = c.continuation.front();
-    if (std::abs(pose.slew - at.slew) <= kAtWaypoint && std::abs(pose.trolley - at.trolley) <= kAtWaypoint &&
-        std::abs(pose.cable_length - at.cable_length) <= kAtWaypoint) {
-      // Left behind, at its waypoint: it holds the rest of its leg from there, until granted (from the
-      // waypoint, not the pose: a hair of slew between them would make the hoist's segment a travel's).
-      const Airspace path = path_airspace(c.continuation, layout_.paths);
-      for (std::size_t k = 0; k < path.count && c.held.count < Airspace::kMaxBoxes; ++k) {
-        c.held.boxes[c.held.count++] = path.boxes[k];
-      }
-      c.held_shared = shared(crane, c.held);
-    } else {
-      c.continuation.clear();
-      c.behind_of.clear();
-    }
-  }
 }
 
 namespace {
@@ -109,12 +72,7 @@ void SiteArbiter::progress(std::size_t crane, const std::vector<Pose>& remaining
                            to_string(c.holding));
   }
   check_waypoints(layout_.cranes[crane].name, remaining);
-  std::vector<Pose> rest_of_leg = remaining;
-  if (c.holding == Holding::path && !c.continuation.empty()) {  // left behind: the rest of its leg too
-    rest_of_leg.insert(rest_of_leg.end(), c.continuation.begin() + 1, c.continuation.end());
-    if (rest_of_leg.size() > Airspace::kMaxBoxes + 1) rest_of_leg = remaining;  // not its path: a broken link
-  }
-  c.held = path_airspace(rest_of_leg, layout_.paths);
+  c.held = path_airspace(remaining, layout_.paths);
   c.held_shared = shared(crane, c.held);
 }
 
@@ -125,8 +83,7 @@ void SiteArbiter::request(std::size_t crane, std::vector<Pose> waypoints, double
   Request r;
   r.airspace = path_airspace(waypoints, layout_.paths);
   r.waypoints = std::move(waypoints);
-  // Left behind, resting at its waypoint: the rest of its leg ranks from when it asked for the leg.
-  r.time = c.holding == Holding::rest && !c.continuation.empty() ? std::min(time, c.continuation_asked) : time;
+  r.time = time;
   r.shared = shared(crane, r.airspace);
   c.request = std::move(r);
 }
@@ -145,9 +102,6 @@ void SiteArbiter::lost(std::size_t crane, bool moved) {
   c.held = whole_reach(layout_.cranes[crane], layout_.paths);
   c.held_shared = true;
   c.path_end.reset();
-  c.continuation.clear();
-  c.behind_of.clear();
-  release_behind(crane);
 }
 
 void SiteArbiter::out_of_service(std::size_t crane, const std::optional<CraneMotion>& last, double report_age) {
@@ -286,26 +240,35 @@ std::optional<std::vector<Pose>> SiteArbiter::yield_path(std::size_t v, const st
   return std::nullopt;
 }
 
-std::size_t SiteArbiter::behind_prefix(std::size_t i, const std::vector<std::size_t>& waits) const {
-  if (!layout_.leave_behind || mode_ != ArbiterMode::coordinated) return 0;
+std::size_t SiteArbiter::part_of_leg(std::size_t i, const std::vector<std::size_t>& waits) const {
+  if (!layout_.part_of_leg || mode_ != ArbiterMode::coordinated) return 0;
   const Request& r = *cranes_[i].request;
   if (r.waypoints.size() < 3 || r.airspace.count + 1 != r.waypoints.size()) return 0;
-  const Airspace own_end = rest_airspace(r.waypoints.back(), layout_.paths);
+  // What the cranes it waits for hold, and, for one moving on a path, the rest box at its end.
+  std::vector<std::pair<std::size_t, Airspace>> kept;
   for (const std::size_t j : waits) {
-    const CraneState& ahead = cranes_[j];
-    // Behind a crane moving on a whole path, which rests out of this path's way.
-    if (ahead.holding != Holding::path || !ahead.continuation.empty() || !ahead.path_end) return 0;
-    if (!clear(i, r.airspace, j, rest_airspace(*ahead.path_end, layout_.paths)) || !clear(i, own_end, j, ahead.held)) {
-      return 0;
+    const CraneState& other = cranes_[j];
+    if (other.holding == Holding::path && other.path_end) {
+      kept.emplace_back(j, rest_airspace(*other.path_end, layout_.paths));
+    } else if (other.holding != Holding::rest) {
+      return 0;  // yielding, silent or out of service: it waits whole
     }
+    kept.emplace_back(j, other.held);
   }
-  for (std::size_t k = 0; k < r.airspace.count; ++k) {
+  const auto clear_of_kept = [&](const Airspace& a) {
+    return std::all_of(kept.begin(), kept.end(), [&](const auto& k) { return clear(i, a, k.first, k.second); });
+  };
+  std::size_t meets = 0;  // the first segment that meets what they keep
+  for (; meets < r.airspace.count; ++meets) {
     Airspace segment;
-    segment.boxes[0] = r.airspace.boxes[k];
+    segment.boxes[0] = r.airspace.boxes[meets];
     segment.count = 1;
-    for (const std::size_t j : waits) {
-      if (!clear(i, segment, j, cranes_[j].held)) return k >= 1 ? k + 1 : 0;  // waypoints 0 .. k (its first clear)
-    }
+    if (!clear_of_kept(segment)) break;
+  }
+  // The last waypoint before it whose rest box keeps clear of them too (not the leg's end: the path
+  // meets them, or it would not wait).
+  for (std::size_t k = std::min(meets, r.airspace.count - 1); k >= 1; --k) {
+    if (clear_of_kept(rest_airspace(r.waypoints[k], layout_.paths))) return k + 1;
   }
   return 0;
 }
@@ -378,10 +341,10 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
     const std::size_t i = order[position];
     std::vector<std::size_t> waits = blockers(i);
     WaitReason why = WaitReason::held;
-    const std::size_t prefix = waits.empty() ? 0 : behind_prefix(i, waits);
-    if (prefix > 0) waits.clear();  // it goes behind them, up to waypoint prefix - 1
+    const std::size_t part = waits.empty() ? 0 : part_of_leg(i, waits);
+    if (part > 0) waits.clear();  // it goes up to waypoint part - 1, and waits there
     for (const std::size_t j : waits) blocks[i][j] = true;
-    if (waits.empty() && cranes_[i].continuation.empty()) {  // left behind, it holds its path already
+    if (waits.empty()) {
       if (const auto k = reserved(i, position)) {
         waits.push_back(*k);
         blocks[i][*k] = true;
@@ -403,19 +366,17 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
       continue;
     }
     CraneState& c = cranes_[i];
-    c.holding = Holding::path;
-    c.held = c.request->airspace;
-    c.held_shared = c.request->shared;
     std::vector<Pose>& waypoints = c.request->waypoints;
-    c.path_end = waypoints.back();
-    c.continuation.clear();
-    c.behind_of.clear();
-    if (prefix > 0) {
-      c.behind_of = blockers(i);
-      c.continuation_asked = c.request->time;
-      c.continuation.assign(waypoints.begin() + static_cast<std::ptrdiff_t>(prefix - 1), waypoints.end());
-      waypoints.resize(prefix);
+    c.holding = Holding::path;
+    if (part > 0) {
+      waypoints.resize(part);
+      c.held = path_airspace(waypoints, layout_.paths);
+      c.held_shared = shared(i, c.held);
+    } else {
+      c.held = c.request->airspace;
+      c.held_shared = c.request->shared;
     }
+    c.path_end = waypoints.back();
     out.push_back({i, Instruction::Kind::go, std::move(waypoints)});
     c.request.reset();
     instructed[i] = true;
@@ -454,8 +415,6 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
         continue;
       }
       CraneState& c = cranes_[victim];
-      c.continuation.clear();
-      c.behind_of.clear();
       c.path_end.reset();
       c.holding = Holding::yield;
       c.held = path_airspace(*path, layout_.paths);

@@ -118,7 +118,7 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.domain_id = s.integer("domain_id", 0, kMaxDomain);
     layout.link_deadline = s.number("link_deadline", kDeadline.lower, kDeadline.upper);
     layout.max_wait = s.number("max_wait", kMaxWait.lower, kMaxWait.upper);
-    layout.leave_behind = s.flag("leave_behind");
+    layout.part_of_leg = s.flag("part_of_leg");
     config::YamlSection paths = s.child("paths");
     layout.paths.trolley_overshoot = paths.number("trolley_overshoot", kOvershoot.lower, kOvershoot.upper);
     layout.paths.slew_overshoot = paths.number("slew_overshoot", kOvershoot.lower, kOvershoot.upper);

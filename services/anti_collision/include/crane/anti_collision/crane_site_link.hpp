@@ -11,7 +11,7 @@
 // up. The crane asks for the whole leg (its report's request, from where it rests) and starts it
 // only when the service's go for that request arrives; a yield it obeys at once (hook up, through
 // the waypoints it is given; it asks again afterwards). A go may grant the first waypoints of the
-// leg only (the service's leaving behind a moving crane, site_arbiter.hpp): the crane moves to the
+// leg only (the service's part of a leg, site_arbiter.hpp): the crane moves to the
 // last of them, and there, at rest (after the dwell, if that is the work height), asks for the
 // rest of the leg from that waypoint; a crane that halts or yields before asks for the whole leg
 // again. It moves waypoint by waypoint: the goal to the next waypoint (COMMAND_MOVE, every axis
@@ -218,7 +218,7 @@ class CraneSiteLink {
   /// under way it has reported passing (passed_, when it is not the segment's start), to the end.
   [[nodiscard]] std::vector<Pose> rest_of_path() const;
   void rest_at(const Pose& here, double time);
-  /// Left behind a moving crane, at the end of the part of its leg it was granted: it asks for the
+  /// At the end of the part of its leg it was granted: it asks for the
   /// rest of the leg from that waypoint (not its measured pose, a hair off it).
   void ask_rest_of_leg(double time);
 
@@ -256,7 +256,7 @@ class CraneSiteLink {
   std::size_t request_from_{0};      // the waypoint of its leg request_[0] is (0: a whole leg asked from rest)
   std::size_t path_from_{0};         // the same for path_[0]
   std::size_t leg_waypoints_{0};     // its leg's waypoints, as first asked
-  std::vector<Pose> rest_of_leg_;    // granted part of its leg (left behind a moving crane): the rest, from
+  std::vector<Pose> rest_of_leg_;    // granted a part of its leg: the rest, from
                                      // path_.back(); empty: the whole leg was granted
   Pose pose_{};                      // the measured pose (the last step's)
   std::uint32_t carried_epoch_{0};

@@ -83,8 +83,10 @@ enum class HoldRule : std::uint8_t {
           // arrived: its leg may meet what that one still holds of its leg (not the rest box at that
           // one's end, nor with its first interval or its own rest box at the end), and it enters each
           // interval only when the interval meets nothing held then, waiting before it where it is
-          // (a stop in the middle of a leg, taken to cost no time). The service's rule with the site
-          // file's leave_behind (SiteArbiter::behind_prefix), which stops at a waypoint
+          // (a stop in the middle of a leg, taken to cost no time). The service's rule of session 38
+          // (it stopped at a waypoint and held the rest of its leg meanwhile), since replaced by its
+          // part of a leg (SiteArbiter::part_of_leg), which also goes behind a crane that will rest
+          // in its way and holds only the part granted
 };
 
 /// An order of every crane's whole legs at once, found by search: the other end of the bound of the

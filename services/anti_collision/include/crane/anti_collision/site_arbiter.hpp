@@ -33,16 +33,12 @@
 // rest airspace keeps clear of the paths that wait for it and whose path there meets nothing held.
 // A crane reports each waypoint it reaches (progress) and holds only the rest of its path.
 //
-// Leaving behind a moving crane (the site file's leave_behind; docs/site.md, "Leaving behind a
-// moving crane"): a request whose path meets only what cranes moving on a whole path still hold of
-// it (not a leg granted this way, nor a yield) is granted up to the waypoint before the first
-// segment that meets it, when its first segment and the rest box at its end keep clear of what they
-// hold and their rest boxes at their ends keep clear of its whole path. It holds its whole path
-// meanwhile: moving, the rest of it (progress); at rest at that waypoint (within kAtWaypoint),
-// the rest of its leg from there, until the leg's rest, which it asks for there, is granted. So the
-// cranes ahead only free what it waits for and rest out of its way: its wait ends when they arrive.
-// A crane that rests elsewhere, is lost or yields holds that no more, nor does one whose crane
-// ahead stops short of its path's end (rests elsewhere, or is lost): it then waits as any crane.
+// A part of a leg (the site file's part_of_leg; docs/site.md, "A part of a leg"): a request that
+// waits only for cranes at rest or moving on a path is granted up to a waypoint where it can wait
+// for them: the last before the first segment that meets what they hold or, for a crane moving,
+// the rest box at its path's end, when its rest box there keeps clear of both (none when that is
+// its first waypoint). It then holds that part only, and asks there for the rest of its leg as a
+// new request. It waits whole for a crane yielding, silent or out of service.
 //
 // The serialized mode is the baseline of issue 34's demo: also, at most one crane at a time
 // travels in shared airspace (the part of its reach that another crane's whole reach meets within
@@ -91,7 +87,6 @@ inline constexpr std::size_t kWaitReasonCount = 4;
 class SiteArbiter {
  public:
   static constexpr double kYieldSlewStep = 0.5236;  // [rad] (30 deg)
-  static constexpr double kAtWaypoint = 0.05;      // [m, rad] a crane left behind rests at its waypoint
 
   /// Every crane starts lost (holding its whole reach) until its first rest(). Throws
   /// common::ConfigError when the layout is invalid (validate()).
@@ -194,10 +189,6 @@ class SiteArbiter {
     std::vector<std::size_t> waits_for;
     WaitReason wait_reason{WaitReason::none};
     std::optional<Pose> path_end;     // holding a path: where it ends (its rest box there)
-    std::vector<Pose> continuation;   // left behind a moving crane: the rest of its leg from the waypoint it
-                                      // waits at (continuation[0]), held until granted; empty: none
-    double continuation_asked{0.0};   // [s] when it asked for the leg (its request for the rest ranks from then)
-    std::vector<std::size_t> behind_of;  // the moving cranes it was left behind
   };
 
   [[nodiscard]] bool starving(std::size_t i) const noexcept;  // rule 0, at decided_at_
@@ -205,13 +196,9 @@ class SiteArbiter {
   [[nodiscard]] bool yields_jib_to(std::size_t i, std::size_t j) const;  // rule 2: i's request gives way to j's
   [[nodiscard]] bool shared(std::size_t i, const Airspace& a) const;
   [[nodiscard]] std::optional<std::vector<Pose>> yield_path(std::size_t victim, const std::vector<std::size_t>& waiting) const;
-  /// Leaving behind: the waypoints of i's request it may be granted now behind the moving cranes
-  /// `waits` (2 or more: up to the waypoint before the first segment that meets what they hold), or
-  /// 0 when it may not go behind them.
-  [[nodiscard]] std::size_t behind_prefix(std::size_t i, const std::vector<std::size_t>& waits) const;
-  /// Crane `ahead` stopped short of its path's end (it rests elsewhere, or is lost): the cranes left
-  /// behind it hold the rest of their legs no more (what they wait for may never clear).
-  void release_behind(std::size_t ahead);
+  /// A part of a leg (the header): the waypoints of i's request granted now, it waiting for the
+  /// cranes `waits` (2 or more), or 0 when it waits whole.
+  [[nodiscard]] std::size_t part_of_leg(std::size_t i, const std::vector<std::size_t>& waits) const;
 
   SiteLayout layout_;
   ArbiterMode mode_;

@@ -108,8 +108,8 @@ struct SiteLayout {
                                       // moving into shared airspace (the supervisor's rule)
   double max_wait{0.0};               // [s] a request that has waited this long goes before every later one
                                       // (the site service's rule 0, site_arbiter.hpp); 0: no limit
-  bool leave_behind{false};           // a leg may leave behind a moving crane and wait at a waypoint before
-                                      // what it still holds (site_arbiter.hpp, "Leaving behind")
+  bool part_of_leg{false};            // a leg may be granted up to a waypoint where it waits for the cranes
+                                      // in its way (site_arbiter.hpp, "A part of a leg")
   PathAllowance paths;
 
   static constexpr std::size_t kMaxCranes = 20;
