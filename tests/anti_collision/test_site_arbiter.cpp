@@ -496,7 +496,8 @@ TEST(SiteArbiter, ProgressFreesThePathBehind) {
 // it asks for the rest, a new request, which waits for B; once B has hoisted, it goes. Without
 // part_of_leg, A waits at -1.5. The same when B will rest in A's way (B's leg reversed: at rest
 // there with nothing to do, B then yields), and when B stands there at rest; A waits whole when its
-// first segment meets B, or when B is silent.
+// first segment meets B, or when B is silent. And it waits at an earlier waypoint when the rest box
+// at the last one before B meets B (a hold allowance wider than the travel's).
 TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) {
   const std::vector<Pose> b_path{{kPi, 1.0, 1.5}, {kPi, 1.0, 0.2}, {kPi - 1.5, 1.0, 0.2}};
   const std::vector<Pose> b_back(b_path.rbegin(), b_path.rend());
@@ -579,6 +580,33 @@ TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) 
   silent.rest(0, a_path.front());
   silent.request(0, a_path, 2.0);
   EXPECT_TRUE(silent.decide(kNow).empty());
+
+  // A waypoint whose rest box meets B is not where A waits: with a hold allowance wider than the
+  // travel's (0.2 rad of slew either side, against 0.07), A's rest box at -0.5 meets B's hoist,
+  // though the travel there does not; A, through -1.0, goes to -1.0 only (to -0.5 with the
+  // shipped 0.02).
+  const std::vector<Pose> a_long{{-1.5, 0.5, 0.2}, {-1.0, 0.5, 0.2}, {-0.5, 0.5, 0.2}, {0.5, 0.5, 0.2}};
+  for (const double slew_hold : {site.paths.slew_hold, 0.2}) {
+    SiteLayout wide = two_towers();
+    wide.part_of_leg = true;
+    wide.paths.slew_hold = slew_hold;
+    const auto meets_b = [&](const Airspace& a) {
+      return airspace_distance(wide.cranes[0], a, wide.cranes[1], path_airspace(b_path, wide.paths)).distance <
+             wide.margins.slow_down;
+    };
+    ASSERT_FALSE(meets_b(path_airspace(std::vector<Pose>{a_long[0], a_long[1], a_long[2]}, wide.paths))) << slew_hold;
+    ASSERT_FALSE(meets_b(rest_airspace(a_long[1], wide.paths)));
+    ASSERT_EQ(meets_b(rest_airspace(a_long[2], wide.paths)), slew_hold == 0.2);
+    SiteArbiter arbiter(wide, ArbiterMode::coordinated);
+    arbiter.rest(0, a_long.front());
+    arbiter.rest(1, b_path.front());
+    arbiter.request(1, b_path, 1.0);
+    ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
+    arbiter.request(0, a_long, 2.0);
+    decided = arbiter.decide(kNow);
+    ASSERT_EQ(decided.size(), 1u);
+    EXPECT_EQ(decided[0].waypoints.size(), slew_hold == 0.2 ? 2u : 3u) << "slew_hold " << slew_hold;
+  }
 }
 
 // The serialized baseline: two requests in shared airspace that keep apart geometrically still go

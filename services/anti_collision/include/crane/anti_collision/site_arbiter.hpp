@@ -196,8 +196,8 @@ class SiteArbiter {
   [[nodiscard]] bool yields_jib_to(std::size_t i, std::size_t j) const;  // rule 2: i's request gives way to j's
   [[nodiscard]] bool shared(std::size_t i, const Airspace& a) const;
   [[nodiscard]] std::optional<std::vector<Pose>> yield_path(std::size_t victim, const std::vector<std::size_t>& waiting) const;
-  /// A part of a leg (the header): the waypoints of i's request granted now, it waiting for the
-  /// cranes `waits` (2 or more), or 0 when it waits whole.
+  /// A part of a leg (the header): how many of i's request's waypoints are granted now while it
+  /// waits for the cranes `waits` (2 or more), or 0 when it waits whole.
   [[nodiscard]] std::size_t part_of_leg(std::size_t i, const std::vector<std::size_t>& waits) const;
 
   SiteLayout layout_;
