@@ -42,6 +42,7 @@ constexpr std::uint32_t kEpoch = 77;
 class Link : public ::testing::Test {
  protected:
   Link() : layout_(load_site_layout(kSite)) {
+    layout_.travel_step = 0.0;  // a leg's waypoints counted below: none on its way (but in ATravelIsAsked...)
     params_.travel_cable_length = 0.2;
     params_.dwell = 1.0;
     params_.settle_timeout = 8.0;
@@ -87,7 +88,7 @@ class Link : public ::testing::Test {
     o.kind = Instruction::Kind::go;
     o.request_id = r->request_id;
     o.seq = seq;
-    o.waypoints = r->request;
+    o.waypoints = stops_of(r->request);  // as the site service sends a whole leg
     return o;
   }
   // The service tells crane 0 to yield through `waypoints`.
@@ -350,6 +351,71 @@ TEST_F(Link, AGoForTheFirstWaypointsOfItsLegMovesThereAndAsksForTheRest) {
   arrive(*g);
   (void)step();
   EXPECT_EQ(link_->jobs_done(), 1);
+}
+
+// Waypoints on the travel's way (the site file's travel_step): the request lists them, a go names
+// the stops of the part granted (stops_of), and the crane moves to its last stop in one move,
+// whether that ends on the travel's way or the whole leg was granted. A go that names waypoints on
+// the way as stops is not the service's: refused.
+TEST_F(Link, ATravelIsAskedWithWaypointsOnItsWayAndGrantedUpToOneOfThem) {
+  layout_.travel_step = 0.25;
+  SiteJob job;
+  job.pick = {0.0, 0.9, 1.5};
+  job.place = {-1.5, 0.5, 1.2};
+  link_.emplace(layout_, 0, params_, std::vector<SiteJob>{job}, kFirstGoal);
+  (void)step();
+  auto r = link_->report();
+  // 0.6 m of trolley in three pieces of 0.2 m.
+  ASSERT_EQ(r->request.size(), 6u);
+  expect_pose(r->request[1], 0.0, 0.5, 0.2);
+  expect_pose(r->request[2], 0.0, 0.7, 0.2);
+  expect_pose(r->request[3], 0.0, 0.9, 0.2);
+  SiteOrder raw = go(1);
+  raw.waypoints = r->request;
+  EXPECT_FALSE(link_->instruction(raw, kEpoch, t_)) << "waypoints on the way are not stops";
+  SiteOrder part = go(2);
+  part.waypoints = stops_of(std::span(r->request).first(3));
+  ASSERT_EQ(part.waypoints.size(), 2u);
+  ASSERT_TRUE(link_->instruction(part, kEpoch, t_));
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->trolley_target, 0.7) << "one move to the waypoint granted";
+  arrive(*g);
+  EXPECT_FALSE(next_goal(0.5).has_value());
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  r = link_->report();
+  ASSERT_EQ(r->request.size(), 4u) << "the rest of the leg, from where it waits";
+  expect_pose(r->request[0], 0.0, 0.7, 0.2);
+  expect_pose(r->request[1], 0.0, 0.9, 0.2);
+  SiteOrder rest = go(3);
+  rest.waypoints = stops_of(r->request);
+  ASSERT_TRUE(link_->instruction(rest, kEpoch, t_));
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->trolley_target, 0.9);
+  arrive(*g);
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->cable_length_target, 1.5) << "lowering: the leg's work height";
+  arrive(*g);
+  g = next_goal(2.0);
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  EXPECT_FALSE(next_goal(0.05).has_value());
+  // The place: 1.5 rad of slew, at most 0.25 apart, but a request holds MAX_WAYPOINTS: six pieces.
+  r = link_->report();
+  ASSERT_EQ(r->request.size(), Airspace::kMaxBoxes + 1);
+  for (std::size_t k = 1; k < 6; ++k) {
+    expect_pose(r->request[k], -0.25 * static_cast<double>(k), 0.9 - 0.4 * static_cast<double>(k) / 6.0, 0.2);
+  }
+  SiteOrder whole = go(4);
+  whole.waypoints = stops_of(r->request);
+  ASSERT_EQ(whole.waypoints.size(), 4u);
+  ASSERT_TRUE(link_->instruction(whole, kEpoch, t_));
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_DOUBLE_EQ(g->slew_target, -1.5) << "granted whole: one move to the travel's end";
+  EXPECT_DOUBLE_EQ(g->trolley_target, 0.5);
 }
 
 // What the crane is doing, as the site's waits are counted by it: the segment under way (the one

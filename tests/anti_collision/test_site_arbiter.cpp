@@ -116,6 +116,35 @@ TEST(Airspace, ASlewingPathContainsEveryHeadingBetween) {
               1e-12);
 }
 
+// A leg's stops (stops_of), by hand: the waypoints on its travel's way go, the hoists' stay; a
+// travel that changes the cable, or runs at another cable length, is a run of its own.
+TEST(Airspace, TheWaypointsOnATravelsWayAreNotStops) {
+  const auto slews = [](const std::vector<Pose>& w) {
+    std::vector<double> out;
+    for (const Pose& p : stops_of(w)) out.push_back(p.slew);
+    return out;
+  };
+  // Hook down, up, three waypoints on the travel's way, its end, lowering, up again.
+  const std::vector<Pose> leg{{-1.5, 0.5, 1.0}, {-1.5, 0.5, 0.2}, {-1.0, 0.6, 0.2}, {-0.5, 0.7, 0.2},
+                              {0.0, 0.8, 0.2},  {0.5, 0.9, 0.2},  {0.5, 0.9, 1.2},  {0.5, 0.9, 0.2}};
+  EXPECT_EQ(slews(leg), (std::vector<double>{-1.5, -1.5, 0.5, 0.5, 0.5}));
+  EXPECT_EQ(stops_of(leg)[2].trolley, 0.9);
+  // A part of it up to a waypoint on the way: one move there.
+  EXPECT_EQ(slews({leg.begin(), leg.begin() + 4}), (std::vector<double>{-1.5, -1.5, -0.5}));
+  // A cable a hair off the travel's (within kSameCable) still travels with it; one further off does not.
+  std::vector<Pose> hair = leg;
+  hair[3].cable_length += 0.5 * kSameCable;
+  EXPECT_EQ(stops_of(hair).size(), 5u);
+  std::vector<Pose> off = leg;
+  off[3].cable_length += 2.0 * kSameCable;
+  EXPECT_EQ(slews(off), (std::vector<double>{-1.5, -1.5, -1.0, -0.5, 0.0, 0.5, 0.5, 0.5}));
+  // Paths with no such run come back as they were: a single segment, a yield's hoist then travel.
+  const std::vector<Pose> yield{{0.0, 0.5, 1.0}, {0.0, 0.5, 0.2}, {0.5236, 0.5, 0.2}};
+  EXPECT_EQ(slews(yield), (std::vector<double>{0.0, 0.0, 0.5236}));
+  EXPECT_TRUE(stops_of(std::vector<Pose>{}).empty());
+  EXPECT_EQ(stops_of(std::vector<Pose>{leg[0]}).size(), 1u);
+}
+
 // The pruning of airspace_distance (a pair whose lower bound is not below the closest so far is
 // skipped) changes nothing: over seeded random pairs of cranes (bases, heights, jibs, widths) and
 // airspaces (paths of 1-5 waypoints over up to a full turn, the whole reach, allowances), the same
@@ -503,15 +532,19 @@ TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) 
   const std::vector<Pose> b_back(b_path.rbegin(), b_path.rend());
   const std::vector<Pose> a_path{{-1.5, 0.5, 0.2}, {-0.5, 0.5, 0.2}, {0.5, 0.5, 0.2}};
   SiteLayout site = two_towers();
-  const auto started = [&](bool part_of_leg, const std::vector<Pose>& b) {
-    site.part_of_leg = part_of_leg;
-    SiteArbiter arbiter(site, ArbiterMode::coordinated);
-    arbiter.rest(0, a_path.front());
+  // B granted `b` first, then A asks for `a`.
+  const auto started_on = [&](const SiteLayout& on, const std::vector<Pose>& b, const std::vector<Pose>& a) {
+    SiteArbiter arbiter(on, ArbiterMode::coordinated);
+    arbiter.rest(0, a.front());
     arbiter.rest(1, b.front());
     arbiter.request(1, b, 1.0);
     EXPECT_EQ(arbiter.decide(kNow).size(), 1u);
-    arbiter.request(0, a_path, 2.0);
+    arbiter.request(0, a, 2.0);
     return arbiter;
+  };
+  const auto started = [&](bool part_of_leg, const std::vector<Pose>& b) {
+    site.part_of_leg = part_of_leg;
+    return started_on(site, b, a_path);
   };
   {
     SiteArbiter arbiter = started(false, b_path);
@@ -568,11 +601,16 @@ TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) 
   EXPECT_EQ(decided[0].kind, Instruction::Kind::yield);
   // B at rest there from the start: the same.
   site.part_of_leg = true;
-  SiteArbiter at_rest(site, ArbiterMode::coordinated);
-  at_rest.rest(0, a_path.front());
-  at_rest.rest(1, b_path.front());
-  at_rest.request(0, a_path, 2.0);
-  decided = at_rest.decide(kNow);
+  // What A, asking for `a`, is granted with B at rest at `b` (and what A holds then).
+  const auto granted_with_b_at = [&](const Pose& b, const std::vector<Pose>& a) {
+    SiteArbiter arbiter_b_rests(site, ArbiterMode::coordinated);
+    arbiter_b_rests.rest(0, a.front());
+    arbiter_b_rests.rest(1, b);
+    arbiter_b_rests.request(0, a, 2.0);
+    auto d = arbiter_b_rests.decide(kNow);
+    return std::make_pair(d, arbiter_b_rests.held(0));
+  };
+  decided = granted_with_b_at(b_path.front(), a_path).first;
   ASSERT_EQ(decided.size(), 1u);
   EXPECT_EQ(decided[0].waypoints.size(), 2u);
   // B silent (its whole reach held): A waits whole.
@@ -584,7 +622,7 @@ TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) 
   // A waypoint whose rest box meets B is not where A waits: with a hold allowance wider than the
   // travel's (0.2 rad of slew either side, against 0.07), A's rest box at -0.5 meets B's hoist,
   // though the travel there does not; A, through -1.0, goes to -1.0 only (to -0.5 with the
-  // shipped 0.02).
+  // shipped 0.02). Each is one move: the waypoints on a travel's way are not stops (stops_of).
   const std::vector<Pose> a_long{{-1.5, 0.5, 0.2}, {-1.0, 0.5, 0.2}, {-0.5, 0.5, 0.2}, {0.5, 0.5, 0.2}};
   for (const double slew_hold : {site.paths.slew_hold, 0.2}) {
     SiteLayout wide = two_towers();
@@ -597,16 +635,20 @@ TEST(SiteArbiter, APartOfALegGoesUpToAWaypointWhereItWaitsForTheCranesInItsWay) 
     ASSERT_FALSE(meets_b(path_airspace(std::vector<Pose>{a_long[0], a_long[1], a_long[2]}, wide.paths))) << slew_hold;
     ASSERT_FALSE(meets_b(rest_airspace(a_long[1], wide.paths)));
     ASSERT_EQ(meets_b(rest_airspace(a_long[2], wide.paths)), slew_hold == 0.2);
-    SiteArbiter arbiter(wide, ArbiterMode::coordinated);
-    arbiter.rest(0, a_long.front());
-    arbiter.rest(1, b_path.front());
-    arbiter.request(1, b_path, 1.0);
-    ASSERT_EQ(arbiter.decide(kNow).size(), 1u);
-    arbiter.request(0, a_long, 2.0);
-    decided = arbiter.decide(kNow);
+    SiteArbiter narrow = started_on(wide, b_path, a_long);
+    decided = narrow.decide(kNow);
     ASSERT_EQ(decided.size(), 1u);
-    EXPECT_EQ(decided[0].waypoints.size(), slew_hold == 0.2 ? 2u : 3u) << "slew_hold " << slew_hold;
+    ASSERT_EQ(decided[0].waypoints.size(), 2u) << "slew_hold " << slew_hold;
+    EXPECT_EQ(decided[0].waypoints[1].slew, slew_hold == 0.2 ? -1.0 : -0.5) << "slew_hold " << slew_hold;
+    EXPECT_TRUE(same_airspace(narrow.held(0), path_airspace(decided[0].waypoints, wide.paths)));
   }
+  // Granted whole, the travel is one move too: from -1.5 straight to 0.5.
+  ASSERT_GE(distance(path(a_long), rest_airspace(b_path.back(), site.paths)), site.margins.slow_down);
+  const auto [whole, held] = granted_with_b_at(b_path.back(), a_long);
+  ASSERT_EQ(whole.size(), 1u);
+  ASSERT_EQ(whole[0].waypoints.size(), 2u);
+  EXPECT_EQ(whole[0].waypoints[1].slew, 0.5);
+  EXPECT_TRUE(same_airspace(held, path_airspace(whole[0].waypoints, site.paths)));
 }
 
 // The serialized baseline: two requests in shared airspace that keep apart geometrically still go

@@ -400,8 +400,11 @@ TEST(SiteRun, AStoppedHostsCraneHoldsItsWholeReachForGood) {
 }
 
 // The site operator's word (HostStop::out_of_service_after, as `crane_site_status --out-of-service`):
-// tc1's host stops 1 s in and the operator puts it out of service 5 s later; the service then holds
-// where tc1 stood instead of its whole reach, and tc2 works on. A crane whose host stopped before
+// tc1's host stops 0.5 s in, while tc1 waits at rest for tc2, and the operator puts it out of
+// service 5 s later; the service then holds where tc1 stood instead of its whole reach, and tc2
+// works on. (At 0.79 s tc1 is granted a part of its leg, to a waypoint on its travel's way: its
+// host stopped after that, the service, not knowing where on that path tc1 stopped, holds the
+// path, which every leg of tc2 meets.) A crane whose host stopped before
 // the service ever heard it cannot be put out of service: its whole reach stays held; one whose
 // host stopped while the service was down can, from the restarted service's memory.
 TEST(SiteRun, AnOperatorPutsAStoppedCraneOutOfServiceAndTheOthersWorkOn) {
@@ -410,17 +413,17 @@ TEST(SiteRun, AnOperatorPutsAStoppedCraneOutOfServiceAndTheOthersWorkOn) {
   const StackConfig config = load_site_crane_config(site);
   const auto shared = random_site_jobs(site, config, 2, 5, SiteJobDraw{1.0, true});
   SiteRunOptions options = in_mode(SiteMode::coordinated);
-  options.host_stops = {HostStop{0, 1.0}};
+  options.host_stops = {HostStop{0, 0.5}};
   const SiteOutcome held = run_site(site, config, shared, options);
   options.host_stops[0].out_of_service_after = 5.0;
   const SiteOutcome o = run_site(site, config, shared, options);
   EXPECT_TRUE(o.completed);
   EXPECT_TRUE(std::isnan(held.cranes[0].out_of_service_at));
-  EXPECT_NEAR(o.cranes[0].out_of_service_at, 6.0, 1e-6);
+  EXPECT_NEAR(o.cranes[0].out_of_service_at, 5.5, 1e-6);
   EXPECT_GT(o.cranes[1].jobs_done, held.cranes[1].jobs_done);
   EXPECT_GE(o.min_distance, site.margins.stop) << o.closest;
   EXPECT_GE(held.min_distance, site.margins.stop) << held.closest;
-  std::printf("tc1's host stopped at 1 s: tc2 did %d jobs of 2 with its whole reach held, %d with tc1 out of service "
+  std::printf("tc1's host stopped at 0.5 s: tc2 did %d jobs of 2 with its whole reach held, %d with tc1 out of service "
               "at %.2f s (stuck: %d); min distance %.3f m (%s)\n", held.cranes[1].jobs_done, o.cranes[1].jobs_done,
               o.cranes[0].out_of_service_at, o.cranes[1].stuck ? 1 : 0, o.min_distance, o.closest.c_str());
 

@@ -92,7 +92,9 @@ TEST(SiteWatch, WhatTheServiceHoldsAndWhatACraneAsksFor) {
   }
   ASSERT_TRUE(watch.report(r, 1.0));
   EXPECT_EQ(watch.held(0).count, 0u) << "no status yet: nothing known to be held";
-  EXPECT_EQ(watch.requested(0).count, 3u) << "one box a segment";
+  // One box a move: the slew and the trolley travel at one cable length, one move (stops_of).
+  ASSERT_EQ(watch.requested(0).count, 2u);
+  EXPECT_DOUBLE_EQ(watch.requested(0).boxes[0].trolley_high, 0.8 + layout.paths.trolley_overshoot + layout.paths.trolley_tracking);
 
   SiteStatus s{};
   s.epoch = 9;

@@ -135,6 +135,22 @@ Airspace path_airspace(std::span<const Pose> waypoints, const PathAllowance& all
   return out;
 }
 
+std::vector<Pose> stops_of(std::span<const Pose> waypoints) {
+  const auto travels_at = [](const Pose& a, const Pose& b, double cable) {
+    return (a.slew != b.slew || a.trolley != b.trolley) && std::abs(a.cable_length - cable) <= kSameCable &&
+           std::abs(b.cable_length - cable) <= kSameCable;
+  };
+  std::vector<Pose> out;
+  for (std::size_t k = 0; k < waypoints.size(); ++k) {
+    // Waypoint k lies inside a run when the segments on both sides of it travel at its cable.
+    const bool inside = k > 0 && k + 1 < waypoints.size() &&
+                        travels_at(waypoints[k - 1], waypoints[k], waypoints[k].cable_length) &&
+                        travels_at(waypoints[k], waypoints[k + 1], waypoints[k].cable_length);
+    if (!inside) out.push_back(waypoints[k]);
+  }
+  return out;
+}
+
 Airspace out_of_service_airspace(const SiteCrane& crane, const Airspace& held, const CraneMotion& last,
                                  double report_age) noexcept {
   const auto faster = [&](double speed, double deceleration) {

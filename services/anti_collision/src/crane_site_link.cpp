@@ -184,10 +184,22 @@ bool CraneSiteLink::instruction(const SiteOrder& order, std::uint32_t epoch, dou
          : (phase_ != Phase::asking && phase_ != Phase::done && phase_ != Phase::aborted)) {
     return false;
   }
+  // A go names the stops of the part of the request granted, its waypoints 0..part_end
+  // (stops_of): the rest is asked from there.
+  std::size_t part_end = 0;
+  if (go) {
+    const auto same = [](const Pose& a, const Pose& b) {
+      return a.slew == b.slew && a.trolley == b.trolley && a.cable_length == b.cable_length;
+    };
+    for (std::size_t j = request_.size() - 1; j >= 1 && part_end == 0; --j) {
+      const std::vector<Pose> stops = stops_of(std::span(request_).first(j + 1));
+      if (std::equal(stops.begin(), stops.end(), order.waypoints.begin(), order.waypoints.end(), same)) part_end = j;
+    }
+    if (part_end == 0) return false;  // not the stops of a part of the request
+  }
   rest_of_leg_.clear();
-  path_from_ = request_from_;
-  if (go && order.waypoints.size() < request_.size()) {  // the first waypoints only: the rest asked at the last
-    rest_of_leg_.assign(request_.begin() + static_cast<std::ptrdiff_t>(order.waypoints.size() - 1), request_.end());
+  if (go && part_end + 1 < request_.size()) {  // a part of the leg: the rest asked at its end
+    rest_of_leg_.assign(request_.begin() + static_cast<std::ptrdiff_t>(part_end), request_.end());
   }
   yielding_ = !go;
   if (yielding_) ++yields_;
@@ -237,13 +249,22 @@ void CraneSiteLink::rest_at(const Pose& here, double time) {
   const WorkPoint& w = legs_[next_leg_].at;
   const double up = params_.travel_cable_length;
   std::vector<Pose> path{here};
-  if (here.cable_length > up + 1e-3) path.push_back({here.slew, here.trolley, up});
+  if (here.cable_length > up + kSameCable) path.push_back({here.slew, here.trolley, up});
+  // Waypoints on the travel's way (the site file's travel_step), as many as the request has room for.
+  const Pose from = path.back();
+  const std::size_t room = Airspace::kMaxBoxes + 1 - path.size() - 3;
+  const double travel = std::max(std::abs(w.slew - from.slew), std::abs(w.trolley - from.trolley));
+  if (layout_.travel_step > 0.0 && travel > layout_.travel_step) {
+    const auto pieces = std::min<std::size_t>(room + 1, static_cast<std::size_t>(std::ceil(travel / layout_.travel_step)));
+    for (std::size_t k = 1; k < pieces; ++k) {
+      const double f = static_cast<double>(k) / static_cast<double>(pieces);
+      path.push_back({from.slew + f * (w.slew - from.slew), from.trolley + f * (w.trolley - from.trolley), up});
+    }
+  }
   path.push_back({w.slew, w.trolley, up});
   path.push_back({w.slew, w.trolley, w.cable_length});
   path.push_back({w.slew, w.trolley, up});
   request_ = std::move(path);
-  request_from_ = 0;
-  leg_waypoints_ = request_.size();
   rest_of_leg_.clear();
   request_id_ = ++requests_;  // a new id: a new request
   phase_ = Phase::asking;
@@ -255,7 +276,6 @@ void CraneSiteLink::ask_rest_of_leg(double time) {
   // From the waypoint it rests at, not its measured pose: a hair of slew between the two would make
   // the next segment, the hoist's, a travel's, held with the travel swing.
   request_ = rest_of_leg_;
-  request_from_ = path_from_ + path_.size() - 1;
   rest_of_leg_.clear();
   request_id_ = ++requests_;
   phase_ = Phase::asking;
@@ -452,9 +472,11 @@ std::optional<Request> CraneSiteLink::advance(double time, const protocol::Crane
   }
   if (!arrived_at_) arrived_at_ = time;
   const bool timed_out = time - *arrived_at_ >= params_.settle_timeout - 1e-9;
+  // The work height: the leg's last waypoint but one (the leg ends lowering, then hoisting up).
+  const bool work_height = !yielding_ && (rest_of_leg_.empty() ? waypoint_ + 2 == path_.size()
+                                                                : rest_of_leg_.size() == 2 && waypoint_ + 1 == path_.size());
   if (!settled(estimate, params_.gravity) && !timed_out) return goal;
   if (timed_out) ++unsettled_moves_;
-  const bool work_height = !yielding_ && path_from_ + waypoint_ + 2 == leg_waypoints_;
   if (waypoint_ + 1 < path_.size() || (work_height && !rest_of_leg_.empty())) {
     if (work_height) {
       phase_ = Phase::dwelling;

@@ -81,7 +81,7 @@ void SiteArbiter::request(std::size_t crane, std::vector<Pose> waypoints, double
   check_waypoints(layout_.cranes[crane].name, waypoints);
   if (!std::isfinite(time)) throw std::invalid_argument("site arbiter: a request time is not finite");
   Request r;
-  r.airspace = path_airspace(waypoints, layout_.paths);
+  r.airspace = path_airspace(stops_of(waypoints), layout_.paths);
   r.waypoints = std::move(waypoints);
   r.time = time;
   r.shared = shared(crane, r.airspace);
@@ -243,7 +243,7 @@ std::optional<std::vector<Pose>> SiteArbiter::yield_path(std::size_t v, const st
 std::size_t SiteArbiter::part_of_leg(std::size_t i, const std::vector<std::size_t>& waits) const {
   if (!layout_.part_of_leg || mode_ != ArbiterMode::coordinated) return 0;
   const Request& r = *cranes_[i].request;
-  if (r.waypoints.size() < 3 || r.airspace.count + 1 != r.waypoints.size()) return 0;
+  if (r.waypoints.size() < 3) return 0;
   // What the cranes it waits for hold, and, for one moving on a path, the rest box at its end.
   std::vector<std::pair<std::size_t, Airspace>> kept;
   for (const std::size_t j : waits) {
@@ -253,22 +253,24 @@ std::size_t SiteArbiter::part_of_leg(std::size_t i, const std::vector<std::size_
     } else if (other.holding != Holding::rest) {
       return 0;  // yielding, silent or out of service: it waits whole
     }
-    kept.emplace_back(j, other.held);
   }
-  const auto clear_of_kept = [&](const Airspace& a) {
+  // What every other crane holds (a part of a leg is not always inside the whole leg's airspace:
+  // its waypoints are the requester's word), and the rest boxes above.
+  const auto clear_of_all = [&](const Airspace& a) {
+    for (std::size_t j = 0; j < cranes_.size(); ++j) {
+      if (j != i && !clear(i, a, j, cranes_[j].held)) return false;
+    }
     return std::all_of(kept.begin(), kept.end(), [&](const auto& k) { return clear(i, a, k.first, k.second); });
   };
-  std::size_t meets = 0;  // the first segment that meets what they keep
-  for (; meets < r.airspace.count; ++meets) {
-    Airspace segment;
-    segment.boxes[0] = r.airspace.boxes[meets];
-    segment.count = 1;
-    if (!clear_of_kept(segment)) break;
-  }
-  // The last waypoint before it whose rest box keeps clear of them too (not the leg's end: the path
-  // meets them, or it would not wait).
-  for (std::size_t k = std::min(meets, r.airspace.count - 1); k >= 1; --k) {
-    if (clear_of_kept(rest_airspace(r.waypoints[k], layout_.paths))) return k + 1;
+  // The last waypoint, not the leg's end (the leg meets them, or it would not wait), up to which
+  // the part's stops and the rest box there keep clear of them. The part grows with k (a travel's
+  // waypoints lie on its way), so that is the last before the first that meets them.
+  const std::span<const Pose> w(r.waypoints);
+  for (std::size_t k = w.size() - 2; k >= 1; --k) {
+    if (clear_of_all(path_airspace(stops_of(w.first(k + 1)), layout_.paths)) &&
+        clear_of_all(rest_airspace(w[k], layout_.paths))) {
+      return k + 1;
+    }
   }
   return 0;
 }
@@ -370,9 +372,11 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
     c.holding = Holding::path;
     if (part > 0) {
       waypoints.resize(part);
+      waypoints = stops_of(waypoints);
       c.held = path_airspace(waypoints, layout_.paths);
       c.held_shared = shared(i, c.held);
     } else {
+      waypoints = stops_of(waypoints);
       c.held = c.request->airspace;
       c.held_shared = c.request->shared;
     }

@@ -50,6 +50,7 @@ void validate(const SiteLayout& layout, const std::string& prefix) {
   require_below(prefix + ".margins.warning", m.warning, "margins.slow_down", m.slow_down, false);
   require_in_range(prefix + ".link_deadline", layout.link_deadline, kDeadline.lower, kDeadline.upper);
   require_in_range(prefix + ".max_wait", layout.max_wait, kMaxWait.lower, kMaxWait.upper);
+  require_in_range(prefix + ".travel_step", layout.travel_step, kTravelStep.lower, kTravelStep.upper);
   require_in_range(prefix + ".paths.trolley_overshoot", layout.paths.trolley_overshoot, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.slew_overshoot", layout.paths.slew_overshoot, kOvershoot.lower, kOvershoot.upper);
   require_in_range(prefix + ".paths.travel_swing", layout.paths.travel_swing, kSwingAllowance.lower, kSwingAllowance.upper);

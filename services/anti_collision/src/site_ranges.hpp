@@ -27,6 +27,7 @@ inline constexpr Range kMargin{1.0e-3, 100.0};
 inline constexpr Range kDeadline{1.0e-3, 10.0};
 inline constexpr Range kMaxWait{0.0, 3600.0};  // [s] 0: no limit
 inline constexpr Range kOvershoot{0.0, 10.0};
+inline constexpr Range kTravelStep{0.0, 10.0};  // [rad or m] 0: no waypoints on a travel's way
 inline constexpr Range kSwingAllowance{0.0, 1.5};
 inline constexpr int kMaxDomain = 232;  // the DDS port mapping's largest domain id
 inline constexpr int kMaxPriority = 100;

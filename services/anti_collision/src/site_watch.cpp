@@ -92,7 +92,7 @@ Airspace SiteWatch::held(std::size_t i) const {
 Airspace SiteWatch::requested(std::size_t i) const {
   const Crane& c = cranes_.at(i);
   if (!c.read || c.read->request_id == 0 || c.read->request.size() < 2) return {};
-  return path_airspace(c.read->request, layout_.paths);
+  return path_airspace(stops_of(c.read->request), layout_.paths);  // as the service would hold it
 }
 
 std::vector<common::Point2> plan_outline(const SiteCrane& crane, const JointBox& box) {

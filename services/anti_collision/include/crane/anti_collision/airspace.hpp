@@ -26,6 +26,7 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "crane/anti_collision/crane_geometry.hpp"
 #include "crane/anti_collision/site_layout.hpp"
@@ -64,6 +65,19 @@ struct Airspace {
 /// them; extra waypoints are ignored): one box per segment (see the header). A single waypoint is
 /// rest_airspace.
 [[nodiscard]] Airspace path_airspace(std::span<const Pose> waypoints, const PathAllowance& allowance) noexcept;
+
+/// [m] two cable lengths this close are one: a crane at rest within it of the travel's cable length
+/// travels without hoisting first (CraneSiteLink), and a run of travels (stops_of) may differ by it.
+inline constexpr double kSameCable = 1e-3;
+
+/// The waypoints a crane stops at on the path through `waypoints`: a run of consecutive segments
+/// that each travel (slew or trolley) at one cable length, the same for the whole run, is one
+/// move, from the run's first waypoint straight to its last; the waypoints inside the run are
+/// dropped. A request may list such waypoints inside its travel so that the site service can grant
+/// a part of the leg that ends there (docs/site.md, "A wait inside the travel"); the service grants,
+/// holds and sends the stops of the part it grants. Cable lengths compare within kSameCable. Paths
+/// with no such run come back unchanged.
+[[nodiscard]] std::vector<Pose> stops_of(std::span<const Pose> waypoints);
 
 /// Everything the crane can reach: any slew, its whole trolley and hook range, the travel swing.
 /// What a crane that stops reporting holds (issue 34, item 4).

@@ -253,9 +253,6 @@ class CraneSiteLink {
   bool stepped_{false};
   CraneMotion motion_{};  // measured, at its last step (its reports carry it)
   std::vector<Pose> request_;
-  std::size_t request_from_{0};      // the waypoint of its leg request_[0] is (0: a whole leg asked from rest)
-  std::size_t path_from_{0};         // the same for path_[0]
-  std::size_t leg_waypoints_{0};     // its leg's waypoints, as first asked
   std::vector<Pose> rest_of_leg_;    // granted a part of its leg: the rest, from
                                      // path_.back(); empty: the whole leg was granted
   Pose pose_{};                      // the measured pose (the last step's)
