@@ -8,13 +8,15 @@
 //
 // A job is two legs (to the pick, to the place), and a leg is: hoist up to the travel height,
 // travel (slew and trolley), lower to the work height, hold `dwell` (hooking or unhooking), hoist
-// up. The crane asks for the whole leg (its report's request, from where it rests) and starts it
-// only when the service's go for that request arrives; a yield it obeys at once (hook up, through
-// the waypoints it is given; it asks again afterwards). A go may grant the first waypoints of the
-// leg only (the service's part of a leg, site_arbiter.hpp): the crane moves to the
-// last of them, and there, at rest (after the dwell, if that is the work height), asks for the
-// rest of the leg from that waypoint; a crane that halts or yields before asks for the whole leg
-// again. It moves waypoint by waypoint: the goal to the next waypoint (COMMAND_MOVE, every axis
+// up. The crane asks for the whole leg (its report's request, from where it rests; its travel with
+// waypoints on its way, evenly spaced on the line of joint space, at most the site file's
+// travel_step apart, as many as MAX_WAYPOINTS holds) and starts it only when the service's go for
+// that request arrives; a yield it obeys at once (hook up, through the waypoints it is given; it
+// asks again afterwards). A go names the stops (airspace.hpp's stops_of) of the leg or of its
+// first waypoints only (the service's part of a leg, site_arbiter.hpp; it may end on the travel's
+// way): the crane moves to the last of them, and there, at rest (after the dwell, if that is the
+// work height), asks for the rest of the leg from that waypoint; a crane that halts or yields
+// before asks for the whole leg again. It moves stop by stop: the goal to the next waypoint (COMMAND_MOVE, every axis
 // named, the trapezoid profile) once the reference of the goal before has arrived and the crane
 // has settled (trolley and slew under 0.01 m/s and rad/s, hoist under 0.01 m/s, swing amplitude
 // under 0.5 deg) or `settle_timeout` after the reference arrived. A goal the planner has not
@@ -59,7 +61,8 @@
 // std::invalid_argument for a job outside the site file's ranges of the crane (slew, trolley, cable
 // length from its hook range) or non-positive dwell, settle timeout, slew acceleration, gravity or
 // travel cable length. instruction() ignores an instruction to another crane, one of an epoch and
-// seq already taken, and one of fewer than 2 waypoints (returns false); step() never throws.
+// seq already taken, one of fewer than 2 waypoints, and a go that names no part's stops of the
+// request it answers (returns false); step() never throws.
 
 #include <cstddef>
 #include <cstdint>

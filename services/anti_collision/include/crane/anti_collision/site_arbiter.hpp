@@ -35,10 +35,12 @@
 //
 // A part of a leg (the site file's part_of_leg; docs/site.md, "A part of a leg"): a request that
 // waits only for cranes at rest or moving on a path is granted up to a waypoint where it can wait
-// for them: the last before the first segment that meets what they hold or, for a crane moving,
-// the rest box at its path's end, when its rest box there keeps clear of both (none when that is
-// its first waypoint). It then holds that part only, and asks there for the rest of its leg as a
-// new request. It waits whole for a crane yielding, silent or out of service.
+// for them: the last, not its first, up to which the part's stops (airspace.hpp's stops_of) and
+// its rest box there keep clear of what every other crane holds and, for a crane it waits for
+// moving, of the rest box at that crane's path's end (the request's waypoints on its travel's way
+// included: docs/site.md, "A wait inside the travel"). It then holds that part only, and asks
+// there for the rest of its leg as a new request. It waits whole for a crane yielding, silent or
+// out of service. Every go names the stops of what it grants, and the crane holds their airspace.
 //
 // The serialized mode is the baseline of issue 34's demo: also, at most one crane at a time
 // travels in shared airspace (the part of its reach that another crane's whole reach meets within
