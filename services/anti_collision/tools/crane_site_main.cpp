@@ -260,6 +260,8 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   }
 
   std::vector<double> min_distance, serial_min, vs_serialized, vs_solo, searched_vs_rest;
+  double worst_vs_solo = 0.0;  // and its set's seed, to trace it alone (--sets 1 --seed)
+  std::uint64_t worst_vs_solo_seed = 0;
   // One row of --bound: per set, the schedule's total time / solo, and the site's / the schedule's.
   struct Ratios {
     std::vector<double> vs_solo, of;
@@ -310,6 +312,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
     if (r.coordinated.completed && r.serialized.completed && r.solo.completed && r.coordinated.stopped_hosts == 0) {
       vs_serialized.push_back(r.coordinated.total_time / r.serialized.total_time);
       vs_solo.push_back(r.coordinated.total_time / r.solo.total_time);
+      if (vs_solo.back() > worst_vs_solo) worst_vs_solo = vs_solo.back(), worst_vs_solo_seed = seed + (&r - results.data());
       if (!std::isnan(r.bound)) {
         anywhere.add(r.bound, r);
         at_rest.add(r.bound_at_rest, r);
@@ -339,8 +342,11 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   std::printf("  total time coordinated / serialized (%zu sets every mode completed): median %.3f  worst %.3f  best %.3f\n",
               vs_serialized.size(), crane::stack::nearest_rank_quantile(vs_serialized, 0.5),
               crane::stack::nearest_rank_quantile(vs_serialized, 1.0), crane::stack::nearest_rank_quantile(vs_serialized, 0.0));
-  std::printf("  total time coordinated / solo:       median %.3f  worst %.3f  best %.3f\n", crane::stack::nearest_rank_quantile(vs_solo, 0.5),
-              crane::stack::nearest_rank_quantile(vs_solo, 1.0), crane::stack::nearest_rank_quantile(vs_solo, 0.0));
+  std::printf("  total time coordinated / solo:       median %.3f  p90 %.3f  worst %.3f  best %.3f", crane::stack::nearest_rank_quantile(vs_solo, 0.5),
+              crane::stack::nearest_rank_quantile(vs_solo, 0.9), crane::stack::nearest_rank_quantile(vs_solo, 1.0),
+              crane::stack::nearest_rank_quantile(vs_solo, 0.0));
+  if (!vs_solo.empty()) std::printf("  (the worst: set seed %llu)", static_cast<unsigned long long>(worst_vs_solo_seed));
+  std::printf("\n");
   const auto print_bound = [](const char* what, const Ratios& row) {
     using crane::stack::nearest_rank_quantile;
     const std::vector<double>& vs_solo_of = row.vs_solo;
