@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -125,6 +126,16 @@ class Link : public ::testing::Test {
       t_ += 0.01;
     }
     return last;
+  }
+  // Asking for the place's leg (hook up at the pick), it is granted the whole leg by go `seq` and
+  // moves it: travel, lower (then the dwell), raise, each arriving and settled.
+  void place_leg_granted(std::uint64_t seq) {
+    ASSERT_TRUE(link_->instruction(go(seq), kEpoch, t_));
+    for (int move = 0; move < 3; ++move) {
+      const auto g = next_goal(2.0);
+      ASSERT_TRUE(g.has_value()) << "move " << move;
+      arrive(*g);
+    }
   }
   // Steps until a goal comes (at most `seconds`).
   std::optional<MoveRequest> next_goal(double seconds = 0.5) {
@@ -261,18 +272,67 @@ TEST_F(Link, MovesWaypointByWaypointDwellsAndCountsTheJob) {
   expect_pose(r->request[1], -1.5, 0.5, 0.2);
   expect_pose(r->request[2], -1.5, 0.5, 1.2);
   // The place: the job is done when its last move settles.
-  ASSERT_TRUE(link_->instruction(go(5), kEpoch, t_));
-  for (int move = 0; move < 3; ++move) {
-    g = next_goal(2.0);
-    ASSERT_TRUE(g.has_value()) << "move " << move;
-    arrive(*g);
-  }
+  place_leg_granted(5);
   (void)step();
   EXPECT_EQ(link_->jobs_done(), 1);
   (void)step();
   EXPECT_EQ(link_->phase(), CraneSiteLink::Phase::done) << "at rest with no leg left, the next cycle";
   EXPECT_EQ(link_->report()->request_id, 0u);
   EXPECT_EQ(link_->unsettled_moves(), 0);
+}
+
+// Its work left (CraneSiteLink::work_left, moves_time) by hand, with the default rates: the trolley
+// 0.4982 m/s and 0.9929 m/s^2, the slew 1.0435 rad/s (rated) and 1.0 rad/s^2, the hoist 0.2 m/s and
+// 0.5 m/s^2; a travel one swing period on 0.2 m of cable longer, every move 1 s of settling more, 1 s
+// of dwell at each work point. The pick's leg from (0, 0.3 m, 0.2 m): the trolley's 0.6 m, lower
+// and raise 1.3 m; the place's leg from the pick hook up: the slew's 1.5 rad (the trolley's 0.4 m
+// takes less), lower and raise 1.0 m.
+TEST_F(Link, ItsWorkLeftByHand) {
+  // (3.43): Z / v + v / a past v^2 / a, else 2 sqrt(Z / a).
+  const auto trapezoid = [](double z, double v, double a) { return z >= v * v / a ? z / v + v / a : 2.0 * std::sqrt(z / a); };
+  const double swing_period = 2.0 * std::numbers::pi * std::sqrt(0.2 / 9.81);
+  const double travel_to_pick = trapezoid(0.6, 0.4982, 0.9929) + swing_period + 1.0;
+  const double hoist_at_pick = trapezoid(1.3, 0.2, 0.5) + 1.0;
+  const double travel_to_place = trapezoid(1.5, 1.0435, 1.0) + swing_period + 1.0;
+  ASSERT_GT(travel_to_place - swing_period - 1.0, trapezoid(0.4, 0.4982, 0.9929));
+  const double hoist_at_place = trapezoid(1.0, 0.2, 0.5) + 1.0;
+  const double place_leg = travel_to_place + 2.0 * hoist_at_place + 1.0;
+  const double whole = travel_to_pick + 2.0 * hoist_at_pick + 1.0 + place_leg;
+  EXPECT_NEAR(whole, 38.58, 0.01);  // 1.706 + 0.897 + 1 + 2 (6.9 + 1) + 1 + 2.481 + 0.897 + 1 + 2 (5.4 + 1) + 1
+
+  (void)step();
+  EXPECT_NEAR(link_->work_left(), whole, 1e-9);
+  EXPECT_NEAR(link_->report()->work_left, whole, 1e-9) << "its report carries it";
+  ASSERT_TRUE(link_->instruction(go(1), kEpoch, t_));
+  auto g = step();
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(link_->work_left(), whole, 1e-9) << "the travel started: the same path ahead";
+  arrive(*g);
+  g = next_goal();
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  (void)step();
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::dwelling);
+  EXPECT_NEAR(link_->work_left(), hoist_at_pick + place_leg, 1e-9) << "at the pick: raise, then the place's leg";
+  g = next_goal(2.0);
+  ASSERT_TRUE(g.has_value());
+  arrive(*g);
+  EXPECT_FALSE(next_goal(0.05).has_value());
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::asking);
+  EXPECT_NEAR(link_->work_left(), place_leg, 1e-9);
+  place_leg_granted(5);
+  (void)step();
+  (void)step();
+  ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::done);
+  EXPECT_EQ(link_->work_left(), 0.0);
+
+  EXPECT_EQ(moves_time(std::vector<Pose>{{0.0, 0.3, 0.2}}, params_), 0.0);
+  EXPECT_THROW((void)moves_time(std::vector<Pose>{{0.0, 0.3, 0.2}, {std::nan(""), 0.3, 0.2}}, params_),
+               std::invalid_argument);
+  CraneLinkParams slow = params_;
+  slow.rated.hoist.rated_speed = 0.0;
+  EXPECT_THROW((void)moves_time(std::vector<Pose>{{0.0, 0.3, 0.2}}, slow), std::invalid_argument);
+  EXPECT_THROW(CraneSiteLink(layout_, 0, slow, {}, kFirstGoal), std::invalid_argument);
 }
 
 // A part of a leg (site_arbiter.hpp): a go for the first waypoints of its leg only. The

@@ -283,14 +283,9 @@ TEST(SiteArbiter, TwoCranesThatWaitForEachOtherAreResolvedByAYield) {
   EXPECT_EQ(arbiter.unresolved(), 0u);
 }
 
-// Rule 0, no starving. A third crane C (jib 3.5 m) at (1, -2), its jib at heading +y at slew 0.
-// B lowers its load at (1, 0) and hoists it again: A's request, to slew its jib from -y to +x
-// over (1, 0), waits for B. C asks later to lower its load at P = (0.5, -0.9), which A's jib
-// sweeps over (|P| = 1.03 < 1.4) but which meets nothing held: 0.42 m in plan from A's jib at
-// -y, 1.03 from B's cable, 1.75 - 1.35 - 0.05 = 0.35 from B's whole reach. Once A has waited
-// max_wait (40 s), C's later request waits for A's instead of taking the place A must pass; and
-// A, starving, no longer gives its jib way to C's cable (rule 2), which would make it yield.
-TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
+// The site of rule 0's tests: A and B of two_towers; a third crane C (jib 3.5 m) at (1, -2), its jib
+// at heading +y at slew 0; a fourth crane E at (4.2, 0).
+SiteLayout four_cranes() {
   SiteLayout site = two_towers();
   SiteCrane c = site.cranes[1];
   c.name = "c";
@@ -309,21 +304,36 @@ TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
   e.slew_zero_heading = 0.0;
   e.domain_id = 14;
   site.cranes.push_back(e);
+  return site;
+}
+
+const double kCSlew = std::atan2(1.1, -0.5) - kPi / 2.0;  // from C's base (1, -2) to P: (-0.5, 1.1)
+const double kCTrolley = std::hypot(0.5, 1.1);
+
+// B lowering and raising at (1, 0) since 0.5 s, A waiting for it since 1 s, C asking since 2 s.
+SiteArbiter waiting_site(const SiteLayout& layout) {
+  SiteArbiter arbiter(layout, ArbiterMode::coordinated);
+  arbiter.rest(0, {-kPi / 2.0, 0.5, 0.2});
+  arbiter.rest(1, {kPi, 1.0, 0.2});
+  arbiter.rest(2, {kCSlew, kCTrolley, 0.2});
+  arbiter.rest(3, {0.0, 0.5, 0.2});
+  arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}, {kPi, 1.0, 0.2}}, 0.0);
+  EXPECT_EQ(arbiter.decide(0.5).size(), 1u);  // B goes
+  arbiter.request(0, {{-kPi / 2.0, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);
+  arbiter.request(2, {{kCSlew, kCTrolley, 0.2}, {kCSlew, kCTrolley, 2.0}}, 2.0);
+  return arbiter;
+}
+
+// Rule 0, no starving. A third crane C (jib 3.5 m) at (1, -2), its jib at heading +y at slew 0.
+// B lowers its load at (1, 0) and hoists it again: A's request, to slew its jib from -y to +x
+// over (1, 0), waits for B. C asks later to lower its load at P = (0.5, -0.9), which A's jib
+// sweeps over (|P| = 1.03 < 1.4) but which meets nothing held: 0.42 m in plan from A's jib at
+// -y, 1.03 from B's cable, 1.75 - 1.35 - 0.05 = 0.35 from B's whole reach. Once A has waited
+// max_wait (40 s), C's later request waits for A's instead of taking the place A must pass; and
+// A, starving, no longer gives its jib way to C's cable (rule 2), which would make it yield.
+TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
+  SiteLayout site = four_cranes();
   site.max_wait = 40.0;
-  const double c_slew = std::atan2(1.1, -0.5) - kPi / 2.0;  // from (1, -2) to P: (-0.5, 1.1)
-  const double c_trolley = std::hypot(0.5, 1.1);
-  const auto waiting_site = [&](const SiteLayout& layout) {
-    SiteArbiter arbiter(layout, ArbiterMode::coordinated);
-    arbiter.rest(0, {-kPi / 2.0, 0.5, 0.2});
-    arbiter.rest(1, {kPi, 1.0, 0.2});
-    arbiter.rest(2, {c_slew, c_trolley, 0.2});
-    arbiter.rest(3, {0.0, 0.5, 0.2});
-    arbiter.request(1, {{kPi, 1.0, 0.2}, {kPi, 1.0, 2.0}, {kPi, 1.0, 0.2}}, 0.0);
-    EXPECT_EQ(arbiter.decide(0.5).size(), 1u);  // B goes
-    arbiter.request(0, {{-kPi / 2.0, 0.5, 0.2}, {0.0, 0.5, 0.2}}, 1.0);
-    arbiter.request(2, {{c_slew, c_trolley, 0.2}, {c_slew, c_trolley, 2.0}}, 2.0);
-    return arbiter;
-  };
   SiteArbiter arbiter = waiting_site(site);
 
   // Before A has waited 40 s, C goes: first come among the requests that can go.
@@ -390,6 +400,69 @@ TEST(SiteArbiter, ARequestThatWaitedMaxWaitGoesBeforeLaterOnesThatMeetIt) {
   EXPECT_EQ(chain.waits_for(0), std::vector<std::size_t>{1u});
 
   EXPECT_THROW((void)arbiter.decide(std::nan("")), std::invalid_argument);
+}
+
+// Rule 0, the most work left first (the site file's most_work_left_first). The site of the test
+// above with no max_wait: A waits for B, and C's later request, which could go, meets A's path.
+// With A's work left more than every other crane's, C waits for A (most_work_left), as for a
+// starving A; with C's the most, or a tie, or the rule off, C goes, first come. Only cranes that
+// report count (E, silent, with more, does not), and only a crane at rest that asks is ranked (B
+// on its path with the most: none is).
+TEST(SiteArbiter, TheRequestOfTheCraneWithTheMostWorkLeftGoesFirst) {
+  SiteLayout site = four_cranes();
+  site.most_work_left_first = true;
+  const auto with_work = [&](const SiteLayout& layout, std::vector<double> work) {
+    SiteArbiter arbiter = waiting_site(layout);
+    for (std::size_t i = 0; i < work.size(); ++i) arbiter.work_left(i, work[i]);
+    return arbiter;
+  };
+  SiteArbiter a_most = with_work(site, {300.0, 100.0, 200.0, 50.0});
+  EXPECT_EQ(a_most.most_work_left(), std::optional<std::size_t>(0u));
+  EXPECT_TRUE(a_most.decide(3.0).empty());
+  EXPECT_EQ(a_most.waits_for(0), std::vector<std::size_t>{1u});
+  EXPECT_EQ(a_most.wait_reason(0), WaitReason::held);
+  EXPECT_EQ(a_most.waits_for(2), std::vector<std::size_t>{0u});
+  EXPECT_EQ(a_most.wait_reason(2), WaitReason::most_work_left);
+  EXPECT_EQ(a_most.yields() + a_most.unresolved(), 0u);  // nor does A give its jib way to C's cable (rule 2)
+  // B rests: A goes, and C waits for what A holds.
+  a_most.rest(1, {kPi, 1.0, 0.2});
+  auto decided = a_most.decide(4.0);
+  ASSERT_EQ(decided.size(), 1u);
+  EXPECT_EQ(decided[0].crane, 0u);
+  EXPECT_EQ(a_most.wait_reason(2), WaitReason::held);
+
+  const auto c_goes = [&](SiteArbiter arbiter, const char* why) {
+    SCOPED_TRACE(why);
+    const auto d = arbiter.decide(3.0);
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_EQ(d[0].crane, 2u);
+    EXPECT_EQ(d[0].kind, Instruction::Kind::go);
+  };
+  SiteArbiter c_most = with_work(site, {200.0, 100.0, 300.0, 50.0});
+  EXPECT_EQ(c_most.most_work_left(), std::optional<std::size_t>(2u));
+  c_goes(c_most, "C has the most work left");
+  SiteArbiter tie = with_work(site, {300.0, 100.0, 300.0, 50.0});
+  EXPECT_EQ(tie.most_work_left(), std::nullopt);
+  c_goes(tie, "A and C tie");
+  SiteLayout off = site;
+  off.most_work_left_first = false;
+  SiteArbiter rule_off = with_work(off, {300.0, 100.0, 200.0, 50.0});
+  EXPECT_EQ(rule_off.most_work_left(), std::nullopt);
+  c_goes(rule_off, "the rule off");
+  SiteArbiter b_most = with_work(site, {300.0, 400.0, 200.0, 50.0});
+  EXPECT_EQ(b_most.most_work_left(), std::nullopt);  // B, on its path, is the critical crane: no request to rank
+  c_goes(b_most, "B, moving, has the most");
+  SiteArbiter e_silent = with_work(site, {300.0, 100.0, 200.0, 900.0});
+  EXPECT_EQ(e_silent.most_work_left(), std::nullopt);  // E reports the most
+  e_silent.lost(3);
+  EXPECT_EQ(e_silent.most_work_left(), std::optional<std::size_t>(0u));  // silent, it is not counted
+  EXPECT_TRUE(e_silent.decide(3.0).empty());
+  EXPECT_EQ(e_silent.wait_reason(2), WaitReason::most_work_left);
+
+  SiteArbiter bad = waiting_site(site);
+  EXPECT_THROW(bad.work_left(0, -1.0), std::invalid_argument);
+  EXPECT_THROW(bad.work_left(0, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(bad.work_left(7, 1.0), std::out_of_range);
 }
 
 // An idle crane in the way (no request of its own) is told to yield as well.
@@ -1178,7 +1251,8 @@ TEST(SiteService, TheStatusSaysWhoWaitsForWhomWhyAndForHowLong) {
   EXPECT_FALSE(status.pending[1]);
   EXPECT_EQ(status.wait_reason[1], SiteStatus::WAIT_NONE);
   EXPECT_EQ(status.waited[1], 0.0);
-  for (const WaitReason reason : {WaitReason::none, WaitReason::held, WaitReason::starving, WaitReason::higher_cable}) {
+  for (const WaitReason reason : {WaitReason::none, WaitReason::held, WaitReason::starving, WaitReason::higher_cable,
+                                  WaitReason::most_work_left}) {
     EXPECT_EQ(crane::protocol::code_name(SiteStatus::kCodes, "WAIT", wait_code(reason)), to_string(reason));
   }
 }
@@ -1405,6 +1479,30 @@ TEST(SiteService, MovingWithoutAGrantAndARestartedService) {
   EXPECT_EQ(restarted.arbiter().holding(0), Holding::path);
 }
 
+// Each crane's work left, on its report (through the IDL message and back), reaches the rules:
+// A asks with 50 s left, B rests with 20 s: A's request is rule 0's; B's 80 s: B is the crane with
+// the most, and it asks for nothing, so none is.
+TEST(SiteService, EachCranesWorkLeftReachesTheRules) {
+  SiteLayout site = two_towers();
+  site.most_work_left_first = true;
+  SiteService service(site, ArbiterMode::coordinated, 5);
+  const auto sent = [](CraneReport r, double work_left) {
+    r.work_left = work_left;
+    crane::protocol::SiteReport m{};
+    to_message(r, m);
+    CraneReport back;
+    EXPECT_EQ(from_message(m, back), "");
+    EXPECT_EQ(back.work_left, work_left);
+    return back;
+  };
+  const Pose a_rest{-1.5, 0.5, 0.2};
+  ASSERT_EQ(service.report(sent(at_rest(0, a_rest, 3, {a_rest, {-1.0, 0.5, 0.2}}), 50.0), 0.0), "");
+  ASSERT_EQ(service.report(sent(at_rest(1, {kPi - 1.5, 0.5, 0.2}), 20.0), 0.0), "");
+  EXPECT_EQ(service.arbiter().most_work_left(), std::optional<std::size_t>(0u));
+  ASSERT_EQ(service.report(sent(at_rest(1, {kPi - 1.5, 0.5, 0.2}), 80.0), 0.05), "");
+  EXPECT_EQ(service.arbiter().most_work_left(), std::nullopt);
+}
+
 // Malformed reports are refused with the field named, counted, and change nothing.
 TEST(SiteService, MalformedReportsAreRefused) {
   SiteService service(two_towers(), ArbiterMode::coordinated, 5);
@@ -1424,7 +1522,13 @@ TEST(SiteService, MalformedReportsAreRefused) {
   CraneReport nan_motion = at_rest(0, a_rest);
   nan_motion.motion.swing_out_of_plane_rate = std::nan("");
   EXPECT_NE(service.report(nan_motion, 0.0).find("the measured motion (slew 0 rad"), std::string::npos);
-  EXPECT_EQ(service.reports_rejected(), 7u);
+  CraneReport negative_work = at_rest(0, a_rest);
+  negative_work.work_left = -2.5;
+  EXPECT_EQ(service.report(negative_work, 0.0),
+            "site service: a report refused: work_left = -2.500000 s is not finite and >= 0");
+  negative_work.work_left = INFINITY;
+  EXPECT_NE(service.report(negative_work, 0.0).find("work_left = inf s"), std::string::npos);
+  EXPECT_EQ(service.reports_rejected(), 9u);
   EXPECT_EQ(service.arbiter().holding(0), Holding::whole_reach);
   EXPECT_FALSE(service.heard(0, 0.0));
   EXPECT_THROW(SiteService(two_towers(), ArbiterMode::coordinated, 0), std::invalid_argument);

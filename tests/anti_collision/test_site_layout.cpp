@@ -65,6 +65,7 @@ TEST(SiteLayout, ShippedSiteLoads) {
   EXPECT_TRUE(site.zones[0].fixed);
   EXPECT_DOUBLE_EQ(site.max_wait, 20.0);
   EXPECT_TRUE(site.part_of_leg);
+  EXPECT_TRUE(site.most_work_left_first);
   EXPECT_DOUBLE_EQ(site.travel_step, 0.5);
   EXPECT_DOUBLE_EQ(site.paths.trolley_hold, 0.01);
   EXPECT_DOUBLE_EQ(site.paths.slew_hold, 0.02);
@@ -105,6 +106,10 @@ TEST(SiteLayout, BadFilesAreRefusedNamingFieldValueAndBound) {
   EXPECT_EQ(refusal(edited("part_of_leg: true", "part_of_leg: often")),
             "site.yaml: site.part_of_leg = 'often' is not a boolean (true or false)");
   EXPECT_EQ(refusal(edited("part_of_leg: true", "part_of_leg_: true")), "site.yaml: missing field site.part_of_leg");
+  EXPECT_EQ(refusal(edited("most_work_left_first: true", "most_work_left_first: 1.5")),
+            "site.yaml: site.most_work_left_first = '1.5' is not a boolean (true or false)");
+  EXPECT_EQ(refusal(edited("most_work_left_first: true", "most_work_left_first_: true")),
+            "site.yaml: missing field site.most_work_left_first");
   EXPECT_EQ(refusal(edited("travel_step: 0.5", "travel_step: -0.1")),
             "site.yaml: site.travel_step = -0.1 is out of range: must be in [0, 10]");
   EXPECT_EQ(refusal(edited("travel_step: 0.5", "travel_step_: 0.5")), "site.yaml: missing field site.travel_step");

@@ -116,7 +116,7 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
     crane["waiting"] = listed && status->pending[i];
     const json waits = listed ? json(ac::waits_for_names(layout, *status, i)) : json::array();
     crane["waits_for"] = waits;
-    // Why (a WAIT_* name: held, starving, higher_cable) and how long its request has waited [s].
+    // Why (a WAIT_* name: held, starving, higher_cable, most_work_left) and how long its request has waited [s].
     crane["wait_reason"] = listed && !waits.empty()
                                ? json(std::string(protocol::code_name(protocol::SiteStatus::kCodes, "WAIT",
                                                                       status->wait_reason[i])))

@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
     const auto document = config::ConfigDocument::load(me.config);
     const auto planner = document.read("trajectory_planner", trajectory_planner::read_params);
     params.travel_cable_length = planner.cable_min_length;
+    params.rated = planner.manual;
     params.gravity = document.facts().crane.gravity;
     // Its goals count up from a fresh id (one goal a waypoint: far fewer than ten a second).
     ac::CraneSiteLink link(layout, static_cast<std::size_t>(index), params, ac::load_site_jobs(jobs_path),

@@ -1,5 +1,7 @@
 #include "crane/anti_collision/crane_site_link.hpp"
 
+#include "crane/trajectory_planner/trapezoid_profile.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -43,6 +45,27 @@ void check_point(const SiteCrane& c, const WorkPoint& w, std::size_t job, const 
   const double longest = c.jib_height - c.hook_height_min;
   if (!(w.cable_length >= shortest - 1e-9 && w.cable_length <= longest + 1e-9)) {
     refuse("cable_length", w.cable_length, shortest, longest);
+  }
+}
+
+// What moves_time needs of `params`, each finite: > 0, the slew speed >= 0 (0: rated).
+void check_rates(const CraneLinkParams& params, const char* who) {
+  const auto positive = [who](const char* field, double value) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument(std::string(who) + ": " + field + " = " + std::to_string(value) + " must be > 0");
+    }
+  };
+  positive("travel_cable_length", params.travel_cable_length);
+  positive("gravity", params.gravity);
+  positive("slew_acceleration", params.slew_acceleration);
+  positive("rated.trolley.rated_speed", params.rated.trolley.rated_speed);
+  positive("rated.trolley.acceleration", params.rated.trolley.acceleration);
+  positive("rated.slew.rated_speed", params.rated.slew.rated_speed);
+  positive("rated.hoist.rated_speed", params.rated.hoist.rated_speed);
+  positive("rated.hoist.acceleration", params.rated.hoist.acceleration);
+  if (!(params.slew_speed >= 0.0) || !std::isfinite(params.slew_speed)) {
+    throw std::invalid_argument(std::string(who) + ": slew_speed = " + std::to_string(params.slew_speed) +
+                                " must be >= 0");
   }
 }
 
@@ -137,18 +160,11 @@ Pose site_start_pose(const SiteLayout& layout, std::size_t crane, double planner
 CraneSiteLink::CraneSiteLink(const SiteLayout& layout, std::size_t crane, const CraneLinkParams& params,
                              std::vector<SiteJob> jobs, std::uint32_t first_goal_id)
     : layout_(layout), crane_(crane), params_(params), guard_(layout, crane), goal_id_(first_goal_id) {
-  const auto positive = [](const char* field, double value) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      throw std::invalid_argument(std::string("site link: ") + field + " = " + std::to_string(value) + " must be > 0");
-    }
-  };
-  positive("travel_cable_length", params.travel_cable_length);
-  positive("dwell", params.dwell);
-  positive("settle_timeout", params.settle_timeout);
-  positive("slew_acceleration", params.slew_acceleration);
-  positive("gravity", params.gravity);
-  if (!(params.slew_speed >= 0.0) || !std::isfinite(params.slew_speed)) {
-    throw std::invalid_argument("site link: slew_speed = " + std::to_string(params.slew_speed) + " must be >= 0");
+  check_rates(params, "site link");
+  if (!(params.dwell > 0.0) || !std::isfinite(params.dwell) || !(params.settle_timeout > 0.0) ||
+      !std::isfinite(params.settle_timeout)) {
+    throw std::invalid_argument("site link: dwell = " + std::to_string(params.dwell) + " s and settle_timeout = " +
+                                std::to_string(params.settle_timeout) + " s must be > 0");
   }
   const SiteCrane& c = layout_.cranes.at(crane_);
   for (std::size_t j = 0; j < jobs.size(); ++j) {
@@ -239,14 +255,8 @@ Request CraneSiteLink::move_to(const Pose& to) {
   return r;
 }
 
-void CraneSiteLink::rest_at(const Pose& here, double time) {
-  guard_.grant(rest_airspace(here, layout_.paths), time);
-  changed_ = true;
-  if (next_leg_ == legs_.size()) {
-    phase_ = Phase::done;
-    return;
-  }
-  const WorkPoint& w = legs_[next_leg_].at;
+std::vector<Pose> CraneSiteLink::leg_path(const Pose& here, std::size_t leg) const {
+  const WorkPoint& w = legs_[leg].at;
   const double up = params_.travel_cable_length;
   std::vector<Pose> path{here};
   if (here.cable_length > up + kSameCable) path.push_back({here.slew, here.trolley, up});
@@ -264,7 +274,17 @@ void CraneSiteLink::rest_at(const Pose& here, double time) {
   path.push_back({w.slew, w.trolley, up});
   path.push_back({w.slew, w.trolley, w.cable_length});
   path.push_back({w.slew, w.trolley, up});
-  request_ = std::move(path);
+  return path;
+}
+
+void CraneSiteLink::rest_at(const Pose& here, double time) {
+  guard_.grant(rest_airspace(here, layout_.paths), time);
+  changed_ = true;
+  if (next_leg_ == legs_.size()) {
+    phase_ = Phase::done;
+    return;
+  }
+  request_ = leg_path(here, next_leg_);
   rest_of_leg_.clear();
   request_id_ = ++requests_;  // a new id: a new request
   phase_ = Phase::asking;
@@ -527,7 +547,73 @@ std::optional<CraneReport> CraneSiteLink::report() const {
     r.request_id = request_id_;
     r.request = request_;
   }
+  r.work_left = work_left();
   return r;
+}
+
+double moves_time(std::span<const Pose> poses, const CraneLinkParams& params) {
+  check_rates(params, "moves_time");
+  for (const Pose& p : poses) {
+    if (!std::isfinite(p.slew) || !std::isfinite(p.trolley) || !std::isfinite(p.cable_length)) {
+      throw std::invalid_argument("moves_time: a pose is not finite");
+    }
+  }
+  using trajectory_planner::AxisLimits;
+  using trajectory_planner::TrapezoidProfile;
+  const AxisLimits trolley{params.rated.trolley.rated_speed, params.rated.trolley.acceleration};
+  const AxisLimits slew{params.slew_speed > 0.0 ? params.slew_speed : params.rated.slew.rated_speed,
+                        params.slew_acceleration};
+  const AxisLimits hoist{params.rated.hoist.rated_speed, params.rated.hoist.acceleration};
+  const double swing_period = 2.0 * std::numbers::pi * std::sqrt(params.travel_cable_length / params.gravity);
+  const std::vector<Pose> stops = stops_of(poses);
+  double total = 0.0;
+  for (std::size_t k = 1; k < stops.size(); ++k) {
+    const Pose& a = stops[k - 1];
+    const Pose& b = stops[k];
+    const double move = std::max({TrapezoidProfile(a.slew, b.slew, slew).duration(),
+                                  TrapezoidProfile(a.trolley, b.trolley, trolley).duration(),
+                                  TrapezoidProfile(a.cable_length, b.cable_length, hoist).duration()});
+    const bool travel = a.slew != b.slew || a.trolley != b.trolley;
+    total += move + (travel ? swing_period : 0.0) + kSettleAllowance;
+  }
+  return total;
+}
+
+double CraneSiteLink::work_left() const {
+  if (!stepped_ || next_leg_ >= legs_.size() || phase_ == Phase::done || phase_ == Phase::braked ||
+      phase_ == Phase::aborted) {
+    return 0.0;
+  }
+  // The rest of the leg it is on, from where it stands (or where its yield ends).
+  std::vector<Pose> rest;
+  if (phase_ == Phase::asking) {
+    rest = request_;
+  } else if ((phase_ == Phase::moving || phase_ == Phase::dwelling || phase_ == Phase::halting) && !yielding_) {
+    rest = rest_of_path();
+    if (!rest_of_leg_.empty()) rest.insert(rest.end(), rest_of_leg_.begin() + 1, rest_of_leg_.end());
+  } else {
+    Pose from = pose_;
+    if (yielding_ && !path_.empty()) {
+      rest = rest_of_path();
+      from = path_.back();
+    }
+    const std::vector<Pose> leg = leg_path(from, next_leg_);
+    rest.insert(rest.end(), leg.begin() + (rest.empty() ? 0 : 1), leg.end());
+  }
+  const WorkPoint& w = legs_[next_leg_].at;
+  const auto at_work_point = [&](const Pose& p) {
+    return p.slew == w.slew && p.trolley == w.trolley && std::abs(p.cable_length - w.cable_length) < kSameCable;
+  };
+  double total = moves_time(rest, params_);
+  if (std::any_of(rest.begin() + std::min<std::ptrdiff_t>(1, std::ssize(rest)), rest.end(), at_work_point)) {
+    total += params_.dwell;
+  }
+  // Each leg after it, from the work point before at the travel height.
+  for (std::size_t k = next_leg_ + 1; k < legs_.size(); ++k) {
+    const WorkPoint& before = legs_[k - 1].at;
+    total += moves_time(leg_path({before.slew, before.trolley, params_.travel_cable_length}, k), params_) + params_.dwell;
+  }
+  return total;
 }
 
 std::vector<Pose> CraneSiteLink::rest_of_path() const {

@@ -25,6 +25,7 @@ const char* to_string(WaitReason reason) noexcept {
     case WaitReason::held: return "held";
     case WaitReason::starving: return "starving";
     case WaitReason::higher_cable: return "higher_cable";
+    case WaitReason::most_work_left: return "most_work_left";
   }
   return "?";
 }
@@ -89,6 +90,33 @@ void SiteArbiter::request(std::size_t crane, std::vector<Pose> waypoints, double
 }
 
 void SiteArbiter::withdraw(std::size_t crane) { cranes_.at(crane).request.reset(); }
+
+void SiteArbiter::work_left(std::size_t crane, double seconds) {
+  CraneState& c = cranes_.at(crane);
+  if (!std::isfinite(seconds) || seconds < 0.0) {
+    throw std::invalid_argument("site arbiter: crane " + layout_.cranes[crane].name + "'s work left " +
+                                std::to_string(seconds) + " s is not finite and >= 0");
+  }
+  c.work_left = seconds;
+}
+
+std::optional<std::size_t> SiteArbiter::most_work_left() const {
+  if (!layout_.most_work_left_first) return std::nullopt;
+  std::optional<std::size_t> most;
+  bool tie = false;
+  for (std::size_t i = 0; i < cranes_.size(); ++i) {
+    const CraneState& c = cranes_[i];
+    if (c.holding == Holding::whole_reach || c.holding == Holding::out_of_service) continue;  // not reporting
+    if (!most || c.work_left > cranes_[*most].work_left) {
+      most = i;
+      tie = false;
+    } else if (c.work_left == cranes_[*most].work_left) {
+      tie = true;
+    }
+  }
+  if (!most || tie || !cranes_[*most].request || cranes_[*most].holding != Holding::rest) return std::nullopt;
+  return most;
+}
 
 void SiteArbiter::lost(std::size_t crane, bool moved) {
   CraneState& c = cranes_.at(crane);
@@ -176,9 +204,11 @@ bool SiteArbiter::starving(std::size_t i) const noexcept {
   return r && layout_.max_wait > 0.0 && decided_at_ >= r->time + layout_.max_wait;
 }
 
+bool SiteArbiter::first(std::size_t i) const noexcept { return starving(i) || critical_ == i; }
+
 bool SiteArbiter::ranks_before(std::size_t i, std::size_t j) const {
-  const bool si = starving(i);
-  const bool sj = starving(j);
+  const bool si = first(i);
+  const bool sj = first(j);
   if (si != sj) return si;
   if (si && cranes_[i].request->time != cranes_[j].request->time) return cranes_[i].request->time < cranes_[j].request->time;
   const int pi = layout_.cranes[i].priority;
@@ -278,6 +308,7 @@ std::size_t SiteArbiter::part_of_leg(std::size_t i, const std::vector<std::size_
 std::vector<Instruction> SiteArbiter::decide(double time) {
   if (!std::isfinite(time)) throw std::invalid_argument("site arbiter: a decision time is not finite");
   decided_at_ = time;
+  critical_ = most_work_left();
   const std::size_t n = cranes_.size();
   std::vector<Instruction> out;
   std::vector<std::size_t> order;
@@ -307,7 +338,7 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
   // Rule 0. The cranes that may never move: silent or out of service, and, in turn, those at rest
   // whose request waits for one of them.
   std::vector<bool> stalled(n, false);
-  if (std::any_of(order.begin(), order.end(), [this](std::size_t i) { return starving(i); })) {
+  if (std::any_of(order.begin(), order.end(), [this](std::size_t i) { return first(i); })) {
     std::vector<std::vector<std::size_t>> asking(n);
     for (std::size_t i = 0; i < n; ++i) {
       stalled[i] = cranes_[i].holding == Holding::whole_reach || cranes_[i].holding == Holding::out_of_service;
@@ -324,13 +355,13 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
       }
     }
   }
-  // The starving request ranked before `position` whose path i's request meets and that still
-  // waits, for no crane that may never move. Every starving request ranks before the others, so
-  // they are decided by then.
+  // The request of rule 0 (starving, or the most work left) ranked before `position` whose path
+  // i's request meets and that still waits, for no crane that may never move. Every such request
+  // ranks before the others, so they are decided by then.
   const auto reserved = [&](std::size_t i, std::size_t position) -> std::optional<std::size_t> {
     for (std::size_t earlier = 0; earlier < position; ++earlier) {
       const std::size_t k = order[earlier];
-      if (k == i || instructed[k] || !starving(k) ||
+      if (k == i || instructed[k] || !first(k) ||
           clear(i, cranes_[i].request->airspace, k, cranes_[k].request->airspace)) {
         continue;
       }
@@ -350,12 +381,12 @@ std::vector<Instruction> SiteArbiter::decide(double time) {
       if (const auto k = reserved(i, position)) {
         waits.push_back(*k);
         blocks[i][*k] = true;
-        why = WaitReason::starving;
+        why = starving(*k) ? WaitReason::starving : WaitReason::most_work_left;
       }
     }
-    if (waits.empty() && !starving(i)) {
+    if (waits.empty() && !first(i)) {
       // Rule 2: a later request of a higher crane whose cable meets this jib, and that could go now
-      // (rule 0 before it: a starving request gives way to none).
+      // (rule 0 before it: a starving request, or the most work left's, gives way to none).
       for (std::size_t later = position + 1; later < order.size() && waits.empty(); ++later) {
         const std::size_t k = order[later];
         if (yields_jib_to(i, k) && blockers(k).empty() && !reserved(k, later)) waits.push_back(k);

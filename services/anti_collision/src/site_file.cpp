@@ -119,6 +119,7 @@ SiteLayout parse_site_layout(const std::string& yaml_text, const std::string& so
     layout.link_deadline = s.number("link_deadline", kDeadline.lower, kDeadline.upper);
     layout.max_wait = s.number("max_wait", kMaxWait.lower, kMaxWait.upper);
     layout.part_of_leg = s.flag("part_of_leg");
+    layout.most_work_left_first = s.flag("most_work_left_first");
     layout.travel_step = s.number("travel_step", kTravelStep.lower, kTravelStep.upper);
     config::YamlSection paths = s.child("paths");
     layout.paths.trolley_overshoot = paths.number("trolley_overshoot", kOvershoot.lower, kOvershoot.upper);

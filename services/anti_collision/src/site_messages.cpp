@@ -51,6 +51,7 @@ std::string from_message(const SiteReport& m, CraneReport& r) {
   r.request_id = m.request_id;
   r.request = m.request_id != 0 ? read_poses(m.request_count, m.request_slew, m.request_trolley, m.request_cable_length)
                                 : std::vector<Pose>{};
+  r.work_left = m.work_left;
   return "";
 }
 
@@ -92,6 +93,7 @@ void to_message(const CraneReport& r, SiteReport& m) noexcept {
   m.request_count = r.request_id != 0 ? write_poses(r.request, m.request_slew, m.request_trolley, m.request_cable_length)
                                       : std::uint8_t{0};
   set_motion(r.motion, m);
+  m.work_left = r.work_left;
 }
 
 void to_message(const SiteOrder& o, std::uint32_t epoch, SiteInstruction& m) noexcept {
@@ -136,6 +138,7 @@ std::uint8_t wait_code(WaitReason reason) noexcept {
     case WaitReason::held: return SiteStatus::WAIT_HELD;
     case WaitReason::starving: return SiteStatus::WAIT_STARVING;
     case WaitReason::higher_cable: return SiteStatus::WAIT_HIGHER_CABLE;
+    case WaitReason::most_work_left: return SiteStatus::WAIT_MOST_WORK_LEFT;
   }
   return SiteStatus::WAIT_NONE;
 }

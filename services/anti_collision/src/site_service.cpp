@@ -60,6 +60,9 @@ std::string SiteService::report(const CraneReport& r, double time) {
                     r.motion.swing_in_plane, r.motion.swing_out_of_plane);
       why = text;
     }
+    if (why.empty() && !(std::isfinite(r.work_left) && r.work_left >= 0.0)) {
+      why = "work_left = " + std::to_string(r.work_left) + " s is not finite and >= 0";
+    }
   }
   if (!why.empty()) {
     ++rejected_;
@@ -67,6 +70,8 @@ std::string SiteService::report(const CraneReport& r, double time) {
   }
 
   Link& link = links_[r.crane];
+  const auto most_work_left = arbiter_.most_work_left();
+  arbiter_.work_left(r.crane, r.work_left);
   link.last_heard = time;
   link.motion = r.motion;
   link.motion_trusted = true;
@@ -132,6 +137,7 @@ std::string SiteService::report(const CraneReport& r, double time) {
     link.pending_id = r.request_id;
     dirty_ = true;
   }
+  if (arbiter_.most_work_left() != most_work_left) dirty_ = true;  // rule 0 ranks another request first
   return "";
 }
 

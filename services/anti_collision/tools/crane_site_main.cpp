@@ -514,10 +514,11 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   const double asked_why = std::accumulate(waited_why.begin(), waited_why.end(), 0.0);
   if (asked_why > 0.0) {
     std::printf("  coordinated waits, by why [%% of %.0f crane-seconds]: its path meets what they hold %.1f, "
-                "a starving request's path (rule 0) %.1f, its jib gives way to a higher cable (rule 2) %.1f, "
-                "no crane %.1f\n",
+                "a starving request's path (rule 0) %.1f, the most work left's path (rule 0) %.1f, its jib gives "
+                "way to a higher cable (rule 2) %.1f, no crane %.1f\n",
                 asked_why, 100.0 * waited_why[static_cast<std::size_t>(WaitReason::held)] / asked_why,
                 100.0 * waited_why[static_cast<std::size_t>(WaitReason::starving)] / asked_why,
+                100.0 * waited_why[static_cast<std::size_t>(WaitReason::most_work_left)] / asked_why,
                 100.0 * waited_why[static_cast<std::size_t>(WaitReason::higher_cable)] / asked_why,
                 100.0 * waited_why[static_cast<std::size_t>(WaitReason::none)] / asked_why);
   }

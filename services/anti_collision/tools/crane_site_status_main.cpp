@@ -2,7 +2,7 @@
 // are, from any host on the site's domain (docs/site.md, "The site service on DDS"). Listens to
 // rt/site/status and rt/site/report for --wait seconds (or until SIGINT/SIGTERM) and prints the
 // last status: one row per crane of the site file (what the service holds for it, whether a
-// request waits, for which cranes, why (held, starving, higher_cable: SiteStatus_'s WAIT_*) and for how
+// request waits, for which cranes, why (held, starving, higher_cable, most_work_left: SiteStatus_'s WAIT_*) and for how
 // long, what the crane last reported: at rest or moving, its pose),
 // then the service's counters, then the distance between every two cranes that reported: at their
 // last reports and the smallest over the listening time (the parts of crane_geometry.hpp at each

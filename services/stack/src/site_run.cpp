@@ -112,6 +112,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
   const double dt = config.facts.sample_period;
   ac::CraneLinkParams params;
   params.travel_cable_length = config.trajectory_planner.cable_min_length;
+  params.rated = config.trajectory_planner.manual;
   params.dwell = options.dwell;
   params.settle_timeout = options.settle_timeout;
   params.slew_acceleration = options.slew_acceleration;

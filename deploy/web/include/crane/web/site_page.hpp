@@ -12,7 +12,7 @@
 //              "counter_jib": m, "state": "at_rest" | "moving" | "silent" (no report yet),
 //              "heard_s_ago": s | null, "holding": "rest" | "path" | "yield" | "whole_reach" | null,
 //              "waiting": bool, "waits_for": ["tc2", ...], "wait_reason": null (it waits for none) |
-//              "held" | "starving" | "higher_cable" (SiteStatus_'s WAIT_*), "waited_s": s (how long its
+//              "held" | "starving" | "higher_cable" | "most_work_left" (SiteStatus_'s WAIT_*), "waited_s": s (how long its
 //              request has waited) | null (none pending), "instruction": "go" | "yield" | null,
 //              "pose": null | {"slew": rad, "trolley": m, "cable_length": m},
 //              "parts": [{"part": "jib", "a": [x, y, z], "b": [x, y, z], "radius": m,

@@ -60,13 +60,15 @@
 // Errors: the constructor throws std::out_of_range for a crane index not on the site and
 // std::invalid_argument for a job outside the site file's ranges of the crane (slew, trolley, cable
 // length from its hook range) or non-positive dwell, settle timeout, slew acceleration, gravity or
-// travel cable length. instruction() ignores an instruction to another crane, one of an epoch and
+// travel cable length, or a rated speed or acceleration (params.rated) that is not > 0.
+// instruction() ignores an instruction to another crane, one of an epoch and
 // seq already taken, one of fewer than 2 waypoints, and a go that names no part's stops of the
 // request it answers (returns false); step() never throws.
 
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "crane/anti_collision/airspace.hpp"
@@ -74,6 +76,7 @@
 #include "crane/anti_collision/site_layout.hpp"
 #include "crane/anti_collision/site_service.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/trajectory_planner/speed_reference.hpp"
 
 namespace crane::anti_collision {
 
@@ -96,7 +99,25 @@ struct CraneLinkParams {
   double slew_acceleration{1.0};    // [rad/s^2] of every move (MoveRequest::slew_max_acceleration)
   double slew_speed{0.0};           // [rad/s] of every move (MoveRequest::slew_max_velocity); 0: the crane's rated
   double gravity{9.81};             // [m/s^2] (the swing amplitude of the settle test)
+  /// The speeds and accelerations its planner moves the trolley and the hoist at (a goal names none
+  /// of theirs: the crane config's trajectory_planner.manual), and the slew's rated speed (for
+  /// slew_speed 0): its work-left estimate (moves_time). Each > 0.
+  trajectory_planner::ManualParams rated{};
 };
+
+/// [s] A move's settling, in the work-left estimate (moves_time): a round figure, for an estimate
+/// that ranks cranes (site_arbiter.hpp's rule 0), not one that schedules them.
+inline constexpr double kSettleAllowance = 1.0;
+
+/// [s] The time a crane takes, alone, through `poses` (the first where it stands), by the estimate
+/// of docs/site.md ("The crane with the most work left first"): it stops where stops_of says; each
+/// move lasts the longest of its axes' trapezoid profiles ((3.43) of Omar 2003: the trolley and the
+/// hoist at `params.rated`, the slew at params.slew_speed, or rated, and params.slew_acceleration),
+/// a travel (the slew or the trolley moves) one swing period 2 pi sqrt(L / g) longer (its shaping
+/// and damping, at L = params.travel_cable_length), and kSettleAllowance more. 0 for fewer than two
+/// poses. No dwell: the caller adds it. std::invalid_argument for a non-finite pose or a rate, a
+/// cable length or gravity that is not > 0.
+[[nodiscard]] double moves_time(std::span<const Pose> poses, const CraneLinkParams& params);
 
 /// [s] a goal the planner has not taken is sent again after this long.
 inline constexpr double kGoalResendPeriod = 1.0;
@@ -162,6 +183,12 @@ class CraneSiteLink {
 
   /// The report to send now; none once braked (see the header) or before the first step.
   [[nodiscard]] std::optional<CraneReport> report() const;
+  /// [s] Its estimate of the time its jobs left take it alone (its reports carry it: the site
+  /// service's rule 0 ranks the crane with the most first): moves_time of the rest of the leg it is
+  /// on (from where it stands, or from its yield's end: a crane halted or yielding asks for the whole
+  /// leg again) and of each leg after, plus the dwell of each work point still ahead. 0 when done,
+  /// braked or given up.
+  [[nodiscard]] double work_left() const;
   /// True when the report changed since the last call (send it now, not only at the period).
   [[nodiscard]] bool report_changed() noexcept;
 
@@ -217,6 +244,9 @@ class CraneSiteLink {
   std::optional<protocol::MoveRequest> advance(double time, const protocol::CraneState& estimate,
                                                const protocol::Reference& reference, bool braked);
   protocol::MoveRequest move_to(const Pose& to);
+  /// Leg `leg` from `here`: hoist up to the travel height (unless there), travel with waypoints on
+  /// its way (the site file's travel_step), lower to the work point, hoist up. What it asks for.
+  [[nodiscard]] std::vector<Pose> leg_path(const Pose& here, std::size_t leg) const;
   /// What it holds of its path: from the last waypoint it reached, or from the point of the segment
   /// under way it has reported passing (passed_, when it is not the segment's start), to the end.
   [[nodiscard]] std::vector<Pose> rest_of_path() const;

@@ -18,7 +18,13 @@
 //      could go but meets it waits for it (in waits_for, and so in the rules against deadlock
 //      below), unless it waits for a crane that may never move: silent, out of service, or, in
 //      turn, at rest with a request that waits for such a crane (the reservation would stop the
-//      others for nothing). A starving request gives its jib way to no cable (rule 2);
+//      others for nothing). A starving request gives its jib way to no cable (rule 2).
+//      The same for the request of the crane with the most work left (the site file's
+//      most_work_left_first; docs/site.md, "The crane with the most work left first"): the crane at
+//      rest with a pending request whose reported work left (work_left()) is more than every other
+//      crane's that reports (silent and out-of-service cranes are not counted; a tie: none). The
+//      crane that finishes last decides when the site is done, so its legs go first. It ranks with
+//      the starving requests, by its request's time;
 //   1. the higher `priority` of the site file;
 //   2. the lower crane yields its jib to the higher crane's cable: when the closest parts of two
 //      pending paths are the lower crane's jib or counter-jib and the higher crane's cable or load,
@@ -80,10 +86,12 @@ enum class Holding : std::uint8_t { rest, path, yield, whole_reach, out_of_servi
 /// Why a pending request waits for the cranes of waits_for (the rules of the header): none (it
 /// does not wait, or it is not decided yet); held: its path meets what they hold (serialized: or
 /// they travel in shared airspace); starving: rule 0, it meets the path a starving request of
-/// theirs reserves; higher_cable: rule 2, it gives its jib way to a higher crane's cable.
-enum class WaitReason : std::uint8_t { none, held, starving, higher_cable };
-inline constexpr std::size_t kWaitReasonCount = 4;
-/// "none", "held", "starving", "higher_cable".
+/// theirs reserves; higher_cable: rule 2, it gives its jib way to a higher crane's cable;
+/// most_work_left: rule 0, it meets the path the request of the crane with the most work left
+/// reserves.
+enum class WaitReason : std::uint8_t { none, held, starving, higher_cable, most_work_left };
+inline constexpr std::size_t kWaitReasonCount = 5;
+/// "none", "held", "starving", "higher_cable", "most_work_left".
 [[nodiscard]] const char* to_string(WaitReason reason) noexcept;
 
 class SiteArbiter {
@@ -108,6 +116,15 @@ class SiteArbiter {
   void progress(std::size_t crane, const std::vector<Pose>& remaining);
   /// Crane `crane` withdraws its pending request (nothing left to do).
   void withdraw(std::size_t crane);
+  /// Crane `crane` reports `seconds` [s] of work left (its jobs' time alone, by its own estimate:
+  /// CraneSiteLink::work_left), for rule 0's crane with the most work left. Every crane starts at 0.
+  /// std::invalid_argument for a negative or non-finite value; std::out_of_range for a crane index
+  /// not on the site.
+  void work_left(std::size_t crane, double seconds);
+  /// The crane whose request rule 0 ranks first for the most work left (the header), as the cranes
+  /// stand now; none when the site file's most_work_left_first is off, no crane reports more work
+  /// left than every other, or that crane is not at rest with a request pending.
+  [[nodiscard]] std::optional<std::size_t> most_work_left() const;
   /// Crane `crane` stopped reporting (`moved` false), or moved without a grant (`moved` true): it
   /// holds its whole reach until its next rest() (or out_of_service(), when it went silent from a
   /// rest or a path; a crane that moved without a grant, out of service or not, cannot be put out
@@ -191,9 +208,11 @@ class SiteArbiter {
     std::vector<std::size_t> waits_for;
     WaitReason wait_reason{WaitReason::none};
     std::optional<Pose> path_end;     // holding a path: where it ends (its rest box there)
+    double work_left{0.0};            // [s] as it last reported
   };
 
   [[nodiscard]] bool starving(std::size_t i) const noexcept;  // rule 0, at decided_at_
+  [[nodiscard]] bool first(std::size_t i) const noexcept;     // rule 0: starving, or critical_
   [[nodiscard]] bool ranks_before(std::size_t i, std::size_t j) const;  // rules 0, 1, 3, 4
   [[nodiscard]] bool yields_jib_to(std::size_t i, std::size_t j) const;  // rule 2: i's request gives way to j's
   [[nodiscard]] bool shared(std::size_t i, const Airspace& a) const;
@@ -208,6 +227,7 @@ class SiteArbiter {
   std::uint64_t yields_{0};
   std::uint64_t unresolved_{0};
   double decided_at_{-std::numeric_limits<double>::infinity()};  // [s] the last decide()'s time
+  std::optional<std::size_t> critical_;  // most_work_left() as the last decide() began
 };
 
 }  // namespace crane::anti_collision

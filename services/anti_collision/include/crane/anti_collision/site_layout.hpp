@@ -110,6 +110,8 @@ struct SiteLayout {
                                       // (the site service's rule 0, site_arbiter.hpp); 0: no limit
   bool part_of_leg{false};            // a leg may be granted up to a waypoint where it waits for the cranes
                                       // in its way (site_arbiter.hpp, "A part of a leg")
+  bool most_work_left_first{false};   // the request of the crane with the most work left goes first (the site
+                                      // service's rule 0, site_arbiter.hpp; each crane reports its estimate)
   double travel_step{0.0};            // [rad or m] each crane asks for a leg's travel with waypoints on its way,
                                       // this far apart at most on the axis that travels further (as many as a
                                       // request holds): a part of a leg may end there (CraneSiteLink); 0: none

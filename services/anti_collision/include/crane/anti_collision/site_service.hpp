@@ -30,7 +30,7 @@
 //
 // Errors: report() refuses a malformed report (an unknown crane, a waypoint count out of range, a
 // non-finite or non-positive cable length, a request of fewer than 2 waypoints, a non-finite
-// measured motion) with a message
+// measured motion, a negative or non-finite work left) with a message
 // naming the field and the value, counts it and changes nothing; it never throws. The constructor
 // throws common::ConfigError for an invalid layout (validate()).
 
@@ -61,6 +61,8 @@ struct CraneReport {
   std::uint64_t instruction_seq{0};     // and its seq (0, 0: none)
   std::uint32_t request_id{0};          // 0: no request
   std::vector<Pose> request;            // request_id != 0: 2 to Airspace::kMaxBoxes + 1, from where it rests
+  double work_left{0.0};                // [s] >= 0: the time its jobs left take it alone, by its own estimate
+                                        // (CraneSiteLink::work_left; SiteArbiter::work_left)
 };
 
 /// What a site service remembers of a crane across its own restart (docs/site.md, "The service's
