@@ -135,6 +135,11 @@ async function main() {
     if ((c.wait_reason || "-") !== theirs.why || (c.waits_for.join(",") || "-") !== theirs.waits_for) {
       problems.push(`${c.name}: the view's wait for [${c.waits_for}] (${c.wait_reason}), crane_site_status's ${theirs.waits_for} (${theirs.why})`);
     }
+    // Its work left, as it reports it (the writer's --work: tc1 123.4 s, tc3 56.7 s, tc2 none).
+    const work = { tc1: 123.4, tc2: 0, tc3: 56.7 }[c.name];
+    if (c.work_left_s !== work || theirs.work_left_s !== work) {
+      problems.push(`${c.name}: work left ${c.work_left_s} s in the view, ${theirs.work_left_s} s in crane_site_status's, written ${work} s`);
+    }
     if (c.waited_s !== null && !(theirs.waited_s >= c.waited_s)) {
       problems.push(`${c.name}: waited ${c.waited_s} s in the view, ${theirs.waited_s} s in crane_site_status's later status`);
     }
@@ -216,6 +221,7 @@ async function main() {
         view: s.view,
         rows: Array.from(document.querySelectorAll("#pairs tr")).slice(1).map((tr) => tr.className),
         craneRows: document.querySelectorAll("#cranes tr").length - 1,
+        workCells: Array.from(document.querySelectorAll("#cranes tr")).slice(1).map((tr) => tr.children[9] && tr.children[9].textContent),
         service: document.getElementById("service").textContent,
       };
     });
@@ -234,6 +240,7 @@ async function main() {
     const asked = seen.view.cranes.filter((c) => c.requested.length > 0 || c.holding === "path");
     if (asked.length === 0) problems.push("no crane asks for or holds a path: the test's --ask was not seen");
     if (seen.craneRows !== n) problems.push(`${seen.craneRows} crane rows`);
+    if (seen.workCells.join(",") !== "123.4,0.0,56.7") problems.push(`the crane rows' work left: ${seen.workCells.join(", ")}`);
     if (seen.rows.length !== seen.view.pairs.length || seen.rows.some((c, i) => c !== seen.view.pairs[i].band)) {
       problems.push(`pair rows ${JSON.stringify(seen.rows)} against bands ${JSON.stringify(seen.view.pairs.map((p) => p.band))}`);
     }

@@ -34,7 +34,7 @@ trap cleanup EXIT
 pids+=($!)
 # tc1 away from the others, asking for a leg over the middle; tc2 and tc3 at rest toward it.
 "$BIN/site_reports_writer" --site "$SITE" --seconds 120 \
-  --at tc1:3.1:0.5:0.2 --at tc2:0.3:0.7:0.3 --at tc3:0.0:0.6:0.2 --ask tc1:-0.5:0.9:1.0 > "$OUT/writer.log" 2>&1 &
+  --at tc1:3.1:0.5:0.2 --at tc2:0.3:0.7:0.3 --at tc3:0.0:0.6:0.2 --ask tc1:-0.5:0.9:1.0 --work tc1:123.4 --work tc3:56.7 > "$OUT/writer.log" 2>&1 &
 pids+=($!)
 "$BIN/crane_web" --config "$CONFIG" --site "$SITE" --port 0 > "$OUT/web.log" 2>&1 &
 pids+=($!)

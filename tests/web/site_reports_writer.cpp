@@ -1,11 +1,13 @@
 // The cranes of a site as the site page's test plays them (tests/web/site_page_test.sh): on the
 // site's domain, every 100 ms, one report per crane named with --at: at rest at its pose, and,
 // for a crane named with --ask, a request for a leg from there (hook up at the pose's cable
-// length, to the slew and trolley asked, down to the cable length asked). It obeys nothing; the
+// length, to the slew and trolley asked, down to the cable length asked), with the work left a
+// crane named with --work reports (0 for the others). It obeys nothing; the
 // site service grants or holds as it would for real cranes. Ends on SIGINT/SIGTERM or after
 // --seconds.
 //
-//   site_reports_writer --site F --at tc1:SLEW:TROLLEY:CABLE ... [--ask tc1:SLEW:TROLLEY:CABLE] [--seconds S]
+//   site_reports_writer --site F --at tc1:SLEW:TROLLEY:CABLE ... [--ask tc1:SLEW:TROLLEY:CABLE]
+//                       [--work tc1:SECONDS ...] [--seconds S]
 //   (SLEW in rad, TROLLEY and CABLE in m)
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -56,6 +58,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> at, ask;
   app.add_option("--at", at, "NAME:SLEW:TROLLEY:CABLE, a crane at rest")->required();
   app.add_option("--ask", ask, "NAME:SLEW:TROLLEY:CABLE, the leg a crane asks for");
+  std::vector<std::string> work;
+  app.add_option("--work", work, "NAME:SECONDS, the work left a crane reports");
   double seconds = 60.0;
   app.add_option("--seconds", seconds, "how long to report");
   CLI11_PARSE(app, argc, argv);
@@ -75,6 +79,11 @@ int main(int argc, char** argv) {
       const ac::Pose from = r.waypoints.front();
       r.request_id = 1;
       r.request = {from, {to.slew, to.trolley, from.cable_length}, to};
+    }
+    for (const auto& text : work) {
+      const auto colon = text.find(':');
+      if (colon == std::string::npos) throw std::invalid_argument("'" + text + "' is not NAME:SECONDS");
+      reports.at(index_of(layout, text.substr(0, colon))).work_left = std::stod(text.substr(colon + 1));
     }
     if (app.count("--domain") == 0) options.domain_id = static_cast<std::uint32_t>(layout.domain_id);
     runtime::install_stop_handlers(nullptr);

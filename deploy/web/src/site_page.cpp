@@ -126,6 +126,7 @@ json site_page_json(const ac::SiteWatch& watch, double time) {
                            : seen.order->kind == ac::Instruction::Kind::go ? json("go")
                                                                             : json("yield");
     json parts = json::array();
+    crane["work_left_s"] = seen.report ? json(seen.report->work_left) : json(nullptr);
     if (seen.report) {
       crane["pose"] = {{"slew", seen.report->slew}, {"trolley", seen.report->trolley},
                        {"cable_length", seen.report->cable_length}};

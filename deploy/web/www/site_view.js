@@ -131,11 +131,13 @@
         c.name + " waits for " + c.waits_for.join(", ") + " (" + c.wait_reason +
         (c.waited_s !== null ? ", " + fixed(c.waited_s, 0) + " s" : "") + ")");
     document.getElementById("waits").textContent = waits.join("; ");
-    const rows = [["", "crane", "state", "holding", "request", "instruction", "slew [deg]", "trolley [m]", "cable [m]", "heard [s ago]"]];
+    const rows = [["", "crane", "state", "holding", "request", "instruction", "slew [deg]", "trolley [m]", "cable [m]",
+                   "work left [s]", "heard [s ago]"]];
     view.cranes.forEach((c, i) => {
       rows.push([i, c.name, c.state, c.holding || "-", c.waiting ? "waiting" : "-", c.instruction || "-",
                  c.pose ? fixed(c.pose.slew * 180 / Math.PI, 1) : "-", c.pose ? fixed(c.pose.trolley, 3) : "-",
-                 c.pose ? fixed(c.pose.cable_length, 3) : "-", fixed(c.heard_s_ago, 1)]);
+                 c.pose ? fixed(c.pose.cable_length, 3) : "-", c.work_left_s !== null ? fixed(c.work_left_s, 1) : "-",
+                 fixed(c.heard_s_ago, 1)]);
     });
     const table = document.getElementById("cranes");
     table.replaceChildren(...rows.map((r, k) => {

@@ -154,17 +154,17 @@ int main(int argc, char** argv) {
     }
     nlohmann::json out{{"epoch", last->epoch}, {"cranes", nlohmann::json::array()}, {"pairs", nlohmann::json::array()}};
     std::printf("%-8s %-12s %-8s %-10s %-12s %-8s %-9s %s\n", "crane", "holding", "request", "waits_for", "why",
-                "waited_s", "reported", "slew_deg trolley_m cable_m");
+                "waited_s", "reported", "slew_deg trolley_m cable_m work_left_s");
     for (std::size_t i = 0; i < n && i < last->holding.size(); ++i) {
       const std::string holding(protocol::code_name(SiteStatus::kCodes, "HOLDING", last->holding[i]));
       const auto& report = cranes[i].report;
       const std::string state = !report ? "-"
                                 : report->state == protocol::SiteReport::STATE_MOVING ? "moving"
                                                                                      : "at_rest";
-      char pose[96] = "-";
-      if (report) {
-        std::snprintf(pose, sizeof pose, "%8.1f %9.3f %7.3f", report->slew * 180.0 / 3.14159265358979323846,
-                      report->trolley, report->cable_length);
+      char pose[128] = "-";
+      if (report) {  // and its work left (the rule of the most work left first)
+        std::snprintf(pose, sizeof pose, "%8.1f %9.3f %7.3f %11.1f", report->slew * 180.0 / 3.14159265358979323846,
+                      report->trolley, report->cable_length, report->work_left);
       }
       // Why it waits for them (a WAIT_* name) and how long its request has waited.
       const std::string why = last->waits_for[i] == 0
@@ -178,6 +178,7 @@ int main(int argc, char** argv) {
       nlohmann::json row{{"name", layout.cranes[i].name}, {"holding", holding}, {"reports", cranes[i].reports},
                          {"state", state}, {"waits_for", waits_for(layout, *last, i)}, {"why", why}};
       if (last->pending[i]) row["waited_s"] = last->waited[i];
+      if (report) row["work_left_s"] = report->work_left;
       if (cranes[i].reports > 0) {  // [s] since the tool started: the rate is reports over the span
         row["first_report_s"] = cranes[i].first_heard;
         row["last_report_s"] = cranes[i].heard;

@@ -14,6 +14,7 @@
 //              "waiting": bool, "waits_for": ["tc2", ...], "wait_reason": null (it waits for none) |
 //              "held" | "starving" | "higher_cable" | "most_work_left" (SiteStatus_'s WAIT_*), "waited_s": s (how long its
 //              request has waited) | null (none pending), "instruction": "go" | "yield" | null,
+//              "work_left_s": s (its reported estimate of its jobs left alone) | null (no report),
 //              "pose": null | {"slew": rad, "trolley": m, "cable_length": m},
 //              "parts": [{"part": "jib", "a": [x, y, z], "b": [x, y, z], "radius": m,
 //                         "upright": bool}, ...],
