@@ -326,6 +326,16 @@ TEST_F(Link, ItsWorkLeftByHand) {
   ASSERT_EQ(link_->phase(), CraneSiteLink::Phase::done);
   EXPECT_EQ(link_->work_left(), 0.0);
 
+  // A NaN estimate at rest (a crane whose estimator fails, asking from where it stands): no throw
+  // in the cycle, and the estimate it had is kept.
+  CraneSiteLink fresh(layout_, 0, params_, {SiteJob{{0.0, 0.9, 1.5}, {-1.5, 0.5, 1.2}}}, kFirstGoal);
+  CraneState nan_estimate{};
+  nan_estimate.slew_angle = std::nan("");
+  fresh.heard(0.0);
+  EXPECT_NO_THROW((void)fresh.step(0.0, nan_estimate, Reference{}, false));
+  EXPECT_EQ(fresh.work_left(), 0.0);
+  EXPECT_EQ(fresh.report()->work_left, 0.0);
+
   EXPECT_EQ(moves_time(std::vector<Pose>{{0.0, 0.3, 0.2}}, params_), 0.0);
   EXPECT_THROW((void)moves_time(std::vector<Pose>{{0.0, 0.3, 0.2}, {std::nan(""), 0.3, 0.2}}, params_),
                std::invalid_argument);

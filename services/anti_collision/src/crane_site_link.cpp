@@ -3,7 +3,9 @@
 #include "crane/trajectory_planner/trapezoid_profile.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -67,6 +69,33 @@ void check_rates(const CraneLinkParams& params, const char* who) {
     throw std::invalid_argument(std::string(who) + ": slew_speed = " + std::to_string(params.slew_speed) +
                                 " must be >= 0");
   }
+}
+
+bool finite(const Pose& p) noexcept {
+  return std::isfinite(p.slew) && std::isfinite(p.trolley) && std::isfinite(p.cable_length);
+}
+
+// moves_time, its arguments checked.
+double checked_moves_time(std::span<const Pose> poses, const CraneLinkParams& params) {
+  using trajectory_planner::AxisLimits;
+  using trajectory_planner::TrapezoidProfile;
+  const AxisLimits trolley{params.rated.trolley.rated_speed, params.rated.trolley.acceleration};
+  const AxisLimits slew{params.slew_speed > 0.0 ? params.slew_speed : params.rated.slew.rated_speed,
+                        params.slew_acceleration};
+  const AxisLimits hoist{params.rated.hoist.rated_speed, params.rated.hoist.acceleration};
+  const double swing_period = 2.0 * std::numbers::pi * std::sqrt(params.travel_cable_length / params.gravity);
+  const std::vector<Pose> stops = stops_of(poses);
+  double total = 0.0;
+  for (std::size_t k = 1; k < stops.size(); ++k) {
+    const Pose& a = stops[k - 1];
+    const Pose& b = stops[k];
+    const double move = std::max({TrapezoidProfile(a.slew, b.slew, slew).duration(),
+                                  TrapezoidProfile(a.trolley, b.trolley, trolley).duration(),
+                                  TrapezoidProfile(a.cable_length, b.cable_length, hoist).duration()});
+    const bool travel = a.slew != b.slew || a.trolley != b.trolley;
+    total += move + (travel ? swing_period : 0.0) + kSettleAllowance;
+  }
+  return total;
 }
 
 }  // namespace
@@ -172,6 +201,14 @@ CraneSiteLink::CraneSiteLink(const SiteLayout& layout, std::size_t crane, const 
     check_point(c, jobs[j].place, j, "place");
     legs_.push_back({jobs[j].pick, false});
     legs_.push_back({jobs[j].place, true});
+  }
+  work_state_.fill(std::numeric_limits<double>::quiet_NaN());
+  // Each leg after the first from the work point before it, at the travel height.
+  legs_after_.assign(legs_.size(), 0.0);
+  for (std::size_t k = legs_.size(); k-- > 1;) {
+    const WorkPoint& before = legs_[k - 1].at;
+    legs_after_[k - 1] = legs_after_[k] + params_.dwell +
+                         checked_moves_time(leg_path({before.slew, before.trolley, params_.travel_cable_length}, k), params_);
   }
 }
 
@@ -325,6 +362,7 @@ std::optional<Request> CraneSiteLink::step(double time, const protocol::CraneSta
   // At rest with legs left, it asks in the same cycle: its report never shows it idle between two
   // legs (the service would take it for an idle crane in the way and tell it to yield).
   if (phase_ == Phase::resting && !link_lost_) rest_at(pose_, time);
+  refresh_work_left();
   return goal;
 }
 
@@ -553,36 +591,23 @@ std::optional<CraneReport> CraneSiteLink::report() const {
 
 double moves_time(std::span<const Pose> poses, const CraneLinkParams& params) {
   check_rates(params, "moves_time");
-  for (const Pose& p : poses) {
-    if (!std::isfinite(p.slew) || !std::isfinite(p.trolley) || !std::isfinite(p.cable_length)) {
-      throw std::invalid_argument("moves_time: a pose is not finite");
-    }
-  }
-  using trajectory_planner::AxisLimits;
-  using trajectory_planner::TrapezoidProfile;
-  const AxisLimits trolley{params.rated.trolley.rated_speed, params.rated.trolley.acceleration};
-  const AxisLimits slew{params.slew_speed > 0.0 ? params.slew_speed : params.rated.slew.rated_speed,
-                        params.slew_acceleration};
-  const AxisLimits hoist{params.rated.hoist.rated_speed, params.rated.hoist.acceleration};
-  const double swing_period = 2.0 * std::numbers::pi * std::sqrt(params.travel_cable_length / params.gravity);
-  const std::vector<Pose> stops = stops_of(poses);
-  double total = 0.0;
-  for (std::size_t k = 1; k < stops.size(); ++k) {
-    const Pose& a = stops[k - 1];
-    const Pose& b = stops[k];
-    const double move = std::max({TrapezoidProfile(a.slew, b.slew, slew).duration(),
-                                  TrapezoidProfile(a.trolley, b.trolley, trolley).duration(),
-                                  TrapezoidProfile(a.cable_length, b.cable_length, hoist).duration()});
-    const bool travel = a.slew != b.slew || a.trolley != b.trolley;
-    total += move + (travel ? swing_period : 0.0) + kSettleAllowance;
-  }
-  return total;
+  if (!std::all_of(poses.begin(), poses.end(), finite)) throw std::invalid_argument("moves_time: a pose is not finite");
+  return checked_moves_time(poses, params);
 }
 
-double CraneSiteLink::work_left() const {
-  if (!stepped_ || next_leg_ >= legs_.size() || phase_ == Phase::done || phase_ == Phase::braked ||
-      phase_ == Phase::aborted) {
-    return 0.0;
+void CraneSiteLink::refresh_work_left() {
+  // What the estimate depends on (rest_of_path() included), compared with the last: far cheaper
+  // than the estimate, and no allocation.
+  const std::array<double, kWorkStateSize> state{
+      static_cast<double>(phase_), static_cast<double>(next_leg_), static_cast<double>(waypoint_),
+      start_next_ ? 1.0 : 0.0, static_cast<double>(request_id_), yielding_ ? 1.0 : 0.0,
+      static_cast<double>(rest_of_leg_.size()), static_cast<double>(path_.size()), passed_.slew, passed_.trolley,
+      passed_.cable_length};
+  if (state == work_state_) return;
+  work_state_ = state;
+  if (next_leg_ >= legs_.size() || phase_ == Phase::done || phase_ == Phase::braked || phase_ == Phase::aborted) {
+    work_left_ = 0.0;
+    return;
   }
   // The rest of the leg it is on, from where it stands (or where its yield ends).
   std::vector<Pose> rest;
@@ -604,16 +629,12 @@ double CraneSiteLink::work_left() const {
   const auto at_work_point = [&](const Pose& p) {
     return p.slew == w.slew && p.trolley == w.trolley && std::abs(p.cable_length - w.cable_length) < kSameCable;
   };
-  double total = moves_time(rest, params_);
+  if (!std::all_of(rest.begin(), rest.end(), finite)) return;  // a NaN estimate: keep the last
+  double total = checked_moves_time(rest, params_) + legs_after_[next_leg_];
   if (std::any_of(rest.begin() + std::min<std::ptrdiff_t>(1, std::ssize(rest)), rest.end(), at_work_point)) {
     total += params_.dwell;
   }
-  // Each leg after it, from the work point before at the travel height.
-  for (std::size_t k = next_leg_ + 1; k < legs_.size(); ++k) {
-    const WorkPoint& before = legs_[k - 1].at;
-    total += moves_time(leg_path({before.slew, before.trolley, params_.travel_cable_length}, k), params_) + params_.dwell;
-  }
-  return total;
+  work_left_ = total;
 }
 
 std::vector<Pose> CraneSiteLink::rest_of_path() const {

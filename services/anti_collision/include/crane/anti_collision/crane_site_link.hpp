@@ -65,6 +65,7 @@
 // seq already taken, one of fewer than 2 waypoints, and a go that names no part's stops of the
 // request it answers (returns false); step() never throws.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -187,8 +188,10 @@ class CraneSiteLink {
   /// service's rule 0 ranks the crane with the most first): moves_time of the rest of the leg it is
   /// on (from where it stands, or from its yield's end: a crane halted or yielding asks for the whole
   /// leg again) and of each leg after, plus the dwell of each work point still ahead. 0 when done,
-  /// braked or given up.
-  [[nodiscard]] double work_left() const;
+  /// braked or given up. As of the last step() that changed what the crane does (its phase, request,
+  /// waypoint, the point it has passed, its leg); a rest of the leg with a non-finite pose (a NaN
+  /// estimate) keeps the estimate before. noexcept: read every cycle.
+  [[nodiscard]] double work_left() const noexcept { return work_left_; }
   /// True when the report changed since the last call (send it now, not only at the period).
   [[nodiscard]] bool report_changed() noexcept;
 
@@ -247,6 +250,8 @@ class CraneSiteLink {
   /// Leg `leg` from `here`: hoist up to the travel height (unless there), travel with waypoints on
   /// its way (the site file's travel_step), lower to the work point, hoist up. What it asks for.
   [[nodiscard]] std::vector<Pose> leg_path(const Pose& here, std::size_t leg) const;
+  /// work_left_ from the crane's state now, when that changed since the last (step()).
+  void refresh_work_left();
   /// What it holds of its path: from the last waypoint it reached, or from the point of the segment
   /// under way it has reported passing (passed_, when it is not the segment's start), to the end.
   [[nodiscard]] std::vector<Pose> rest_of_path() const;
@@ -260,6 +265,11 @@ class CraneSiteLink {
   CraneLinkParams params_;
   GrantGuard guard_;
   std::vector<Leg> legs_;
+  std::vector<double> legs_after_;   // [s] legs_after_[k]: moves_time and dwells of the legs after leg k
+  double work_left_{0.0};            // [s] work_left()
+  static constexpr std::size_t kWorkStateSize = 11;
+  std::array<double, kWorkStateSize> work_state_{};  // what work_left_ was computed from (refresh_work_left):
+                                                     // NaN until the first step (NaN equals nothing)
   std::size_t next_leg_{0};
   Phase phase_{Phase::resting};
   std::uint32_t goal_id_;            // the last goal's request id
