@@ -740,6 +740,15 @@ StopSeen stopped_for_good(const std::vector<BoardMonitor::Write>& writes, std::i
   return seen;
 }
 
+// Whether the crane drives now, as stopped_for_good counts it: the board had energized outputs
+// within the last 3 cycles. A stall of the command chain on a loaded machine makes the bridge hold
+// its outputs safe and brake the drives under way (WARNING_DRIVES_BRAKED): seen in a local CI run,
+// 2026-11-30, safe writes from 36 ms before an estop was typed to the command. A stop typed then
+// finds no crane driving.
+bool driving_now(HilStack& stack) {
+  return stopped_for_good(stack.monitor().writes(), hb::monotonic_time_ns()).driving;
+}
+
 // What the board and the supervisor showed in the second before `ns` (a failure's diagnostic): each
 // safe write, and each status whose mode, warnings or faults differ from the one before.
 std::string recent_history(HilStack& stack, std::int64_t ns) {
@@ -795,6 +804,7 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
   std::vector<double> relayed, direct;
   constexpr int kStops = 5;
   int protective_stops = 0;  // moves the supervisor stopped itself before the command was typed
+  int paused_moves = 0;      // moves braked when the command would be typed (driving_now)
   // After a protective stop, `deploy/crane reset`: the supervisor refuses it (exit 3) while a fault
   // is still active, as an overspeed is while the braked trolley slows down (seen in a local CI run,
   // 2026-11-27: a reset typed as the fault latched was refused). Asked again each 0.5 s, 5 s at most;
@@ -841,7 +851,16 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
       ASSERT_TRUE(stack.start_move(at < 0.65 ? 1.0 : 0.3)) << "stop " << i << " from " << at << " m";
       stack.run_for(0.5);
       ASSERT_TRUE(stack.status().has_value());
-      if (stack.status()->mode() != Status::MODE_FAULT) break;
+      if (stack.status()->mode() != Status::MODE_FAULT && driving_now(stack)) break;
+      if (stack.status()->mode() != Status::MODE_FAULT) {
+        // Braked under way: moved again (at most 3 times a stop), counted.
+        ASSERT_LT(attempt, 3) << "no move was driving before stop " << i << "\n"
+                              << recent_history(stack, hb::monotonic_time_ns());
+        ++paused_moves;
+        std::printf("[ note     ] stop %d: no energized output in the last 3 cycles (mode %d, warnings 0x%x); move again\n", i,
+                    static_cast<int>(stack.status()->mode()), stack.status()->warnings());
+        continue;
+      }
       ASSERT_LT(attempt, 3) << "the supervisor stopped every move before stop " << i << "\n"
                             << recent_history(stack, hb::monotonic_time_ns());
       ++protective_stops;
@@ -889,8 +908,8 @@ TEST(FaultInjection, EmergencyStopFromTheOperatorsShellBrakesAtOnce) {
     return std::string(text);
   };
   std::printf("[ figure   ] deploy/crane estop to brakes engaged, %d stops each: operator relay %s; a participant of its "
-              "own (--direct) %s; moves stopped by the supervisor before the command: %d\n",
-              kStops, summary(relayed).c_str(), summary(direct).c_str(), protective_stops);
+              "own (--direct) %s; moves stopped by the supervisor before the command: %d; moves braked by a stall before it: %d\n",
+              kStops, summary(relayed).c_str(), summary(direct).c_str(), protective_stops, paused_moves);
   const auto relay_log = read_file(stack.dir() / "operator_relay.log");
   std::size_t served = 0;
   for (auto at = relay_log.find("operator command 'estop'"); at != std::string::npos;
@@ -937,8 +956,13 @@ TEST(FaultInjection, TheOperatorRelayServesAnEstopBesideHostileClients) {
   const int malformed = connect_relay();
   EXPECT_EQ(write(malformed, "estop\n", 6), 6);  // its argument lacks the NUL
 
-  ASSERT_TRUE(stack.start_move(1.0));
-  stack.run_for(0.5);
+  // Driving when the estop is typed (driving_now: a move braked by a stall is moved again).
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    ASSERT_TRUE(stack.start_move(attempt % 2 == 0 ? 1.0 : 0.3));
+    stack.run_for(0.5);
+    if (driving_now(stack)) break;
+    std::printf("[ note     ] no energized output in the last 3 cycles; move again\n");
+  }
   const std::string script = "CRANE_BUILD_DIR='" + kBin + "/..' '" + std::string(CRANE_SOURCE_DIR) + "/deploy/crane' estop --domain " +
                              std::to_string(stack.domain()) + " > /dev/null";
   const std::int64_t typed_ns = hb::monotonic_time_ns();
