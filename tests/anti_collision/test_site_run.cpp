@@ -243,6 +243,41 @@ TEST(SiteRun, ACraneThatLeavesItsGrantIsBrakedByItsOwnGuard) {
               o.guard_first.c_str(), o.min_distance, o.closest.c_str());
 }
 
+// Every crane's plant 10 % less friction than its stack assumes (SiteRunOptions::plant_mismatch,
+// `crane_site demo --plant-mismatch 1 1 0.9`): the friction compensation then overcompensates,
+// and the default controller's hold (delay1) limit-cycles with the load swinging (docs/site.md,
+// "Plants off their configuration"). Whatever the control does, the site keeps its stop margin:
+// the guards brake a crane whose swing leaves its grant, and its supervisor latches what it sees.
+// The mismatch reaches the plants: the same jobs end otherwise than on the nominal plants.
+TEST(SiteRun, PlantsOffTheirConfigurationStillKeepTheStopMargin) {
+  const auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
+  const StackConfig config = load_site_crane_config(site);
+  const auto jobs = random_site_jobs(site, config, 2, 1);
+  SiteRunOptions options;
+  options.time_limit = 300.0;
+  const SiteOutcome nominal = run_site(site, config, jobs, options);
+  options.plant_mismatch.friction_factor = 0.9;
+  const SiteOutcome off = run_site(site, config, jobs, options);
+  EXPECT_TRUE(nominal.completed);
+  EXPECT_GE(nominal.min_distance, site.margins.stop) << nominal.closest;
+  EXPECT_GE(off.min_distance, site.margins.stop) << off.closest;
+  int nominal_unsettled = 0, off_unsettled = 0, faulted = 0, braked = 0;
+  for (const auto& c : nominal.cranes) nominal_unsettled += c.unsettled_moves;
+  for (const auto& c : off.cranes) {
+    off_unsettled += c.unsettled_moves;
+    faulted += c.latched_faults != 0 ? 1 : 0;
+    braked += std::isfinite(c.braked_at) ? 1 : 0;
+  }
+  EXPECT_TRUE(off.completed != nominal.completed || off.total_time != nominal.total_time ||
+              off_unsettled != nominal_unsettled)
+      << "the plants' friction changed nothing: the mismatch did not reach them";
+  std::printf("nominal plants: completed %d, %.1f s, %d moves unsettled, min distance %.3f m; friction x0.9: completed "
+              "%d, %.1f s, %d moves unsettled, %d cranes faulted, %d braked by their guard (%s), min distance %.3f m "
+              "(%s)\n",
+              nominal.completed ? 1 : 0, nominal.total_time, nominal_unsettled, nominal.min_distance, off.completed ? 1 : 0,
+              off.total_time, off_unsettled, faulted, braked, off.guard_first.c_str(), off.min_distance, off.closest.c_str());
+}
+
 TEST(SiteRun, ASiteOfOneCraneRunsAsThatCraneAlone) {
   auto site = crane::anti_collision::load_site_layout(kSource + "/deploy/config/site_three_towers.yaml");
   site.cranes.resize(1);

@@ -20,7 +20,9 @@
 //       and prints the reaction times; --degraded D, D random degraded links (delay and loss,
 //       stack::random_degraded_links); --stopped-hosts H, H cranes' hosts stopped for good
 //       (stack::random_host_stops), put out of service by the site operator S s after the stop with
-//       --out-of-service-after S; --shared-points P draws jobs that share fewer points.
+//       --out-of-service-after S; --shared-points P draws jobs that share fewer points;
+//       --plant-mismatch L M F runs every crane's plant off its configuration (cable length, load
+//       mass and friction factors, in every mode).
 //
 //   crane_site jobs --site FILE [--jobs J] [--seed S] --out DIR
 //       the demo's seeded job set S (the same jobs `demo --sets 1 --seed S` runs) written as one job
@@ -152,7 +154,7 @@ struct SetResult {
 };
 
 int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, int threads, const DemoFaults& injected,
-         const crane::stack::SiteJobDraw& draw, bool bound) {
+         const crane::stack::SiteJobDraw& draw, bool bound, const crane::plant::PlantMismatch& mismatch) {
   const int faults = injected.lost;
   const int degraded = injected.degraded;
   using namespace crane::stack;
@@ -179,6 +181,7 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
         options.host_stops = random_host_stops(site, injected.stopped_hosts, seed + static_cast<std::uint64_t>(s));
         for (HostStop& h : options.host_stops) h.out_of_service_after = injected.out_of_service_after;
         options.loss_seed = seed + static_cast<std::uint64_t>(s);
+        options.plant_mismatch = mismatch;  // every mode's plants alike
         r.coordinated = run_site(site, config, set, options);
         options.faults.clear();
         options.host_stops.clear();
@@ -245,6 +248,10 @@ int demo(const std::string& site_path, int sets, int jobs, std::uint64_t seed, i
   if (draw.others_clear) {  // --shared-points
     std::printf("; points within another crane's reach with probability %.2f, the others clear of every other jib",
                 draw.shared_probability);
+  }
+  if (mismatch.cable_length_factor != 1.0 || mismatch.load_mass_factor != 1.0 || mismatch.friction_factor != 1.0) {
+    std::printf("; every crane's plant off its configuration: cable length x%.2f, load mass x%.2f, friction x%.2f",
+                mismatch.cable_length_factor, mismatch.load_mass_factor, mismatch.friction_factor);
   }
   std::printf("\n\n");
   std::printf("set 0 (seed %llu):\n%-12s %-6s %5s %10s %10s %7s %10s %7s\n", static_cast<unsigned long long>(seed),
@@ -588,6 +595,13 @@ int main(int argc, char** argv) {
                        "probability that a pick or place point lies within another crane's reach, the others then "
                        "clear of every other crane's jib (default: 0.7, the others anywhere: the jobs of docs/site.md)")
           ->check(CLI::Range(0.0, 1.0));
+  std::vector<double> plant_mismatch;
+  demo_command
+      ->add_option("--plant-mismatch", plant_mismatch,
+                   "every crane's simulated plant off its configuration, in every mode (crane_sim's --mismatch): cable "
+                   "length, load mass and friction factors (default: 1 1 1)")
+      ->expected(3)
+      ->check(CLI::Range(0.1, 10.0));
   bool bound = false;
   demo_command->add_flag("--bound", bound,
                          "also the bound of any order of grants, from the solo runs (about 13 s of CPU a set more)");
@@ -602,7 +616,13 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    return demo(site_path, sets, jobs, seed, threads, injected, draw, bound);
+    crane::plant::PlantMismatch mismatch;
+    if (plant_mismatch.size() == 3) {
+      mismatch.cable_length_factor = plant_mismatch[0];
+      mismatch.load_mass_factor = plant_mismatch[1];
+      mismatch.friction_factor = plant_mismatch[2];
+    }
+    return demo(site_path, sets, jobs, seed, threads, injected, draw, bound, mismatch);
   }
   return 1;
 }

@@ -135,6 +135,7 @@ SiteOutcome run_together(const ac::SiteLayout& site, const StackConfig& config,
     InProcessOptions o;
     o.initial_slew_angle = start.slew;
     o.initial_trolley_position = start.trolley;
+    o.mismatch = options.plant_mismatch;
     if (cranes[i].stop_cycle < limit) {  // from its host's stop on, nothing reaches its drives
       o.lost_commands_from = cranes[i].stop_cycle;
       o.lost_commands = limit + 1 - cranes[i].stop_cycle;

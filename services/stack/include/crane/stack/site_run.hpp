@@ -41,6 +41,7 @@
 #include "crane/anti_collision/crane_site_link.hpp"
 #include "crane/anti_collision/schedule_bound.hpp"
 #include "crane/anti_collision/site_arbiter.hpp"
+#include "crane/plant/plant_stage.hpp"
 #include "crane/stack/stack_config.hpp"
 
 namespace crane::stack {
@@ -112,6 +113,9 @@ struct SiteRunOptions {
   std::vector<LinkFault> faults;
   std::vector<HostStop> host_stops;
   std::uint64_t loss_seed{1};  // draws which messages a degraded link loses
+  // Every crane's simulated plant off its configuration, as crane_sim's --mismatch: the cable length,
+  // load mass and friction factors (plant::PlantMismatch; the stacks still assume the configuration).
+  plant::PlantMismatch plant_mismatch{};
   // A crane that disobeys: at `time` [s] crane `crane` is told to move to `to` without asking the
   // site service (a test of its guard, grant_guard.hpp).
   struct Rogue {
