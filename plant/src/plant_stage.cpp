@@ -1,6 +1,7 @@
 #include "crane/plant/plant_stage.hpp"
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 
 #include "crane/common/validation.hpp"
@@ -29,6 +30,18 @@ void validate(const PlantMismatch& m) {
   common::require_in_range("plant.mismatch.friction_factor", m.friction_factor, 0.0, 10.0);
   common::require_in_range("plant.mismatch.sensor_delay_cycles", m.sensor_delay_cycles, 0, PlantStage::kMaxSensorDelay);
   common::require_in_range("plant.mismatch.friction_change_factor", m.friction_change_factor, 0.1, 10.0);
+}
+
+PlantMismatch mismatch_from_factors(std::span<const double> factors) {
+  if (factors.size() != 3) {
+    throw std::invalid_argument("plant mismatch: " + std::to_string(factors.size()) +
+                                " factors given, 3 expected (cable length, load mass, friction)");
+  }
+  PlantMismatch m;
+  m.cable_length_factor = factors[0];
+  m.load_mass_factor = factors[1];
+  m.friction_factor = factors[2];
+  return m;
 }
 
 SimulatorParameters read_params(config::YamlSection& s, const common::StackFacts& facts) {

@@ -616,12 +616,8 @@ int main(int argc, char** argv) {
   if (jobs_command->parsed()) return write_jobs(site_path, jobs, seed, out);
   if (demo_command->parsed()) {
     draw.others_clear = shared_option->count() > 0;
-    crane::plant::PlantMismatch mismatch;
-    if (plant_mismatch.size() == 3) {
-      mismatch.cable_length_factor = plant_mismatch[0];
-      mismatch.load_mass_factor = plant_mismatch[1];
-      mismatch.friction_factor = plant_mismatch[2];
-    }
+    const crane::plant::PlantMismatch mismatch =
+        plant_mismatch.empty() ? crane::plant::PlantMismatch{} : crane::plant::mismatch_from_factors(plant_mismatch);
     return demo(site_path, sets, jobs, seed, threads, injected, draw, bound, mismatch);
   }
   return 1;

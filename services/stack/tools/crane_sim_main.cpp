@@ -97,15 +97,6 @@ struct Selection {
   plant::PlantMismatch mismatch{};  // demo: the plant's (crane_demo's --plant-*-factor)
 };
 
-// --mismatch L m f: the plant's cable length, load mass and friction factors (CLI11 checks the count).
-plant::PlantMismatch mismatch_of(const std::vector<double>& factors) {
-  plant::PlantMismatch m;
-  m.cable_length_factor = factors.at(0);
-  m.load_mass_factor = factors.at(1);
-  m.friction_factor = factors.at(2);
-  return m;
-}
-
 // The configuration with the command line's integrator, if any.
 stack::StackConfig load_config(const Selection& s) {
   auto cfg = stack::load_stack_config(s.config_path);
@@ -534,7 +525,7 @@ int follow(const Selection& s, int intervals, bool corners, const std::vector<do
   };
   std::vector<Corner> runs{{"nominal", {}}};
   if (mismatch.size() == 3) {
-    const plant::PlantMismatch m = mismatch_of(mismatch);
+    const plant::PlantMismatch m = plant::mismatch_from_factors(mismatch);
     runs = {{stack::mismatch_label(m), m}};
   }
   if (corners) {
@@ -1110,7 +1101,7 @@ int main(int argc, char** argv) {
   try {
     if (*gantry_cmd) return gantry_gains(full_forward_gain);
     if (*demo_cmd) {
-      if (demo_mismatch.size() == 3) s.mismatch = mismatch_of(demo_mismatch);
+      if (demo_mismatch.size() == 3) s.mismatch = plant::mismatch_from_factors(demo_mismatch);
       return demo(s, out_dir);
     }
     if (*sweep_cmd) {

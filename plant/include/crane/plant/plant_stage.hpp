@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "crane/common/stack_facts.hpp"
 #include "crane/plant/crane_simulator.hpp"
@@ -40,6 +41,10 @@ struct PlantMismatch {
 };
 /// Throws common::ConfigError naming the field ("plant.mismatch.<name>"), the value and the bound.
 void validate(const PlantMismatch& mismatch);
+/// The command lines' `--mismatch L M F` (crane_sim, crane_site demo's --plant-mismatch): the cable
+/// length, load mass and friction factors [-], every other field nominal. std::invalid_argument for
+/// a count other than 3; the ranges are validate()'s, checked where the plant is made.
+[[nodiscard]] PlantMismatch mismatch_from_factors(std::span<const double> factors);
 
 struct PlantStageParams {
   SimulatorParameters simulator{};   // the configured crane, integrator settings, initial state
