@@ -737,7 +737,7 @@ TEST(TrackingStage, AConfidentPayloadEstimateReplacesTheConfiguredMass) {
 
 // The tracking stage's params from its YAML block on `facts`, with the follower law.
 tracking::TrackingStageParams follower_stage_params(const common::StackFacts& facts) {
-  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true, estimate_friction_factor: false}");
   config::YamlSection block(yaml, "tracking");
   tracking::TrackingStageParams params = tracking::read_params(block, facts);
   params.law = tracking::TrackingLaw::follower;
@@ -810,6 +810,15 @@ TEST(TrackingStage, TheFollowerLawAppliesTheFeedforwardAndGainTheReferenceCarrie
   EXPECT_EQ(command.sliding_friction_reduction, 0.0);
 }
 
+// The factor handed along a move: 1 until the estimate has rows enough (cycle `first_estimate`,
+// recorded here the first time `factor` leaves 1), then toward `target` at 1/s, 0.01 a cycle.
+void expect_ramp_to(double target, int k, double factor, int& first_estimate) {
+  if (first_estimate < 0 && factor != 1.0) first_estimate = k;
+  if (first_estimate >= 0) {
+    EXPECT_NEAR(factor, std::min(target, 1.0 + 0.01 * (k - first_estimate + 1)), 1e-6) << k;
+  }
+}
+
 // Along a move the follower's stage estimates the plant's friction over the model's from its own
 // feedback (friction_factor_estimate.hpp) and hands it, every cycle, to the friction compensation
 // (LinearCommand_.friction_factor), which scales its stiction and the sliding part it keeps by it:
@@ -849,10 +858,7 @@ TEST(TrackingStage, TheFollowerHandsTheCompensationTheFrictionFactorItEstimatesA
     // The model's friction (1) until the move has 20 rows (from k = 11, where v_ref >= 0.05 m/s),
     // then toward the estimate, 1.3, at 1/s (0.01 a cycle), and 1.3 from then on: the rows add back
     // what the compensation took over, so the estimate does not drift toward 1 as the feedback shrinks.
-    if (first_estimate < 0 && command.friction_factor != 1.0) first_estimate = k;
-    if (first_estimate >= 0) {
-      EXPECT_NEAR(command.friction_factor, std::min(1.3, 1.0 + 0.01 * (k - first_estimate + 1)), 1e-6) << k;
-    }
+    expect_ramp_to(1.3, k, command.friction_factor, first_estimate);
     applied = command.friction_factor;
   }
   EXPECT_EQ(first_estimate, 30);
@@ -870,7 +876,8 @@ TEST(TrackingStage, TheFollowerHandsTheCompensationTheFrictionFactorItEstimatesA
     EXPECT_EQ(command.sliding_friction_reduction, 0.3) << request;
     EXPECT_NEAR(command.friction_factor, 1.3, 1e-6) << request;
   }
-  // A new move starts with the model's friction (factor 1) until it has rows of its own.
+  // A new move starts with the model's friction (factor 1) until it has rows of its own (the PD
+  // law's carries the last move's; ThePdLawEstimatesTheFrictionFactorWhenConfiguredAndCarriesItToTheNextMove).
   reference.request_id = 5;
   ASSERT_EQ(stage.step(at_rest(301, law.position[0]), reference, protocol::AntiSwingCommand{}, command),
             common::StepStatus::ok);
@@ -885,6 +892,88 @@ TEST(TrackingStage, TheFollowerHandsTheCompensationTheFrictionFactorItEstimatesA
     } catch (const common::ConfigError& error) {
       EXPECT_NE(std::string(error.what()).find("tracking.friction_factor_rate"), std::string::npos) << error.what();
     }
+  }
+}
+
+// With tracking.estimate_friction_factor the PD law (`tracking`, delay1's) estimates the friction
+// factor from its own voltage as the follower does from its feedback (it has no feedforward), hands
+// it along the move at 1/s at most and at the target as estimated, and carries it into the next
+// move: here the trolley's position error is made what a plant with 30 % more friction leaves to the
+// law, 0.3 F(v_ref) + 0.05 a_ref less what the compensation adds with the factor it was handed.
+// Without the setting (the dissertation's (3.5)) the factor stays unset (0).
+TEST(TrackingStage, ThePdLawEstimatesTheFrictionFactorWhenConfiguredAndCarriesItToTheNextMove) {
+  const common::StackFacts facts;
+  const auto stage_params = [&](bool estimate) {
+    const auto yaml = YAML::Load(std::string("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, "
+                                             "slew_enabled: true, estimate_friction_factor: ") +
+                                 (estimate ? "true}" : "false}"));
+    config::YamlSection block(yaml, "tracking");
+    return tracking::read_params(block, facts);
+  };
+  tracking::TrackingStage stage{stage_params(true)};
+  tracking::TrackingStage dissertation{stage_params(false)};
+  const common::AxisFriction& friction = facts.crane.trolley_friction;
+  protocol::Reference reference;
+  reference.cable_length = 1.0;
+  reference.request_id = 4;
+  // The law's voltage per metre of trolley error at rest on the reference (e' = 0, no swing): (3.37).
+  protocol::LinearCommand probe;
+  ASSERT_EQ(dissertation.step(at_rest(1, -0.01), reference, protocol::AntiSwingCommand{}, probe), common::StepStatus::ok);
+  const double per_metre = probe.trolley_voltage / 0.01;
+  ASSERT_GT(per_metre, 1.0);
+  protocol::LinearCommand command;
+  protocol::LinearCommand unset;
+  double applied = 1.0;
+  int first_estimate = -1;
+  // The load swings, and the law's voltage answers it (m_t g phi / K_mx of (3.37)): not friction,
+  // the rows leave it out. Every 7th cycle the drive stands still (a stall): no row.
+  const double swing_volts_per_rad = facts.crane.mass_ratio() * facts.crane.gravity / facts.crane.trolley_drive_gain;
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.01 * k;
+    reference.trolley_position = 0.3 + 0.2 * (1.0 - std::cos(std::numbers::pi * t / 2.0));
+    reference.trolley_velocity = 0.1 * std::numbers::pi * std::sin(std::numbers::pi * t / 2.0);
+    reference.trolley_acceleration = 0.05 * std::numbers::pi * std::numbers::pi * std::cos(std::numbers::pi * t / 2.0);
+    const double sliding = friction.coulomb_positive + friction.viscous_positive * reference.trolley_velocity;
+    const double compensated = std::min(1.0, applied) - 1.0;  // the compensation keeps min(1, f) of F
+    const double voltage = (0.3 - compensated) * sliding + 0.05 * reference.trolley_acceleration;
+    const double swing = 0.03 * std::sin(2.0 * std::numbers::pi * t);  // [rad]
+    auto state = at_rest(static_cast<std::uint64_t>(k + 2), reference.trolley_position - voltage / per_metre);
+    state.swing_in_plane = swing;
+    const bool stalled = k % 7 == 3;
+    state.trolley_velocity = stalled ? 0.0 : reference.trolley_velocity;
+    ASSERT_EQ(stage.step(state, reference, protocol::AntiSwingCommand{}, command), common::StepStatus::ok);
+    ASSERT_EQ(dissertation.step(state, reference, protocol::AntiSwingCommand{}, unset), common::StepStatus::ok);
+    if (!stalled) {
+      EXPECT_NEAR(command.trolley_voltage, voltage + swing_volts_per_rad * swing, 1e-9);
+    }
+    EXPECT_EQ(command.trolley_voltage, unset.trolley_voltage) << "the law's voltage is the dissertation's";
+    EXPECT_EQ(unset.friction_factor, 0.0) << k;
+    // 1 until 20 rows (from k = 11, v >= 0.05 m/s, less the stalled cycles), then toward 1.3 at
+    // 0.01 a cycle.
+    expect_ramp_to(1.3, k, command.friction_factor, first_estimate);
+    applied = command.friction_factor;
+  }
+  EXPECT_EQ(first_estimate, 33);
+  ASSERT_NEAR(applied, 1.3, 1e-6);
+  // At the target and holding (request 0): the estimate. A new move with no travel of its own (the
+  // hoist alone) keeps it.
+  reference.trolley_velocity = 0.0;
+  reference.trolley_acceleration = 0.0;
+  for (const std::uint32_t request : {4U, 0U, 5U}) {
+    reference.request_id = request;
+    reference.cable_length_rate = request == 5 ? 0.1 : 0.0;
+    ASSERT_EQ(stage.step(at_rest(300, reference.trolley_position), reference, protocol::AntiSwingCommand{}, command),
+              common::StepStatus::ok);
+    EXPECT_NEAR(command.friction_factor, 1.3, 1e-6) << request;
+  }
+  // The shipped configurations name the setting (a missing one is an error, as every field).
+  const auto missing = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: true}");
+  config::YamlSection block(missing, "tracking");
+  try {
+    (void)tracking::read_params(block, facts);
+    ADD_FAILURE() << "a block without estimate_friction_factor accepted";
+  } catch (const common::ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("tracking.estimate_friction_factor"), std::string::npos) << error.what();
   }
 }
 
@@ -928,7 +1017,7 @@ TEST(TrackingStage, TheFollowerLawDrivesTheBridgeOfAnOverheadCrane) {
   common::StackFacts overhead;
   overhead.crane_kind = common::CraneKind::overhead;
   overhead.bridge = common::BridgeParameters{50.0, 1.5, {1.0, 1.2, 0.5, 0.6, 0.7, 0.8}};
-  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false}");
+  const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false, estimate_friction_factor: false}");
   config::YamlSection block(yaml, "tracking");
   tracking::TrackingStageParams params = tracking::read_params(block, overhead);
   params.law = tracking::TrackingLaw::follower;
@@ -1236,7 +1325,7 @@ TEST(StagesBridge, TheBridgeGetsTheTrolleyLawOfItsGantryView) {
   // Tracking, from the configuration readers of both facts.
   tracking::TrackingStageParams tp_overhead, tp_gantry;
   {
-    const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false}");
+    const auto yaml = YAML::Load("{proportional_gain: 100.0, derivative_gain: 20.0, min_radius: 0.1, slew_enabled: false, estimate_friction_factor: false}");
     config::YamlSection s1(yaml, "tracking");
     tp_overhead = tracking::read_params(s1, overhead);
     config::YamlSection s2(yaml, "tracking");

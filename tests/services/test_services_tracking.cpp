@@ -210,7 +210,8 @@ TEST(TrackingController, AccelerationFeedforwardAddsTheReferenceAcceleration) {
 
 // The friction factor (friction_factor_estimate.hpp) from rows made by hand: the LQR's part of the
 // voltage is (f - 1) F(v_ref) + c_j a_ref plus seeded noise, on both drive axes at once; f is
-// recovered, an axis without rows (a gantry's second axis) leaves it solvable, too few rows give 1.
+// recovered, an axis without rows (a gantry's second axis) leaves it solvable, too few rows give 1
+// (or the prior a move was started with).
 TEST(FrictionFactorEstimate, RecoversTheFrictionFactorFromTheFeedbackRows) {
   const crane::common::CraneParameters crane;
   // The model's sliding friction (3.1) by hand: c+ + b+ v, -c- + b- v.
@@ -255,6 +256,20 @@ TEST(FrictionFactorEstimate, RecoversTheFrictionFactorFromTheFeedbackRows) {
   sparse.reset();
   EXPECT_EQ(sparse.rows(), 0);
   EXPECT_EQ(sparse.factor(), 1.0);
+  // A prior (the last move's factor) stands until the move has min_rows rows of its own, clamped to
+  // [min_factor, max_factor]; not finite: the model's friction.
+  sparse.reset(0.8);
+  EXPECT_EQ(sparse.factor(), 0.8);
+  for (int k = 0; k < 19; ++k) sparse.add(0, 0.0, 0.3, 0.0);
+  EXPECT_EQ(sparse.factor(), 0.8);
+  sparse.add(0, 0.0, 0.3, 0.0);  // the 20th row: no feedback left, f = 1
+  EXPECT_NEAR(sparse.factor(), 1.0, 1e-12);
+  sparse.reset(7.0);
+  EXPECT_EQ(sparse.factor(), tr::FrictionFactorParams{}.max_factor);
+  sparse.reset(0.1);
+  EXPECT_EQ(sparse.factor(), tr::FrictionFactorParams{}.min_factor);
+  sparse.reset(std::nan(""));
+  EXPECT_EQ(sparse.factor(), 1.0);
 
   // Bad params name the field.
   const auto message = [&](const tr::FrictionFactorParams& p) {
@@ -274,6 +289,48 @@ TEST(FrictionFactorEstimate, RecoversTheFrictionFactorFromTheFeedbackRows) {
   p = {};
   p.min_reference_speed = 0.0;
   EXPECT_NE(message(p).find("friction_factor.min_reference_speed"), std::string::npos) << message(p);
+}
+
+// With max_standard_error (the PD law's estimate, tracking_stage.hpp) f is handed only once the rows
+// know it: the standard error of theta_0 from their residuals, sigma^2 (Phi^T Phi)^-1_00. Rows of a
+// plant of 0.7 with 1 V of noise (30 of them) leave the prior; 250 rows with 0.02 V give f.
+TEST(FrictionFactorEstimate, AFactorNotKnownToWithinTheStandardErrorLeavesThePrior) {
+  const crane::common::CraneParameters crane;
+  tr::FrictionFactorParams params;
+  params.max_standard_error = 0.06;
+  const auto rows = [&](tr::FrictionFactorEstimate& estimate, int count, double sigma, unsigned seed) {
+    std::mt19937 random(seed);
+    std::normal_distribution<double> noise(0.0, sigma);
+    for (int k = 0; k < count; ++k) {
+      const double t = 0.01 * (k + 20);
+      const double v = 0.4 * std::sin(std::numbers::pi * t / 2.5);
+      const double a = 0.4 * std::numbers::pi / 2.5 * std::cos(std::numbers::pi * t / 2.5);
+      const double f = crane.trolley_friction.coulomb_positive + crane.trolley_friction.viscous_positive * v;
+      estimate.add(0, -0.3 * f + 0.08 * a + noise(random), v, a);
+    }
+  };
+  tr::FrictionFactorEstimate noisy(crane.trolley_friction, crane.slew_friction, params);
+  noisy.reset(0.9);
+  rows(noisy, 30, 1.0, 3);
+  EXPECT_EQ(noisy.rows(), 30);
+  EXPECT_EQ(noisy.factor(), 0.9) << "not known: the prior";
+  tr::FrictionFactorEstimate unchecked(crane.trolley_friction, crane.slew_friction);
+  rows(unchecked, 30, 1.0, 3);
+  EXPECT_NE(unchecked.factor(), 1.0) << "without the check the same rows give their f";
+  tr::FrictionFactorEstimate quiet(crane.trolley_friction, crane.slew_friction, params);
+  quiet.reset(0.9);
+  rows(quiet, 230, 0.02, 5);
+  EXPECT_NEAR(quiet.factor(), 0.7, 0.01);
+  for (const double bad : {-0.1, std::numeric_limits<double>::quiet_NaN()}) {
+    tr::FrictionFactorParams p;
+    p.max_standard_error = bad;
+    try {
+      tr::FrictionFactorEstimate refused(crane.trolley_friction, crane.slew_friction, p);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("friction_factor.max_standard_error"), std::string::npos) << error.what();
+    }
+  }
 }
 
 // The breakaway ramp by hand (breakaway_ramp.hpp): 100 Hz, deadband 3 mm, at rest below 5 mm/s for

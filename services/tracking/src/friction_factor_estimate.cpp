@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -20,12 +21,15 @@ FrictionFactorEstimate::FrictionFactorEstimate(const common::AxisFriction& troll
   common::require_in_range("friction_factor.min_rows", params.min_rows, 3, 1000000);
   common::require_greater("friction_factor.min_factor", params.min_factor, 0.0);
   common::require_in_range("friction_factor.max_factor", params.max_factor, params.min_factor, 100.0);
+  common::require_in_range("friction_factor.max_standard_error", params.max_standard_error, 0.0, 100.0);
 }
 
-void FrictionFactorEstimate::reset() noexcept {
+void FrictionFactorEstimate::reset(double prior) noexcept {
+  prior_ = std::isfinite(prior) ? std::clamp(prior, params_.min_factor, params_.max_factor) : 1.0;
   for (auto& row : information_) std::fill(std::begin(row), std::end(row), 0.0);
   std::fill(std::begin(moment_), std::end(moment_), 0.0);
   rows_ = 0;
+  squares_ = 0.0;
 }
 
 void FrictionFactorEstimate::add(int axis, double feedback_voltage, double reference_speed,
@@ -46,11 +50,12 @@ void FrictionFactorEstimate::add(int axis, double feedback_voltage, double refer
     for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];
     moment_[r] += phi[r] * y;
   }
+  squares_ += y * y;
   ++rows_;
 }
 
 double FrictionFactorEstimate::factor() const noexcept {
-  if (rows_ < params_.min_rows) return 1.0;
+  if (rows_ < params_.min_rows) return prior_;
   Eigen::Matrix3d a;
   Eigen::Vector3d b;
   for (int r = 0; r < 3; ++r) {
@@ -61,7 +66,15 @@ double FrictionFactorEstimate::factor() const noexcept {
   a.diagonal().array() += ridge;
   const Eigen::Vector3d theta = a.ldlt().solve(b);
   const double f = 1.0 + theta[0];
-  if (!std::isfinite(f)) return 1.0;
+  if (!std::isfinite(f)) return prior_;
+  if (params_.max_standard_error > 0.0) {
+    // The standard error of theta_0 from the rows' residuals: sigma^2 (Phi^T Phi)^-1_00, sigma^2 the
+    // residual sum of squares over the rows less the three unknowns.
+    const double residual = std::max(0.0, squares_ - 2.0 * theta.dot(b) + theta.dot(a * theta));
+    const double variance = residual / static_cast<double>(std::max(1, rows_ - 3));
+    const double standard_error = std::sqrt(variance * a.inverse()(0, 0));
+    if (!(standard_error <= params_.max_standard_error)) return prior_;
+  }
   return std::clamp(f, params_.min_factor, params_.max_factor);
 }
 

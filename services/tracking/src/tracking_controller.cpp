@@ -100,10 +100,12 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   output.trolley_tracking_action = V_xp;
   output.trolley_normalized_action = V_bar_x;
   output.swing_period = T;
+  output.trolley_swing_voltage = m_t * g * est.swing_in_plane / p.trolley_drive_gain;
   output.command.trolley_voltage = clamp_voltage(V_x, p.voltage_limit, output.trolley_saturated);
   if (p.slew_enabled) {
     output.slew_tracking_action = V_yp;
     output.slew_normalized_action = V_bar_y;
+    output.slew_swing_voltage = -m_r * g * x_safe * est.swing_out_of_plane / p.slew_drive_gain;
     output.command.slew_voltage = clamp_voltage(V_gamma, p.voltage_limit, output.slew_saturated);
   }
   output.command.hoist_speed = ref.cable_length.velocity;
@@ -111,7 +113,8 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   // which the voltage clamp passes through: the safe output instead (found by tests/fuzz/topic_gates).
   const double outputs[] = {output.command.trolley_voltage, output.command.slew_voltage, output.trolley_tracking_action,
                             output.slew_tracking_action, output.trolley_normalized_action,
-                            output.slew_normalized_action, output.swing_period};
+                            output.slew_normalized_action, output.swing_period, output.trolley_swing_voltage,
+                            output.slew_swing_voltage};
   for (const double value : outputs) {
     if (!std::isfinite(value)) {
       output = TrackingOutput{};

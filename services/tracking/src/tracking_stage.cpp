@@ -64,8 +64,10 @@ TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts
   gains.derivative_gain = s.number("derivative_gain", 0.0, 1.0e3);
   gains.min_radius = s.number("min_radius", 1e-3, 100.0);
   gains.slew_enabled = s.flag("slew_enabled");
+  const bool estimate_friction_factor = s.flag("estimate_friction_factor");
   s.finish();
   TrackingStageParams p = params_for(facts.crane, gains, facts);
+  p.estimate_friction_factor = estimate_friction_factor;
   if (facts.crane_kind == common::CraneKind::overhead) {
     TrackingParams bridge_gains = gains;
     bridge_gains.slew_enabled = false;
@@ -82,9 +84,12 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
       voltage_limit_(params.tracking.voltage_limit),
       trolley_drive_mass_(params.trolley_drive_mass),
       jib_inertia_(params.jib_inertia),
-      friction_factor_(params.trolley_friction, params.second_friction),
+      friction_factor_(params.trolley_friction, params.second_friction,
+                       params.law == TrackingLaw::tracking ? params.tracking_friction_factor : FrictionFactorParams{}),
       friction_factor_step_(params.friction_factor_rate * params.sample_period),
-      breakaway_(params.breakaway, params.sample_period) {
+      breakaway_(params.breakaway, params.sample_period),
+      estimate_friction_factor_(params.estimate_friction_factor && params.law == TrackingLaw::tracking),
+      tracking_friction_factor_speed_(params.tracking_friction_factor.min_reference_speed) {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
   common::require_greater("tracking.friction_factor_rate", params.friction_factor_rate, 0.0);
   common::require_finite("tracking.friction_factor_rate", params.friction_factor_rate);
@@ -99,6 +104,7 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
     TrackingStageParams bridge = *params.bridge;
     bridge.law = law_ == TrackingLaw::follower ? TrackingLaw::tracking : law_;  // follow() drives the bridge
     bridge.bridge.reset();
+    bridge.estimate_friction_factor = false;  // this stage estimates it on both drives
     bridge_ = std::make_unique<TrackingStage>(bridge);
   }
 }
@@ -143,6 +149,7 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   command.hoist_speed = result.command.hoist_speed;
   command.trolley_tracking_action = result.trolley_tracking_action;
   command.slew_tracking_action = result.slew_tracking_action;
+  swing_voltage_ = {result.trolley_swing_voltage, result.slew_swing_voltage};
   if (bridge_) {
     protocol::LinearCommand bridge;
     const auto bridge_status = bridge_->step(common::bridge_view(estimate), common::bridge_view(reference),
@@ -151,8 +158,74 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
     command.bridge_tracking_action = bridge.trolley_tracking_action;
     if (status == common::StepStatus::ok) status = bridge_status;
   }
+  if (estimate_friction_factor_ && status == common::StepStatus::ok) {
+    // The PD law has no feedforward. A row is its voltage less the part that answers the load's
+    // swing (the load's reaction, not the drive's friction), along a planned move (not the
+    // operator's stick, request 0, whose stops and stalls the rows do not model), where the measured
+    // speed slides the reference's way (the compensation then adds its sliding part, which the row
+    // assumes; on the filtered slew rate it lags the reference by a few cycles).
+    const bool bridge = bridge_ != nullptr;
+    start_friction_estimate(reference, true);
+    const std::array<double, 2> voltage{command.trolley_voltage, bridge ? command.bridge_voltage : command.slew_voltage};
+    const std::array<double, 2> swing{swing_voltage_[0], bridge ? bridge_->swing_voltage_[0] : swing_voltage_[1]};
+    const std::array<double, 2> speed{estimate.trolley_velocity, bridge ? estimate.bridge_velocity : estimate.slew_rate};
+    const std::array<double, 2> reference_speed{reference.trolley_velocity,
+                                                bridge ? reference.bridge_velocity : reference.slew_rate};
+    std::array<bool, 2> rows{};
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      rows[axis] = reference.request_id != 0 && speed[axis] * reference_speed[axis] > 0.0 &&
+                   std::abs(speed[axis]) >= tracking_friction_factor_speed_;
+    }
+    command.friction_factor = hand_friction_factor(reference, bridge, voltage, swing, 0.0, rows);
+  }
   common::same_cycle(estimate.header, command.header);
   return status;
+}
+
+bool TrackingStage::start_friction_estimate(const protocol::Reference& reference, bool carry) noexcept {
+  if (reference.request_id == 0 || reference.request_id == friction_request_) return false;  // 0: holding
+  // With `carry`, the last move's factor is the new one's until it has rows enough (the plant's
+  // friction does not change with the move; a hoist alone gives no rows); else the model's.
+  const double carried = carry ? friction_factor_.factor() : 1.0;
+  friction_factor_.reset(carried);
+  friction_request_ = reference.request_id;
+  handed_friction_factor_ = carried;
+  return true;
+}
+
+bool TrackingStage::at_target(const protocol::Reference& reference, bool bridge) noexcept {
+  return reference.trolley_velocity == 0.0 && reference.trolley_acceleration == 0.0 &&
+         (bridge ? reference.bridge_velocity : reference.slew_rate) == 0.0 &&
+         (bridge ? reference.bridge_acceleration : reference.slew_acceleration) == 0.0;
+}
+
+double TrackingStage::hand_friction_factor(const protocol::Reference& reference, bool bridge,
+                                           const std::array<double, 2>& voltage, const std::array<double, 2>& known,
+                                           double reduction, const std::array<bool, 2>& rows) noexcept {
+  // Rows along the move, from the feedback's part of each drive's voltage where it is not clamped. A
+  // row adds back the share the compensation took over from the feedback with the factor handed with
+  // the last command. Along the move the handed factor follows the estimate at friction_factor_rate
+  // at most (the prior until this one has rows enough); at the target it is the estimate.
+  const std::array<double, 2> reference_speed{reference.trolley_velocity,
+                                              bridge ? reference.bridge_velocity : reference.slew_rate};
+  const std::array<double, 2> reference_acceleration{
+      reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
+  const double compensated_share = friction_compensation::kept_sliding_share(reduction, handed_friction_factor_) -
+                                   friction_compensation::kept_sliding_share(reduction, 1.0);
+  for (int axis = 0; axis < 2; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    if (rows[a] && std::abs(voltage[a]) < voltage_limit_) {
+      friction_factor_.add(axis, voltage[a] - known[a], reference_speed[a], reference_acceleration[a],
+                           compensated_share);
+    }
+  }
+  const double estimate_factor = friction_factor_.factor();
+  handed_friction_factor_ =
+      at_target(reference, bridge)
+          ? estimate_factor
+          : handed_friction_factor_ + std::clamp(estimate_factor - handed_friction_factor_, -friction_factor_step_,
+                                                 friction_factor_step_);
+  return handed_friction_factor_;
 }
 
 common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
@@ -173,35 +246,12 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
       !(reduction >= 0.0 && reduction <= 1.0)) {
     return common::StepStatus::rejected_nonfinite;  // 0 V, the safe output
   }
-  // The friction factor (friction_factor_estimate.hpp): rows along the move, from the LQR's part of
-  // each drive's voltage where it is not clamped. A row adds back the share the compensation took
-  // over from the feedback with the factor handed with the last command. Along the move the handed
-  // factor follows the estimate at friction_factor_rate at most (1 until the move has rows
-  // enough); at the target it is the estimate.
-  if (reference.request_id != 0 && reference.request_id != friction_request_) {  // a new move (0: holding)
-    friction_factor_.reset();
-    breakaway_.reset();
-    friction_request_ = reference.request_id;
-    handed_friction_factor_ = 1.0;
-  }
-  const std::array<double, 2> reference_speed{reference.trolley_velocity,
-                                              bridge ? reference.bridge_velocity : reference.slew_rate};
-  const std::array<double, 2> reference_acceleration{
-      reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
-  const double compensated_share = friction_compensation::kept_sliding_share(reduction, handed_friction_factor_) -
-                                   friction_compensation::kept_sliding_share(reduction, 1.0);
-  for (int axis = 0; axis < 2; ++axis) {
-    const auto a = static_cast<std::size_t>(axis);
-    if (std::abs(u[a]) < voltage_limit_) {
-      friction_factor_.add(axis, u[a] - law.feedforward[a], reference_speed[a], reference_acceleration[a],
-                           compensated_share);
-    }
-  }
-  const bool at_target = reference_speed[0] == 0.0 && reference_speed[1] == 0.0 && reference_acceleration[0] == 0.0 &&
-                         reference_acceleration[1] == 0.0;
+  // The friction factor (friction_factor_estimate.hpp), from the LQR's part of the voltage.
+  if (start_friction_estimate(reference, false)) breakaway_.reset();
+  command.friction_factor = hand_friction_factor(reference, bridge, u, law.feedforward, reduction, {true, true});
   // At the target, a drive the friction holds at rest off it is ramped toward it.
   std::array<double, 2> voltage = u;
-  if (at_target) {
+  if (at_target(reference, bridge)) {
     for (std::size_t axis = 0; axis < 2; ++axis) {
       const std::size_t slot = axis == 0 ? 0 : 2;  // the trolley, the slew or the bridge
       const double ramp = breakaway_.step(static_cast<int>(axis), position[slot] - law.position[slot], velocity[slot]);
@@ -214,12 +264,6 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   (bridge ? command.bridge_voltage : command.slew_voltage) = voltage[1];
   command.hoist_speed = reference.cable_length_rate;
   command.sliding_friction_reduction = reduction;
-  const double estimate_factor = friction_factor_.factor();
-  handed_friction_factor_ =
-      at_target ? estimate_factor
-                : handed_friction_factor_ + std::clamp(estimate_factor - handed_friction_factor_,
-                                                       -friction_factor_step_, friction_factor_step_);
-  command.friction_factor = handed_friction_factor_;
   return common::StepStatus::ok;
 }
 

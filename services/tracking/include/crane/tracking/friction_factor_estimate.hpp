@@ -19,8 +19,10 @@
 // the axis's own). Least squares over every row of the move, solved when asked:
 //   (Phi^T Phi + ridge I) theta = Phi^T u_fb,
 // the ridge (1e-9 of the information's trace) only so an axis with no rows (a gantry's second axis)
-// leaves its coefficient at 0. factor() is f clamped to [min_factor, max_factor], and 1 while fewer
-// than min_rows rows were taken (no information: the model's friction).
+// leaves its coefficient at 0. factor() is f clamped to [min_factor, max_factor], and the prior while
+// fewer than min_rows rows were taken (or, with max_standard_error, while f is not known to within
+// it): 1 (the model's friction) at first, and what the last move found when reset() is handed it (a
+// move with no travel, the hoist's alone, learns nothing and keeps it).
 //
 // Real-time: add() and factor() are noexcept and allocate nothing. reset() starts a new move.
 // Errors: the constructor throws common::ConfigError naming the field, the value and the bound.
@@ -34,6 +36,10 @@ struct FrictionFactorParams {
   int min_rows{20};                  // [-] >= 3: fewer rows give factor() = 1
   double min_factor{0.5};            // [-] > 0
   double max_factor{2.0};            // [-] >= min_factor
+  // [-] >= 0; > 0: factor() is the prior while the standard error of f (from the rows' residuals) is
+  // above it: a move too short or too disturbed to say (the PD law's rows carry its anti-swing
+  // action, and a short slew alone gives few); 0: no such check (the follower's).
+  double max_standard_error{0.0};
 };
 
 class FrictionFactorEstimate {
@@ -42,8 +48,9 @@ class FrictionFactorEstimate {
   FrictionFactorEstimate(const common::AxisFriction& trolley, const common::AxisFriction& second,
                          const FrictionFactorParams& params = {});
 
-  /// Forgets every row (a new move).
-  void reset() noexcept;
+  /// Forgets every row (a new move); `prior` [-] is factor() until the new move has min_rows rows,
+  /// clamped to [min_factor, max_factor] (not finite: 1).
+  void reset(double prior = 1.0) noexcept;
 
   /// One cycle of axis `axis` (0 or 1): the LQR's part of the voltage [V], the reference speed [m/s
   /// or rad/s] and acceleration, and s [-], the share of the model's sliding friction the
@@ -52,7 +59,7 @@ class FrictionFactorEstimate {
   void add(int axis, double feedback_voltage, double reference_speed, double reference_acceleration,
            double compensated_share = 0.0) noexcept;
 
-  /// f, the plant's sliding friction over the model's (see the header); 1 without enough rows.
+  /// f, the plant's sliding friction over the model's (see the header); the prior without enough rows.
   [[nodiscard]] double factor() const noexcept;
   [[nodiscard]] int rows() const noexcept { return rows_; }
 
@@ -62,6 +69,8 @@ class FrictionFactorEstimate {
   double information_[3][3]{};  // Phi^T Phi
   double moment_[3]{};          // Phi^T u_fb
   int rows_{0};
+  double prior_{1.0};
+  double squares_{0.0};  // sum of the rows' u_fb^2 (the residual's)
 };
 
 }  // namespace crane::tracking

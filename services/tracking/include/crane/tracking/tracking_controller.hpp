@@ -60,6 +60,11 @@ struct TrackingOutput {
   double trolley_normalized_action{0.0};   // [-] V_bar_x = V_xp + V_xs
   double slew_normalized_action{0.0};      // [-] V_bar_y = V_yp + V_ys
   double swing_period{0.0};                // [s] T
+  // [V] the parts of the voltages that answer the load's swing, before the clamp: m_t g phi / K_mx of
+  // (3.37) and -m_r g x theta / K_mgamma of (3.38) (0 with the slew disabled). The friction factor's
+  // rows leave them out (tracking_stage.hpp).
+  double trolley_swing_voltage{0.0};
+  double slew_swing_voltage{0.0};
   bool trolley_saturated{false};
   bool slew_saturated{false};
 };

@@ -22,12 +22,27 @@
 //                            at rest off the target gets the breakaway ramp (breakaway_ramp.hpp); a reference
 //                            without a law (holding, a stop, manual motion) is tracked by
 //                            `tracking`
+// With estimate_friction_factor (the config's tracking.estimate_friction_factor), the `tracking` law
+// too estimates the plant's friction over the model's along each move and hands it to the friction
+// compensation as the follower does (along the move at friction_factor_rate at most, at the target
+// the estimate): the compensation (3.5) then adds f times the model's stiction at rest and min(1, f)
+// of its sliding part, so a plant with less friction than the model is not over-compensated into a
+// limit cycle at the hold, nor one with more left stuck with its swing undamped. Its rows: the law's
+// voltage (it has no feedforward) less its swing terms (TrackingOutput's swing voltages: the load's
+// reaction, not the drive's friction), on a drive whose measured speed slides the reference's way
+// (the compensation then adds the sliding part the row assumes; the filtered slew rate lags the
+// reference). The factor is handed once known to within tracking_friction_factor's
+// max_standard_error, and carried from one move into the next (a hoist alone gives no rows); the
+// follower's starts each move from 1. No breakaway ramp under this law (docs/optimal_control.md,
+// "The friction factor under delay1"). Without the setting, LinearCommand_.friction_factor stays 0
+// (the configured friction) under that law.
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
 // Every law takes the load (m_t, m_r of (3.37)-(3.38) and the gain schedule) from the estimate's
 // payload_mass while payload_confident is set (the online estimate, crane::adaptation), and from the
 // configured crane otherwise.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -65,6 +80,14 @@ struct TrackingStageParams {
   // [1/s] > 0: how fast the friction factor the follower hands the compensation along a move may
   // change (its estimate from the move's first rows is noisy; at the target it hands the estimate).
   double friction_factor_rate{1.0};
+  // The `tracking` law estimates and hands the friction factor too (see the header); false: the
+  // dissertation's (3.5) with the configured friction.
+  bool estimate_friction_factor{false};
+  // The PD law's estimate: its rows carry the anti-swing action, so f is handed only once known to
+  // within max_standard_error (a short slew alone gives too few rows; below it the last move's
+  // factor stands). 0.06 from the ShortCable sweep (docs/robustness.md, "The friction factor under
+  // delay1"); the follower's keeps FrictionFactorParams' defaults.
+  FrictionFactorParams tracking_friction_factor{0.05, 20, 0.5, 2.0, 0.06};
   // The follower's hold at the target: integral action against a drive stuck off it.
   BreakawayRampParams breakaway{};
   double sample_period{0.01};  // [s] > 0, the cycle (facts.sample_period)
@@ -74,7 +97,7 @@ struct TrackingStageParams {
 };
 
 /// Reads the `tracking:` block: proportional_gain [-] in [0, 1e4], derivative_gain [-] in [0, 1e3],
-/// min_radius [m] in [1e-3, 100], slew_enabled; the crane's model constants, the voltage limit and
+/// min_radius [m] in [1e-3, 100], slew_enabled, estimate_friction_factor; the crane's model constants, the voltage limit and
 /// the cable range from facts. The law is `tracking` (processes choose another with --controller).
 /// Throws common::ConfigError naming the field, value and bound.
 [[nodiscard]] TrackingStageParams read_params(config::YamlSection& block, const common::StackFacts& facts);
@@ -97,6 +120,19 @@ class TrackingStage {
   /// The follower law on a reference that carries one.
   [[nodiscard]] common::StepStatus follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
                                           protocol::LinearCommand& command) noexcept;
+  /// A new estimate when `reference` names a move other than the last (request_id 0: holding), from
+  /// the last move's factor with `carry` (the PD law's), else from the model's (1, the follower's);
+  /// true then.
+  bool start_friction_estimate(const protocol::Reference& reference, bool carry) noexcept;
+  /// The reference at rest on both drives (the trolley and the slew, or the bridge).
+  [[nodiscard]] static bool at_target(const protocol::Reference& reference, bool bridge) noexcept;
+  /// This cycle's rows (the drives' voltages [V] less the part the row leaves out, `known` [V]: the
+  /// follower's feedforward, the PD law's swing terms; `reduction` the command's
+  /// sliding_friction_reduction; `rows` the drives that may add one) and the factor to hand with the
+  /// command.
+  [[nodiscard]] double hand_friction_factor(const protocol::Reference& reference, bool bridge,
+                                            const std::array<double, 2>& voltage, const std::array<double, 2>& known,
+                                            double reduction, const std::array<bool, 2>& rows) noexcept;
 
   TrackingLaw law_;
   TrackingController tracking_;
@@ -110,6 +146,9 @@ class TrackingStage {
   double friction_factor_step_;     // [-] the most the handed factor changes in a cycle along a move
   double handed_friction_factor_{1.0};  // handed to the compensation with the last command (this move's)
   BreakawayRamp breakaway_;  // the follower's hold, reset when the reference moves or a move starts
+  bool estimate_friction_factor_;  // under the `tracking` law too
+  double tracking_friction_factor_speed_;  // [m/s or rad/s] the PD law's rows: the measured speed at least this
+  std::array<double, 2> swing_voltage_{};  // [V] the PD law's swing terms of the last cycle (tracking_controller.hpp)
 };
 
 }  // namespace crane::tracking
