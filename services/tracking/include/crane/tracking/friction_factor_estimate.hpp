@@ -33,7 +33,7 @@ namespace crane::tracking {
 
 struct FrictionFactorParams {
   double min_reference_speed{0.05};  // [m/s or rad/s] > 0: rows only where the reference slides
-  int min_rows{20};                  // [-] >= 3: fewer rows give factor() = 1
+  int min_rows{20};                  // [-] >= 3: fewer rows give factor() = the prior
   double min_factor{0.5};            // [-] > 0
   double max_factor{2.0};            // [-] >= min_factor
   // [-] >= 0; > 0: factor() is the prior while the standard error of f (from the rows' residuals) is

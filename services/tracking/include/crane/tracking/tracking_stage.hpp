@@ -87,7 +87,7 @@ struct TrackingStageParams {
   // within max_standard_error (a short slew alone gives too few rows; below it the last move's
   // factor stands). 0.06 from the ShortCable sweep (docs/robustness.md, "The friction factor under
   // delay1"); the follower's keeps FrictionFactorParams' defaults.
-  FrictionFactorParams tracking_friction_factor{0.05, 20, 0.5, 2.0, 0.06};
+  FrictionFactorParams tracking_friction_factor{.max_standard_error = 0.06};
   // The follower's hold at the target: integral action against a drive stuck off it.
   BreakawayRampParams breakaway{};
   double sample_period{0.01};  // [s] > 0, the cycle (facts.sample_period)
