@@ -1126,29 +1126,31 @@ TEST(ShortCable, TheLoadSettlesHookUpAfterASlew) {
   EXPECT_GT(longest_session9, 10.0) << "near the mast -75 limit-cycles (why the gain is lower)";
 }
 
-// The PD law's friction factor (tracking.estimate_friction_factor, tracking_stage.hpp; off in the
+// The PD law's friction factor (tracking.estimate_friction_factor, tracking_stage.hpp; on in the
 // shipped configuration) on plants whose friction is off the configuration by -30 % to +30 %:
 // delay1 with the compensation (3.5) of the configured friction limit-cycles where the plant has
 // less (the compensation pushes the drive on at rest) and leaves the drive stuck with the swing
 // undamped where it has more, hook up (0.2 m) and at 1 m alike. With the factor the law estimates
-// along the move, every move of the grid settles, the nominal plant's too; without it most do not
-// (the cause). The short slew alone (-1.2 -> -0.9 rad) gives too few rows to know the factor, and
-// is run on the nominal plant only, where the factor must stay the model's
-// (docs/optimal_control.md, "The friction factor under delay1").
+// along the move (the momentum balance, friction_momentum_balance.hpp), every move of the grid
+// settles, the nominal plant's too, and ends with the plant's factor to within 0.05; without it
+// most do not (the cause). The short slew alone slides too briefly to know the factor, and is run
+// on the nominal plant only (docs/optimal_control.md, "The friction factor under delay1").
 TEST(FrictionOffTheModel, Delay1SettlesWithTheFrictionFactorItEstimatesAlongTheMove) {
-  const auto configured = lab();
-  ASSERT_FALSE(configured.tracking.estimate_friction_factor) << "off in the shipped configuration (the nominal site)";
-  auto estimated = configured;
-  estimated.tracking.estimate_friction_factor = true;
+  const auto estimated = lab();
+  ASSERT_TRUE(estimated.tracking.estimate_friction_factor) << "on in the shipped configuration";
+  auto configured = estimated;
+  configured.tracking.estimate_friction_factor = false;  // the dissertation's (3.5)
   int unsettled_without = 0;
   int moves = 0;
   for (const double friction : {0.7, 0.9, 1.0, 1.1, 1.3}) {
     for (const double cable_length : {0.2, 1.0}) {
       for (const double trolley_to : {0.3, 0.6, 0.9}) {
         for (const double slew_to : {1.3, 0.3, -0.9}) {
-          // The short slew on the nominal plant only: there the factor must stay the model's (a
-          // factor from its few rows, 1.07 at 0.2 m and 0.9 m, limit-cycles the hold).
-          if (slew_to == -0.9 && friction != 1.0) continue;
+          // The short slew alone (0.3 rad, the trolley still) on the nominal plant only: it slides
+          // for less than the three blocks of 0.5 s the estimate needs, so a plant off the model
+          // keeps the model's factor there (on a crane the last move's carries; session 44's rows
+          // handed 1.07 on the nominal plant here, which limit-cycled the hold).
+          if (slew_to == -0.9 && trolley_to == 0.9 && friction != 1.0) continue;
           const HookUpMove with = hook_up_move(estimated, cable_length, slew_to, trolley_to, friction);
           const HookUpMove without = hook_up_move(configured, cable_length, slew_to, trolley_to, friction);
           std::printf("friction x%.1f, L = %.1f m, slew -1.2 -> %.1f rad, trolley 0.9 -> %.1f m: settled %.2f s (swing) "
@@ -1162,7 +1164,7 @@ TEST(FrictionOffTheModel, Delay1SettlesWithTheFrictionFactorItEstimatesAlongTheM
           EXPECT_LT(with.swinging_s, 6.0) << where;
           EXPECT_LT(with.off_s, 6.0) << where;
           EXPECT_EQ(with.faults, 0U) << where;
-          EXPECT_NEAR(with.friction_factor, friction, 0.15) << where;
+          EXPECT_NEAR(with.friction_factor, friction, 0.05) << where;
           if (without.swinging_s > 10.0 || without.off_s > 10.0 || without.faults != 0U) ++unsettled_without;
           ++moves;
         }

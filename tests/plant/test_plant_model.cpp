@@ -2,8 +2,10 @@
 // plus conservation laws and the pendulum period of the simulated plant.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -11,6 +13,7 @@
 
 #include "crane/plant/crane_simulator.hpp"
 #include "crane/plant/tower_crane_model.hpp"
+#include "crane/tracking/tracking_controller.hpp"
 
 namespace crane::plant {
 namespace {
@@ -230,6 +233,55 @@ TEST(NonlinearModel, MatchesNumericalLagrangianAtRandomStates) {
     EXPECT_LT(worst_residual, 1e-5) << "m=" << m;
     std::printf("m=%g: worst mass-matrix error %.3g, worst Euler-Lagrange residual %.3g\n", m, worst_mass,
                 worst_residual);
+  }
+}
+
+// The tracking law's momenta (tracking_controller.hpp), which the PD law's friction factor balances
+// its voltage against (friction_momentum_balance.hpp), are this independent Lagrangian's: dLag/dx_dot
+// and dLag/dgamma_dot over the drives' force per volt, and dLag/dx (= dT/dx: V does not depend on x)
+// over the trolley's, at seeded random states with the hoist moving.
+TEST(NonlinearModel, TheTrackingLawsMomentaAreTheLagrangiansAtRandomStates) {
+  std::mt19937 rng(20032);  // seeded
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (double m : {2.0, 0.3}) {
+    const common::CraneParameters params = lab_crane(m);
+    const tracking::TrackingController law(tracking::tracking_params_from(params));
+    const RefParams ref{m, params.gravity, params.trolley_drive_mass, params.trolley_mass, params.jib_inertia};
+    const double trolley_force_per_volt = params.trolley_drive_mass * params.trolley_drive_gain;
+    const double slew_torque_per_volt = params.jib_inertia * params.slew_drive_gain;
+    double worst = 0.0;
+    for (int sample = 0; sample < kRandomStates; ++sample) {
+      const Vec4 q{0.5 + 1.5 * unit(rng), 0.6 * unit(rng), std::numbers::pi * unit(rng), 0.6 * unit(rng)};
+      const Vec4 qd{unit(rng), 1.5 * unit(rng), unit(rng), 1.5 * unit(rng)};
+      const Real L = 1.25 + 0.75 * unit(rng), Ld = 0.5 * unit(rng);
+      tracking::TrackingInput in;
+      in.estimate.trolley_position = static_cast<double>(q[0]);
+      in.estimate.swing_in_plane = static_cast<double>(q[1]);
+      in.estimate.slew_angle = static_cast<double>(q[2]);
+      in.estimate.swing_out_of_plane = static_cast<double>(q[3]);
+      in.estimate.trolley_velocity = static_cast<double>(qd[0]);
+      in.estimate.swing_in_plane_rate = static_cast<double>(qd[1]);
+      in.estimate.slew_rate = static_cast<double>(qd[2]);
+      in.estimate.swing_out_of_plane_rate = static_cast<double>(qd[3]);
+      in.estimate.cable_length = static_cast<double>(L);
+      in.estimate.cable_length_rate = static_cast<double>(Ld);
+      tracking::TrackingOutput out;
+      ASSERT_EQ(law.step(in, out), common::StepStatus::ok);
+      const Real h = 1e-5L;
+      Vec4 qp = q, qm = q;
+      qp[0] += h;
+      qm[0] -= h;
+      const Real dLag_dx = (lagrangian(ref, qp, qd, L, Ld) - lagrangian(ref, qm, qd, L, Ld)) / (2 * h);
+      const double expected[] = {static_cast<double>(momentum(ref, 0, q, qd, L, Ld)) / trolley_force_per_volt,
+                                 static_cast<double>(momentum(ref, 2, q, qd, L, Ld)) / slew_torque_per_volt,
+                                 static_cast<double>(dLag_dx) / trolley_force_per_volt};
+      const double got[] = {out.trolley_momentum, out.slew_momentum, out.trolley_centripetal_voltage};
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(got[i], expected[i], 1e-7 * (1.0 + std::abs(expected[i]))) << "m=" << m << " sample " << sample << " " << i;
+        worst = std::max(worst, std::abs(got[i] - expected[i]));
+      }
+    }
+    std::printf("m=%g: worst momentum error %.3g V s\n", m, worst);
   }
 }
 

@@ -1,9 +1,11 @@
 // Tests of the state estimator core (section 4.3).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <string>
 
 #include "crane/common/validation.hpp"
@@ -58,6 +60,36 @@ TEST(Differentiator, RampGivesExactSlopeAfterTransient) {
     for (int k = 1; k <= 200; ++k) y = d.update(x0 + v * k / kFs);
     EXPECT_NEAR(y, v, 1e-12) << static_cast<int>(kind);
   }
+}
+
+// differentiator_lag: the backward difference (4.8) followed by G(z) gives what the differentiator
+// gives, sample by sample, on a seeded random signal; G's DC gain is 1 and (4.8)'s G is 1.
+TEST(Differentiator, ItsLagAfterTheBackwardDifferenceIsTheDifferentiator) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> step(-0.01, 0.01);
+  for (const auto kind : kKinds) {
+    const auto tf = se::differentiator_coefficients(kind, kFs);
+    const auto lag = se::differentiator_lag(tf, kFs);
+    EXPECT_NEAR(lag.dc_gain(), 1.0, 1e-12) << static_cast<int>(kind);
+    se::DiscreteFilter direct(tf);
+    se::DiscreteFilter lagged(lag);
+    double x = 0.2;
+    double previous = x;
+    direct.initialize(x, 0.0);
+    lagged.initialize(0.0, 0.0);
+    double worst = 0.0;
+    for (int k = 0; k < 500; ++k) {
+      x += step(random);
+      const double expected = direct.update(x);
+      worst = std::max(worst, std::abs(lagged.update(kFs * (x - previous)) - expected));
+      previous = x;
+    }
+    EXPECT_LT(worst, 1e-12) << static_cast<int>(kind);
+  }
+  const auto backward = se::differentiator_lag(se::differentiator_coefficients(se::DifferentiatorKind::backward, kFs), kFs);
+  EXPECT_DOUBLE_EQ(backward.b0, 1.0);
+  EXPECT_DOUBLE_EQ(backward.b1, 0.0);
+  EXPECT_DOUBLE_EQ(backward.a1, 0.0);
 }
 
 TEST(Differentiator, PrintedCoefficientsOf410RoundTheExactOnes) {

@@ -10,6 +10,7 @@
 #include "crane/common/validation.hpp"
 #include "crane/tracking/breakaway_ramp.hpp"
 #include "crane/tracking/friction_factor_estimate.hpp"
+#include "crane/tracking/friction_momentum_balance.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
 namespace tr = crane::tracking;
@@ -329,6 +330,84 @@ TEST(FrictionFactorEstimate, AFactorNotKnownToWithinTheStandardErrorLeavesThePri
       ADD_FAILURE() << bad << " accepted";
     } catch (const crane::common::ConfigError& error) {
       EXPECT_NE(std::string(error.what()).find("friction_factor.max_standard_error"), std::string::npos) << error.what();
+    }
+  }
+}
+
+// With a resolution (the PD law's, 0.01) the factor is handed to the nearest multiple of it; a
+// resolution outside [0, 0.1] is refused, naming it.
+TEST(FrictionFactorEstimate, TheResolutionRoundsTheFactor) {
+  const crane::common::CraneParameters crane;
+  tr::FrictionFactorParams params;
+  params.min_rows = 3;
+  tr::FrictionFactorEstimate fine(crane.trolley_friction, crane.slew_friction, params);
+  params.resolution = 0.01;
+  tr::FrictionFactorEstimate rounded(crane.trolley_friction, crane.slew_friction, params);
+  for (const double friction : {1.0, 2.0, 1.5}) {  // y = -0.0037 F: f = 0.9963
+    fine.add_row(0, -0.0037 * friction, friction, 0.0);
+    rounded.add_row(0, -0.0037 * friction, friction, 0.0);
+  }
+  EXPECT_NEAR(fine.factor(), 0.9963, 1e-9);
+  EXPECT_NEAR(rounded.factor(), 1.0, 1e-12);
+  // One more row, y = -0.6 V at F = 3 V: f = 1 - (0.0037 x 7.25 + 1.8) / 16.25 = 0.8876, handed 0.89.
+  fine.add_row(0, -0.6, 3.0, 0.0);
+  rounded.add_row(0, -0.6, 3.0, 0.0);
+  EXPECT_NEAR(fine.factor(), 1.0 - (0.0037 * 7.25 + 1.8) / 16.25, 1e-9);
+  EXPECT_NEAR(rounded.factor(), 0.89, 1e-12);
+  for (const double bad : {-0.01, 0.2, std::numeric_limits<double>::quiet_NaN()}) {
+    tr::FrictionFactorParams p;
+    p.resolution = bad;
+    try {
+      tr::FrictionFactorEstimate refused(crane.trolley_friction, crane.slew_friction, p);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("friction_factor.resolution"), std::string::npos) << error.what();
+    }
+  }
+}
+
+// The momentum balance's rows by hand, with the estimator's lag taken as none (B = G = 1): then
+// H(z) = (z^-1 + z^-2)/2, a block sums T H[u] and H[F] and takes the momentum's change from the
+// cycle before its first; a stretch's rest closes at its first cycle that does not slide; a
+// non-finite input drops the open block; a bad block length is refused, naming it.
+TEST(FrictionMomentumBalance, RowsByHand) {
+  const crane::state_estimator::DiscreteTransferFunction none{};
+  tr::FrictionMomentumBalance balance(none, none, 0.01, 3);
+  // At rest before: u = 2 V, F = 0, p = 0.1 V s (initialises the filters on the first cycle).
+  EXPECT_FALSE(balance.step(2.0, 0.0, 0.1, false));
+  EXPECT_FALSE(balance.step(2.0, 0.0, 0.1, false));
+  // Sliding: u = 4 V, F = 1 V from here; H delays them by 1.5 cycles.
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.2, true));  // H[u] = (2 + 2)/2, H[F] = 0
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.3, true));  // (4 + 2)/2, (1 + 0)/2
+  const auto row = balance.step(4.0, 1.0, 0.4, true);  // (4 + 4)/2, 1
+  ASSERT_TRUE(row);
+  EXPECT_NEAR(row->balance, 0.01 * (2.0 + 3.0 + 4.0) - (0.4 - 0.1), 1e-12);
+  EXPECT_NEAR(row->friction, 0.01 * (0.0 + 0.5 + 1.0), 1e-12);
+  // Two more sliding cycles, then the stretch ends: a row of two, to the last sliding cycle's p.
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.5, true));
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.7, true));
+  const auto rest = balance.step(4.0, 1.0, 9.0, false);
+  ASSERT_TRUE(rest);
+  EXPECT_NEAR(rest->balance, 0.01 * (4.0 + 4.0) - (0.7 - 0.4), 1e-12);
+  EXPECT_NEAR(rest->friction, 0.02, 1e-12);
+  // A NaN drops the open block: the cycles before it make no row.
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  EXPECT_FALSE(balance.step(4.0, 1.0, std::numeric_limits<double>::quiet_NaN(), true));
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  EXPECT_TRUE(balance.step(4.0, 1.0, 0.1, true)) << "three cycles after the NaN";
+  // So does a new move (drop_block).
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  balance.drop_block();
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  EXPECT_FALSE(balance.step(4.0, 1.0, 0.1, true));
+  EXPECT_TRUE(balance.step(4.0, 1.0, 0.1, true));
+  for (const int cycles : {0, -1}) {
+    try {
+      tr::FrictionMomentumBalance refused(none, none, 0.01, cycles);
+      ADD_FAILURE() << cycles << " accepted";
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("block_cycles"), std::string::npos) << error.what();
     }
   }
 }

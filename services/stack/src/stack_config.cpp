@@ -53,6 +53,7 @@ StackConfig read(const config::ConfigDocument& doc) {
   c.trajectory_planner = doc.read("trajectory_planner", trajectory_planner::read_params);
   c.anti_swing = doc.read("anti_swing", anti_swing::read_params);
   c.tracking = doc.read("tracking", tracking::read_params);
+  c.tracking.estimator = c.state_estimator.estimator;  // the PD law's momentum balance lags as its rates
   c.friction_compensation = doc.read("friction_compensation", friction_compensation::read_params);
   c.hardware_bridge = doc.read("hardware_bridge", [&](config::YamlSection& block, const common::StackFacts& facts) {
     return hardware_bridge::read_params(block, facts, c.actuation);

@@ -42,4 +42,12 @@ DiscreteTransferFunction differentiator_coefficients(DifferentiatorKind kind,
   return tf;
 }
 
+DiscreteTransferFunction differentiator_lag(const DiscreteTransferFunction& differentiator,
+                                           double sample_rate) noexcept {
+  // b0 + b1 z^-1 + b2 z^-2 = (1 - z^-1)(c0 + c1 z^-1) with c0 = b0, c1 = b0 + b1 (= -b2).
+  const double c0 = differentiator.b0 / sample_rate;
+  const double c1 = (differentiator.b0 + differentiator.b1) / sample_rate;
+  return {c0, c1, 0.0, differentiator.a1, differentiator.a2};
+}
+
 }  // namespace crane::state_estimator

@@ -5,6 +5,7 @@
 #include <array>
 
 #include "crane/runtime/stage_node.hpp"
+#include "crane/state_estimator/state_estimator_stage.hpp"
 #include "crane/tracking/tracking_stage.hpp"
 
 int main(int argc, char** argv) {
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
       },
       [controller_name, feedforward](runtime::StageContext& ctx) -> std::function<void()> {
         auto params = ctx.config.read("tracking", tracking::read_params);
+        // The PD law's momentum balance lags as the estimator's rates (tracking_stage.hpp).
+        params.estimator = ctx.config.read("state_estimator", state_estimator::read_params).estimator;
         params.law = tracking::law_from_name(*controller_name, "--controller");
         params.tracking.acceleration_feedforward = *feedforward;
         auto stage = std::make_shared<tracking::TrackingStage>(params);

@@ -22,6 +22,7 @@ FrictionFactorEstimate::FrictionFactorEstimate(const common::AxisFriction& troll
   common::require_greater("friction_factor.min_factor", params.min_factor, 0.0);
   common::require_in_range("friction_factor.max_factor", params.max_factor, params.min_factor, 100.0);
   common::require_in_range("friction_factor.max_standard_error", params.max_standard_error, 0.0, 100.0);
+  common::require_in_range("friction_factor.resolution", params.resolution, 0.0, 0.1);
 }
 
 void FrictionFactorEstimate::reset(double prior) noexcept {
@@ -41,11 +42,15 @@ void FrictionFactorEstimate::add(int axis, double feedback_voltage, double refer
   }
   if (std::abs(reference_speed) < params_.min_reference_speed) return;
   // F(v_ref) (3.1), as the compensation computes it (the one place it is written).
-  double phi[3] = {friction_compensation::sliding_friction_voltage(friction_[axis], reference_speed,
-                                                                   reference_speed > 0.0 ? 1 : -1),
-                   0.0, 0.0};
-  phi[1 + axis] = reference_acceleration;
-  const double y = feedback_voltage + compensated_share * phi[0];
+  const double friction = friction_compensation::sliding_friction_voltage(friction_[axis], reference_speed,
+                                                                          reference_speed > 0.0 ? 1 : -1);
+  add_row(axis, feedback_voltage + compensated_share * friction, friction, reference_acceleration);
+}
+
+void FrictionFactorEstimate::add_row(int axis, double y, double friction, double inertia) noexcept {
+  if (axis < 0 || axis > 1 || !std::isfinite(y) || !std::isfinite(friction) || !std::isfinite(inertia)) return;
+  double phi[3] = {friction, 0.0, 0.0};
+  phi[1 + axis] = inertia;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) information_[r][c] += phi[r] * phi[c];
     moment_[r] += phi[r] * y;
@@ -69,13 +74,16 @@ double FrictionFactorEstimate::factor() const noexcept {
   if (!std::isfinite(f)) return prior_;
   if (params_.max_standard_error > 0.0) {
     // The standard error of theta_0 from the rows' residuals: sigma^2 (Phi^T Phi)^-1_00, sigma^2 the
-    // residual sum of squares over the rows less the three unknowns.
+    // residual sum of squares over the rows less the unknowns.
     const double residual = std::max(0.0, squares_ - 2.0 * theta.dot(b) + theta.dot(a * theta));
-    const double variance = residual / static_cast<double>(std::max(1, rows_ - 3));
+    int unknowns = 0;  // the columns with rows (the PD law's balance has the friction's alone)
+    for (int c = 0; c < 3; ++c) unknowns += information_[c][c] > 0.0 ? 1 : 0;
+    const double variance = residual / static_cast<double>(std::max(1, rows_ - unknowns));
     const double standard_error = std::sqrt(variance * a.inverse()(0, 0));
     if (!(standard_error <= params_.max_standard_error)) return prior_;
   }
-  return std::clamp(f, params_.min_factor, params_.max_factor);
+  const double clamped = std::clamp(f, params_.min_factor, params_.max_factor);
+  return params_.resolution > 0.0 ? params_.resolution * std::round(clamped / params_.resolution) : clamped;
 }
 
 }  // namespace crane::tracking

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "crane/common/validation.hpp"
@@ -17,6 +18,7 @@ TrackingParams validated(const TrackingParams& p) {
   common::require_at_least("tracking.mass_ratio", p.mass_ratio, 0.0);
   common::require_at_least("tracking.load_inertia_ratio", p.load_inertia_ratio, 0.0);
   common::require_at_least("tracking.trolley_inertia_ratio", p.trolley_inertia_ratio, 0.0);
+  common::require_at_least("tracking.trolley_mass_ratio", p.trolley_mass_ratio, 0.0);
   common::require_greater("tracking.gravity", p.gravity, 0.0);
   common::require_greater("tracking.min_radius", p.min_radius, 0.0);
   common::require_greater("tracking.min_cable_length", p.min_cable_length, 0.0);
@@ -38,6 +40,7 @@ TrackingParams tracking_params_from(const common::CraneParameters& crane) {
   params.mass_ratio = crane.mass_ratio();
   params.load_inertia_ratio = crane.load_inertia_ratio();
   params.trolley_inertia_ratio = crane.trolley_inertia_ratio();
+  params.trolley_mass_ratio = crane.trolley_mass / crane.trolley_drive_mass;
   params.gravity = crane.gravity;
   params.voltage_limit = crane.dac_range;
   return params;
@@ -100,12 +103,10 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   output.trolley_tracking_action = V_xp;
   output.trolley_normalized_action = V_bar_x;
   output.swing_period = T;
-  output.trolley_swing_voltage = m_t * g * est.swing_in_plane / p.trolley_drive_gain;
   output.command.trolley_voltage = clamp_voltage(V_x, p.voltage_limit, output.trolley_saturated);
   if (p.slew_enabled) {
     output.slew_tracking_action = V_yp;
     output.slew_normalized_action = V_bar_y;
-    output.slew_swing_voltage = -m_r * g * x_safe * est.swing_out_of_plane / p.slew_drive_gain;
     output.command.slew_voltage = clamp_voltage(V_gamma, p.voltage_limit, output.slew_saturated);
   }
   output.command.hoist_speed = ref.cable_length.velocity;
@@ -113,13 +114,40 @@ common::StepStatus TrackingController::step(const TrackingInput& input,
   // which the voltage clamp passes through: the safe output instead (found by tests/fuzz/topic_gates).
   const double outputs[] = {output.command.trolley_voltage, output.command.slew_voltage, output.trolley_tracking_action,
                             output.slew_tracking_action, output.trolley_normalized_action,
-                            output.slew_normalized_action, output.swing_period, output.trolley_swing_voltage,
-                            output.slew_swing_voltage};
+                            output.slew_normalized_action, output.swing_period};
   for (const double value : outputs) {
     if (!std::isfinite(value)) {
       output = TrackingOutput{};
       return common::StepStatus::rejected_nonfinite;
     }
+  }
+  // The momenta (see the header), with the load's kinematics of tower_crane_model.cpp.
+  const double gamma_dot = p.slew_enabled ? est.slew_rate : 0.0;
+  const double phi = est.swing_in_plane;
+  const double theta = est.swing_out_of_plane;
+  const double phi_dot = est.swing_in_plane_rate;
+  const double theta_dot = est.swing_out_of_plane_rate;
+  const double L_m = est.cable_length;
+  const double L_dot = est.cable_length_rate;
+  const double c_theta = std::cos(theta), s_theta = std::sin(theta), c_phi = std::cos(phi), s_phi = std::sin(phi);
+  const double u[3] = {-c_theta * s_phi, s_theta, -c_theta * c_phi};
+  const double u_phi[3] = {-c_theta * c_phi, 0.0, c_theta * s_phi};
+  const double u_theta[3] = {s_theta * s_phi, c_theta, s_theta * c_phi};
+  const double r_x = x + L_m * u[0];
+  const double r_y = L_m * u[1];
+  const double r_dot_x = est.trolley_velocity + L_dot * u[0] + L_m * (u_phi[0] * phi_dot + u_theta[0] * theta_dot);
+  const double r_dot_y = L_dot * u[1] + L_m * (u_phi[1] * phi_dot + u_theta[1] * theta_dot);
+  const double v_x = r_dot_x - gamma_dot * r_y;
+  const double v_y = r_dot_y + gamma_dot * r_x;
+  output.trolley_momentum = (est.trolley_velocity + m_t * v_x) / p.trolley_drive_gain;
+  output.trolley_centripetal_voltage =
+      (p.trolley_mass_ratio * x * gamma_dot * gamma_dot + m_t * gamma_dot * v_y) / p.trolley_drive_gain;
+  output.slew_momentum =
+      p.slew_enabled ? ((1.0 + M_r * x * x) * gamma_dot + m_r * (r_x * v_y - r_y * v_x)) / p.slew_drive_gain : 0.0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(output.trolley_momentum) || !std::isfinite(output.trolley_centripetal_voltage) ||
+      !std::isfinite(output.slew_momentum)) {
+    output.trolley_momentum = output.slew_momentum = output.trolley_centripetal_voltage = nan;
   }
   return common::StepStatus::ok;
 }

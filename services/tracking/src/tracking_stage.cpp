@@ -56,6 +56,20 @@ TrackingStageParams params_for(const common::CraneParameters& crane, const Track
   return p;
 }
 
+// The PD law's momentum balance of one drive, lagging as the estimator's rates do.
+FrictionMomentumBalance balance_for(const TrackingStageParams& params) {
+  common::require_in_range("tracking.friction_balance_block", params.friction_balance_block, params.sample_period,
+                           1000.0);
+  // The estimator's own validation (StateEstimator's constructor) names a bad field first.
+  const state_estimator::StateEstimator estimator(params.estimator);
+  const auto& e = params.estimator;
+  return FrictionMomentumBalance(
+      state_estimator::butterworth_low_pass(e.cutoff_frequency, e.sample_rate),
+      state_estimator::differentiator_lag(state_estimator::differentiator_coefficients(e.differentiator, e.sample_rate),
+                                          e.sample_rate),
+      params.sample_period, static_cast<int>(std::lround(params.friction_balance_block / params.sample_period)));
+}
+
 }  // namespace
 
 TrackingStageParams read_params(config::YamlSection& s, const common::StackFacts& facts) {
@@ -89,7 +103,9 @@ TrackingStage::TrackingStage(const TrackingStageParams& params)
       friction_factor_step_(params.friction_factor_rate * params.sample_period),
       breakaway_(params.breakaway, params.sample_period),
       estimate_friction_factor_(params.estimate_friction_factor && params.law == TrackingLaw::tracking),
-      tracking_friction_factor_speed_(params.tracking_friction_factor.min_reference_speed) {
+      tracking_friction_factor_speed_(params.tracking_friction_factor.min_reference_speed),
+      balance_{balance_for(params), balance_for(params)},
+      friction_model_{params.trolley_friction, params.second_friction} {
   common::require_greater("tracking.trolley_drive_mass", trolley_drive_mass_, 0.0);
   common::require_greater("tracking.friction_factor_rate", params.friction_factor_rate, 0.0);
   common::require_finite("tracking.friction_factor_rate", params.friction_factor_rate);
@@ -149,7 +165,7 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
   command.hoist_speed = result.command.hoist_speed;
   command.trolley_tracking_action = result.trolley_tracking_action;
   command.slew_tracking_action = result.slew_tracking_action;
-  swing_voltage_ = {result.trolley_swing_voltage, result.slew_swing_voltage};
+  momentum_ = {result.trolley_momentum, result.trolley_centripetal_voltage, result.slew_momentum};
   if (bridge_) {
     protocol::LinearCommand bridge;
     const auto bridge_status = bridge_->step(common::bridge_view(estimate), common::bridge_view(reference),
@@ -159,27 +175,41 @@ common::StepStatus TrackingStage::step(const protocol::CraneState& estimate, con
     if (status == common::StepStatus::ok) status = bridge_status;
   }
   if (estimate_friction_factor_ && status == common::StepStatus::ok) {
-    // The PD law has no feedforward. A row is its voltage less the part that answers the load's
-    // swing (the load's reaction, not the drive's friction), along a planned move (not the
-    // operator's stick, request 0, whose stops and stalls the rows do not model), where the measured
-    // speed slides the reference's way (the compensation then adds its sliding part, which the row
-    // assumes; on the filtered slew rate it lags the reference by a few cycles).
-    const bool bridge = bridge_ != nullptr;
-    start_friction_estimate(reference, true);
-    const std::array<double, 2> voltage{command.trolley_voltage, bridge ? command.bridge_voltage : command.slew_voltage};
-    const std::array<double, 2> swing{swing_voltage_[0], bridge ? bridge_->swing_voltage_[0] : swing_voltage_[1]};
-    const std::array<double, 2> speed{estimate.trolley_velocity, bridge ? estimate.bridge_velocity : estimate.slew_rate};
-    const std::array<double, 2> reference_speed{reference.trolley_velocity,
-                                                bridge ? reference.bridge_velocity : reference.slew_rate};
-    std::array<bool, 2> rows{};
-    for (std::size_t axis = 0; axis < 2; ++axis) {
-      rows[axis] = reference.request_id != 0 && speed[axis] * reference_speed[axis] > 0.0 &&
-                   std::abs(speed[axis]) >= tracking_friction_factor_speed_;
-    }
-    command.friction_factor = hand_friction_factor(reference, bridge, voltage, swing, 0.0, rows);
+    command.friction_factor = hand_balanced_friction_factor(estimate, reference, bridge_ != nullptr, command);
   }
   common::same_cycle(estimate.header, command.header);
   return status;
+}
+
+double TrackingStage::hand_balanced_friction_factor(const protocol::CraneState& estimate,
+                                                    const protocol::Reference& reference, bool bridge,
+                                                    const protocol::LinearCommand& command) noexcept {
+  // Rows along a planned move (not the operator's stick, request 0, whose stops and stalls the rows
+  // do not model), where the measured speed slides the reference's way (the compensation then adds
+  // the sliding part the row assumes) and the law's voltage is not clamped.
+  if (start_friction_estimate(reference, true)) {
+    for (auto& b : balance_) b.drop_block();
+  }
+  const std::array<double, 2> voltage{command.trolley_voltage, bridge ? command.bridge_voltage : command.slew_voltage};
+  // The bridge's stage holds the bridge's momentum as its trolley's.
+  const std::array<double, 2> momentum{momentum_[0], bridge ? bridge_->momentum_[0] : momentum_[2]};
+  const std::array<double, 2> centripetal{momentum_[1], bridge ? bridge_->momentum_[1] : 0.0};
+  const std::array<double, 2> speed{estimate.trolley_velocity, bridge ? estimate.bridge_velocity : estimate.slew_rate};
+  const std::array<double, 2> reference_speed{reference.trolley_velocity,
+                                              bridge ? reference.bridge_velocity : reference.slew_rate};
+  const double share = compensated_share(0.0);
+  for (std::size_t a = 0; a < 2; ++a) {
+    const double friction =
+        reference_speed[a] == 0.0
+            ? 0.0
+            : friction_compensation::sliding_friction_voltage(friction_model_[a], reference_speed[a],
+                                                              reference_speed[a] > 0.0 ? 1 : -1);
+    const bool sliding = reference.request_id != 0 && speed[a] * reference_speed[a] > 0.0 &&
+                         std::abs(speed[a]) >= tracking_friction_factor_speed_ && std::abs(voltage[a]) < voltage_limit_;
+    const auto row = balance_[a].step(voltage[a] + centripetal[a] + share * friction, friction, momentum[a], sliding);
+    if (row) friction_factor_.add_row(static_cast<int>(a), row->balance, row->friction, 0.0);
+  }
+  return next_handed_friction_factor(reference, bridge);
 }
 
 bool TrackingStage::start_friction_estimate(const protocol::Reference& reference, bool carry) noexcept {
@@ -199,26 +229,14 @@ bool TrackingStage::at_target(const protocol::Reference& reference, bool bridge)
          (bridge ? reference.bridge_acceleration : reference.slew_acceleration) == 0.0;
 }
 
-double TrackingStage::hand_friction_factor(const protocol::Reference& reference, bool bridge,
-                                           const std::array<double, 2>& voltage, const std::array<double, 2>& known,
-                                           double reduction, const std::array<bool, 2>& rows) noexcept {
-  // Rows along the move, from the feedback's part of each drive's voltage where it is not clamped. A
-  // row adds back the share the compensation took over from the feedback with the factor handed with
-  // the last command. Along the move the handed factor follows the estimate at friction_factor_rate
-  // at most (the prior until this one has rows enough); at the target it is the estimate.
-  const std::array<double, 2> reference_speed{reference.trolley_velocity,
-                                              bridge ? reference.bridge_velocity : reference.slew_rate};
-  const std::array<double, 2> reference_acceleration{
-      reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
-  const double compensated_share = friction_compensation::kept_sliding_share(reduction, handed_friction_factor_) -
-                                   friction_compensation::kept_sliding_share(reduction, 1.0);
-  for (int axis = 0; axis < 2; ++axis) {
-    const auto a = static_cast<std::size_t>(axis);
-    if (rows[a] && std::abs(voltage[a]) < voltage_limit_) {
-      friction_factor_.add(axis, voltage[a] - known[a], reference_speed[a], reference_acceleration[a],
-                           compensated_share);
-    }
-  }
+double TrackingStage::compensated_share(double reduction) const noexcept {
+  return friction_compensation::kept_sliding_share(reduction, handed_friction_factor_) -
+         friction_compensation::kept_sliding_share(reduction, 1.0);
+}
+
+double TrackingStage::next_handed_friction_factor(const protocol::Reference& reference, bool bridge) noexcept {
+  // Along the move the handed factor follows the estimate at friction_factor_rate at most (the prior
+  // until this one has rows enough); at the target it is the estimate.
   const double estimate_factor = friction_factor_.factor();
   handed_friction_factor_ =
       at_target(reference, bridge)
@@ -226,6 +244,26 @@ double TrackingStage::hand_friction_factor(const protocol::Reference& reference,
           : handed_friction_factor_ + std::clamp(estimate_factor - handed_friction_factor_, -friction_factor_step_,
                                                  friction_factor_step_);
   return handed_friction_factor_;
+}
+
+double TrackingStage::hand_friction_factor(const protocol::Reference& reference, bool bridge,
+                                           const std::array<double, 2>& voltage, const std::array<double, 2>& known,
+                                           double reduction) noexcept {
+  // Rows along the move, from the feedback's part of each drive's voltage where it is not clamped. A
+  // row adds back the share the compensation took over from the feedback with the factor handed with
+  // the last command.
+  const std::array<double, 2> reference_speed{reference.trolley_velocity,
+                                              bridge ? reference.bridge_velocity : reference.slew_rate};
+  const std::array<double, 2> reference_acceleration{
+      reference.trolley_acceleration, bridge ? reference.bridge_acceleration : reference.slew_acceleration};
+  const double share = compensated_share(reduction);
+  for (int axis = 0; axis < 2; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    if (std::abs(voltage[a]) < voltage_limit_) {
+      friction_factor_.add(axis, voltage[a] - known[a], reference_speed[a], reference_acceleration[a], share);
+    }
+  }
+  return next_handed_friction_factor(reference, bridge);
 }
 
 common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, const protocol::Reference& reference,
@@ -248,7 +286,7 @@ common::StepStatus TrackingStage::follow(const protocol::CraneState& estimate, c
   }
   // The friction factor (friction_factor_estimate.hpp), from the LQR's part of the voltage.
   if (start_friction_estimate(reference, false)) breakaway_.reset();
-  command.friction_factor = hand_friction_factor(reference, bridge, u, law.feedforward, reduction, {true, true});
+  command.friction_factor = hand_friction_factor(reference, bridge, u, law.feedforward, reduction);
   // At the target, a drive the friction holds at rest off it is ramped toward it.
   std::array<double, 2> voltage = u;
   if (at_target(reference, bridge)) {

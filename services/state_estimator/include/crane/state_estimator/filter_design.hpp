@@ -30,4 +30,14 @@ enum class DifferentiatorKind {
 [[nodiscard]] DiscreteTransferFunction differentiator_coefficients(DifferentiatorKind kind,
                                                                    double sample_rate) noexcept;
 
+/// The lag a differentiator adds to the rate it measures: G(z) = D(z) / (fs (1 - z^-1)), D its
+/// coefficients (`differentiator`, a differentiator_coefficients() result: b0 + b1 + b2 = 0, a zero at
+/// DC) and fs (1 - z^-1) the backward difference (4.8), the rate over the last sample period. So
+/// D(z) x = G(z) [fs (x(k) - x(k-1))]: G is 1 for (4.8), (8/7) / (1 + z^-1/7) for (4.9) and
+/// 3 r (1 + z^-1) / (1 + r z^-1)^2 for (4.10); its DC gain is 1 (each differentiator's ramp gain).
+/// Dimensionless. A filter that must lag as the estimator's rates do runs it after the low-pass
+/// (tracking::FrictionMomentumBalance). `sample_rate` [Hz] > 0.
+[[nodiscard]] DiscreteTransferFunction differentiator_lag(const DiscreteTransferFunction& differentiator,
+                                                          double sample_rate) noexcept;
+
 }  // namespace crane::state_estimator

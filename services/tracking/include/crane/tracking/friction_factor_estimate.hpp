@@ -19,12 +19,17 @@
 // the axis's own). Least squares over every row of the move, solved when asked:
 //   (Phi^T Phi + ridge I) theta = Phi^T u_fb,
 // the ridge (1e-9 of the information's trace) only so an axis with no rows (a gantry's second axis)
-// leaves its coefficient at 0. factor() is f clamped to [min_factor, max_factor], and the prior while
+// leaves its coefficient at 0. factor() is f clamped to [min_factor, max_factor] (and rounded to
+// resolution), and the prior while
 // fewer than min_rows rows were taken (or, with max_standard_error, while f is not known to within
 // it): 1 (the model's friction) at first, and what the last move found when reset() is handed it (a
 // move with no travel, the hoist's alone, learns nothing and keeps it).
 //
-// Real-time: add() and factor() are noexcept and allocate nothing. reset() starts a new move.
+// The PD law (tracking_stage.hpp) feeds it other rows through add_row(): the blocks of the balance
+// of the crane's momentum (friction_momentum_balance.hpp), whose momenta carry the model's inertia,
+// so their second column is 0.
+//
+// Real-time: add(), add_row() and factor() are noexcept and allocate nothing. reset() starts a new move.
 // Errors: the constructor throws common::ConfigError naming the field, the value and the bound.
 
 #include "crane/common/crane_parameters.hpp"
@@ -40,6 +45,12 @@ struct FrictionFactorParams {
   // above it: a move too short or too disturbed to say (the PD law's rows carry its anti-swing
   // action, and a short slew alone gives few); 0: no such check (the follower's).
   double max_standard_error{0.0};
+  // [-] in [0, 0.1]; > 0: factor() is f rounded to a multiple of it, the estimate's resolution (the
+  // PD law's, 0.01: on the nominal crane it hands exactly 1, the configured friction, and the digits
+  // below it, which differ with the plant integrator's tolerance, do not move the compensation and
+  // with it the hold's stick-slip; docs/optimal_control.md, "The friction factor under delay1");
+  // 0: none (the follower's).
+  double resolution{0.0};
 };
 
 class FrictionFactorEstimate {
@@ -58,6 +69,12 @@ class FrictionFactorEstimate {
   /// 0 with factor 1). Ignored where the reference does not slide or an input is not finite.
   void add(int axis, double feedback_voltage, double reference_speed, double reference_acceleration,
            double compensated_share = 0.0) noexcept;
+
+  /// One row of the regression as it stands, y = theta_0 `friction` + theta_(1+axis) `inertia` + e (the
+  /// unit of y, e.g. [V s] for the PD law's momentum balance, friction_momentum_balance.hpp; `inertia`
+  /// 0 there: the momenta carry the model's inertia). add() builds its rows with it. Ignored if `axis`
+  /// is not 0 or 1 or an input is not finite. The standard error counts the columns that have rows.
+  void add_row(int axis, double y, double friction, double inertia) noexcept;
 
   /// f, the plant's sliding friction over the model's (see the header); the prior without enough rows.
   [[nodiscard]] double factor() const noexcept;

@@ -12,6 +12,19 @@
 // (3.38) prints m_r g x_bar theta; (2.30) and (3.32) give m_r g x theta with x in metres.
 // |x| is floored at min_radius (keeping its sign, + at 0) where x divides.
 // Hoist: hoist_speed = reference cable_length velocity [m/s].
+// Beside the voltages, the crane's generalized momenta along its two drives, for the friction
+// factor's momentum balance (friction_momentum_balance.hpp): from the kinetic energy T of the jib,
+// the trolley and the load (the tower crane of plant/src/tower_crane_model.cpp, (2.11) with ERRATA:
+// the load at r = x e_x + L u(phi, theta), u = (-cos theta sin phi, sin theta, -cos theta cos phi), in
+// the jib frame turning at gamma_dot), each over the drive's force per volt, with the law's own
+// constants (M = M_drive, J_o):
+//   p_x / (M K_mx)          = (x_dot + m_t v_x) / K_mx
+//   p_gamma / (J_o K_mgamma) = ((1 + M_r x^2) gamma_dot + m_r (r x v)_z) / K_mgamma
+//   dT/dx / (M K_mx)        = (M_t/M x gamma_dot^2 + m_t gamma_dot v_y) / K_mx
+// v = r_dot + gamma_dot e_z x r the load's velocity. Lagrange's equations of x and gamma then read
+// dp_x/dt - dT/dx = the trolley's drive force less its friction, dp_gamma/dt = the slew's torque
+// less its friction: the load's swing, the jib's Coriolis and the trolley's centripetal force are
+// in the momenta, not left in a voltage. A gantry (slew disabled) has gamma_dot = 0.
 //
 // Real-time: step() is noexcept, allocates nothing.
 
@@ -30,6 +43,8 @@ struct TrackingParams {
   double mass_ratio{0.09};             // [-] m_t = m/M (3.53)
   double load_inertia_ratio{0.28};     // [1/m^2] m_r = m/J_o (3.53)
   double trolley_inertia_ratio{0.27};  // [1/m^2] M_r = M/J_o (3.53)
+  double trolley_mass_ratio{0.087};    // [-] M_t/M: the trolley's own mass over the mass its drive moves
+                                       // (its centripetal force in dT/dx; the momenta only)
   double gravity{9.8};                 // [m/s^2]
   double min_radius{0.1};              // [m] floor on |x| in (3.38), > 0
   double min_cable_length{0.1};        // [m] floor on the measured L, > 0
@@ -60,11 +75,13 @@ struct TrackingOutput {
   double trolley_normalized_action{0.0};   // [-] V_bar_x = V_xp + V_xs
   double slew_normalized_action{0.0};      // [-] V_bar_y = V_yp + V_ys
   double swing_period{0.0};                // [s] T
-  // [V] the parts of the voltages that answer the load's swing, before the clamp: m_t g phi / K_mx of
-  // (3.37) and -m_r g x theta / K_mgamma of (3.38) (0 with the slew disabled). The friction factor's
-  // rows leave them out (tracking_stage.hpp).
-  double trolley_swing_voltage{0.0};
-  double slew_swing_voltage{0.0};
+  // The generalized momenta along the trolley and the slew over the drive's force per volt [V s],
+  // and dT/dx over the trolley's [V] (see the header), from the estimate and the law's load (m_t,
+  // m_r of this cycle); 0 on the slew with the slew disabled. NaN when a rate only they use (the
+  // swings', the cable's) is not finite: the voltages do not need them.
+  double trolley_momentum{0.0};
+  double slew_momentum{0.0};
+  double trolley_centripetal_voltage{0.0};
   bool trolley_saturated{false};
   bool slew_saturated{false};
 };
@@ -78,7 +95,8 @@ class TrackingController {
 
   /// rejected_nonfinite if any used input is NaN/Inf, or if finite inputs so large that the law
   /// overflows (e.g. a trolley position of 1e200 m: x^2 is Inf, and Inf - Inf a NaN voltage) give a
-  /// non-finite output: output set to zero voltages and actions. ok: every output field is finite.
+  /// non-finite output: output set to zero voltages and actions. ok: every output field is finite
+  /// but the momenta (see TrackingOutput).
   [[nodiscard]] common::StepStatus step(const TrackingInput& input, TrackingOutput& output) const noexcept;
 
   [[nodiscard]] const TrackingParams& params() const noexcept { return params_; }

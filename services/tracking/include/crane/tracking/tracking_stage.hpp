@@ -27,15 +27,16 @@
 // compensation as the follower does (along the move at friction_factor_rate at most, at the target
 // the estimate): the compensation (3.5) then adds f times the model's stiction at rest and min(1, f)
 // of its sliding part, so a plant with less friction than the model is not over-compensated into a
-// limit cycle at the hold, nor one with more left stuck with its swing undamped. Its rows: the law's
-// voltage (it has no feedforward) less its swing terms (TrackingOutput's swing voltages: the load's
-// reaction, not the drive's friction), on a drive whose measured speed slides the reference's way
-// (the compensation then adds the sliding part the row assumes; the filtered slew rate lags the
-// reference). The factor is handed once known to within tracking_friction_factor's
-// max_standard_error, and carried from one move into the next (a hoist alone gives no rows); the
-// follower's starts each move from 1. No breakaway ramp under this law (docs/optimal_control.md,
-// "The friction factor under delay1"). Without the setting, LinearCommand_.friction_factor stays 0
-// (the configured friction) under that law.
+// limit cycle at the hold, nor one with more left stuck with its swing undamped. Its rows: the
+// balance of the crane's generalized momentum along each drive (friction_momentum_balance.hpp: the
+// law's voltage summed over blocks of friction_balance_block through the estimator's lag, against the
+// change of TrackingOutput's momenta), over the cycles where the drive's measured speed slides the
+// reference's way (the compensation then adds the sliding part the row assumes). The factor is
+// handed once known to within tracking_friction_factor's max_standard_error, and carried from one
+// move into the next (a hoist alone gives no rows); the follower's starts each move from 1. No
+// breakaway ramp under this law (docs/optimal_control.md, "The friction factor under delay1").
+// Without the setting, LinearCommand_.friction_factor stays 0 (the configured friction) under that
+// law.
 // The gain-scheduling laws do not use the anti-swing command; the stage still takes it, so the
 // chain (and its timing) is the same for every law. A new law: an enumerator, its name, its case.
 // Every law takes the load (m_t, m_r of (3.37)-(3.38) and the gain schedule) from the estimate's
@@ -51,8 +52,10 @@
 #include "crane/common/stack_facts.hpp"
 #include "crane/gain_scheduling/gain_scheduling_controller.hpp"
 #include "crane/protocol/messages.hpp"
+#include "crane/state_estimator/state_estimator.hpp"
 #include "crane/tracking/breakaway_ramp.hpp"
 #include "crane/tracking/friction_factor_estimate.hpp"
+#include "crane/tracking/friction_momentum_balance.hpp"
 #include "crane/tracking/tracking_controller.hpp"
 
 namespace crane::config {
@@ -83,11 +86,17 @@ struct TrackingStageParams {
   // The `tracking` law estimates and hands the friction factor too (see the header); false: the
   // dissertation's (3.5) with the configured friction.
   bool estimate_friction_factor{false};
-  // The PD law's estimate: its rows carry the anti-swing action, so f is handed only once known to
-  // within max_standard_error (a short slew alone gives too few rows; below it the last move's
-  // factor stands). 0.06 from the ShortCable sweep (docs/robustness.md, "The friction factor under
-  // delay1"); the follower's keeps FrictionFactorParams' defaults.
-  FrictionFactorParams tracking_friction_factor{.max_standard_error = 0.06};
+  // The PD law's estimate: a row per block of the momentum balance, f handed once it has min_rows of
+  // them and is known to within max_standard_error (a short slew alone gives too few; then the last
+  // move's factor stands), to the nearest resolution; min_reference_speed is the measured speed a
+  // row's cycles need. Measured
+  // in docs/optimal_control.md, "The friction factor under delay1"; the follower's keeps
+  // FrictionFactorParams' defaults.
+  FrictionFactorParams tracking_friction_factor{.min_rows = 3, .max_standard_error = 0.05, .resolution = 0.01};
+  double friction_balance_block{0.5};  // [s] in [sample_period, 1000]: the balance's blocks (its rows)
+  // The estimator whose rates the momenta come from (the state_estimator block's: its low-pass and
+  // differentiator; the balance's voltage side runs through the same lag).
+  state_estimator::StateEstimatorParams estimator{};
   // The follower's hold at the target: integral action against a drive stuck off it.
   BreakawayRampParams breakaway{};
   double sample_period{0.01};  // [s] > 0, the cycle (facts.sample_period)
@@ -126,13 +135,19 @@ class TrackingStage {
   bool start_friction_estimate(const protocol::Reference& reference, bool carry) noexcept;
   /// The reference at rest on both drives (the trolley and the slew, or the bridge).
   [[nodiscard]] static bool at_target(const protocol::Reference& reference, bool bridge) noexcept;
-  /// This cycle's rows (the drives' voltages [V] less the part the row leaves out, `known` [V]: the
-  /// follower's feedforward, the PD law's swing terms; `reduction` the command's
-  /// sliding_friction_reduction; `rows` the drives that may add one) and the factor to hand with the
-  /// command.
+  /// The follower's rows of this cycle (the drives' voltages [V] less their feedforward, `known` [V];
+  /// `reduction` the command's sliding_friction_reduction) and the factor to hand with the command.
   [[nodiscard]] double hand_friction_factor(const protocol::Reference& reference, bool bridge,
                                             const std::array<double, 2>& voltage, const std::array<double, 2>& known,
-                                            double reduction, const std::array<bool, 2>& rows) noexcept;
+                                            double reduction) noexcept;
+  /// The PD law's: this cycle into each drive's momentum balance, whose closed blocks are rows.
+  [[nodiscard]] double hand_balanced_friction_factor(const protocol::CraneState& estimate,
+                                                     const protocol::Reference& reference, bool bridge,
+                                                     const protocol::LinearCommand& command) noexcept;
+  /// The factor to hand along the move (toward the estimate at friction_factor_rate) or at the target.
+  [[nodiscard]] double next_handed_friction_factor(const protocol::Reference& reference, bool bridge) noexcept;
+  /// kept_sliding_share's excess with the factor handed with the last command (reduction `reduction`).
+  [[nodiscard]] double compensated_share(double reduction) const noexcept;
 
   TrackingLaw law_;
   TrackingController tracking_;
@@ -148,7 +163,10 @@ class TrackingStage {
   BreakawayRamp breakaway_;  // the follower's hold, reset when the reference moves or a move starts
   bool estimate_friction_factor_;  // under the `tracking` law too
   double tracking_friction_factor_speed_;  // [m/s or rad/s] the PD law's rows: the measured speed at least this
-  std::array<double, 2> swing_voltage_{};  // [V] the PD law's swing terms of the last cycle (tracking_controller.hpp)
+  // The PD law's momenta of the last cycle (TrackingOutput: the trolley's, dT/dx's voltage, the slew's).
+  std::array<double, 3> momentum_{};
+  std::array<FrictionMomentumBalance, 2> balance_;  // the PD law's, per drive (trolley; slew or bridge)
+  std::array<common::AxisFriction, 2> friction_model_;  // the drives' model friction (the rows' F)
 };
 
 }  // namespace crane::tracking
