@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -28,6 +29,23 @@ tr::TrackingInput base_input() {
   in.estimate.slew_angle = 0.0;
   in.reference.slew.position = 0.0;
   return in;
+}
+
+// Each of `bad` set into the field by `set` is refused by FrictionFactorEstimate's constructor, the
+// error naming `field`.
+template <typename Set>
+void expect_refused(std::initializer_list<double> bad, Set set, const std::string& field) {
+  const crane::common::CraneParameters crane;
+  for (const double value : bad) {
+    tr::FrictionFactorParams p;
+    set(p, value);
+    try {
+      tr::FrictionFactorEstimate refused(crane.trolley_friction, crane.slew_friction, p);
+      ADD_FAILURE() << field << " = " << value << " accepted";
+    } catch (const crane::common::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find(field), std::string::npos) << error.what();
+    }
+  }
 }
 }  // namespace
 
@@ -322,16 +340,9 @@ TEST(FrictionFactorEstimate, AFactorNotKnownToWithinTheStandardErrorLeavesThePri
   quiet.reset(0.9);
   rows(quiet, 230, 0.02, 5);
   EXPECT_NEAR(quiet.factor(), 0.7, 0.01);
-  for (const double bad : {-0.1, std::numeric_limits<double>::quiet_NaN()}) {
-    tr::FrictionFactorParams p;
-    p.max_standard_error = bad;
-    try {
-      tr::FrictionFactorEstimate refused(crane.trolley_friction, crane.slew_friction, p);
-      ADD_FAILURE() << bad << " accepted";
-    } catch (const crane::common::ConfigError& error) {
-      EXPECT_NE(std::string(error.what()).find("friction_factor.max_standard_error"), std::string::npos) << error.what();
-    }
-  }
+  expect_refused({-0.1, std::numeric_limits<double>::quiet_NaN()},
+                 [](tr::FrictionFactorParams& p, double v) { p.max_standard_error = v; },
+                 "friction_factor.max_standard_error");
 }
 
 // With a resolution (the PD law's, 0.01) the factor is handed to the nearest multiple of it; a
@@ -354,16 +365,8 @@ TEST(FrictionFactorEstimate, TheResolutionRoundsTheFactor) {
   rounded.add_row(0, -0.6, 3.0, 0.0);
   EXPECT_NEAR(fine.factor(), 1.0 - (0.0037 * 7.25 + 1.8) / 16.25, 1e-9);
   EXPECT_NEAR(rounded.factor(), 0.89, 1e-12);
-  for (const double bad : {-0.01, 0.2, std::numeric_limits<double>::quiet_NaN()}) {
-    tr::FrictionFactorParams p;
-    p.resolution = bad;
-    try {
-      tr::FrictionFactorEstimate refused(crane.trolley_friction, crane.slew_friction, p);
-      ADD_FAILURE() << bad << " accepted";
-    } catch (const crane::common::ConfigError& error) {
-      EXPECT_NE(std::string(error.what()).find("friction_factor.resolution"), std::string::npos) << error.what();
-    }
-  }
+  expect_refused({-0.01, 0.2, std::numeric_limits<double>::quiet_NaN()},
+                 [](tr::FrictionFactorParams& p, double v) { p.resolution = v; }, "friction_factor.resolution");
 }
 
 // The momentum balance's rows by hand, with the estimator's lag taken as none (B = G = 1): then
